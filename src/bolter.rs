@@ -1,0 +1,133 @@
+//! Bolter vocabulary shared by the packets: the steps of the bolter state machine (Figure 8),
+//! the direction of a run, and the multiplexer lines that select a pair.
+//!
+//! ```
+//! use mmic::bolter::{BolterStep, MuxLines};
+//! use mmic::command::BolterPair;
+//! assert_eq!(BolterStep::from_wire(BolterStep::Rotate.to_wire()), Some(BolterStep::Rotate));
+//! assert_eq!(MuxLines::for_pair(BolterPair::P3), MuxLines { a0: true, a1: false });
+//! ```
+
+pub use crate::command::BolterPair;
+
+/// Bolting or unbolting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum BolterDirection {
+    /// Engage and lock the fasteners (wire 1).
+    Bolt,
+    /// Unlock and release them (wire 2).
+    Unbolt,
+}
+
+impl BolterDirection {
+    /// Wire value.
+    pub const fn to_wire(self) -> u8 {
+        match self {
+            BolterDirection::Bolt => 1,
+            BolterDirection::Unbolt => 2,
+        }
+    }
+
+    /// Direction from its wire value.
+    pub const fn from_wire(b: u8) -> Option<BolterDirection> {
+        match b {
+            1 => Some(BolterDirection::Bolt),
+            2 => Some(BolterDirection::Unbolt),
+            _ => None,
+        }
+    }
+}
+
+/// A step of the bolter state machine (Figure 8) that a side is executing. Steps marked * end
+/// on a current threshold and have a timeout.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum BolterStep {
+    /// 1*: translate towards the fastener and push until the current threshold.
+    Descend,
+    /// 2: go back to the initial configuration.
+    Retract,
+    /// 3*: descend again until the threshold, to engage.
+    DescendEngage,
+    /// 4*: rotate the head until the current says locked (unlocked when unbolting).
+    Rotate,
+    /// 5: counter-rotate to free the head.
+    CounterRotate,
+    /// 6: return to the initial configuration.
+    ReturnHome,
+    /// 7: run finished, pair (un)bolted.
+    Done,
+    /// 8: run failed (timeout).
+    Failed,
+}
+
+impl BolterStep {
+    /// All steps in order.
+    pub const ALL: [BolterStep; 8] = [
+        BolterStep::Descend,
+        BolterStep::Retract,
+        BolterStep::DescendEngage,
+        BolterStep::Rotate,
+        BolterStep::CounterRotate,
+        BolterStep::ReturnHome,
+        BolterStep::Done,
+        BolterStep::Failed,
+    ];
+
+    /// Wire value 1..=8 (0 on the wire means idle).
+    pub const fn to_wire(self) -> u8 {
+        self as u8 + 1
+    }
+
+    /// Step from its wire value.
+    pub const fn from_wire(b: u8) -> Option<BolterStep> {
+        if b >= 1 && b <= 8 {
+            Some(Self::ALL[(b - 1) as usize])
+        } else {
+            None
+        }
+    }
+}
+
+/// The ADG1604 select lines A0 and A1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct MuxLines {
+    /// Line A0 high.
+    pub a0: bool,
+    /// Line A1 high.
+    pub a1: bool,
+}
+
+impl MuxLines {
+    /// The paper lists the combinations of "A0-A1 (low-low, low-high, high-low, high-high)";
+    /// pairs 1–4 take them in that order, so (A0, A1) is pair n − 1 in binary, A0 the high bit.
+    pub const fn for_pair(p: BolterPair) -> MuxLines {
+        let n = p.number() - 1;
+        MuxLines {
+            a0: n & 0b10 != 0,
+            a1: n & 0b01 != 0,
+        }
+    }
+
+    /// Wire byte: bit 0 = A0, bit 1 = A1.
+    pub const fn to_wire(self) -> u8 {
+        self.a0 as u8 | (self.a1 as u8) << 1
+    }
+
+    /// Lines from the wire byte; other bits must be zero.
+    pub const fn from_wire(b: u8) -> Option<MuxLines> {
+        if b > 0b11 {
+            None
+        } else {
+            Some(MuxLines {
+                a0: b & 1 != 0,
+                a1: b & 2 != 0,
+            })
+        }
+    }
+}

@@ -1,0 +1,911 @@
+//! The command set of Table 1 as one enum, and its wire encoding in the 14-byte command packet.
+//!
+//! Byte 5 of the packet (Table 2) is an *opcode*: one value per command variant class, so the
+//! discrete choices (side, module, pair, primitive, mode, on/off) live in the opcode and the
+//! parameter bytes 6–11 carry only the quantities Table 2 names for them: the hip target in
+//! bytes 6–7, arm A's in 8–9, arm B's in 10–11, and, for a reconfiguration, the final state in
+//! byte 8 and the initial state in byte 9. Every parameter byte a command does not use must be
+//! zero, so a corrupted or mis-built packet is refused instead of guessed at.
+//!
+//! ```
+//! use mmic::command::{Command, ServoTarget};
+//! use mmic::units::{PulseWidth, Side};
+//! use mmic::motion::State;
+//!
+//! let c = Command::Arm { side: Side::B, target: ServoTarget::Position(PulseWidth::new(1200).unwrap()) };
+//! let (opcode, params) = c.encode();
+//! assert_eq!(opcode, 0x26);
+//! assert_eq!(params, [0, 0, 0, 0, 0xb0, 0x04]); // 1200 µs, low byte first, in bytes 10–11
+//! assert_eq!(Command::decode(opcode, params), Ok(c));
+//!
+//! let r = Command::reconfigure(State::A, State::M).unwrap();
+//! assert_eq!(r.encode(), (0x60, [0, 0, b'm', b'a', 0, 0]));
+//! assert!(Command::reconfigure(State::A, State::D).is_err()); // d is not a final state
+//! ```
+
+use crate::mode::Mode;
+use crate::motion::{Primitive, State};
+use crate::units::{HipAngle, Module, PulseWidth, Side};
+use core::fmt;
+
+/// Index in the command packet of the first parameter byte (Table 2 byte 6).
+pub const PARAM_OFFSET: usize = 6;
+/// Number of parameter bytes (Table 2 bytes 6–11).
+pub const PARAM_LEN: usize = 6;
+
+/// Where an arm or gripper goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum ServoTarget {
+    /// Totally contract (arm retracted / gripper released).
+    Contract,
+    /// Totally extend (arm out / gripper engaged on the face).
+    Extend,
+    /// Partially contract or extend: go to this pulse width.
+    Position(PulseWidth),
+}
+
+/// Where the hip goes: one of the common positions, or any angle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum HipTarget {
+    /// The contracted-gripped (home) angle, a configuration value.
+    Home,
+    /// Arms in line: 180.00°.
+    Straight,
+    /// Quarter turn clockwise: 90.00°.
+    RightAngleCw,
+    /// Quarter turn counter-clockwise: 270.00°.
+    RightAngleCcw,
+    /// Any other angle.
+    Angle(HipAngle),
+}
+
+/// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "u8", into = "u8")
+)]
+#[repr(u8)]
+pub enum BolterPair {
+    /// Pair 1.
+    P1 = 1,
+    /// Pair 2.
+    P2 = 2,
+    /// Pair 3.
+    P3 = 3,
+    /// Pair 4.
+    P4 = 4,
+}
+
+impl BolterPair {
+    /// Pairs 1..=4 in the order "all four" runs them.
+    pub const ALL: [BolterPair; 4] = [
+        BolterPair::P1,
+        BolterPair::P2,
+        BolterPair::P3,
+        BolterPair::P4,
+    ];
+
+    /// Pair number 1..=4.
+    pub const fn number(self) -> u8 {
+        self as u8
+    }
+
+    /// Pair with number `n`.
+    pub const fn from_number(n: u8) -> Option<BolterPair> {
+        if n >= 1 && n <= 4 {
+            Some(Self::ALL[(n - 1) as usize])
+        } else {
+            None
+        }
+    }
+}
+
+/// A pair number outside 1..=4.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("bolter pair must be 1..=4, found {0}")]
+pub struct BolterPairError(pub u8);
+
+impl TryFrom<u8> for BolterPair {
+    type Error = BolterPairError;
+    fn try_from(n: u8) -> Result<BolterPair, BolterPairError> {
+        BolterPair::from_number(n).ok_or(BolterPairError(n))
+    }
+}
+
+impl From<BolterPair> for u8 {
+    fn from(p: BolterPair) -> u8 {
+        p.number()
+    }
+}
+
+/// Which fasteners a bolt or unbolt command works on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Fasteners {
+    /// One pair.
+    Pair(BolterPair),
+    /// Pairs 1–4 in order, stopping at the first that fails.
+    All,
+}
+
+/// A bolter command (Table 1, "Bolter").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum BolterCommand {
+    /// Bolt a pair of fasteners, or all four.
+    Bolt(Fasteners),
+    /// Unbolt a pair of fasteners, or all four.
+    Unbolt(Fasteners),
+    /// Move both bolters down.
+    Down,
+}
+
+/// What a power command switches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum PowerTarget {
+    /// One module.
+    Module(Module),
+    /// Every module.
+    All,
+}
+
+/// A validated reconfiguration: the initial state and a different, matched target state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Reconfiguration {
+    initial: State,
+    target: State,
+}
+
+impl Reconfiguration {
+    /// Refused when `target` is not a matched (final) state or equals `initial`.
+    pub const fn new(initial: State, target: State) -> Result<Self, ReconfigurationError> {
+        if !target.is_matched() {
+            Err(ReconfigurationError::TargetNotMatched { target })
+        } else if initial as u8 == target as u8 {
+            Err(ReconfigurationError::SameState { state: target })
+        } else {
+            Ok(Reconfiguration { initial, target })
+        }
+    }
+
+    /// Where the operator believes the robot is (checked against the detected state).
+    pub const fn initial(self) -> State {
+        self.initial
+    }
+
+    /// Where it must end: a matched state.
+    pub const fn target(self) -> State {
+        self.target
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for Reconfiguration {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Raw {
+            initial: State,
+            target: State,
+        }
+        let r = Raw::deserialize(d)?;
+        Reconfiguration::new(r.initial, r.target).map_err(serde::de::Error::custom)
+    }
+}
+
+/// A reconfiguration that cannot be executed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum ReconfigurationError {
+    /// Only matched states are final states (Section 6).
+    #[error("target state {target} is not a matched (final) state")]
+    TargetNotMatched {
+        /// The refused target.
+        target: State,
+    },
+    /// Initial equals target: not a reconfiguration (the black cells of Figure 9).
+    #[error("initial and target state are both {state}: not a reconfiguration")]
+    SameState {
+        /// The state given twice.
+        state: State,
+    },
+}
+
+/// A command to the robot (Table 1, plus `ClearFaults`, which the fault latching of Section 7
+/// needs and the paper does not list).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(rename_all = "snake_case", deny_unknown_fields)
+)]
+pub enum Command {
+    /// Request a heartbeat packet.
+    Heartbeat,
+    /// Emergency stop of the current motion.
+    Stop,
+    /// After a stop, resume the motion.
+    Reset,
+    /// Trigger the assembly system operation fault.
+    SystemFault,
+    /// Clear the latched faults whose conditions no longer hold (extension).
+    ClearFaults,
+    /// Change operating mode.
+    Mode(Mode),
+    /// Move one arm.
+    Arm {
+        /// Which arm.
+        side: Side,
+        /// Where to.
+        target: ServoTarget,
+    },
+    /// Move one gripper.
+    Gripper {
+        /// Which gripper.
+        side: Side,
+        /// Where to.
+        target: ServoTarget,
+    },
+    /// Rotate the hip.
+    Hip(HipTarget),
+    /// Bolt, unbolt or lower the bolters.
+    Bolter(BolterCommand),
+    /// Execute one motion primitive.
+    Primitive(Primitive),
+    /// Reconfigure from an initial to a target state.
+    Reconfigure(Reconfiguration),
+    /// Switch power to one or all modules.
+    Power {
+        /// What to switch.
+        target: PowerTarget,
+        /// On or off.
+        on: bool,
+    },
+}
+
+/// Opcodes (Table 2 byte 5). Gaps are unassigned and refused.
+pub mod opcode {
+    /// Heartbeat request.
+    pub const HEARTBEAT: u8 = 0x01;
+    /// Stop.
+    pub const STOP: u8 = 0x02;
+    /// Reset (resume after stop).
+    pub const RESET: u8 = 0x03;
+    /// Assembly system operation fault.
+    pub const SYSTEM_FAULT: u8 = 0x04;
+    /// Clear latched faults.
+    pub const CLEAR_FAULTS: u8 = 0x05;
+    /// Mode: Standby, Operational, Safed = base + 0, 1, 2.
+    pub const MODE: u8 = 0x10;
+    /// Arm A: contract, extend, position = base + 0, 1, 2; arm B at base + 4.
+    pub const ARM: u8 = 0x20;
+    /// Gripper A: contract, extend, position = base + 0, 1, 2; gripper B at base + 4.
+    pub const GRIPPER: u8 = 0x28;
+    /// Hip: home, straight, 90° CW, 90° CCW, angle = base + 0..=4.
+    pub const HIP: u8 = 0x30;
+    /// Bolt pair 1..=4 = base + 0..=3; all = base + 4.
+    pub const BOLT: u8 = 0x40;
+    /// Unbolt pair 1..=4 = base + 0..=3; all = base + 4.
+    pub const UNBOLT: u8 = 0x48;
+    /// Bolters down.
+    pub const BOLTERS_DOWN: u8 = 0x4f;
+    /// Primitive n (1..=8) = base + n.
+    pub const PRIMITIVE: u8 = 0x50;
+    /// Reconfigure: final state in byte 8, initial in byte 9.
+    pub const RECONFIGURE: u8 = 0x60;
+    /// Power on module i (Module::ALL order) = base + i; all = base + 7.
+    pub const POWER_ON: u8 = 0x70;
+    /// Power off module i = base + i; all = base + 7.
+    pub const POWER_OFF: u8 = 0x78;
+}
+
+/// A parameter slot of Table 2, as a range of the 6 parameter bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Slot {
+    /// Bytes 6–7: hip target.
+    Hip,
+    /// Bytes 8–9: arm A target, or final (8) / initial (9) state.
+    ArmA,
+    /// Bytes 10–11: arm B target.
+    ArmB,
+}
+
+impl Slot {
+    /// Offset of the slot's low byte among the parameter bytes.
+    pub const fn offset(self) -> usize {
+        match self {
+            Slot::Hip => 0,
+            Slot::ArmA => 2,
+            Slot::ArmB => 4,
+        }
+    }
+
+    /// Slot carrying a servo target for `side`'s arm or gripper.
+    pub const fn for_side(side: Side) -> Slot {
+        match side {
+            Side::A => Slot::ArmA,
+            Side::B => Slot::ArmB,
+        }
+    }
+}
+
+/// A parameter block that does not decode to a command.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum CommandError {
+    /// Byte 5 holds no assigned opcode.
+    #[error("byte 5: unknown command id {id:#04x}")]
+    UnknownId {
+        /// The refused opcode.
+        id: u8,
+    },
+    /// A parameter byte the command does not use is not zero.
+    #[error("byte {index}: unused by command {id:#04x}, must be 0, found {found:#04x}")]
+    UnusedNotZero {
+        /// Opcode.
+        id: u8,
+        /// Packet byte index (6..=11).
+        index: usize,
+        /// Its value.
+        found: u8,
+    },
+    /// A pulse width outside the servo range.
+    #[error("bytes {index}-{}: pulse width must be {}..={} us, found {found}", index + 1, PulseWidth::MIN_US, PulseWidth::MAX_US)]
+    PulseWidth {
+        /// Packet index of the low byte.
+        index: usize,
+        /// Value found.
+        found: u16,
+    },
+    /// A hip angle at or above 360°.
+    #[error("bytes {index}-{}: hip angle must be < 36000 (0.01 deg), found {found}", index + 1)]
+    HipAngle {
+        /// Packet index of the low byte.
+        index: usize,
+        /// Value found.
+        found: u16,
+    },
+    /// A state byte that is no Table 5 letter.
+    #[error("byte {index}: state must be 'a'..='o' (0x61..=0x6f), found {found:#04x}")]
+    State {
+        /// Packet index.
+        index: usize,
+        /// Value found.
+        found: u8,
+    },
+    /// A well-formed but impossible reconfiguration.
+    #[error("bytes 8-9: {0}")]
+    Reconfiguration(#[from] ReconfigurationError),
+}
+
+fn get_u16(p: &[u8; PARAM_LEN], slot: Slot) -> u16 {
+    let o = slot.offset();
+    u16::from_le_bytes([p[o], p[o + 1]])
+}
+
+fn put_u16(p: &mut [u8; PARAM_LEN], slot: Slot, v: u16) {
+    let o = slot.offset();
+    let b = v.to_le_bytes();
+    p[o] = b[0];
+    p[o + 1] = b[1];
+}
+
+fn side_of(id: u8, base: u8) -> Side {
+    if id - base >= 4 {
+        Side::B
+    } else {
+        Side::A
+    }
+}
+
+impl Command {
+    /// A reconfiguration command; see [`Reconfiguration::new`].
+    pub const fn reconfigure(
+        initial: State,
+        target: State,
+    ) -> Result<Command, ReconfigurationError> {
+        match Reconfiguration::new(initial, target) {
+            Ok(r) => Ok(Command::Reconfigure(r)),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Opcode and the six parameter bytes (packet bytes 6..=11).
+    pub fn encode(&self) -> (u8, [u8; PARAM_LEN]) {
+        let mut p = [0u8; PARAM_LEN];
+        let servo = |base: u8, side: Side, target: ServoTarget, p: &mut [u8; PARAM_LEN]| {
+            let side_off = if side == Side::B { 4 } else { 0 };
+            match target {
+                ServoTarget::Contract => base + side_off,
+                ServoTarget::Extend => base + side_off + 1,
+                ServoTarget::Position(pw) => {
+                    put_u16(p, Slot::for_side(side), pw.micros());
+                    base + side_off + 2
+                }
+            }
+        };
+        let id = match *self {
+            Command::Heartbeat => opcode::HEARTBEAT,
+            Command::Stop => opcode::STOP,
+            Command::Reset => opcode::RESET,
+            Command::SystemFault => opcode::SYSTEM_FAULT,
+            Command::ClearFaults => opcode::CLEAR_FAULTS,
+            Command::Mode(m) => opcode::MODE + m.to_wire() - 1,
+            Command::Arm { side, target } => servo(opcode::ARM, side, target, &mut p),
+            Command::Gripper { side, target } => servo(opcode::GRIPPER, side, target, &mut p),
+            Command::Hip(h) => match h {
+                HipTarget::Home => opcode::HIP,
+                HipTarget::Straight => opcode::HIP + 1,
+                HipTarget::RightAngleCw => opcode::HIP + 2,
+                HipTarget::RightAngleCcw => opcode::HIP + 3,
+                HipTarget::Angle(a) => {
+                    put_u16(&mut p, Slot::Hip, a.centidegrees());
+                    opcode::HIP + 4
+                }
+            },
+            Command::Bolter(b) => match b {
+                BolterCommand::Bolt(Fasteners::Pair(n)) => opcode::BOLT + n.number() - 1,
+                BolterCommand::Bolt(Fasteners::All) => opcode::BOLT + 4,
+                BolterCommand::Unbolt(Fasteners::Pair(n)) => opcode::UNBOLT + n.number() - 1,
+                BolterCommand::Unbolt(Fasteners::All) => opcode::UNBOLT + 4,
+                BolterCommand::Down => opcode::BOLTERS_DOWN,
+            },
+            Command::Primitive(pr) => opcode::PRIMITIVE + pr.number(),
+            Command::Reconfigure(r) => {
+                p[Slot::ArmA.offset()] = r.target.to_wire();
+                p[Slot::ArmA.offset() + 1] = r.initial.to_wire();
+                opcode::RECONFIGURE
+            }
+            Command::Power { target, on } => {
+                let base = if on {
+                    opcode::POWER_ON
+                } else {
+                    opcode::POWER_OFF
+                };
+                match target {
+                    PowerTarget::Module(m) => base + m.index(),
+                    PowerTarget::All => base + 7,
+                }
+            }
+        };
+        (id, p)
+    }
+
+    /// The command for opcode `id` and parameter bytes `p` (packet bytes 6..=11).
+    pub fn decode(id: u8, p: [u8; PARAM_LEN]) -> Result<Command, CommandError> {
+        // Which parameter bytes this opcode uses, as a bit mask over p[0..6].
+        let (cmd, used): (Command, u8) = match id {
+            opcode::HEARTBEAT => (Command::Heartbeat, 0),
+            opcode::STOP => (Command::Stop, 0),
+            opcode::RESET => (Command::Reset, 0),
+            opcode::SYSTEM_FAULT => (Command::SystemFault, 0),
+            opcode::CLEAR_FAULTS => (Command::ClearFaults, 0),
+            0x10..=0x12 => match Mode::from_wire(id - opcode::MODE + 1) {
+                Some(m) => (Command::Mode(m), 0),
+                None => return Err(CommandError::UnknownId { id }),
+            },
+            0x20..=0x22 | 0x24..=0x26 | 0x28..=0x2a | 0x2c..=0x2e => {
+                let base = if id < opcode::GRIPPER {
+                    opcode::ARM
+                } else {
+                    opcode::GRIPPER
+                };
+                let side = side_of(id, base);
+                let slot = Slot::for_side(side);
+                let (target, used) = match (id - base) % 4 {
+                    0 => (ServoTarget::Contract, 0),
+                    1 => (ServoTarget::Extend, 0),
+                    _ => {
+                        let raw = get_u16(&p, slot);
+                        let pw = PulseWidth::new(raw).map_err(|_| CommandError::PulseWidth {
+                            index: PARAM_OFFSET + slot.offset(),
+                            found: raw,
+                        })?;
+                        (ServoTarget::Position(pw), 0b11 << slot.offset())
+                    }
+                };
+                let cmd = if base == opcode::ARM {
+                    Command::Arm { side, target }
+                } else {
+                    Command::Gripper { side, target }
+                };
+                (cmd, used)
+            }
+            0x30..=0x34 => match id - opcode::HIP {
+                0 => (Command::Hip(HipTarget::Home), 0),
+                1 => (Command::Hip(HipTarget::Straight), 0),
+                2 => (Command::Hip(HipTarget::RightAngleCw), 0),
+                3 => (Command::Hip(HipTarget::RightAngleCcw), 0),
+                _ => {
+                    let raw = get_u16(&p, Slot::Hip);
+                    let a = HipAngle::new(raw).map_err(|_| CommandError::HipAngle {
+                        index: PARAM_OFFSET,
+                        found: raw,
+                    })?;
+                    (Command::Hip(HipTarget::Angle(a)), 0b11)
+                }
+            },
+            0x40..=0x44 | 0x48..=0x4c => {
+                let base = if id < opcode::UNBOLT {
+                    opcode::BOLT
+                } else {
+                    opcode::UNBOLT
+                };
+                let which = match BolterPair::from_number(id - base + 1) {
+                    Some(n) => Fasteners::Pair(n),
+                    None => Fasteners::All,
+                };
+                let b = if base == opcode::BOLT {
+                    BolterCommand::Bolt(which)
+                } else {
+                    BolterCommand::Unbolt(which)
+                };
+                (Command::Bolter(b), 0)
+            }
+            opcode::BOLTERS_DOWN => (Command::Bolter(BolterCommand::Down), 0),
+            0x51..=0x58 => match Primitive::from_number(id - opcode::PRIMITIVE) {
+                Some(pr) => (Command::Primitive(pr), 0),
+                None => return Err(CommandError::UnknownId { id }),
+            },
+            opcode::RECONFIGURE => {
+                let at = Slot::ArmA.offset();
+                let state = |i: usize| {
+                    State::from_wire(p[i]).ok_or(CommandError::State {
+                        index: PARAM_OFFSET + i,
+                        found: p[i],
+                    })
+                };
+                let target = state(at)?;
+                let initial = state(at + 1)?;
+                (
+                    Command::Reconfigure(Reconfiguration::new(initial, target)?),
+                    0b11 << at,
+                )
+            }
+            0x70..=0x7f => {
+                let on = id < opcode::POWER_OFF;
+                let i = (id - opcode::POWER_ON) % 8;
+                let target = match Module::from_index(i) {
+                    Some(m) => PowerTarget::Module(m),
+                    None => PowerTarget::All,
+                };
+                (Command::Power { target, on }, 0)
+            }
+            _ => return Err(CommandError::UnknownId { id }),
+        };
+        for (i, &b) in p.iter().enumerate() {
+            if used & (1 << i) == 0 && b != 0 {
+                return Err(CommandError::UnusedNotZero {
+                    id,
+                    index: PARAM_OFFSET + i,
+                    found: b,
+                });
+            }
+        }
+        Ok(cmd)
+    }
+
+    /// Table 1 row this command belongs to.
+    pub const fn kind(&self) -> CommandKind {
+        match self {
+            Command::Heartbeat => CommandKind::Heartbeat,
+            Command::Stop => CommandKind::Stop,
+            Command::Reset => CommandKind::Reset,
+            Command::SystemFault => CommandKind::SystemFault,
+            Command::ClearFaults => CommandKind::ClearFaults,
+            Command::Mode(_) => CommandKind::Mode,
+            Command::Arm { .. } => CommandKind::Arm,
+            Command::Gripper { .. } => CommandKind::Gripper,
+            Command::Hip(_) => CommandKind::Hip,
+            Command::Bolter(_) => CommandKind::Bolter,
+            Command::Primitive(_) => CommandKind::Primitive,
+            Command::Reconfigure(_) => CommandKind::Reconfiguration,
+            Command::Power { .. } => CommandKind::PowerControl,
+        }
+    }
+}
+
+/// The rows of Table 1 (plus the `ClearFaults` extension): what mode rules and spec/ talk about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum CommandKind {
+    /// Single module: arm.
+    Arm,
+    /// Single module: gripper.
+    Gripper,
+    /// Single module: hip.
+    Hip,
+    /// Single module: bolter.
+    Bolter,
+    /// Primitive motion.
+    Primitive,
+    /// Stop.
+    Stop,
+    /// Reset.
+    Reset,
+    /// Power control.
+    PowerControl,
+    /// Reconfiguration.
+    Reconfiguration,
+    /// Mode.
+    Mode,
+    /// System fault.
+    SystemFault,
+    /// Heartbeat.
+    Heartbeat,
+    /// Clear latched faults (extension, not in Table 1).
+    ClearFaults,
+}
+
+impl CommandKind {
+    /// Table 1 order, then the extension.
+    pub const ALL: [CommandKind; 13] = [
+        CommandKind::Arm,
+        CommandKind::Gripper,
+        CommandKind::Hip,
+        CommandKind::Bolter,
+        CommandKind::Primitive,
+        CommandKind::Stop,
+        CommandKind::Reset,
+        CommandKind::PowerControl,
+        CommandKind::Reconfiguration,
+        CommandKind::Mode,
+        CommandKind::SystemFault,
+        CommandKind::Heartbeat,
+        CommandKind::ClearFaults,
+    ];
+
+    /// snake_case name, as in spec/ and JSON.
+    pub const fn name(self) -> &'static str {
+        match self {
+            CommandKind::Arm => "arm",
+            CommandKind::Gripper => "gripper",
+            CommandKind::Hip => "hip",
+            CommandKind::Bolter => "bolter",
+            CommandKind::Primitive => "primitive",
+            CommandKind::Stop => "stop",
+            CommandKind::Reset => "reset",
+            CommandKind::PowerControl => "power_control",
+            CommandKind::Reconfiguration => "reconfiguration",
+            CommandKind::Mode => "mode",
+            CommandKind::SystemFault => "system_fault",
+            CommandKind::Heartbeat => "heartbeat",
+            CommandKind::ClearFaults => "clear_faults",
+        }
+    }
+}
+
+impl fmt::Display for CommandKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Every command whose parameters are discrete, plus each parameterised variant at the given
+/// representative values: the "variant classes" that exhaustive checks iterate over.
+///
+/// `visit` is called once per command; 61 calls, one per opcode.
+pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl FnMut(Command)) {
+    visit(Command::Heartbeat);
+    visit(Command::Stop);
+    visit(Command::Reset);
+    visit(Command::SystemFault);
+    visit(Command::ClearFaults);
+    for m in Mode::ALL {
+        visit(Command::Mode(m));
+    }
+    for side in Side::ALL {
+        for target in [
+            ServoTarget::Contract,
+            ServoTarget::Extend,
+            ServoTarget::Position(pw),
+        ] {
+            visit(Command::Arm { side, target });
+        }
+    }
+    for side in Side::ALL {
+        for target in [
+            ServoTarget::Contract,
+            ServoTarget::Extend,
+            ServoTarget::Position(pw),
+        ] {
+            visit(Command::Gripper { side, target });
+        }
+    }
+    for h in [
+        HipTarget::Home,
+        HipTarget::Straight,
+        HipTarget::RightAngleCw,
+        HipTarget::RightAngleCcw,
+        HipTarget::Angle(angle),
+    ] {
+        visit(Command::Hip(h));
+    }
+    for bolt in [true, false] {
+        for which in [
+            Fasteners::Pair(BolterPair::P1),
+            Fasteners::Pair(BolterPair::P2),
+            Fasteners::Pair(BolterPair::P3),
+            Fasteners::Pair(BolterPair::P4),
+            Fasteners::All,
+        ] {
+            visit(Command::Bolter(if bolt {
+                BolterCommand::Bolt(which)
+            } else {
+                BolterCommand::Unbolt(which)
+            }));
+        }
+    }
+    visit(Command::Bolter(BolterCommand::Down));
+    for p in Primitive::ALL {
+        visit(Command::Primitive(p));
+    }
+    visit(Command::Reconfigure(Reconfiguration {
+        initial: State::A,
+        target: State::M,
+    }));
+    for on in [true, false] {
+        for m in Module::ALL {
+            visit(Command::Power {
+                target: PowerTarget::Module(m),
+                on,
+            });
+        }
+        visit(Command::Power {
+            target: PowerTarget::All,
+            on,
+        });
+    }
+}
+
+/// Calls `visit` with every representable command: each variant class with every pulse width,
+/// every hip angle and every valid reconfiguration: 44,143 calls.
+pub fn for_each_command(mut visit: impl FnMut(Command)) {
+    for_each_variant_class(PulseWidth::CENTER, HipAngle::ZERO, |c| match c {
+        Command::Arm {
+            side,
+            target: ServoTarget::Position(_),
+        } => {
+            for us in PulseWidth::MIN_US..=PulseWidth::MAX_US {
+                if let Ok(pw) = PulseWidth::new(us) {
+                    visit(Command::Arm {
+                        side,
+                        target: ServoTarget::Position(pw),
+                    });
+                }
+            }
+        }
+        Command::Gripper {
+            side,
+            target: ServoTarget::Position(_),
+        } => {
+            for us in PulseWidth::MIN_US..=PulseWidth::MAX_US {
+                if let Ok(pw) = PulseWidth::new(us) {
+                    visit(Command::Gripper {
+                        side,
+                        target: ServoTarget::Position(pw),
+                    });
+                }
+            }
+        }
+        Command::Hip(HipTarget::Angle(_)) => {
+            for a in 0..HipAngle::TURN {
+                if let Ok(a) = HipAngle::new(a) {
+                    visit(Command::Hip(HipTarget::Angle(a)));
+                }
+            }
+        }
+        Command::Reconfigure(_) => {
+            for initial in State::ALL {
+                for target in State::MATCHED {
+                    if let Ok(r) = Reconfiguration::new(initial, target) {
+                        visit(Command::Reconfigure(r));
+                    }
+                }
+            }
+        }
+        other => visit(other),
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_command_round_trips_through_its_encoding() {
+        let mut n = 0;
+        for_each_command(|c| {
+            let (id, p) = c.encode();
+            assert_eq!(Command::decode(id, p), Ok(c), "{c:?}");
+            n += 1;
+        });
+        // 61 classes; 4 positional servo classes × 2001 widths, 36000 angles, 84 reconfigurations.
+        assert_eq!(n, 61 - 4 - 1 - 1 + 4 * 2001 + 36000 + (15 * 6 - 6));
+    }
+
+    #[test]
+    fn opcodes_are_distinct_per_variant_class() {
+        let mut seen = [false; 256];
+        let mut classes = 0;
+        for_each_variant_class(PulseWidth::CENTER, HipAngle::ZERO, |c| {
+            let (id, _) = c.encode();
+            assert!(!seen[id as usize], "opcode {id:#04x} used twice");
+            seen[id as usize] = true;
+            classes += 1;
+        });
+        assert_eq!(classes, 61);
+        // Every other opcode is refused, whatever the parameters.
+        for id in 0..=255u8 {
+            if !seen[id as usize] {
+                assert_eq!(
+                    Command::decode(id, [0; 6]),
+                    Err(CommandError::UnknownId { id })
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn unused_parameter_bytes_must_be_zero() {
+        for_each_variant_class(PulseWidth::CENTER, HipAngle::ZERO, |c| {
+            let (id, p) = c.encode();
+            for i in 0..PARAM_LEN {
+                let mut q = p;
+                q[i] ^= 0x01;
+                // Either the byte was unused (refused as such) or it was a value: then it must
+                // decode to a different command or be refused; never to the same command.
+                assert_ne!(Command::decode(id, q), Ok(c), "{c:?} byte {i}");
+            }
+        });
+    }
+
+    #[test]
+    fn range_errors_name_the_byte() {
+        let bad = 2501u16.to_le_bytes();
+        assert_eq!(
+            Command::decode(0x26, [0, 0, 0, 0, bad[0], bad[1]]),
+            Err(CommandError::PulseWidth {
+                index: 10,
+                found: 2501
+            })
+        );
+        let bad = 36000u16.to_le_bytes();
+        assert_eq!(
+            Command::decode(0x34, [bad[0], bad[1], 0, 0, 0, 0]),
+            Err(CommandError::HipAngle {
+                index: 6,
+                found: 36000
+            })
+        );
+        assert_eq!(
+            Command::decode(0x60, [0, 0, b'z', b'a', 0, 0]),
+            Err(CommandError::State {
+                index: 8,
+                found: b'z'
+            })
+        );
+        assert_eq!(
+            Command::decode(0x60, [0, 0, b'd', b'a', 0, 0]),
+            Err(CommandError::Reconfiguration(
+                ReconfigurationError::TargetNotMatched { target: State::D }
+            ))
+        );
+        assert_eq!(
+            Command::decode(0x60, [0, 0, b'a', b'a', 0, 0]),
+            Err(CommandError::Reconfiguration(
+                ReconfigurationError::SameState { state: State::A }
+            ))
+        );
+    }
+}

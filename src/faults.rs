@@ -1,0 +1,231 @@
+//! The fault bit map carried in the heartbeat's three fault bytes (Table 3 bytes 60–62).
+//!
+//! Byte 60 holds bits 0–7, byte 61 bits 8–15, byte 62 bits 16–23. One bit per Table 8 row; the
+//! overcurrent rows are split into the idle check and the operational check because the paper
+//! describes two checks with different thresholds and an operator needs to know which fired.
+//! Bits 13–23 are reserved and must be zero.
+//!
+//! ```
+//! use mmic::faults::{Fault, Faults};
+//! let f = Faults::EMPTY.with(Fault::LowBattery).with(Fault::HipMismatch);
+//! assert!(f.contains(Fault::LowBattery));
+//! assert_eq!(Faults::from_wire(f.to_wire()), Ok(f));
+//! assert_eq!(f.iter().count(), 2);
+//! ```
+
+use core::fmt;
+
+/// One autonomously detectable fault (Table 8), with its bit number in the fault bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+#[repr(u8)]
+pub enum Fault {
+    /// Three consecutive failed (un)bolting attempts.
+    BoltingFailure = 0,
+    /// Arm contraction not sensed by the switch.
+    ArmNotContracted = 1,
+    /// Bolter current above its idle limit at the start or end of a reconfiguration.
+    BolterOvercurrentIdle = 2,
+    /// Bolter current above its absolute limit.
+    BolterOvercurrent = 3,
+    /// Gripper current above its idle limit at the start or end of a reconfiguration.
+    GripperOvercurrentIdle = 4,
+    /// Gripper current above its absolute limit.
+    GripperOvercurrent = 5,
+    /// Locomotion (arm and hip) current above its idle limit at the start or end of a reconfiguration.
+    LocomotionOvercurrentIdle = 6,
+    /// Locomotion current above its absolute limit.
+    LocomotionOvercurrent = 7,
+    /// Hip angle far from its contracted-gripped value when entering Operational.
+    HipMismatch = 8,
+    /// Reconfiguration command's initial state differs from the detected state.
+    InitialStateMismatch = 9,
+    /// Board B heartbeat missing, or a command to B never acknowledged.
+    InternalCommLoss = 10,
+    /// V_batA or V_batB below threshold for longer than the debounce time.
+    LowBattery = 11,
+    /// Assembly system operation fault, injected by command.
+    AssemblySystem = 12,
+}
+
+impl Fault {
+    /// Every fault, in bit order.
+    pub const ALL: [Fault; 13] = [
+        Fault::BoltingFailure,
+        Fault::ArmNotContracted,
+        Fault::BolterOvercurrentIdle,
+        Fault::BolterOvercurrent,
+        Fault::GripperOvercurrentIdle,
+        Fault::GripperOvercurrent,
+        Fault::LocomotionOvercurrentIdle,
+        Fault::LocomotionOvercurrent,
+        Fault::HipMismatch,
+        Fault::InitialStateMismatch,
+        Fault::InternalCommLoss,
+        Fault::LowBattery,
+        Fault::AssemblySystem,
+    ];
+
+    /// Bit number in the 24-bit fault map.
+    pub const fn bit(self) -> u8 {
+        self as u8
+    }
+
+    /// Stable snake_case name (spec/ and JSON).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Fault::BoltingFailure => "bolting_failure",
+            Fault::ArmNotContracted => "arm_not_contracted",
+            Fault::BolterOvercurrentIdle => "bolter_overcurrent_idle",
+            Fault::BolterOvercurrent => "bolter_overcurrent",
+            Fault::GripperOvercurrentIdle => "gripper_overcurrent_idle",
+            Fault::GripperOvercurrent => "gripper_overcurrent",
+            Fault::LocomotionOvercurrentIdle => "locomotion_overcurrent_idle",
+            Fault::LocomotionOvercurrent => "locomotion_overcurrent",
+            Fault::HipMismatch => "hip_mismatch",
+            Fault::InitialStateMismatch => "initial_state_mismatch",
+            Fault::InternalCommLoss => "internal_comm_loss",
+            Fault::LowBattery => "low_battery",
+            Fault::AssemblySystem => "assembly_system",
+        }
+    }
+}
+
+impl fmt::Display for Fault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A set of faults: the latched fault map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Faults(u32);
+
+/// Bits set in the fault bytes that name no fault.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("fault bytes set reserved bits {reserved:#08x} (only bits 0..=12 name faults)")]
+pub struct ReservedFaultBits {
+    /// The reserved bits that were set.
+    pub reserved: u32,
+}
+
+impl Faults {
+    /// No fault.
+    pub const EMPTY: Faults = Faults(0);
+    /// Mask of the defined bits.
+    pub const DEFINED: u32 = (1 << Fault::ALL.len()) - 1;
+
+    /// This set plus `fault`.
+    pub const fn with(self, fault: Fault) -> Faults {
+        Faults(self.0 | 1 << fault.bit())
+    }
+
+    /// This set minus `fault`.
+    pub const fn without(self, fault: Fault) -> Faults {
+        Faults(self.0 & !(1 << fault.bit()))
+    }
+
+    /// Whether `fault` is in the set.
+    pub const fn contains(self, fault: Fault) -> bool {
+        self.0 & (1 << fault.bit()) != 0
+    }
+
+    /// Whether the set is empty.
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+
+    /// Union.
+    pub const fn union(self, other: Faults) -> Faults {
+        Faults(self.0 | other.0)
+    }
+
+    /// The raw 24-bit map.
+    pub const fn bits(self) -> u32 {
+        self.0
+    }
+
+    /// The three fault bytes, byte 60 first.
+    pub const fn to_wire(self) -> [u8; 3] {
+        [self.0 as u8, (self.0 >> 8) as u8, (self.0 >> 16) as u8]
+    }
+
+    /// Fault set from the three fault bytes; reserved bits are refused.
+    pub const fn from_wire(b: [u8; 3]) -> Result<Faults, ReservedFaultBits> {
+        let raw = b[0] as u32 | (b[1] as u32) << 8 | (b[2] as u32) << 16;
+        let reserved = raw & !Self::DEFINED;
+        if reserved != 0 {
+            Err(ReservedFaultBits { reserved })
+        } else {
+            Ok(Faults(raw))
+        }
+    }
+
+    /// The faults in the set, in bit order.
+    pub fn iter(self) -> impl Iterator<Item = Fault> {
+        Fault::ALL.into_iter().filter(move |f| self.contains(*f))
+    }
+}
+
+impl FromIterator<Fault> for Faults {
+    fn from_iter<I: IntoIterator<Item = Fault>>(iter: I) -> Faults {
+        iter.into_iter().fold(Faults::EMPTY, Faults::with)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for Faults {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeSeq;
+        let mut seq = s.serialize_seq(None)?;
+        for f in self.iter() {
+            seq.serialize_element(&f)?;
+        }
+        seq.end()
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for Faults {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Faults, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Faults;
+            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str("a list of fault names")
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Faults, A::Error> {
+                let mut set = Faults::EMPTY;
+                while let Some(f) = a.next_element::<Fault>()? {
+                    set = set.with(f);
+                }
+                Ok(set)
+            }
+        }
+        d.deserialize_seq(V)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_subset_round_trips_and_reserved_bits_are_refused() {
+        for raw in 0..=Faults::DEFINED {
+            let b = [raw as u8, (raw >> 8) as u8, (raw >> 16) as u8];
+            let f = Faults::from_wire(b).unwrap();
+            assert_eq!(f.to_wire(), b);
+            assert_eq!(f.iter().collect::<Faults>(), f);
+        }
+        for bit in 13..24 {
+            let raw = 1u32 << bit;
+            let b = [raw as u8, (raw >> 8) as u8, (raw >> 16) as u8];
+            assert_eq!(
+                Faults::from_wire(b),
+                Err(ReservedFaultBits { reserved: raw })
+            );
+        }
+    }
+}

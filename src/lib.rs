@@ -1,0 +1,40 @@
+//! # mmic — the MMIC-I robot's firmware as a checked library
+//!
+//! MMIC-I (NASA Ames, ARMADAS) is an inchworm robot that crawls inside a lattice of voxels,
+//! grips faces and bolts them together. This crate is the robot's firmware logic as pure,
+//! allocation-free functions: the packets of the paper's Tables 2–4 (and the A→B command the
+//! paper leaves out), the command set of Table 1, and the types the rest of the firmware is
+//! built from. Every packet is a fixed-size [`zerocopy`] view plus a typed `Repr` with
+//! `parse`/`emit`, in the manner of smoltcp's `wire` module.
+//!
+//! ```
+//! use mmic::command::{Command, ServoTarget};
+//! use mmic::units::{BoardNumber, Side};
+//! use mmic::wire::command::{CommandRepr, COMMAND_LEN};
+//!
+//! let repr = CommandRepr {
+//!     board: BoardNumber::new(1).unwrap(),
+//!     command: Command::Arm { side: Side::A, target: ServoTarget::Contract },
+//! };
+//! let mut bytes = [0u8; COMMAND_LEN];
+//! repr.emit(&mut bytes);
+//! assert_eq!(CommandRepr::parse(&bytes), Ok(repr));
+//!
+//! // One flipped bit anywhere is caught (here by the CRC-16/CCITT-FALSE checksum).
+//! bytes[5] ^= 0x10;
+//! assert!(CommandRepr::parse(&bytes).is_err());
+//! ```
+//!
+//! Design decisions that the paper leaves open (header bytes, checksum, units, command IDs)
+//! are listed with their rationale in `spec/decisions.toml` of the repository.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod bolter;
+pub mod command;
+pub mod faults;
+pub mod mode;
+pub mod motion;
+pub mod units;
+pub mod wire;

@@ -1,0 +1,381 @@
+//! Physical quantities and identifiers carried in packets, each with the unit and range that
+//! `spec/decisions.toml` fixes (the paper names the fields but gives no unit or scale).
+//!
+//! ```
+//! use mmic::units::{PulseWidth, HipAngle};
+//! let pw = PulseWidth::new(1500).unwrap();
+//! assert_eq!(pw.micros(), 1500);
+//! assert!(PulseWidth::new(2501).is_err());
+//! assert_eq!(HipAngle::new(18000).unwrap().centidegrees(), 18000); // 180.00°
+//! ```
+
+use core::fmt;
+
+/// Out-of-range value handed to a unit constructor; carries the offending value and the range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("{quantity} must be in {min}..={max}, found {found}")]
+pub struct RangeError {
+    /// Which quantity was being built.
+    pub quantity: &'static str,
+    /// Smallest accepted value.
+    pub min: u32,
+    /// Largest accepted value.
+    pub max: u32,
+    /// The value that was refused.
+    pub found: u32,
+}
+
+/// Side of the robot. The robot is symmetric about the hip; board A is on side A.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Side {
+    /// Side A: board A (primary, WiFi client, hip), "fwd" in Table 6.
+    #[cfg_attr(feature = "serde", serde(rename = "a"))]
+    A,
+    /// Side B: board B (subordinate, serial to A), "back" in Table 6.
+    #[cfg_attr(feature = "serde", serde(rename = "b"))]
+    B,
+}
+
+impl Side {
+    /// Both sides, A first.
+    pub const ALL: [Side; 2] = [Side::A, Side::B];
+}
+
+impl fmt::Display for Side {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Side::A => "A",
+            Side::B => "B",
+        })
+    }
+}
+
+/// Number of a robot's WiFi client (board A) on a server, Table 2 byte 4 and Table 3 byte 4.
+///
+/// 1..=255; 0 is refused so that a zeroed buffer can never address a robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "u8", into = "u8")
+)]
+pub struct BoardNumber(core::num::NonZeroU8);
+
+impl BoardNumber {
+    /// The first robot.
+    pub const ONE: BoardNumber = BoardNumber(core::num::NonZeroU8::MIN);
+
+    /// Board number `n`, refused when 0.
+    pub const fn new(n: u8) -> Result<Self, RangeError> {
+        match core::num::NonZeroU8::new(n) {
+            Some(n) => Ok(BoardNumber(n)),
+            None => Err(RangeError {
+                quantity: "board number",
+                min: 1,
+                max: 255,
+                found: 0,
+            }),
+        }
+    }
+
+    /// The number as it goes on the wire.
+    pub const fn get(self) -> u8 {
+        self.0.get()
+    }
+}
+
+impl TryFrom<u8> for BoardNumber {
+    type Error = RangeError;
+    fn try_from(n: u8) -> Result<Self, RangeError> {
+        BoardNumber::new(n)
+    }
+}
+
+impl From<BoardNumber> for u8 {
+    fn from(b: BoardNumber) -> u8 {
+        b.get()
+    }
+}
+
+/// Servo pulse width in microseconds, the unit of every arm and gripper target and "now" field.
+///
+/// Range 500..=2500 µs, the standard hobby-servo pulse range the MMIC-I servos accept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "u16", into = "u16")
+)]
+pub struct PulseWidth(u16);
+
+impl PulseWidth {
+    /// Shortest pulse accepted, µs.
+    pub const MIN_US: u16 = 500;
+    /// Longest pulse accepted, µs.
+    pub const MAX_US: u16 = 2500;
+    /// Shortest pulse.
+    pub const MIN: PulseWidth = PulseWidth(Self::MIN_US);
+    /// Longest pulse.
+    pub const MAX: PulseWidth = PulseWidth(Self::MAX_US);
+    /// Neutral pulse, 1500 µs.
+    pub const CENTER: PulseWidth = PulseWidth(1500);
+
+    /// A pulse of `us` microseconds, refused outside 500..=2500.
+    pub const fn new(us: u16) -> Result<Self, RangeError> {
+        if us >= Self::MIN_US && us <= Self::MAX_US {
+            Ok(PulseWidth(us))
+        } else {
+            Err(RangeError {
+                quantity: "servo pulse width (us)",
+                min: Self::MIN_US as u32,
+                max: Self::MAX_US as u32,
+                found: us as u32,
+            })
+        }
+    }
+
+    /// The pulse width clamped into range: for controllers whose arithmetic may leave it.
+    pub const fn saturating(us: u16) -> Self {
+        if us < Self::MIN_US {
+            Self::MIN
+        } else if us > Self::MAX_US {
+            Self::MAX
+        } else {
+            PulseWidth(us)
+        }
+    }
+
+    /// Microseconds.
+    pub const fn micros(self) -> u16 {
+        self.0
+    }
+}
+
+impl TryFrom<u16> for PulseWidth {
+    type Error = RangeError;
+    fn try_from(us: u16) -> Result<Self, RangeError> {
+        PulseWidth::new(us)
+    }
+}
+
+impl From<PulseWidth> for u16 {
+    fn from(p: PulseWidth) -> u16 {
+        p.micros()
+    }
+}
+
+/// Hip angle in hundredths of a degree, 0..=35999 (0.00° ..= 359.99°).
+///
+/// The paper calls the hip field "hip PWM", but the hip is a continuous-rotation servo closed
+/// around an absolute magnetic encoder, so the commanded quantity is an angle. Centidegrees
+/// keep the 3° and 10°/s of Section 5 exact in integers and fit a u16.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "u16", into = "u16")
+)]
+pub struct HipAngle(u16);
+
+impl HipAngle {
+    /// One full turn, in centidegrees (exclusive upper bound).
+    pub const TURN: u16 = 36000;
+    /// 0.00°.
+    pub const ZERO: HipAngle = HipAngle(0);
+
+    /// `cdeg` hundredths of a degree, refused at or above 360.00°.
+    pub const fn new(cdeg: u16) -> Result<Self, RangeError> {
+        if cdeg < Self::TURN {
+            Ok(HipAngle(cdeg))
+        } else {
+            Err(RangeError {
+                quantity: "hip angle (0.01 deg)",
+                min: 0,
+                max: Self::TURN as u32 - 1,
+                found: cdeg as u32,
+            })
+        }
+    }
+
+    /// Hundredths of a degree.
+    pub const fn centidegrees(self) -> u16 {
+        self.0
+    }
+}
+
+impl TryFrom<u16> for HipAngle {
+    type Error = RangeError;
+    fn try_from(v: u16) -> Result<Self, RangeError> {
+        HipAngle::new(v)
+    }
+}
+
+impl From<HipAngle> for u16 {
+    fn from(a: HipAngle) -> u16 {
+        a.centidegrees()
+    }
+}
+
+/// A voltage in millivolts (battery 10.0–12.6 V, regulator 7.4 V: both fit a u16).
+pub type Millivolts = u16;
+/// A current in milliamperes (unsigned: the sense resistors measure draw only).
+pub type Milliamps = u16;
+
+/// A powered module (Table 1 "Power Control": individual modules).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Module {
+    /// Hip servo (board A).
+    Hip,
+    /// Extension arm, side A.
+    ArmA,
+    /// Extension arm, side B.
+    ArmB,
+    /// Gripper, side A.
+    GripperA,
+    /// Gripper, side B.
+    GripperB,
+    /// Bolter, side A.
+    BolterA,
+    /// Bolter, side B.
+    BolterB,
+}
+
+impl Module {
+    /// Every module, in wire order (index = offset within the power command ranges).
+    pub const ALL: [Module; 7] = [
+        Module::Hip,
+        Module::ArmA,
+        Module::ArmB,
+        Module::GripperA,
+        Module::GripperB,
+        Module::BolterA,
+        Module::BolterB,
+    ];
+
+    /// Index 0..7 in [`Module::ALL`].
+    pub const fn index(self) -> u8 {
+        self as u8
+    }
+
+    /// Module with index `i`, if any.
+    pub const fn from_index(i: u8) -> Option<Module> {
+        if (i as usize) < Self::ALL.len() {
+            Some(Self::ALL[i as usize])
+        } else {
+            None
+        }
+    }
+
+    /// Side the module sits on; the hip belongs to board A.
+    pub const fn side(self) -> Side {
+        match self {
+            Module::Hip | Module::ArmA | Module::GripperA | Module::BolterA => Side::A,
+            _ => Side::B,
+        }
+    }
+}
+
+/// A lattice axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Axis {
+    /// X.
+    #[cfg_attr(feature = "serde", serde(rename = "x"))]
+    X,
+    /// Y.
+    #[cfg_attr(feature = "serde", serde(rename = "y"))]
+    Y,
+    /// Z.
+    #[cfg_attr(feature = "serde", serde(rename = "z"))]
+    Z,
+}
+
+impl Axis {
+    /// X, Y, Z.
+    pub const ALL: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
+
+    /// ASCII letter on the wire: `X`, `Y`, `Z`.
+    pub const fn to_wire(self) -> u8 {
+        match self {
+            Axis::X => b'X',
+            Axis::Y => b'Y',
+            Axis::Z => b'Z',
+        }
+    }
+
+    /// Axis from its wire letter.
+    pub const fn from_wire(b: u8) -> Option<Axis> {
+        match b {
+            b'X' => Some(Axis::X),
+            b'Y' => Some(Axis::Y),
+            b'Z' => Some(Axis::Z),
+            _ => None,
+        }
+    }
+}
+
+/// Sign along an axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Sign {
+    /// Positive direction.
+    #[cfg_attr(feature = "serde", serde(rename = "+"))]
+    Positive,
+    /// Negative direction.
+    #[cfg_attr(feature = "serde", serde(rename = "-"))]
+    Negative,
+}
+
+impl Sign {
+    /// ASCII on the wire: `+` or `-`.
+    pub const fn to_wire(self) -> u8 {
+        match self {
+            Sign::Positive => b'+',
+            Sign::Negative => b'-',
+        }
+    }
+
+    /// Sign from its wire character.
+    pub const fn from_wire(b: u8) -> Option<Sign> {
+        match b {
+            b'+' => Some(Sign::Positive),
+            b'-' => Some(Sign::Negative),
+            _ => None,
+        }
+    }
+}
+
+/// Direction of gravity in an IMU's frame: the axis with the largest acceleration and its sign
+/// (Table 4 bytes 36–37).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Gravity {
+    /// Dominant axis.
+    pub axis: Axis,
+    /// Sign of gravity along it.
+    pub sign: Sign,
+}
+
+/// Voltage and current readings of one side's ADS7828 (Table 3 bytes 25–52, Table 4 bytes 12–25).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct Electrical {
+    /// Battery voltage V_bat, mV.
+    pub v_bat: Millivolts,
+    /// Battery current I_bat, mA.
+    pub i_bat: Milliamps,
+    /// Locomotion (arm and hip) current I_loc, mA.
+    pub i_loc: Milliamps,
+    /// Gripper current I_grip, mA.
+    pub i_grip: Milliamps,
+    /// 3.3 V rail current I_3v3, mA.
+    pub i_3v3: Milliamps,
+    /// Regulated voltage V_reg, mV.
+    pub v_reg: Millivolts,
+    /// Bolter current I_bo, mA.
+    pub i_bo: Milliamps,
+}

@@ -1,0 +1,169 @@
+//! The 14-byte command packet of Table 2 (opsUI → server → board A).
+//!
+//! ```
+//! use mmic::command::Command;
+//! use mmic::motion::State;
+//! use mmic::units::BoardNumber;
+//! use mmic::wire::command::CommandRepr;
+//!
+//! let repr = CommandRepr { board: BoardNumber::ONE, command: Command::reconfigure(State::A, State::M).unwrap() };
+//! let bytes = repr.to_bytes();
+//! assert_eq!(&bytes[..4], b"MICM");
+//! assert_eq!(bytes[5], 0x60);            // reconfigure opcode
+//! assert_eq!((bytes[8], bytes[9]), (b'm', b'a')); // final, initial state
+//! assert_eq!(CommandRepr::parse(&bytes), Ok(repr));
+//! ```
+
+use super::layout::{span, FieldSpec, Unit};
+use super::{check, field_err, seal, Packet, PacketKind, WireError};
+use crate::command::{Command, PARAM_LEN, PARAM_OFFSET};
+use crate::units::BoardNumber;
+use zerocopy::byteorder::little_endian::U16;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
+
+/// Length of the command packet.
+pub const COMMAND_LEN: usize = 14;
+
+/// Table 2, byte for byte.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+)]
+#[repr(C)]
+pub struct CommandPacket {
+    /// Bytes 0–3: `MICM`.
+    pub header: [u8; 4],
+    /// Byte 4: robot number.
+    pub board: u8,
+    /// Byte 5: opcode.
+    pub command: u8,
+    /// Bytes 6–7: hip target (0.01°).
+    pub hip: U16,
+    /// Bytes 8–9: arm A target (µs), or final state (8) and initial state (9).
+    pub arm_a: U16,
+    /// Bytes 10–11: arm B target (µs).
+    pub arm_b: U16,
+    /// Bytes 12–13: CRC-16 of bytes 0–11.
+    pub checksum: U16,
+}
+
+impl Packet for CommandPacket {
+    const KIND: PacketKind = PacketKind::Command;
+}
+
+const _: () = assert!(core::mem::size_of::<CommandPacket>() == COMMAND_LEN);
+
+/// Byte ranges, from the layout.
+pub mod field {
+    use super::*;
+    use core::ops::Range;
+    /// Header.
+    pub const HEADER: Range<usize> = span!(CommandPacket, header, [u8; 4]);
+    /// Board number.
+    pub const BOARD: Range<usize> = span!(CommandPacket, board, u8);
+    /// Opcode.
+    pub const COMMAND: Range<usize> = span!(CommandPacket, command, u8);
+    /// Hip target.
+    pub const HIP: Range<usize> = span!(CommandPacket, hip, U16);
+    /// Arm A target / final+initial state.
+    pub const ARM_A: Range<usize> = span!(CommandPacket, arm_a, U16);
+    /// Arm B target.
+    pub const ARM_B: Range<usize> = span!(CommandPacket, arm_b, U16);
+    /// Checksum.
+    pub const CHECKSUM: Range<usize> = span!(CommandPacket, checksum, U16);
+}
+
+/// Field table (spec/packets/command.toml is checked against it).
+pub const FIELDS: &[FieldSpec] = &[
+    FieldSpec {
+        name: "header",
+        range: field::HEADER,
+        unit: Unit::Header,
+        paper: "header",
+    },
+    FieldSpec {
+        name: "board",
+        range: field::BOARD,
+        unit: Unit::Board,
+        paper: "board number",
+    },
+    FieldSpec {
+        name: "command",
+        range: field::COMMAND,
+        unit: Unit::Opcode,
+        paper: "command",
+    },
+    FieldSpec {
+        name: "hip",
+        range: field::HIP,
+        unit: Unit::Parameter,
+        paper: "hip PWM",
+    },
+    FieldSpec {
+        name: "arm_a",
+        range: field::ARM_A,
+        unit: Unit::Parameter,
+        paper: "arm A PWM/ final state",
+    },
+    FieldSpec {
+        name: "arm_b",
+        range: field::ARM_B,
+        unit: Unit::Parameter,
+        paper: "arm B PWM",
+    },
+    FieldSpec {
+        name: "checksum",
+        range: field::CHECKSUM,
+        unit: Unit::Crc16,
+        paper: "checksum",
+    },
+];
+
+const _: () =
+    assert!(field::HIP.start == PARAM_OFFSET && field::ARM_B.end == PARAM_OFFSET + PARAM_LEN);
+
+/// A command addressed to one robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct CommandRepr {
+    /// Robot (board A) the command is for.
+    pub board: BoardNumber,
+    /// The command.
+    pub command: Command,
+}
+
+impl CommandRepr {
+    /// Checks length, header, checksum, board number, opcode and parameters.
+    pub fn parse(bytes: &[u8]) -> Result<CommandRepr, WireError> {
+        let p: &CommandPacket = check(bytes)?;
+        let board = BoardNumber::new(p.board).map_err(|_| {
+            field_err(
+                PacketKind::Command,
+                field::BOARD.start,
+                "board",
+                "1..=255",
+                0,
+            )
+        })?;
+        let mut params = [0u8; PARAM_LEN];
+        params.copy_from_slice(&bytes[PARAM_OFFSET..PARAM_OFFSET + PARAM_LEN]);
+        let command = Command::decode(p.command, params)?;
+        Ok(CommandRepr { board, command })
+    }
+
+    /// Writes the packet, header and checksum included.
+    pub fn emit(&self, out: &mut [u8; COMMAND_LEN]) {
+        let (id, params) = self.command.encode();
+        out[field::BOARD.start] = self.board.get();
+        out[field::COMMAND.start] = id;
+        out[PARAM_OFFSET..PARAM_OFFSET + PARAM_LEN].copy_from_slice(&params);
+        seal(PacketKind::Command, out);
+    }
+
+    /// The packet as a new array.
+    pub fn to_bytes(&self) -> [u8; COMMAND_LEN] {
+        let mut out = [0u8; COMMAND_LEN];
+        self.emit(&mut out);
+        out
+    }
+}

@@ -1,0 +1,447 @@
+//! The 66-byte WiFi heartbeat of Table 3 (board A → server → opsUI).
+//!
+//! ```
+//! use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
+//! let hb = HeartbeatRepr::default();
+//! let bytes = hb.to_bytes();
+//! assert_eq!(bytes.len(), HEARTBEAT_LEN);
+//! assert_eq!(&bytes[57..60], &[0, 0, 0]); // the "empty" bytes
+//! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
+//! ```
+
+use super::layout::{span, FieldSpec, Unit};
+use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
+use crate::command::BolterPair;
+use crate::faults::Faults;
+use crate::mode::Mode;
+use crate::motion::State;
+use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
+use zerocopy::byteorder::little_endian::U16;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
+
+/// Length of the WiFi heartbeat.
+pub const HEARTBEAT_LEN: usize = 66;
+const KIND: PacketKind = PacketKind::Heartbeat;
+
+/// Table 3, byte for byte.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+)]
+#[repr(C)]
+#[allow(missing_docs)] // each field is described in FIELDS and spec/packets/heartbeat.toml
+pub struct HeartbeatPacket {
+    pub header: [u8; 4],
+    pub board: u8,
+    pub hip_target: U16,
+    pub hip_now: U16,
+    pub arm_a_target: U16,
+    pub arm_a_now: U16,
+    pub arm_b_target: U16,
+    pub arm_b_now: U16,
+    pub gripper_a_target: U16,
+    pub gripper_a_now: U16,
+    pub gripper_b_target: U16,
+    pub gripper_b_now: U16,
+    pub v_bat_a: U16,
+    pub i_bat_a: U16,
+    pub i_loc_a: U16,
+    pub i_grip_a: U16,
+    pub i_3v3_a: U16,
+    pub v_reg_a: U16,
+    pub i_bo_a: U16,
+    pub v_bat_b: U16,
+    pub i_bat_b: U16,
+    pub i_loc_b: U16,
+    pub i_grip_b: U16,
+    pub i_3v3_b: U16,
+    pub v_reg_b: U16,
+    pub i_bo_b: U16,
+    pub target_state: u8,
+    pub command_complete: u8,
+    pub active_bolter: u8,
+    pub bolter_attempt: u8,
+    pub empty: [u8; 3],
+    pub faults: [u8; 3],
+    pub mode: u8,
+    pub checksum: U16,
+}
+
+impl Packet for HeartbeatPacket {
+    const KIND: PacketKind = KIND;
+}
+
+const _: () = assert!(core::mem::size_of::<HeartbeatPacket>() == HEARTBEAT_LEN);
+
+macro_rules! f {
+    ($name:literal, $field:ident, $ty:ty, $unit:ident, $paper:literal) => {
+        FieldSpec {
+            name: $name,
+            range: span!(HeartbeatPacket, $field, $ty),
+            unit: Unit::$unit,
+            paper: $paper,
+        }
+    };
+}
+
+/// Field table, from the layout (spec/packets/heartbeat.toml is checked against it).
+pub const FIELDS: &[FieldSpec] = &[
+    f!("header", header, [u8; 4], Header, "header"),
+    f!("board", board, u8, Board, "board number"),
+    f!("hip_target", hip_target, U16, Centidegrees, "hip-target"),
+    f!("hip_now", hip_now, U16, Centidegrees, "hip-now"),
+    f!("arm_a_target", arm_a_target, U16, Micros, "arm A-target"),
+    f!("arm_a_now", arm_a_now, U16, Micros, "arm A-now"),
+    f!("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
+    f!("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
+    f!(
+        "gripper_a_target",
+        gripper_a_target,
+        U16,
+        Micros,
+        "gripper A-target"
+    ),
+    f!("gripper_a_now", gripper_a_now, U16, Micros, "gripper A-now"),
+    f!(
+        "gripper_b_target",
+        gripper_b_target,
+        U16,
+        Micros,
+        "gripper B-target"
+    ),
+    f!("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
+    f!("electrical_a.v_bat", v_bat_a, U16, Millivolts, "V_{batA}"),
+    f!("electrical_a.i_bat", i_bat_a, U16, Milliamps, "I_{batA}"),
+    f!("electrical_a.i_loc", i_loc_a, U16, Milliamps, "I_{locA}"),
+    f!("electrical_a.i_grip", i_grip_a, U16, Milliamps, "I_{gripA}"),
+    f!("electrical_a.i_3v3", i_3v3_a, U16, Milliamps, "I_{3v3A}"),
+    f!("electrical_a.v_reg", v_reg_a, U16, Millivolts, "V_{regA}"),
+    f!("electrical_a.i_bo", i_bo_a, U16, Milliamps, "I_{boA}"),
+    f!("electrical_b.v_bat", v_bat_b, U16, Millivolts, "V_{batB}"),
+    f!("electrical_b.i_bat", i_bat_b, U16, Milliamps, "I_{batB}"),
+    f!("electrical_b.i_loc", i_loc_b, U16, Milliamps, "I_{locB}"),
+    f!("electrical_b.i_grip", i_grip_b, U16, Milliamps, "I_{gripB}"),
+    f!("electrical_b.i_3v3", i_3v3_b, U16, Milliamps, "I_{3v3B}"),
+    f!("electrical_b.v_reg", v_reg_b, U16, Millivolts, "V_{regB}"),
+    f!("electrical_b.i_bo", i_bo_b, U16, Milliamps, "I_{boB}"),
+    f!(
+        "target_state",
+        target_state,
+        u8,
+        StateLetter,
+        "target state"
+    ),
+    f!(
+        "command_complete",
+        command_complete,
+        u8,
+        Bool,
+        "command complete"
+    ),
+    f!("active_bolter", active_bolter, u8, Enum, "active bolter"),
+    f!("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
+    f!("empty", empty, [u8; 3], Reserved, "empty"),
+    f!("faults", faults, [u8; 3], Bits, "fault byte"),
+    f!("mode", mode, u8, Enum, "operating mode"),
+    f!("checksum", checksum, U16, Crc16, "checksum"),
+];
+
+/// Which attempt of the bolter state machine is running: 0 (none), 1, 2 or 3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "u8", into = "u8")
+)]
+pub struct BolterAttempt(u8);
+
+impl BolterAttempt {
+    /// Three attempts at most (Table 8).
+    pub const MAX: u8 = 3;
+    /// No attempt running.
+    pub const NONE: BolterAttempt = BolterAttempt(0);
+
+    /// Attempt `n`, refused above 3.
+    pub const fn new(n: u8) -> Result<Self, crate::units::RangeError> {
+        if n <= Self::MAX {
+            Ok(BolterAttempt(n))
+        } else {
+            Err(crate::units::RangeError {
+                quantity: "bolter attempt",
+                min: 0,
+                max: 3,
+                found: n as u32,
+            })
+        }
+    }
+
+    /// The attempt number.
+    pub const fn get(self) -> u8 {
+        self.0
+    }
+}
+
+impl TryFrom<u8> for BolterAttempt {
+    type Error = crate::units::RangeError;
+    fn try_from(n: u8) -> Result<Self, Self::Error> {
+        BolterAttempt::new(n)
+    }
+}
+
+impl From<BolterAttempt> for u8 {
+    fn from(a: BolterAttempt) -> u8 {
+        a.get()
+    }
+}
+
+/// The WiFi heartbeat: the robot's whole status.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct HeartbeatRepr {
+    /// Robot number.
+    pub board: BoardNumber,
+    /// Commanded hip angle.
+    pub hip_target: HipAngle,
+    /// Measured hip angle (encoder).
+    pub hip_now: HipAngle,
+    /// Arm A target pulse.
+    pub arm_a_target: PulseWidth,
+    /// Arm A last interpolated pulse.
+    pub arm_a_now: PulseWidth,
+    /// Arm B target pulse.
+    pub arm_b_target: PulseWidth,
+    /// Arm B last interpolated pulse.
+    pub arm_b_now: PulseWidth,
+    /// Gripper A target pulse.
+    pub gripper_a_target: PulseWidth,
+    /// Gripper A last interpolated pulse.
+    pub gripper_a_now: PulseWidth,
+    /// Gripper B target pulse.
+    pub gripper_b_target: PulseWidth,
+    /// Gripper B last interpolated pulse.
+    pub gripper_b_now: PulseWidth,
+    /// Side A voltages and currents.
+    pub electrical_a: Electrical,
+    /// Side B voltages and currents (relayed from B's internal heartbeat).
+    pub electrical_b: Electrical,
+    /// Last commanded target state; none before the first reconfiguration.
+    pub target_state: Option<State>,
+    /// The last command has completed.
+    pub command_complete: bool,
+    /// Bolter pair being operated, if any.
+    pub active_bolter: Option<BolterPair>,
+    /// Attempt of the bolter state machine on that pair.
+    pub bolter_attempt: BolterAttempt,
+    /// Latched faults.
+    pub faults: Faults,
+    /// Operating mode.
+    pub mode: Mode,
+}
+
+impl Default for HeartbeatRepr {
+    /// Robot 1 at startup: Standby, no fault, servos centred, hip at 180°.
+    fn default() -> Self {
+        let straight = match HipAngle::new(18000) {
+            Ok(a) => a,
+            Err(_) => HipAngle::ZERO,
+        };
+        HeartbeatRepr {
+            board: BoardNumber::ONE,
+            hip_target: straight,
+            hip_now: straight,
+            arm_a_target: PulseWidth::CENTER,
+            arm_a_now: PulseWidth::CENTER,
+            arm_b_target: PulseWidth::CENTER,
+            arm_b_now: PulseWidth::CENTER,
+            gripper_a_target: PulseWidth::CENTER,
+            gripper_a_now: PulseWidth::CENTER,
+            gripper_b_target: PulseWidth::CENTER,
+            gripper_b_now: PulseWidth::CENTER,
+            electrical_a: Electrical::default(),
+            electrical_b: Electrical::default(),
+            target_state: None,
+            command_complete: false,
+            active_bolter: None,
+            bolter_attempt: BolterAttempt::NONE,
+            faults: Faults::EMPTY,
+            mode: Mode::Standby,
+        }
+    }
+}
+
+pub(crate) fn pulse(
+    kind: PacketKind,
+    name: &'static str,
+    at: usize,
+    v: U16,
+) -> Result<PulseWidth, WireError> {
+    PulseWidth::new(v.get()).map_err(|_| field_err(kind, at, name, "500..=2500 us", v.get() as u32))
+}
+
+fn angle(name: &'static str, at: usize, v: U16) -> Result<HipAngle, WireError> {
+    HipAngle::new(v.get())
+        .map_err(|_| field_err(KIND, at, name, "0..=35999 (0.01 deg)", v.get() as u32))
+}
+
+/// Index of the first byte of layout field `$f`.
+macro_rules! at {
+    ($f:ident) => {
+        core::mem::offset_of!(HeartbeatPacket, $f)
+    };
+}
+
+impl HeartbeatRepr {
+    /// Checks length, header, checksum and every field.
+    pub fn parse(bytes: &[u8]) -> Result<HeartbeatRepr, WireError> {
+        let p: &HeartbeatPacket = check(bytes)?;
+        let board =
+            BoardNumber::new(p.board).map_err(|_| field_err(KIND, 4, "board", "1..=255", 0))?;
+        let target_state = match p.target_state {
+            0 => None,
+            b => Some(State::from_wire(b).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(target_state),
+                    "target_state",
+                    "0 or 'a'..='o'",
+                    b as u32,
+                )
+            })?),
+        };
+        let active_bolter = match p.active_bolter {
+            0 => None,
+            b => Some(BolterPair::from_number(b).ok_or_else(|| {
+                field_err(KIND, at!(active_bolter), "active_bolter", "0..=4", b as u32)
+            })?),
+        };
+        let bolter_attempt = BolterAttempt::new(p.bolter_attempt).map_err(|_| {
+            field_err(
+                KIND,
+                at!(bolter_attempt),
+                "bolter_attempt",
+                "0..=3",
+                p.bolter_attempt as u32,
+            )
+        })?;
+        for (i, &b) in p.empty.iter().enumerate() {
+            if b != 0 {
+                return Err(field_err(KIND, at!(empty) + i, "empty", "0", b as u32));
+            }
+        }
+        let faults = Faults::from_wire(p.faults)
+            .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=12 only", e.reserved))?;
+        let mode = Mode::from_wire(p.mode).ok_or_else(|| {
+            field_err(
+                KIND,
+                at!(mode),
+                "mode",
+                "1 (standby), 2 (operational) or 3 (safed)",
+                p.mode as u32,
+            )
+        })?;
+        Ok(HeartbeatRepr {
+            board,
+            hip_target: angle("hip_target", at!(hip_target), p.hip_target)?,
+            hip_now: angle("hip_now", at!(hip_now), p.hip_now)?,
+            arm_a_target: pulse(KIND, "arm_a_target", at!(arm_a_target), p.arm_a_target)?,
+            arm_a_now: pulse(KIND, "arm_a_now", at!(arm_a_now), p.arm_a_now)?,
+            arm_b_target: pulse(KIND, "arm_b_target", at!(arm_b_target), p.arm_b_target)?,
+            arm_b_now: pulse(KIND, "arm_b_now", at!(arm_b_now), p.arm_b_now)?,
+            gripper_a_target: pulse(
+                KIND,
+                "gripper_a_target",
+                at!(gripper_a_target),
+                p.gripper_a_target,
+            )?,
+            gripper_a_now: pulse(KIND, "gripper_a_now", at!(gripper_a_now), p.gripper_a_now)?,
+            gripper_b_target: pulse(
+                KIND,
+                "gripper_b_target",
+                at!(gripper_b_target),
+                p.gripper_b_target,
+            )?,
+            gripper_b_now: pulse(KIND, "gripper_b_now", at!(gripper_b_now), p.gripper_b_now)?,
+            electrical_a: Electrical {
+                v_bat: p.v_bat_a.get(),
+                i_bat: p.i_bat_a.get(),
+                i_loc: p.i_loc_a.get(),
+                i_grip: p.i_grip_a.get(),
+                i_3v3: p.i_3v3_a.get(),
+                v_reg: p.v_reg_a.get(),
+                i_bo: p.i_bo_a.get(),
+            },
+            electrical_b: Electrical {
+                v_bat: p.v_bat_b.get(),
+                i_bat: p.i_bat_b.get(),
+                i_loc: p.i_loc_b.get(),
+                i_grip: p.i_grip_b.get(),
+                i_3v3: p.i_3v3_b.get(),
+                v_reg: p.v_reg_b.get(),
+                i_bo: p.i_bo_b.get(),
+            },
+            target_state,
+            command_complete: get_bool(
+                KIND,
+                at!(command_complete),
+                "command_complete",
+                p.command_complete,
+            )?,
+            active_bolter,
+            bolter_attempt,
+            faults,
+            mode,
+        })
+    }
+
+    /// Writes the packet, header and checksum included.
+    pub fn emit(&self, out: &mut [u8; HEARTBEAT_LEN]) {
+        let u = |v: u16| U16::new(v);
+        let pw = |v: PulseWidth| U16::new(v.micros());
+        let (ea, eb) = (&self.electrical_a, &self.electrical_b);
+        let p = HeartbeatPacket {
+            header: KIND.header(),
+            board: self.board.get(),
+            hip_target: u(self.hip_target.centidegrees()),
+            hip_now: u(self.hip_now.centidegrees()),
+            arm_a_target: pw(self.arm_a_target),
+            arm_a_now: pw(self.arm_a_now),
+            arm_b_target: pw(self.arm_b_target),
+            arm_b_now: pw(self.arm_b_now),
+            gripper_a_target: pw(self.gripper_a_target),
+            gripper_a_now: pw(self.gripper_a_now),
+            gripper_b_target: pw(self.gripper_b_target),
+            gripper_b_now: pw(self.gripper_b_now),
+            v_bat_a: u(ea.v_bat),
+            i_bat_a: u(ea.i_bat),
+            i_loc_a: u(ea.i_loc),
+            i_grip_a: u(ea.i_grip),
+            i_3v3_a: u(ea.i_3v3),
+            v_reg_a: u(ea.v_reg),
+            i_bo_a: u(ea.i_bo),
+            v_bat_b: u(eb.v_bat),
+            i_bat_b: u(eb.i_bat),
+            i_loc_b: u(eb.i_loc),
+            i_grip_b: u(eb.i_grip),
+            i_3v3_b: u(eb.i_3v3),
+            v_reg_b: u(eb.v_reg),
+            i_bo_b: u(eb.i_bo),
+            target_state: self.target_state.map_or(0, State::to_wire),
+            command_complete: self.command_complete as u8,
+            active_bolter: self.active_bolter.map_or(0, BolterPair::number),
+            bolter_attempt: self.bolter_attempt.get(),
+            empty: [0; 3],
+            faults: self.faults.to_wire(),
+            mode: self.mode.to_wire(),
+            checksum: U16::ZERO,
+        };
+        out.copy_from_slice(p.as_bytes());
+        seal(KIND, out);
+    }
+
+    /// The packet as a new array.
+    pub fn to_bytes(&self) -> [u8; HEARTBEAT_LEN] {
+        let mut out = [0u8; HEARTBEAT_LEN];
+        self.emit(&mut out);
+        out
+    }
+}

@@ -1,0 +1,489 @@
+//! The 47-byte internal heartbeat of Table 4 (board B → board A, sent periodically).
+//!
+//! ```
+//! use mmic::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
+//! let hb = InternalHeartbeatRepr { command_received: 42, ..Default::default() };
+//! let bytes = hb.to_bytes();
+//! assert_eq!(bytes.len(), INTERNAL_HEARTBEAT_LEN);
+//! assert_eq!(bytes[35], 42); // Table 4 "command received": the echoed A→B sequence number
+//! assert_eq!(InternalHeartbeatRepr::parse(&bytes), Ok(hb));
+//! ```
+
+use super::heartbeat::pulse;
+use super::layout::{span, FieldSpec, Unit};
+use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
+use crate::bolter::{BolterDirection, BolterPair, BolterStep, MuxLines};
+use crate::units::{Axis, Electrical, Gravity, PulseWidth, Sign};
+use zerocopy::byteorder::little_endian::U16;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
+
+/// Length of the internal heartbeat.
+pub const INTERNAL_HEARTBEAT_LEN: usize = 47;
+const KIND: PacketKind = PacketKind::InternalHeartbeat;
+
+/// Table 4, byte for byte. Bytes 26–34, "bolter B operation auxiliary variables" in the
+/// paper, are laid out here as nine one-byte fields (see [`BolterAux`]).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+)]
+#[repr(C)]
+#[allow(missing_docs)] // each field is described in FIELDS and spec/packets/internal-heartbeat.toml
+pub struct InternalHeartbeatPacket {
+    pub header: [u8; 4],
+    pub arm_b_target: U16,
+    pub arm_b_now: U16,
+    pub gripper_b_target: U16,
+    pub gripper_b_now: U16,
+    pub v_bat_b: U16,
+    pub i_bat_b: U16,
+    pub i_loc_b: U16,
+    pub i_grip_b: U16,
+    pub i_3v3_b: U16,
+    pub v_reg_b: U16,
+    pub i_bo_b: U16,
+    pub bolter_step: u8,
+    pub bolter_seq: u8,
+    pub bolter_pair: u8,
+    pub bolter_direction: u8,
+    pub bolter_threshold: u8,
+    pub bolter_locked: u8,
+    pub bolter_timed_out: u8,
+    pub bolter_at_home: u8,
+    pub bolter_mux: u8,
+    pub command_received: u8,
+    pub g_sign: u8,
+    pub g_axis: u8,
+    pub arm_over_idle: u8,
+    pub gripper_over_idle: u8,
+    pub bolter_over_idle: u8,
+    pub arm_overcurrent: u8,
+    pub gripper_overcurrent: u8,
+    pub bolter_overcurrent: u8,
+    pub arm_contracted: u8,
+    pub checksum: U16,
+}
+
+impl Packet for InternalHeartbeatPacket {
+    const KIND: PacketKind = KIND;
+}
+
+const _: () = assert!(core::mem::size_of::<InternalHeartbeatPacket>() == INTERNAL_HEARTBEAT_LEN);
+
+macro_rules! f {
+    ($name:literal, $field:ident, $ty:ty, $unit:ident, $paper:literal) => {
+        FieldSpec {
+            name: $name,
+            range: span!(InternalHeartbeatPacket, $field, $ty),
+            unit: Unit::$unit,
+            paper: $paper,
+        }
+    };
+}
+
+macro_rules! at {
+    ($f:ident) => {
+        core::mem::offset_of!(InternalHeartbeatPacket, $f)
+    };
+}
+
+const AUX: &str = "bolter B operation auxiliary variables";
+
+/// Field table, from the layout (spec/packets/internal-heartbeat.toml is checked against it).
+pub const FIELDS: &[FieldSpec] = &[
+    f!("header", header, [u8; 4], Header, "header"),
+    f!("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
+    f!("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
+    f!(
+        "gripper_b_target",
+        gripper_b_target,
+        U16,
+        Micros,
+        "gripper B-target"
+    ),
+    f!("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
+    f!("electrical_b.v_bat", v_bat_b, U16, Millivolts, "V_{batB}"),
+    f!("electrical_b.i_bat", i_bat_b, U16, Milliamps, "I_{batB}"),
+    f!("electrical_b.i_loc", i_loc_b, U16, Milliamps, "I_{locB}"),
+    f!("electrical_b.i_grip", i_grip_b, U16, Milliamps, "I_{gripB}"),
+    f!("electrical_b.i_3v3", i_3v3_b, U16, Milliamps, "I_{3v3B}"),
+    f!("electrical_b.v_reg", v_reg_b, U16, Millivolts, "V_{regB}"),
+    f!("electrical_b.i_bo", i_bo_b, U16, Milliamps, "I_{boB}"),
+    FieldSpec {
+        name: "bolter_aux.step",
+        range: span!(InternalHeartbeatPacket, bolter_step, u8),
+        unit: Unit::Enum,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.seq",
+        range: span!(InternalHeartbeatPacket, bolter_seq, u8),
+        unit: Unit::Sequence,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.pair",
+        range: span!(InternalHeartbeatPacket, bolter_pair, u8),
+        unit: Unit::Enum,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.direction",
+        range: span!(InternalHeartbeatPacket, bolter_direction, u8),
+        unit: Unit::Enum,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.threshold_reached",
+        range: span!(InternalHeartbeatPacket, bolter_threshold, u8),
+        unit: Unit::Bool,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.locked",
+        range: span!(InternalHeartbeatPacket, bolter_locked, u8),
+        unit: Unit::Bool,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.timed_out",
+        range: span!(InternalHeartbeatPacket, bolter_timed_out, u8),
+        unit: Unit::Bool,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.at_home",
+        range: span!(InternalHeartbeatPacket, bolter_at_home, u8),
+        unit: Unit::Bool,
+        paper: AUX,
+    },
+    FieldSpec {
+        name: "bolter_aux.mux",
+        range: span!(InternalHeartbeatPacket, bolter_mux, u8),
+        unit: Unit::Bits,
+        paper: AUX,
+    },
+    f!(
+        "command_received",
+        command_received,
+        u8,
+        Sequence,
+        "command received"
+    ),
+    f!("gravity.sign", g_sign, u8, Enum, "g direction sign"),
+    f!("gravity.axis", g_axis, u8, Enum, "g direction axis"),
+    f!("arm_over_idle", arm_over_idle, u8, Bool, "arm B over-idle"),
+    f!(
+        "gripper_over_idle",
+        gripper_over_idle,
+        u8,
+        Bool,
+        "gripper B over-idle"
+    ),
+    f!(
+        "bolter_over_idle",
+        bolter_over_idle,
+        u8,
+        Bool,
+        "bolter B over-idle"
+    ),
+    f!(
+        "arm_overcurrent",
+        arm_overcurrent,
+        u8,
+        Bool,
+        "arm B overcurrent"
+    ),
+    f!(
+        "gripper_overcurrent",
+        gripper_overcurrent,
+        u8,
+        Bool,
+        "gripper B overcurrent"
+    ),
+    f!(
+        "bolter_overcurrent",
+        bolter_overcurrent,
+        u8,
+        Bool,
+        "bolter B overcurrent"
+    ),
+    f!(
+        "arm_contracted",
+        arm_contracted,
+        u8,
+        Bool,
+        "arm B contracted"
+    ),
+    f!("checksum", checksum, U16, Crc16, "checksum"),
+];
+
+/// Bolter B's progress, the nine "auxiliary variables" A needs to keep both bolters in step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct BolterAux {
+    /// Step B is executing; none when idle (wire 0).
+    pub step: Option<BolterStep>,
+    /// Sequence number of the A→B command that ordered that step.
+    pub seq: u8,
+    /// Pair B has selected; none when idle.
+    pub pair: Option<BolterPair>,
+    /// Bolting or unbolting; none when idle.
+    pub direction: Option<BolterDirection>,
+    /// B's bolter current passed its threshold in the current step.
+    pub threshold_reached: bool,
+    /// B's current says the fastener is locked (unlocked when unbolting).
+    pub locked: bool,
+    /// The current step timed out on B.
+    pub timed_out: bool,
+    /// Bolter B is in its initial configuration.
+    pub at_home: bool,
+    /// Read-back of B's multiplexer lines.
+    pub mux: MuxLines,
+}
+
+/// Board B's status, sent to A periodically.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct InternalHeartbeatRepr {
+    /// Arm B target pulse.
+    pub arm_b_target: PulseWidth,
+    /// Arm B last interpolated pulse.
+    pub arm_b_now: PulseWidth,
+    /// Gripper B target pulse.
+    pub gripper_b_target: PulseWidth,
+    /// Gripper B last interpolated pulse.
+    pub gripper_b_now: PulseWidth,
+    /// Side B voltages and currents.
+    pub electrical_b: Electrical,
+    /// Bolter B progress.
+    pub bolter_aux: BolterAux,
+    /// Sequence number of the last A→B command received (the acknowledgement).
+    pub command_received: u8,
+    /// Gravity in B's IMU frame; none before the first IMU reading (both bytes 0).
+    pub gravity: Option<Gravity>,
+    /// Arm B current above its idle limit.
+    pub arm_over_idle: bool,
+    /// Gripper B current above its idle limit.
+    pub gripper_over_idle: bool,
+    /// Bolter B current above its idle limit.
+    pub bolter_over_idle: bool,
+    /// Arm B current above its absolute limit.
+    pub arm_overcurrent: bool,
+    /// Gripper B current above its absolute limit.
+    pub gripper_overcurrent: bool,
+    /// Bolter B current above its absolute limit.
+    pub bolter_overcurrent: bool,
+    /// Arm B's contraction switch is pressed.
+    pub arm_contracted: bool,
+}
+
+impl Default for InternalHeartbeatRepr {
+    /// Board B at startup: servos centred, nothing measured, nothing received.
+    fn default() -> Self {
+        InternalHeartbeatRepr {
+            arm_b_target: PulseWidth::CENTER,
+            arm_b_now: PulseWidth::CENTER,
+            gripper_b_target: PulseWidth::CENTER,
+            gripper_b_now: PulseWidth::CENTER,
+            electrical_b: Electrical::default(),
+            bolter_aux: BolterAux::default(),
+            command_received: 0,
+            gravity: None,
+            arm_over_idle: false,
+            gripper_over_idle: false,
+            bolter_over_idle: false,
+            arm_overcurrent: false,
+            gripper_overcurrent: false,
+            bolter_overcurrent: false,
+            arm_contracted: false,
+        }
+    }
+}
+
+impl InternalHeartbeatRepr {
+    /// Checks length, header, checksum and every field.
+    pub fn parse(bytes: &[u8]) -> Result<InternalHeartbeatRepr, WireError> {
+        let p: &InternalHeartbeatPacket = check(bytes)?;
+        let b = |i: usize, name: &'static str, v: u8| get_bool(KIND, i, name, v);
+        let step = match p.bolter_step {
+            0 => None,
+            v => Some(BolterStep::from_wire(v).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(bolter_step),
+                    "bolter_aux.step",
+                    "0 (idle) or 1..=8",
+                    v as u32,
+                )
+            })?),
+        };
+        let pair = match p.bolter_pair {
+            0 => None,
+            v => Some(BolterPair::from_number(v).ok_or_else(|| {
+                field_err(KIND, at!(bolter_pair), "bolter_aux.pair", "0..=4", v as u32)
+            })?),
+        };
+        let direction = match p.bolter_direction {
+            0 => None,
+            v => Some(BolterDirection::from_wire(v).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(bolter_direction),
+                    "bolter_aux.direction",
+                    "0, 1 (bolt) or 2 (unbolt)",
+                    v as u32,
+                )
+            })?),
+        };
+        let mux = MuxLines::from_wire(p.bolter_mux).ok_or_else(|| {
+            field_err(
+                KIND,
+                at!(bolter_mux),
+                "bolter_aux.mux",
+                "bits 0 (A0) and 1 (A1) only",
+                p.bolter_mux as u32,
+            )
+        })?;
+        let gravity = match (p.g_sign, p.g_axis) {
+            (0, 0) => None,
+            (s, a) => {
+                let sign = Sign::from_wire(s).ok_or_else(|| {
+                    field_err(
+                        KIND,
+                        at!(g_sign),
+                        "gravity.sign",
+                        "'+' or '-' (or 0 with axis 0)",
+                        s as u32,
+                    )
+                })?;
+                let axis = Axis::from_wire(a).ok_or_else(|| {
+                    field_err(
+                        KIND,
+                        at!(g_axis),
+                        "gravity.axis",
+                        "'X', 'Y' or 'Z' (or 0 with sign 0)",
+                        a as u32,
+                    )
+                })?;
+                Some(Gravity { axis, sign })
+            }
+        };
+        Ok(InternalHeartbeatRepr {
+            arm_b_target: pulse(KIND, "arm_b_target", at!(arm_b_target), p.arm_b_target)?,
+            arm_b_now: pulse(KIND, "arm_b_now", at!(arm_b_now), p.arm_b_now)?,
+            gripper_b_target: pulse(
+                KIND,
+                "gripper_b_target",
+                at!(gripper_b_target),
+                p.gripper_b_target,
+            )?,
+            gripper_b_now: pulse(KIND, "gripper_b_now", at!(gripper_b_now), p.gripper_b_now)?,
+            electrical_b: Electrical {
+                v_bat: p.v_bat_b.get(),
+                i_bat: p.i_bat_b.get(),
+                i_loc: p.i_loc_b.get(),
+                i_grip: p.i_grip_b.get(),
+                i_3v3: p.i_3v3_b.get(),
+                v_reg: p.v_reg_b.get(),
+                i_bo: p.i_bo_b.get(),
+            },
+            bolter_aux: BolterAux {
+                step,
+                seq: p.bolter_seq,
+                pair,
+                direction,
+                threshold_reached: b(
+                    at!(bolter_threshold),
+                    "bolter_aux.threshold_reached",
+                    p.bolter_threshold,
+                )?,
+                locked: b(at!(bolter_locked), "bolter_aux.locked", p.bolter_locked)?,
+                timed_out: b(
+                    at!(bolter_timed_out),
+                    "bolter_aux.timed_out",
+                    p.bolter_timed_out,
+                )?,
+                at_home: b(at!(bolter_at_home), "bolter_aux.at_home", p.bolter_at_home)?,
+                mux,
+            },
+            command_received: p.command_received,
+            gravity,
+            arm_over_idle: b(at!(arm_over_idle), "arm_over_idle", p.arm_over_idle)?,
+            gripper_over_idle: b(
+                at!(gripper_over_idle),
+                "gripper_over_idle",
+                p.gripper_over_idle,
+            )?,
+            bolter_over_idle: b(
+                at!(bolter_over_idle),
+                "bolter_over_idle",
+                p.bolter_over_idle,
+            )?,
+            arm_overcurrent: b(at!(arm_overcurrent), "arm_overcurrent", p.arm_overcurrent)?,
+            gripper_overcurrent: b(
+                at!(gripper_overcurrent),
+                "gripper_overcurrent",
+                p.gripper_overcurrent,
+            )?,
+            bolter_overcurrent: b(
+                at!(bolter_overcurrent),
+                "bolter_overcurrent",
+                p.bolter_overcurrent,
+            )?,
+            arm_contracted: b(at!(arm_contracted), "arm_contracted", p.arm_contracted)?,
+        })
+    }
+
+    /// Writes the packet, header and checksum included.
+    pub fn emit(&self, out: &mut [u8; INTERNAL_HEARTBEAT_LEN]) {
+        let u = |v: u16| U16::new(v);
+        let pw = |v: PulseWidth| U16::new(v.micros());
+        let e = &self.electrical_b;
+        let a = &self.bolter_aux;
+        let p = InternalHeartbeatPacket {
+            header: KIND.header(),
+            arm_b_target: pw(self.arm_b_target),
+            arm_b_now: pw(self.arm_b_now),
+            gripper_b_target: pw(self.gripper_b_target),
+            gripper_b_now: pw(self.gripper_b_now),
+            v_bat_b: u(e.v_bat),
+            i_bat_b: u(e.i_bat),
+            i_loc_b: u(e.i_loc),
+            i_grip_b: u(e.i_grip),
+            i_3v3_b: u(e.i_3v3),
+            v_reg_b: u(e.v_reg),
+            i_bo_b: u(e.i_bo),
+            bolter_step: a.step.map_or(0, BolterStep::to_wire),
+            bolter_seq: a.seq,
+            bolter_pair: a.pair.map_or(0, BolterPair::number),
+            bolter_direction: a.direction.map_or(0, BolterDirection::to_wire),
+            bolter_threshold: a.threshold_reached as u8,
+            bolter_locked: a.locked as u8,
+            bolter_timed_out: a.timed_out as u8,
+            bolter_at_home: a.at_home as u8,
+            bolter_mux: a.mux.to_wire(),
+            command_received: self.command_received,
+            g_sign: self.gravity.map_or(0, |g| g.sign.to_wire()),
+            g_axis: self.gravity.map_or(0, |g| g.axis.to_wire()),
+            arm_over_idle: self.arm_over_idle as u8,
+            gripper_over_idle: self.gripper_over_idle as u8,
+            bolter_over_idle: self.bolter_over_idle as u8,
+            arm_overcurrent: self.arm_overcurrent as u8,
+            gripper_overcurrent: self.gripper_overcurrent as u8,
+            bolter_overcurrent: self.bolter_overcurrent as u8,
+            arm_contracted: self.arm_contracted as u8,
+            checksum: U16::ZERO,
+        };
+        out.copy_from_slice(p.as_bytes());
+        seal(KIND, out);
+    }
+
+    /// The packet as a new array.
+    pub fn to_bytes(&self) -> [u8; INTERNAL_HEARTBEAT_LEN] {
+        let mut out = [0u8; INTERNAL_HEARTBEAT_LEN];
+        self.emit(&mut out);
+        out
+    }
+}

@@ -1,0 +1,100 @@
+//! Field tables: name, byte range, unit and the paper's label for every field of a packet,
+//! built from the zerocopy layouts so that the layout struct stays the one place a range is
+//! defined. spec/ is checked against these tables, and the review pages are rendered from them.
+
+use core::ops::Range;
+
+/// Byte range of field `$f` (of type `$ft`) in layout `$t`.
+macro_rules! span {
+    ($t:ty, $f:ident, $ft:ty) => {
+        core::mem::offset_of!($t, $f)..core::mem::offset_of!($t, $f) + core::mem::size_of::<$ft>()
+    };
+}
+pub(crate) use span;
+
+/// Unit or encoding of a field, as spec/ names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unit {
+    /// Fixed ASCII bytes.
+    Header,
+    /// Robot number 1..=255.
+    Board,
+    /// Command opcode (see the command table).
+    Opcode,
+    /// Servo pulse width, µs, 500..=2500.
+    Micros,
+    /// Hip angle, 0.01°, 0..=35999.
+    Centidegrees,
+    /// Voltage, mV.
+    Millivolts,
+    /// Current, mA.
+    Milliamps,
+    /// 0 or 1.
+    Bool,
+    /// State letter 'a'..='o', or 0 for none.
+    StateLetter,
+    /// A small enumeration documented with the field.
+    Enum,
+    /// Bit map documented with the field.
+    Bits,
+    /// Wrapping 8-bit sequence number.
+    Sequence,
+    /// Zero on emit; refused unless zero on parse.
+    Reserved,
+    /// Parameter bytes whose meaning depends on the opcode.
+    Parameter,
+    /// CRC-16/CCITT-FALSE, little-endian.
+    Crc16,
+}
+
+impl Unit {
+    /// Name as written in spec/.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Unit::Header => "header",
+            Unit::Board => "board",
+            Unit::Opcode => "opcode",
+            Unit::Micros => "us",
+            Unit::Centidegrees => "0.01 deg",
+            Unit::Millivolts => "mV",
+            Unit::Milliamps => "mA",
+            Unit::Bool => "bool",
+            Unit::StateLetter => "state",
+            Unit::Enum => "enum",
+            Unit::Bits => "bits",
+            Unit::Sequence => "seq",
+            Unit::Reserved => "reserved",
+            Unit::Parameter => "param",
+            Unit::Crc16 => "crc16",
+        }
+    }
+}
+
+/// One field of a packet.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FieldSpec {
+    /// Field name (spec/ and JSON).
+    pub name: &'static str,
+    /// Byte range in the packet.
+    pub range: Range<usize>,
+    /// Unit or encoding.
+    pub unit: Unit,
+    /// The paper's label for these bytes (two-byte fields: without "lowByte"/"highByte").
+    pub paper: &'static str,
+}
+
+impl FieldSpec {
+    /// The label the paper's grid shows in cell `index` (which must lie in `range`).
+    pub fn cell(&self, index: usize, out: &mut impl core::fmt::Write) -> core::fmt::Result {
+        if self.range.len() == 2 {
+            let half = if index == self.range.start {
+                "lowByte"
+            } else {
+                "highByte"
+            };
+            write!(out, "{half} {}", self.paper)
+        } else {
+            out.write_str(self.paper)
+        }
+    }
+}

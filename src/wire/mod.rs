@@ -1,0 +1,289 @@
+//! Packets: a fixed-size [`zerocopy`] layout per packet (the one place its field ranges are
+//! defined), a typed `Repr` with `parse`/`emit`, and a deframer for byte streams.
+//!
+//! Every packet is `header (4) | body | checksum (2)`. The header differs per packet type so a
+//! packet sent to the wrong parser is refused at byte 0; the checksum is CRC-16/CCITT-FALSE
+//! over all preceding bytes, low byte first like every u16 of the paper's tables.
+//!
+//! ```
+//! use mmic::wire::{PacketKind, WireError};
+//! use mmic::wire::command::CommandRepr;
+//!
+//! // A heartbeat header in front of a command parser is refused at the header check.
+//! let mut bytes = [0u8; 14];
+//! bytes[..4].copy_from_slice(&PacketKind::Heartbeat.header());
+//! assert!(matches!(CommandRepr::parse(&bytes), Err(WireError::Header { .. })));
+//! ```
+
+use core::fmt;
+use zerocopy::{FromBytes, Immutable, KnownLayout, Unaligned};
+
+pub mod b_command;
+pub mod checksum;
+pub mod command;
+pub mod deframer;
+pub mod heartbeat;
+pub mod internal_heartbeat;
+mod layout;
+
+pub use layout::{FieldSpec, Unit};
+
+use crate::command::CommandError;
+
+/// Length of every header.
+pub const HEADER_LEN: usize = 4;
+/// Length of every checksum.
+pub const CHECKSUM_LEN: usize = 2;
+/// Length of the longest packet (the WiFi heartbeat).
+pub const MAX_PACKET_LEN: usize = 66;
+
+/// The four packet types.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub enum PacketKind {
+    /// opsUI → server → board A, 14 bytes (Table 2).
+    Command,
+    /// Board A → server → opsUI, 66 bytes (Table 3).
+    Heartbeat,
+    /// Board B → board A over the internal serial line, 47 bytes (Table 4).
+    InternalHeartbeat,
+    /// Board A → board B over the internal serial line, 15 bytes (not in the paper).
+    BCommand,
+}
+
+impl PacketKind {
+    /// All kinds.
+    pub const ALL: [PacketKind; 4] = [
+        PacketKind::Command,
+        PacketKind::Heartbeat,
+        PacketKind::InternalHeartbeat,
+        PacketKind::BCommand,
+    ];
+
+    /// The four header bytes: "MI" (MMIC-I) and two letters naming the type, readable in a
+    /// capture; any two headers differ in at least 5 bits.
+    pub const fn header(self) -> [u8; HEADER_LEN] {
+        match self {
+            PacketKind::Command => *b"MICM",
+            PacketKind::Heartbeat => *b"MIHB",
+            PacketKind::InternalHeartbeat => *b"MIih",
+            PacketKind::BCommand => *b"MIbc",
+        }
+    }
+
+    /// Total length in bytes, header and checksum included.
+    pub const fn len(self) -> usize {
+        match self {
+            PacketKind::Command => command::COMMAND_LEN,
+            PacketKind::Heartbeat => heartbeat::HEARTBEAT_LEN,
+            PacketKind::InternalHeartbeat => internal_heartbeat::INTERNAL_HEARTBEAT_LEN,
+            PacketKind::BCommand => b_command::B_COMMAND_LEN,
+        }
+    }
+
+    /// Kind whose header is `h`.
+    pub fn from_header(h: &[u8]) -> Option<PacketKind> {
+        Self::ALL.into_iter().find(|k| k.header() == h)
+    }
+
+    /// The CLI / spec name.
+    pub const fn name(self) -> &'static str {
+        match self {
+            PacketKind::Command => "command",
+            PacketKind::Heartbeat => "heartbeat",
+            PacketKind::InternalHeartbeat => "internal-heartbeat",
+            PacketKind::BCommand => "b-command",
+        }
+    }
+
+    /// Kind with CLI / spec name `s`.
+    pub fn from_name(s: &str) -> Option<PacketKind> {
+        Self::ALL.into_iter().find(|k| k.name() == s)
+    }
+
+    /// Field table of this packet, byte order.
+    pub const fn fields(self) -> &'static [FieldSpec] {
+        match self {
+            PacketKind::Command => command::FIELDS,
+            PacketKind::Heartbeat => heartbeat::FIELDS,
+            PacketKind::InternalHeartbeat => internal_heartbeat::FIELDS,
+            PacketKind::BCommand => b_command::FIELDS,
+        }
+    }
+}
+
+impl fmt::Display for PacketKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Why bytes are not a valid packet. Checks run in this order: length, header, checksum,
+/// fields; the first failure is reported with the numbers that explain it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum WireError {
+    /// Wrong number of bytes.
+    #[error("{kind} packet: length must be {expected} bytes, found {found}")]
+    Length {
+        /// Packet type being parsed.
+        kind: PacketKind,
+        /// Its fixed length.
+        expected: usize,
+        /// Bytes given.
+        found: usize,
+    },
+    /// Bytes 0–3 are not this packet's header.
+    #[error("{kind} packet: header must be {expected:02x?}, found {found:02x?}")]
+    Header {
+        /// Packet type being parsed.
+        kind: PacketKind,
+        /// Its header.
+        expected: [u8; HEADER_LEN],
+        /// Bytes 0–3 found.
+        found: [u8; HEADER_LEN],
+    },
+    /// The checksum bytes disagree with the CRC of the preceding bytes.
+    #[error("{kind} packet: checksum carried {carried:#06x}, computed {computed:#06x}")]
+    Checksum {
+        /// Packet type being parsed.
+        kind: PacketKind,
+        /// The last two bytes, little-endian.
+        carried: u16,
+        /// CRC-16/CCITT-FALSE of the other bytes.
+        computed: u16,
+    },
+    /// A field holds a value outside its domain.
+    #[error("{kind} packet: byte {index} ({field}): expected {expected}, found {found:#x}")]
+    Field {
+        /// Packet type being parsed.
+        kind: PacketKind,
+        /// Index of the (first) offending byte.
+        index: usize,
+        /// Field name, as in spec/.
+        field: &'static str,
+        /// What the field may hold.
+        expected: &'static str,
+        /// What it held.
+        found: u32,
+    },
+    /// The command packet's opcode and parameters are no command.
+    #[error("command packet: {0}")]
+    Command(#[from] CommandError),
+}
+
+impl WireError {
+    /// Short machine name of the failed check: `length`, `header`, `checksum`, `field`, `command`.
+    pub const fn check(&self) -> &'static str {
+        match self {
+            WireError::Length { .. } => "length",
+            WireError::Header { .. } => "header",
+            WireError::Checksum { .. } => "checksum",
+            WireError::Field { .. } => "field",
+            WireError::Command(_) => "command",
+        }
+    }
+}
+
+/// A packet layout: fixed size, no padding, byte-aligned, readable from any bytes.
+pub trait Packet: FromBytes + KnownLayout + Immutable + Unaligned + Sized {
+    /// Which packet this is.
+    const KIND: PacketKind;
+}
+
+/// Length, header and checksum checks; on success a view of the bytes as `P`.
+pub fn check<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
+    let kind = P::KIND;
+    let expected = kind.len();
+    if bytes.len() != expected {
+        return Err(WireError::Length {
+            kind,
+            expected,
+            found: bytes.len(),
+        });
+    }
+    let (body, crc) = bytes.split_at(expected - CHECKSUM_LEN);
+    let found = [bytes[0], bytes[1], bytes[2], bytes[3]];
+    if found != kind.header() {
+        return Err(WireError::Header {
+            kind,
+            expected: kind.header(),
+            found,
+        });
+    }
+    let carried = u16::from_le_bytes([crc[0], crc[1]]);
+    let computed = checksum::crc16(body);
+    if carried != computed {
+        return Err(WireError::Checksum {
+            kind,
+            carried,
+            computed,
+        });
+    }
+    P::ref_from_bytes(bytes).map_err(|_| WireError::Length {
+        kind,
+        expected,
+        found: bytes.len(),
+    })
+}
+
+/// Writes header and checksum around a body already written into `out`.
+pub(crate) fn seal(kind: PacketKind, out: &mut [u8]) {
+    let n = out.len();
+    out[..HEADER_LEN].copy_from_slice(&kind.header());
+    let crc = checksum::crc16(&out[..n - CHECKSUM_LEN]);
+    out[n - CHECKSUM_LEN..].copy_from_slice(&crc.to_le_bytes());
+}
+
+/// A field check failure, for the parsers.
+pub(crate) const fn field_err(
+    kind: PacketKind,
+    index: usize,
+    field: &'static str,
+    expected: &'static str,
+    found: u32,
+) -> WireError {
+    WireError::Field {
+        kind,
+        index,
+        field,
+        expected,
+        found,
+    }
+}
+
+/// Reads a boolean byte: exactly 0 or 1.
+pub(crate) fn get_bool(
+    kind: PacketKind,
+    index: usize,
+    field: &'static str,
+    b: u8,
+) -> Result<bool, WireError> {
+    match b {
+        0 => Ok(false),
+        1 => Ok(true),
+        _ => Err(field_err(kind, index, field, "0 or 1", b as u32)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn headers_are_far_apart() {
+        for a in PacketKind::ALL {
+            for b in PacketKind::ALL {
+                if a != b {
+                    let d: u32 = a
+                        .header()
+                        .iter()
+                        .zip(b.header())
+                        .map(|(x, y)| (x ^ y).count_ones())
+                        .sum();
+                    assert!(d >= 5, "{a} vs {b}: {d} bits");
+                }
+            }
+        }
+    }
+}
