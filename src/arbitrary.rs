@@ -33,7 +33,9 @@ use crate::command::{
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
 use crate::motion::{Primitive, State, StateKind};
-use crate::units::{Axis, BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth, Side, Sign};
+use crate::units::{
+    Axis, BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth, Side, Sign,
+};
 use crate::wire::b_command::{BCommandRepr, BPower, BolterOrder};
 use crate::wire::command::CommandRepr;
 use crate::wire::heartbeat::{BolterAttempt, HeartbeatRepr};
@@ -130,8 +132,8 @@ arbitrary_boxed!(
 );
 arbitrary_boxed!(
     HipAngle,
-    bounded_u16(0, HipAngle::TURN - 1).prop_filter_map("hip angle < 36000", |a| HipAngle::new(a)
-        .ok())
+    bounded_u16(0, HipAngle::TURN - 1)
+        .prop_filter_map("hip angle < 36000", |a| HipAngle::new(a).ok())
 );
 arbitrary_boxed!(
     BolterAttempt,
@@ -156,15 +158,17 @@ arbitrary_boxed!(
         wire_u16(),
         wire_u16()
     ]
-    .prop_map(|[v_bat, i_bat, i_loc, i_grip, i_3v3, v_reg, i_bo]| Electrical {
-        v_bat,
-        i_bat,
-        i_loc,
-        i_grip,
-        i_3v3,
-        v_reg,
-        i_bo,
-    })
+    .prop_map(
+        |[v_bat, i_bat, i_loc, i_grip, i_3v3, v_reg, i_bo]| Electrical {
+            v_bat,
+            i_bat,
+            i_loc,
+            i_grip,
+            i_3v3,
+            v_reg,
+            i_bo,
+        }
+    )
 );
 arbitrary_boxed!(
     Faults,

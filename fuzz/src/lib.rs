@@ -1,1 +1,233 @@
-//! Fuzz targets live in `tests/`; see the repository README.
+//! Coverage-guided fuzz targets for mmic's four parsers and its deframer, and their seed corpus.
+//!
+//! The targets are the bolero tests in `tests/targets.rs`; the properties they check are the
+//! functions of `mmic-proofs`, shared with the proof harnesses. Under plain `cargo test` each
+//! target runs for a second on random inputs and replays its committed seed corpus
+//! (`tests/__fuzz__/<target>/corpus/`); under `cargo bolero test` it is fuzzed with libFuzzer.
+//! See `fuzz/README.md` for the commands.
+//!
+//! This library generates that seed corpus: valid packets and near misses (one length, header,
+//! checksum or field check away from valid) for each parser, and short streams for the
+//! deframer. `cargo run -p mmic-fuzz --bin mmic-fuzz-seeds` writes them; the test
+//! `tests/seeds.rs` fails when the committed files differ from what [`seeds`] generates.
+//!
+//! ```
+//! let seeds = mmic_fuzz::seeds();
+//! assert!(mmic_fuzz::TARGETS.iter().all(|t| seeds.iter().any(|s| s.target == *t)));
+//! ```
+
+use mmic::bolter::{BolterDirection, BolterStep};
+use mmic::command::{BolterPair, Command, HipTarget, PowerTarget, ServoTarget};
+use mmic::mode::Mode;
+use mmic::motion::State;
+use mmic::units::{BoardNumber, HipAngle, Module, PulseWidth, Side};
+use mmic::wire::b_command::{BCommandRepr, BolterOrder};
+use mmic::wire::command::CommandRepr;
+use mmic::wire::heartbeat::HeartbeatRepr;
+use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
+use mmic::wire::PacketKind;
+use mmic_proofs::seal;
+
+/// The fuzz targets, one per parser and one for the deframer (test names in
+/// `tests/targets.rs`, and the names `cargo bolero test` takes).
+pub const TARGETS: [&str; 5] = [
+    "command_parser",
+    "heartbeat_parser",
+    "internal_heartbeat_parser",
+    "b_command_parser",
+    "deframer_stream",
+];
+
+/// One seed file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SeedFile {
+    /// Target it belongs to (one of [`TARGETS`]).
+    pub target: &'static str,
+    /// File name in the target's corpus directory.
+    pub name: String,
+    /// Contents.
+    pub bytes: Vec<u8>,
+}
+
+/// Target name of the parser for `kind`.
+pub fn parser_target(kind: PacketKind) -> &'static str {
+    match kind {
+        PacketKind::Command => TARGETS[0],
+        PacketKind::Heartbeat => TARGETS[1],
+        PacketKind::InternalHeartbeat => TARGETS[2],
+        PacketKind::BCommand => TARGETS[3],
+    }
+}
+
+fn pw(us: u16) -> PulseWidth {
+    PulseWidth::new(us).expect("valid pulse width")
+}
+
+/// Valid packets of every kind, named.
+pub fn valid_packets() -> Vec<(PacketKind, &'static str, Vec<u8>)> {
+    let board = BoardNumber::new(7).expect("valid board");
+    let cmd = |name, command| {
+        (
+            PacketKind::Command,
+            name,
+            CommandRepr { board, command }.to_bytes().to_vec(),
+        )
+    };
+    vec![
+        cmd("stop", Command::Stop),
+        cmd("mode-operational", Command::Mode(Mode::Operational)),
+        cmd(
+            "arm-b-1200us",
+            Command::Arm {
+                side: Side::B,
+                target: ServoTarget::Position(pw(1200)),
+            },
+        ),
+        cmd(
+            "gripper-a-extend",
+            Command::Gripper {
+                side: Side::A,
+                target: ServoTarget::Extend,
+            },
+        ),
+        cmd(
+            "hip-angle-35999",
+            Command::Hip(HipTarget::Angle(HipAngle::new(35999).expect("valid angle"))),
+        ),
+        cmd(
+            "reconfigure-h-to-n",
+            Command::reconfigure(State::H, State::N).expect("valid reconfiguration"),
+        ),
+        cmd(
+            "power-off-bolter-b",
+            Command::Power {
+                target: PowerTarget::Module(Module::BolterB),
+                on: false,
+            },
+        ),
+        (
+            PacketKind::Heartbeat,
+            "default",
+            HeartbeatRepr::default().to_bytes().to_vec(),
+        ),
+        (
+            PacketKind::InternalHeartbeat,
+            "default",
+            InternalHeartbeatRepr::default().to_bytes().to_vec(),
+        ),
+        (
+            PacketKind::BCommand,
+            "unbolt-pair-3-rotate",
+            BCommandRepr {
+                seq: 42,
+                power: Default::default(),
+                stop: false,
+                arm_target: pw(1800),
+                gripper_target: pw(2200),
+                bolter: Some(BolterOrder {
+                    pair: BolterPair::P3,
+                    direction: BolterDirection::Unbolt,
+                    step: BolterStep::Rotate,
+                }),
+            }
+            .to_bytes()
+            .to_vec(),
+        ),
+    ]
+}
+
+/// A byte of each packet whose value is out of its field's domain when set to `value`: the
+/// field near misses (the checksum is rewritten, so only the field check fails).
+fn field_miss(kind: PacketKind) -> (usize, u8) {
+    match kind {
+        PacketKind::Command => (5, 0x00),         // opcode 0: unassigned
+        PacketKind::Heartbeat => (63, 0x00),      // mode 0: no mode
+        PacketKind::InternalHeartbeat => (44, 2), // arm contracted: not a boolean
+        PacketKind::BCommand => (5, 0x20),        // flags: undefined bit 5
+    }
+}
+
+/// Every seed file of every target.
+pub fn seeds() -> Vec<SeedFile> {
+    let mut out = Vec::new();
+    let valid = valid_packets();
+    for (kind, name, bytes) in &valid {
+        let target = parser_target(*kind);
+        let mut push = |suffix: &str, bytes: Vec<u8>| {
+            out.push(SeedFile {
+                target,
+                name: format!("{name}{suffix}"),
+                bytes,
+            })
+        };
+        push("", bytes.clone());
+        // Checksum near miss: the last bit of the checksum flipped.
+        let mut b = bytes.clone();
+        *b.last_mut().expect("non-empty") ^= 0x01;
+        push("-checksum-miss", b);
+        // Header near miss: the next kind's header.
+        let other = PacketKind::ALL[(PacketKind::ALL
+            .iter()
+            .position(|k| k == kind)
+            .expect("kind")
+            + 1)
+            % 4];
+        let mut b = bytes.clone();
+        b[..4].copy_from_slice(&other.header());
+        push("-header-miss", b);
+        // Length near misses: one byte short, one byte long.
+        push("-short", bytes[..bytes.len() - 1].to_vec());
+        let mut b = bytes.clone();
+        b.push(0);
+        push("-long", b);
+        // Field near miss, with a correct checksum.
+        let (at, value) = field_miss(*kind);
+        let mut b = bytes.clone();
+        b[at] = value;
+        seal(*kind, &mut b);
+        push("-field-miss", b);
+    }
+    // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.
+    let packet = |k: PacketKind| {
+        valid
+            .iter()
+            .find(|(kind, _, _)| *kind == k)
+            .map(|(_, _, b)| b.clone())
+            .expect("a valid packet of each kind")
+    };
+    let cmd = packet(PacketKind::Command);
+    let mut streams: Vec<(&str, Vec<u8>)> = Vec::new();
+    let mut s = b"\x00junk".to_vec();
+    s.extend_from_slice(&cmd);
+    streams.push(("garbage-then-command", s));
+    let mut s = Vec::new();
+    for k in PacketKind::ALL {
+        s.extend_from_slice(&packet(k));
+    }
+    streams.push(("all-four-back-to-back", s));
+    let mut s = b"MIHB".to_vec();
+    s.extend_from_slice(&[0xaa; 7]);
+    s.extend_from_slice(&cmd);
+    streams.push(("false-header-hides-command", s));
+    let mut s = cmd.clone();
+    *s.last_mut().expect("non-empty") ^= 0x80;
+    s.extend_from_slice(&cmd);
+    s.extend_from_slice(b"MI");
+    streams.push(("bad-checksum-good-packet-header-prefix", s));
+    for (name, stream) in streams {
+        for (plan_name, plan) in [
+            ("one-read", [69u8, 69, 69, 69]),
+            ("bytewise", [0, 0, 0, 0]),
+            ("mixed", [4, 12, 1, 30]),
+        ] {
+            let mut bytes = plan.to_vec();
+            bytes.extend_from_slice(&stream);
+            out.push(SeedFile {
+                target: TARGETS[4],
+                name: format!("{name}-{plan_name}"),
+                bytes,
+            });
+        }
+    }
+    out
+}

@@ -36,11 +36,11 @@ use mmic::mode::Mode;
 use mmic::motion::State;
 use mmic::units::{Axis, BoardNumber, Electrical, Gravity, HipAngle, PulseWidth, Sign};
 use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder, B_COMMAND_LEN};
-use mmic::wire::heartbeat::BolterAttempt;
-use mmic::wire::internal_heartbeat::BolterAux;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::deframer::{Deframed, Deframer, Frame};
+use mmic::wire::heartbeat::BolterAttempt;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
+use mmic::wire::internal_heartbeat::BolterAux;
 use mmic::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
 use mmic::wire::{PacketKind, WireError, CHECKSUM_LEN, HEADER_LEN, MAX_PACKET_LEN};
 
@@ -312,7 +312,11 @@ fn sample_internal_heartbeat(s: &mut Seed<'_>) -> InternalHeartbeatRepr {
             0 => None,
             k => Some(Gravity {
                 axis: Axis::ALL[(k as usize - 1) % 3],
-                sign: if k <= 3 { Sign::Positive } else { Sign::Negative },
+                sign: if k <= 3 {
+                    Sign::Positive
+                } else {
+                    Sign::Negative
+                },
             }),
         },
         arm_over_idle: s.bool(),

@@ -26,9 +26,11 @@ fn command_parse_never_panics() {
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(16))]
 fn command_parse_never_panics_any_length() {
-    bolero::check!().with_max_len(MAX_LEN).for_each(|bytes: &[u8]| {
-        check_parse::<CommandRepr>(bytes);
-    });
+    bolero::check!()
+        .with_max_len(MAX_LEN)
+        .for_each(|bytes: &[u8]| {
+            check_parse::<CommandRepr>(bytes);
+        });
 }
 
 /// Any body with the right header and a correct checksum is accepted canonically

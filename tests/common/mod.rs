@@ -1,0 +1,59 @@
+//! Oracles shared by the integration tests, written from the definitions and independent of the
+//! library: a bitwise CRC-16/CCITT-FALSE (the library uses the `crc` crate's table) and the
+//! framing verdict in the documented check order.
+#![allow(dead_code)] // each test file uses part of this module
+
+use mmic::wire::{PacketKind, WireError, CHECKSUM_LEN, HEADER_LEN};
+
+/// CRC-16/CCITT-FALSE: poly 0x1021, init 0xFFFF, MSB first, no final xor; one bit at a time.
+pub fn crc16_bitwise(bytes: &[u8]) -> u16 {
+    let mut crc: u16 = 0xffff;
+    for &b in bytes {
+        crc ^= (b as u16) << 8;
+        for _ in 0..8 {
+            crc = if crc & 0x8000 != 0 {
+                (crc << 1) ^ 0x1021
+            } else {
+                crc << 1
+            };
+        }
+    }
+    crc
+}
+
+/// Writes `kind`'s header and the bitwise CRC of everything before the last two bytes.
+pub fn seal(kind: PacketKind, packet: &mut [u8]) {
+    assert_eq!(packet.len(), kind.len());
+    let n = packet.len();
+    packet[..HEADER_LEN].copy_from_slice(&kind.header());
+    let crc = crc16_bitwise(&packet[..n - CHECKSUM_LEN]);
+    packet[n - CHECKSUM_LEN..].copy_from_slice(&crc.to_le_bytes());
+}
+
+/// The error `parse` must return for `bytes` as a `kind` packet if length, header or checksum
+/// is wrong (checked in that order); `None` when all three hold.
+pub fn framing_error(kind: PacketKind, bytes: &[u8]) -> Option<WireError> {
+    if bytes.len() != kind.len() {
+        return Some(WireError::Length {
+            kind,
+            expected: kind.len(),
+            found: bytes.len(),
+        });
+    }
+    let found: [u8; HEADER_LEN] = bytes[..HEADER_LEN].try_into().unwrap();
+    if found != kind.header() {
+        return Some(WireError::Header {
+            kind,
+            expected: kind.header(),
+            found,
+        });
+    }
+    let (body, crc) = bytes.split_at(bytes.len() - CHECKSUM_LEN);
+    let carried = u16::from_le_bytes([crc[0], crc[1]]);
+    let computed = crc16_bitwise(body);
+    (carried != computed).then_some(WireError::Checksum {
+        kind,
+        carried,
+        computed,
+    })
+}
