@@ -79,6 +79,7 @@ macro_rules! f {
             range: span!(HeartbeatPacket, $field, $ty),
             unit: Unit::$unit,
             paper: $paper,
+            cells: &[],
         }
     };
 }
@@ -140,7 +141,13 @@ pub const FIELDS: &[FieldSpec] = &[
     f!("active_bolter", active_bolter, u8, Enum, "active bolter"),
     f!("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
     f!("empty", empty, [u8; 3], Reserved, "empty"),
-    f!("faults", faults, [u8; 3], Bits, "fault byte"),
+    FieldSpec {
+        name: "faults",
+        range: span!(HeartbeatPacket, faults, [u8; 3]),
+        unit: Unit::Bits,
+        paper: "fault byte0-2",
+        cells: &["fault byte0", "fault byte1", "fault byte2"],
+    },
     f!("mode", mode, u8, Enum, "operating mode"),
     f!("checksum", checksum, U16, Crc16, "checksum"),
 ];
