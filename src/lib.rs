@@ -36,5 +36,6 @@ pub mod command;
 pub mod faults;
 pub mod mode;
 pub mod motion;
+pub mod refusal;
 pub mod units;
 pub mod wire;
