@@ -137,6 +137,11 @@ impl Faults {
         self.0 == 0
     }
 
+    /// Whether every fault of `self` is in `other`.
+    pub const fn is_subset_of(self, other: Faults) -> bool {
+        self.0 & !other.0 == 0
+    }
+
     /// Union.
     pub const fn union(self, other: Faults) -> Faults {
         Faults(self.0 | other.0)

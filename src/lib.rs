@@ -37,5 +37,6 @@ pub mod faults;
 pub mod mode;
 pub mod motion;
 pub mod refusal;
+pub mod safety;
 pub mod units;
 pub mod wire;
