@@ -63,6 +63,22 @@ pub enum HipTarget {
     Angle(HipAngle),
 }
 
+/// The angle a hip target stands for; `None` for [`HipTarget::Home`], whose angle is a
+/// configuration value (the contracted-gripped angle).
+pub const fn preset_angle(t: HipTarget) -> Option<HipAngle> {
+    let cdeg = match t {
+        HipTarget::Home => return None,
+        HipTarget::Straight => 18000,
+        HipTarget::RightAngleCw => 9000,
+        HipTarget::RightAngleCcw => 27000,
+        HipTarget::Angle(a) => return Some(a),
+    };
+    match HipAngle::new(cdeg) {
+        Ok(a) => Some(a),
+        Err(_) => None,
+    }
+}
+
 /// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[cfg_attr(

@@ -1,9 +1,10 @@
-//! The fault bit map carried in the heartbeat's three fault bytes (Table 3 bytes 60–62).
+//! The fault bit map carried in the heartbeat's first two fault bytes (Table 3 bytes 60–61).
 //!
-//! Byte 60 holds bits 0–7, byte 61 bits 8–15, byte 62 bits 16–23. One bit per Table 8 row; the
-//! overcurrent rows are split into the idle check and the operational check because the paper
-//! describes two checks with different thresholds and an operator needs to know which fired.
-//! Bits 13–23 are reserved and must be zero.
+//! Byte 60 holds bits 0–7, byte 61 bits 8–15. One bit per Table 8 row; the overcurrent rows are
+//! split into the idle check and the operational check because the paper describes two checks
+//! with different thresholds and an operator needs to know which fired. Bits 13–15 are
+//! reserved and must be zero. The third fault byte (62) carries the last command's
+//! [`Refusal`](crate::refusal::Refusal).
 //!
 //! ```
 //! use mmic::faults::{Fault, Faults};
@@ -98,13 +99,13 @@ impl fmt::Display for Fault {
     }
 }
 
-/// A set of faults: the latched fault map.
+/// A set of faults: the latched fault map, or the conditions holding now.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Faults(u32);
 
 /// Bits set in the fault bytes that name no fault.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[error("fault bytes set reserved bits {reserved:#08x} (only bits 0..=12 name faults)")]
+#[error("fault bytes set reserved bits {reserved:#06x} (only bits 0..=12 name faults)")]
 pub struct ReservedFaultBits {
     /// The reserved bits that were set.
     pub reserved: u32,
@@ -136,24 +137,29 @@ impl Faults {
         self.0 == 0
     }
 
+    /// Whether every fault of `self` is in `other`.
+    pub const fn is_subset_of(self, other: Faults) -> bool {
+        self.0 & !other.0 == 0
+    }
+
     /// Union.
     pub const fn union(self, other: Faults) -> Faults {
         Faults(self.0 | other.0)
     }
 
-    /// The raw 24-bit map.
+    /// The raw 16-bit map.
     pub const fn bits(self) -> u32 {
         self.0
     }
 
-    /// The three fault bytes, byte 60 first.
-    pub const fn to_wire(self) -> [u8; 3] {
-        [self.0 as u8, (self.0 >> 8) as u8, (self.0 >> 16) as u8]
+    /// The two fault bytes, byte 60 first.
+    pub const fn to_wire(self) -> [u8; 2] {
+        [self.0 as u8, (self.0 >> 8) as u8]
     }
 
-    /// Fault set from the three fault bytes; reserved bits are refused.
-    pub const fn from_wire(b: [u8; 3]) -> Result<Faults, ReservedFaultBits> {
-        let raw = b[0] as u32 | (b[1] as u32) << 8 | (b[2] as u32) << 16;
+    /// Fault set from the two fault bytes; reserved bits are refused.
+    pub const fn from_wire(b: [u8; 2]) -> Result<Faults, ReservedFaultBits> {
+        let raw = b[0] as u32 | (b[1] as u32) << 8;
         let reserved = raw & !Self::DEFINED;
         if reserved != 0 {
             Err(ReservedFaultBits { reserved })
@@ -214,14 +220,14 @@ mod tests {
     #[test]
     fn every_subset_round_trips_and_reserved_bits_are_refused() {
         for raw in 0..=Faults::DEFINED {
-            let b = [raw as u8, (raw >> 8) as u8, (raw >> 16) as u8];
+            let b = [raw as u8, (raw >> 8) as u8];
             let f = Faults::from_wire(b).unwrap();
             assert_eq!(f.to_wire(), b);
             assert_eq!(f.iter().collect::<Faults>(), f);
         }
-        for bit in 13..24 {
+        for bit in 13..16 {
             let raw = 1u32 << bit;
-            let b = [raw as u8, (raw >> 8) as u8, (raw >> 16) as u8];
+            let b = [raw as u8, (raw >> 8) as u8];
             assert_eq!(
                 Faults::from_wire(b),
                 Err(ReservedFaultBits { reserved: raw })

@@ -38,5 +38,7 @@ pub mod command;
 pub mod faults;
 pub mod mode;
 pub mod motion;
+pub mod refusal;
+pub mod safety;
 pub mod units;
 pub mod wire;

@@ -65,6 +65,7 @@ macro_rules! f {
             range: span!(BCommandPacket, $field, $ty),
             unit: Unit::$unit,
             paper: $paper,
+            cells: &[],
         }
     };
 }

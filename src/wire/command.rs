@@ -79,42 +79,52 @@ pub const FIELDS: &[FieldSpec] = &[
         range: field::HEADER,
         unit: Unit::Header,
         paper: "header",
+        cells: &[],
     },
     FieldSpec {
         name: "board",
         range: field::BOARD,
         unit: Unit::Board,
         paper: "board number",
+        cells: &[],
     },
     FieldSpec {
         name: "command",
         range: field::COMMAND,
         unit: Unit::Opcode,
         paper: "command",
+        cells: &[],
     },
     FieldSpec {
         name: "hip",
         range: field::HIP,
         unit: Unit::Parameter,
         paper: "hip PWM",
+        cells: &[],
     },
     FieldSpec {
         name: "arm_a",
         range: field::ARM_A,
         unit: Unit::Parameter,
         paper: "arm A PWM/ final state",
+        cells: &[
+            "lowByte arm A PWM/ final state",
+            "highByte arm A PWM/ init state",
+        ],
     },
     FieldSpec {
         name: "arm_b",
         range: field::ARM_B,
         unit: Unit::Parameter,
         paper: "arm B PWM",
+        cells: &[],
     },
     FieldSpec {
         name: "checksum",
         range: field::CHECKSUM,
         unit: Unit::Crc16,
         paper: "checksum",
+        cells: &[],
     },
 ];
 

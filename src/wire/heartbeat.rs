@@ -15,6 +15,7 @@ use crate::command::BolterPair;
 use crate::faults::Faults;
 use crate::mode::Mode;
 use crate::motion::State;
+use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use zerocopy::byteorder::little_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -61,7 +62,8 @@ pub struct HeartbeatPacket {
     pub active_bolter: u8,
     pub bolter_attempt: u8,
     pub empty: [u8; 3],
-    pub faults: [u8; 3],
+    pub faults: [u8; 2],
+    pub refusal: u8,
     pub mode: u8,
     pub checksum: U16,
 }
@@ -79,6 +81,7 @@ macro_rules! f {
             range: span!(HeartbeatPacket, $field, $ty),
             unit: Unit::$unit,
             paper: $paper,
+            cells: &[],
         }
     };
 }
@@ -140,7 +143,14 @@ pub const FIELDS: &[FieldSpec] = &[
     f!("active_bolter", active_bolter, u8, Enum, "active bolter"),
     f!("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
     f!("empty", empty, [u8; 3], Reserved, "empty"),
-    f!("faults", faults, [u8; 3], Bits, "fault byte"),
+    FieldSpec {
+        name: "faults",
+        range: span!(HeartbeatPacket, faults, [u8; 2]),
+        unit: Unit::Bits,
+        paper: "fault byte0-1",
+        cells: &["fault byte0", "fault byte1"],
+    },
+    f!("refusal", refusal, u8, Enum, "fault byte2"),
     f!("mode", mode, u8, Enum, "operating mode"),
     f!("checksum", checksum, U16, Crc16, "checksum"),
 ];
@@ -234,6 +244,8 @@ pub struct HeartbeatRepr {
     pub bolter_attempt: BolterAttempt,
     /// Latched faults.
     pub faults: Faults,
+    /// Why the command this heartbeat answers was refused; none when it was accepted.
+    pub refusal: Option<Refusal>,
     /// Operating mode.
     pub mode: Mode,
 }
@@ -264,6 +276,7 @@ impl Default for HeartbeatRepr {
             active_bolter: None,
             bolter_attempt: BolterAttempt::NONE,
             faults: Faults::EMPTY,
+            refusal: None,
             mode: Mode::Standby,
         }
     }
@@ -330,6 +343,18 @@ impl HeartbeatRepr {
         }
         let faults = Faults::from_wire(p.faults)
             .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=12 only", e.reserved))?;
+        let refusal = match p.refusal {
+            0 => None,
+            v => Some(Refusal::from_wire(v).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(refusal),
+                    "refusal",
+                    "0 (accepted) or 1..=7",
+                    v as u32,
+                )
+            })?),
+        };
         let mode = Mode::from_wire(p.mode).ok_or_else(|| {
             field_err(
                 KIND,
@@ -389,6 +414,7 @@ impl HeartbeatRepr {
             active_bolter,
             bolter_attempt,
             faults,
+            refusal,
             mode,
         })
     }
@@ -431,6 +457,7 @@ impl HeartbeatRepr {
             bolter_attempt: self.bolter_attempt.get(),
             empty: [0; 3],
             faults: self.faults.to_wire(),
+            refusal: self.refusal.map_or(0, Refusal::to_wire),
             mode: self.mode.to_wire(),
             checksum: U16::ZERO,
         };

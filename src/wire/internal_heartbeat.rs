@@ -76,6 +76,7 @@ macro_rules! f {
             range: span!(InternalHeartbeatPacket, $field, $ty),
             unit: Unit::$unit,
             paper: $paper,
+            cells: &[],
         }
     };
 }
@@ -113,54 +114,63 @@ pub const FIELDS: &[FieldSpec] = &[
         range: span!(InternalHeartbeatPacket, bolter_step, u8),
         unit: Unit::Enum,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.seq",
         range: span!(InternalHeartbeatPacket, bolter_seq, u8),
         unit: Unit::Sequence,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.pair",
         range: span!(InternalHeartbeatPacket, bolter_pair, u8),
         unit: Unit::Enum,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.direction",
         range: span!(InternalHeartbeatPacket, bolter_direction, u8),
         unit: Unit::Enum,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.threshold_reached",
         range: span!(InternalHeartbeatPacket, bolter_threshold, u8),
         unit: Unit::Bool,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.locked",
         range: span!(InternalHeartbeatPacket, bolter_locked, u8),
         unit: Unit::Bool,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.timed_out",
         range: span!(InternalHeartbeatPacket, bolter_timed_out, u8),
         unit: Unit::Bool,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.at_home",
         range: span!(InternalHeartbeatPacket, bolter_at_home, u8),
         unit: Unit::Bool,
         paper: AUX,
+        cells: &[],
     },
     FieldSpec {
         name: "bolter_aux.mux",
         range: span!(InternalHeartbeatPacket, bolter_mux, u8),
         unit: Unit::Bits,
         paper: AUX,
+        cells: &[],
     },
     f!(
         "command_received",

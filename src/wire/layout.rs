@@ -81,12 +81,22 @@ pub struct FieldSpec {
     pub unit: Unit,
     /// The paper's label for these bytes (two-byte fields: without "lowByte"/"highByte").
     pub paper: &'static str,
+    /// The paper's grid cells for these bytes when they are not derived from `paper`
+    /// (empty: derived, see [`FieldSpec::cell`]).
+    pub cells: &'static [&'static str],
 }
 
 impl FieldSpec {
-    /// The label the paper's grid shows in cell `index` (which must lie in `range`).
+    /// The label the paper's grid shows in cell `index` (which must lie in `range`): the
+    /// explicit `cells` if given; else "lowByte"/"highByte" + `paper` for two-byte fields;
+    /// else `paper` in every cell (the paper's merged cells).
     pub fn cell(&self, index: usize, out: &mut impl core::fmt::Write) -> core::fmt::Result {
-        if self.range.len() == 2 {
+        if let Some(c) = index
+            .checked_sub(self.range.start)
+            .and_then(|i| self.cells.get(i))
+        {
+            out.write_str(c)
+        } else if self.range.len() == 2 {
             let half = if index == self.range.start {
                 "lowByte"
             } else {

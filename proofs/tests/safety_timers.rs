@@ -1,0 +1,90 @@
+//! The fault timers over arbitrary time sequences, including the wrap of the u32 millisecond
+//! clock: each harness compares the detector with a direct computation on 64-bit absolute time.
+//! Under `cargo test`: random inputs; `cargo bolero test`: fuzzing; `cargo kani --tests`: a
+//! proof over all inputs of the fixed length (8 samples).
+
+use mmic::safety::detect::{CommMonitor, Config, LowBattery};
+
+const SAMPLES: usize = 8;
+
+/// Low battery fires at a sample iff the voltage has been below 10.0 V at every sample of a run
+/// ending there whose span is more than 500 ms; the clock may start anywhere, wrap included.
+#[test]
+#[cfg_attr(kani, kani::proof, kani::unwind(10))]
+fn low_battery_fires_exactly_after_half_a_second() {
+    bolero::check!()
+        .with_type::<(u32, [(u16, bool, bool); SAMPLES])>()
+        .for_each(|(start, samples)| {
+            let cfg = Config::default();
+            let mut lb = LowBattery::default();
+            let mut abs: u64 = *start as u64;
+            let mut run_start: Option<u64> = None;
+            for (i, &(dt, low_a, low_b)) in samples.iter().enumerate() {
+                if i > 0 {
+                    abs += dt as u64;
+                }
+                let now = abs as u32; // the wrapping clock the robot sees
+                let (va, vb) = (
+                    if low_a { 9_999 } else { 10_000 },
+                    if low_b { 9_999 } else { 12_600 },
+                );
+                let below = low_a || low_b;
+                run_start = if below {
+                    Some(run_start.unwrap_or(abs))
+                } else {
+                    None
+                };
+                let expected = run_start.is_some_and(|s| abs - s > 500);
+                assert_eq!(lb.update(&cfg, now, va, vb), expected, "sample {i}");
+            }
+        });
+}
+
+/// Comm loss fires iff B has been silent for more than the timeout (counting from the first
+/// tick) or the pending command has been sent three times unacknowledged.
+#[test]
+#[cfg_attr(kani, kani::proof, kani::unwind(10))]
+fn comm_loss_fires_exactly_after_timeout_or_three_sends() {
+    bolero::check!()
+        .with_type::<(u32, [(u16, u8, u8); SAMPLES])>()
+        .for_each(|(start, events)| {
+            let cfg = Config::default();
+            let mut c = CommMonitor::default();
+            let mut abs: u64 = *start as u64;
+            let mut last_heard: Option<u64> = None; // last heartbeat, or the first tick
+            let mut last_obs: u64 = abs; // last tick or heartbeat
+            let mut pending: Option<(u8, u8)> = None; // (seq, sends)
+            for (i, &(dt, what, seq)) in events.iter().enumerate() {
+                if i > 0 {
+                    abs += dt as u64;
+                }
+                let now = abs as u32;
+                match what % 3 {
+                    0 => {
+                        c.tick(now);
+                        last_heard.get_or_insert(abs);
+                        last_obs = abs;
+                    }
+                    1 => {
+                        c.heartbeat(now, seq % 4);
+                        last_heard = Some(abs);
+                        last_obs = abs;
+                        if pending.is_some_and(|(p, _)| p == seq % 4) {
+                            pending = None;
+                        }
+                    }
+                    _ => {
+                        c.sent(seq % 4);
+                        pending = match pending {
+                            Some((p, n)) if p == seq % 4 => Some((p, n.saturating_add(1))),
+                            _ => Some((seq % 4, 1)),
+                        };
+                    }
+                }
+                // Silence is measured up to the last tick or heartbeat the monitor has seen.
+                let silent = last_heard.map_or(0, |h| last_obs - h);
+                let expected = silent > 500 || pending.is_some_and(|(_, n)| n >= 3);
+                assert_eq!(c.lost(&cfg), expected, "event {i}");
+            }
+        });
+}

@@ -1,0 +1,359 @@
+//! Fault detectors for Table 8: pure functions of filtered sensor values, time and events,
+//! with every threshold in one [`Config`].
+//!
+//! Time is a `u32` millisecond clock that wraps every 49.7 days. Detectors never compare
+//! timestamps; they add up the elapsed time between successive calls with `wrapping_sub`, so
+//! the wrap is invisible. A step that looks longer than 2^31 ms can only be the clock going
+//! backwards; it is counted as 0 ms rather than as a huge jump.
+//!
+//! ```
+//! use mmic::safety::detect::{Config, LowBattery};
+//! let cfg = Config::default();
+//! let mut lb = LowBattery::default();
+//! let t0 = u32::MAX - 100; // across the clock's wrap
+//! assert!(!lb.update(&cfg, t0, 9_900, 11_000));
+//! assert!(!lb.update(&cfg, t0.wrapping_add(500), 9_900, 11_000)); // 500 ms: not yet
+//! assert!(lb.update(&cfg, t0.wrapping_add(501), 9_900, 11_000)); // more than 0.5 s
+//! ```
+
+use crate::faults::{Fault, Faults};
+use crate::units::{Electrical, HipAngle, Milliamps, Millivolts};
+
+/// Current limits of the three module classes of Table 8.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    /// Locomotion: arm and hip current I_loc.
+    pub locomotion: Milliamps,
+    /// Gripper current I_grip.
+    pub gripper: Milliamps,
+    /// Bolter current I_bo.
+    pub bolter: Milliamps,
+}
+
+/// Every fault threshold, with documented defaults (spec/modes.toml lists them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Config {
+    /// Low battery: V_batA or V_batB strictly below this (Section 2: "Below 10 V, the battery is
+    /// considered out of charge").
+    pub low_battery_mv: Millivolts,
+    /// Low battery: for strictly longer than this (Section 7: "for more than 0.5 seconds").
+    pub low_battery_ms: u32,
+    /// Internal comm loss: no board-B heartbeat for strictly longer than this. Default 500 ms,
+    /// five periods of B's 100 ms heartbeat.
+    pub comm_timeout_ms: u32,
+    /// Internal comm loss: the same command sent to B this many times without an
+    /// acknowledgement. Default 3.
+    pub comm_max_unacked: u8,
+    /// Idle check: current at rest above these (robot gripped, not moving) at the start and end
+    /// of a reconfiguration. Defaults: locomotion 400 mA, gripper 200 mA, bolter 200 mA.
+    pub idle: Limits,
+    /// Operational check, always: absolute limits. Defaults: locomotion 3000 mA, gripper
+    /// 1500 mA, bolter 2000 mA.
+    pub absolute: Limits,
+    /// The hip angle of the contracted-gripped (home) configuration. Default 180.00°.
+    pub hip_home: HipAngle,
+    /// Hip mismatch when entering Operational: reading farther than this from `hip_home`
+    /// (circular distance, 0.01°). Default 10.00°.
+    pub hip_tolerance: u16,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Config {
+            low_battery_mv: 10_000,
+            low_battery_ms: 500,
+            comm_timeout_ms: 500,
+            comm_max_unacked: 3,
+            idle: Limits {
+                locomotion: 400,
+                gripper: 200,
+                bolter: 200,
+            },
+            absolute: Limits {
+                locomotion: 3000,
+                gripper: 1500,
+                bolter: 2000,
+            },
+            hip_home: match HipAngle::new(18000) {
+                Ok(a) => a,
+                Err(_) => HipAngle::ZERO,
+            },
+            hip_tolerance: 1000,
+        }
+    }
+}
+
+/// Milliseconds from `last` to `now` on the wrapping clock; 0 if the clock went backwards.
+pub const fn elapsed(last: u32, now: u32) -> u32 {
+    let d = now.wrapping_sub(last);
+    if d > i32::MAX as u32 {
+        0
+    } else {
+        d
+    }
+}
+
+/// A condition that must hold continuously for longer than a duration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Debounce {
+    /// Time of the previous sample while the condition held.
+    last: Option<u32>,
+    /// How long it has held, saturating.
+    held_ms: u32,
+}
+
+impl Debounce {
+    /// Feeds one sample; true when the condition has held for strictly more than `limit_ms`.
+    /// The time between two samples that both hold counts as held.
+    pub fn update(&mut self, now: u32, holds: bool, limit_ms: u32) -> bool {
+        if !holds {
+            *self = Debounce::default();
+            return false;
+        }
+        if let Some(last) = self.last {
+            self.held_ms = self.held_ms.saturating_add(elapsed(last, now));
+        }
+        self.last = Some(now);
+        self.held_ms > limit_ms
+    }
+
+    /// How long the condition has held so far.
+    pub const fn held_ms(&self) -> u32 {
+        self.held_ms
+    }
+}
+
+/// Low battery (Table 8): V_batA or V_batB below the threshold for longer than the duration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct LowBattery(Debounce);
+
+impl LowBattery {
+    /// Feeds the filtered battery voltages of both sides; true while the fault condition holds.
+    pub fn update(
+        &mut self,
+        cfg: &Config,
+        now: u32,
+        v_bat_a: Millivolts,
+        v_bat_b: Millivolts,
+    ) -> bool {
+        let below = v_bat_a < cfg.low_battery_mv || v_bat_b < cfg.low_battery_mv;
+        self.0.update(now, below, cfg.low_battery_ms)
+    }
+}
+
+/// Internal communication loss (Table 8): no heartbeat from board B for too long, or the same
+/// command sent to B repeatedly without acknowledgement.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CommMonitor {
+    last_seen: Option<u32>,
+    silent_ms: u32,
+    pending: Option<u8>,
+    sends: u8,
+}
+
+impl CommMonitor {
+    /// Advances time; silence counts from the first call (boot) until B's first heartbeat.
+    pub fn tick(&mut self, now: u32) {
+        if let Some(last) = self.last_seen {
+            self.silent_ms = self.silent_ms.saturating_add(elapsed(last, now));
+        }
+        self.last_seen = Some(now);
+    }
+
+    /// Board B's heartbeat arrived, echoing sequence number `ack` ("command received").
+    pub fn heartbeat(&mut self, now: u32, ack: u8) {
+        self.last_seen = Some(now);
+        self.silent_ms = 0;
+        if self.pending == Some(ack) {
+            self.pending = None;
+            self.sends = 0;
+        }
+    }
+
+    /// A command with sequence number `seq` was sent to B (a resend repeats the number).
+    pub fn sent(&mut self, seq: u8) {
+        if self.pending == Some(seq) {
+            self.sends = self.sends.saturating_add(1);
+        } else {
+            self.pending = Some(seq);
+            self.sends = 1;
+        }
+    }
+
+    /// Whether the fault condition holds.
+    pub fn lost(&self, cfg: &Config) -> bool {
+        self.silent_ms > cfg.comm_timeout_ms
+            || (self.pending.is_some() && self.sends >= cfg.comm_max_unacked)
+    }
+
+    /// Milliseconds since B's last heartbeat (saturating).
+    pub const fn silent_ms(&self) -> u32 {
+        self.silent_ms
+    }
+}
+
+fn over(e: &Electrical, l: &Limits, loco: Fault, grip: Fault, bolt: Fault) -> Faults {
+    let mut f = Faults::EMPTY;
+    if e.i_loc > l.locomotion {
+        f = f.with(loco);
+    }
+    if e.i_grip > l.gripper {
+        f = f.with(grip);
+    }
+    if e.i_bo > l.bolter {
+        f = f.with(bolt);
+    }
+    f
+}
+
+/// Operational overcurrent check, performed at all times: any module of either side above its
+/// absolute limit.
+pub fn operational_overcurrent(cfg: &Config, a: &Electrical, b: &Electrical) -> Faults {
+    use Fault::*;
+    let lim = &cfg.absolute;
+    over(
+        a,
+        lim,
+        LocomotionOvercurrent,
+        GripperOvercurrent,
+        BolterOvercurrent,
+    )
+    .union(over(
+        b,
+        lim,
+        LocomotionOvercurrent,
+        GripperOvercurrent,
+        BolterOvercurrent,
+    ))
+}
+
+/// Idle overcurrent check, at the start and the end of a reconfiguration: any module of either
+/// side drawing more than its at-rest limit (not gripping, arm stuck, bolter caught).
+pub fn idle_overcurrent(cfg: &Config, a: &Electrical, b: &Electrical) -> Faults {
+    use Fault::*;
+    let lim = &cfg.idle;
+    over(
+        a,
+        lim,
+        LocomotionOvercurrentIdle,
+        GripperOvercurrentIdle,
+        BolterOvercurrentIdle,
+    )
+    .union(over(
+        b,
+        lim,
+        LocomotionOvercurrentIdle,
+        GripperOvercurrentIdle,
+        BolterOvercurrentIdle,
+    ))
+}
+
+/// Circular distance between two hip angles, in 0.01°, 0..=18000.
+pub const fn hip_distance(a: HipAngle, b: HipAngle) -> u16 {
+    let (x, y) = (a.centidegrees(), b.centidegrees());
+    let d = x.abs_diff(y);
+    if d > HipAngle::TURN / 2 {
+        HipAngle::TURN - d
+    } else {
+        d
+    }
+}
+
+/// Hip mismatch check when entering Operational: true when the reading is within tolerance of
+/// the contracted-gripped angle.
+pub const fn hip_at_home(cfg: &Config, hip_now: HipAngle) -> bool {
+    hip_distance(hip_now, cfg.hip_home) <= cfg.hip_tolerance
+}
+
+/// Arm not fully contracted (Table 8): after a contraction finished, the switch is not pressed.
+pub const fn arm_contraction_fault(contraction_finished: bool, switch_pressed: bool) -> bool {
+    contraction_finished && !switch_pressed
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn low_battery_boundaries() {
+        let cfg = Config::default();
+        // Exactly 10.0 V is not below; 9.999 V is.
+        let mut lb = LowBattery::default();
+        for t in (0..=2000).step_by(10) {
+            assert!(!lb.update(&cfg, t, 10_000, 10_000));
+        }
+        let mut lb = LowBattery::default();
+        assert!(!lb.update(&cfg, 1000, 12_000, 9_999));
+        assert!(!lb.update(&cfg, 1500, 12_000, 9_999));
+        assert!(lb.update(&cfg, 1501, 12_000, 9_999));
+        // One good sample resets the debounce.
+        assert!(!lb.update(&cfg, 1502, 12_000, 10_000));
+        assert!(!lb.update(&cfg, 1503, 9_000, 12_000));
+        assert!(!lb.update(&cfg, 2003, 9_000, 12_000));
+        assert!(lb.update(&cfg, 2004, 9_000, 12_000));
+    }
+
+    #[test]
+    fn clock_going_backwards_counts_as_no_time() {
+        let mut d = Debounce::default();
+        assert!(!d.update(1000, true, 500));
+        assert!(!d.update(900, true, 500));
+        assert_eq!(d.held_ms(), 0);
+    }
+
+    #[test]
+    fn comm_loss_by_silence_and_by_unacknowledged_resends() {
+        let cfg = Config::default();
+        let mut c = CommMonitor::default();
+        c.tick(0);
+        c.tick(500);
+        assert!(!c.lost(&cfg));
+        c.tick(501);
+        assert!(c.lost(&cfg));
+        c.heartbeat(600, 0);
+        assert!(!c.lost(&cfg));
+        c.sent(7);
+        c.sent(7);
+        assert!(!c.lost(&cfg));
+        c.heartbeat(650, 6); // acknowledges an older command: not this one
+        c.sent(7);
+        assert!(c.lost(&cfg));
+        c.heartbeat(700, 7);
+        assert!(!c.lost(&cfg));
+    }
+
+    #[test]
+    fn hip_distance_is_circular() {
+        let a = |c| HipAngle::new(c).unwrap();
+        assert_eq!(hip_distance(a(100), a(35900)), 200);
+        assert_eq!(hip_distance(a(0), a(18000)), 18000);
+        let cfg = Config::default();
+        assert!(hip_at_home(&cfg, a(17000)) && hip_at_home(&cfg, a(19000)));
+        assert!(!hip_at_home(&cfg, a(16999)) && !hip_at_home(&cfg, a(19001)));
+    }
+
+    #[test]
+    fn overcurrent_is_strictly_above_the_limit_on_either_side() {
+        let cfg = Config::default();
+        let ok = Electrical {
+            i_loc: 3000,
+            i_grip: 1500,
+            i_bo: 2000,
+            ..Default::default()
+        };
+        assert!(operational_overcurrent(&cfg, &ok, &ok).is_empty());
+        let hot = Electrical { i_grip: 1501, ..ok };
+        assert_eq!(
+            operational_overcurrent(&cfg, &ok, &hot),
+            Faults::EMPTY.with(Fault::GripperOvercurrent)
+        );
+        let rest = Electrical {
+            i_loc: 401,
+            ..Default::default()
+        };
+        assert_eq!(
+            idle_overcurrent(&cfg, &rest, &Electrical::default()),
+            Faults::EMPTY.with(Fault::LocomotionOvercurrentIdle)
+        );
+    }
+}

@@ -1,0 +1,169 @@
+//! src/safety/ equals spec/modes.toml: Table 7's acceptance and power, Table 8's modes,
+//! deferral and kinds, refusal codes and threshold defaults.
+
+use mmic::command::CommandKind;
+use mmic::faults::Fault;
+use mmic::mode::Mode;
+use mmic::refusal::Refusal;
+use mmic::safety::detect::Config;
+use mmic::safety::policy::{accepts, fault_action, is_condition, powered, regulator_on};
+use mmic::safety::ModuleSet;
+use mmic::units::Module;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+#[derive(Deserialize)]
+struct Spec {
+    table7: BTreeMap<String, Vec<String>>,
+    accepts: BTreeMap<String, Vec<String>>,
+    power: Power,
+    fault: Vec<FaultRow>,
+    refusals: BTreeMap<String, u8>,
+    thresholds: Thresholds,
+    inconsistency: Vec<BTreeMap<String, String>>,
+}
+
+#[derive(Deserialize)]
+struct Power {
+    standby: Vec<String>,
+    safed: Vec<String>,
+    operational: Vec<String>,
+    regulator: BTreeMap<String, bool>,
+}
+
+#[derive(Deserialize)]
+struct FaultRow {
+    name: String,
+    table8: String,
+    mode: String,
+    deferred: bool,
+    kind: String,
+}
+
+#[derive(Deserialize)]
+struct Limits {
+    locomotion: u16,
+    gripper: u16,
+    bolter: u16,
+}
+
+#[derive(Deserialize)]
+struct Thresholds {
+    low_battery_mv: u16,
+    low_battery_ms: u32,
+    comm_timeout_ms: u32,
+    comm_max_unacked: u8,
+    idle: Limits,
+    absolute: Limits,
+    hip_home: u16,
+    hip_tolerance: u16,
+}
+
+fn spec() -> Spec {
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/modes.toml");
+    toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+fn module_name(m: Module) -> &'static str {
+    match m {
+        Module::Hip => "hip",
+        Module::ArmA => "arm_a",
+        Module::ArmB => "arm_b",
+        Module::GripperA => "gripper_a",
+        Module::GripperB => "gripper_b",
+        Module::BolterA => "bolter_a",
+        Module::BolterB => "bolter_b",
+    }
+}
+
+#[test]
+fn table7_acceptance_and_power_equal_spec() {
+    let s = spec();
+    for row in ["entry", "power", "commands", "exit"] {
+        assert_eq!(s.table7[row].len(), 3, "table7.{row}");
+    }
+    for mode in Mode::ALL {
+        let want: Vec<&str> = s.accepts[mode.name()].iter().map(String::as_str).collect();
+        let got: Vec<&str> = CommandKind::ALL
+            .iter()
+            .filter(|k| accepts(mode, **k))
+            .map(|k| k.name())
+            .collect();
+        assert_eq!(got, want, "{mode}: accepted command kinds");
+        let want = match mode {
+            Mode::Standby => &s.power.standby,
+            Mode::Safed => &s.power.safed,
+            Mode::Operational => &s.power.operational,
+        };
+        let got: Vec<&str> = powered(mode, ModuleSet::ALL)
+            .iter()
+            .map(module_name)
+            .collect();
+        assert_eq!(got, *want, "{mode}: powered");
+        assert_eq!(
+            regulator_on(mode),
+            s.power.regulator[mode.name()],
+            "{mode}: regulator"
+        );
+    }
+}
+
+#[test]
+fn table8_modes_deferral_and_kinds_equal_spec() {
+    let s = spec();
+    assert_eq!(s.fault.len(), Fault::ALL.len());
+    for (f, row) in Fault::ALL.iter().zip(&s.fault) {
+        assert_eq!(f.name(), row.name);
+        assert!(!row.table8.is_empty());
+        let a = fault_action(*f);
+        assert_eq!(a.mode.name(), row.mode, "{f}: mode");
+        assert_eq!(a.deferred, row.deferred, "{f}: deferred");
+        assert_eq!(
+            if is_condition(*f) {
+                "condition"
+            } else {
+                "event"
+            },
+            row.kind,
+            "{f}: kind"
+        );
+    }
+    assert!(s.inconsistency.len() >= 2);
+}
+
+#[test]
+fn refusal_codes_and_thresholds_equal_spec() {
+    let s = spec();
+    assert_eq!(s.refusals.len(), Refusal::ALL.len());
+    for r in Refusal::ALL {
+        assert_eq!(s.refusals[r.name()], r.to_wire(), "{r}");
+    }
+    let c = Config::default();
+    let t = &s.thresholds;
+    assert_eq!(
+        (
+            c.low_battery_mv,
+            c.low_battery_ms,
+            c.comm_timeout_ms,
+            c.comm_max_unacked,
+            c.hip_home.centidegrees(),
+            c.hip_tolerance
+        ),
+        (
+            t.low_battery_mv,
+            t.low_battery_ms,
+            t.comm_timeout_ms,
+            t.comm_max_unacked,
+            t.hip_home,
+            t.hip_tolerance
+        )
+    );
+    assert_eq!(
+        (c.idle.locomotion, c.idle.gripper, c.idle.bolter),
+        (t.idle.locomotion, t.idle.gripper, t.idle.bolter)
+    );
+    assert_eq!(
+        (c.absolute.locomotion, c.absolute.gripper, c.absolute.bolter),
+        (t.absolute.locomotion, t.absolute.gripper, t.absolute.bolter)
+    );
+}
