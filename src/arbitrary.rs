@@ -33,6 +33,7 @@ use crate::command::{
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
 use crate::motion::{Primitive, State, StateKind};
+use crate::refusal::Refusal;
 use crate::units::{
     Axis, BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth, Side, Sign,
 };
@@ -88,7 +89,8 @@ arbitrary_from_all!(
     BolterStep,
     BolterPair,
     PacketKind,
-    CommandKind
+    CommandKind,
+    Refusal
 );
 
 /// Implements `Arbitrary` as a boxed strategy built by `$body`.
@@ -176,7 +178,7 @@ arbitrary_boxed!(
     prop_oneof![1 => Just(0u32), 1 => Just(Faults::DEFINED), 8 => 0..=Faults::DEFINED]
         .prop_filter_map("defined fault bits only", |raw| {
             let b = raw.to_le_bytes();
-            Faults::from_wire([b[0], b[1], b[2]]).ok()
+            Faults::from_wire([b[0], b[1]]).ok()
         })
 );
 
@@ -283,6 +285,7 @@ arbitrary_boxed!(
             option::of(any::<BolterPair>()),
             any::<BolterAttempt>(),
             any::<Faults>(),
+            option::of(any::<Refusal>()),
             any::<Mode>(),
         ),
     )
@@ -291,7 +294,7 @@ arbitrary_boxed!(
                 (board, hip_target, hip_now),
                 [arm_a_target, arm_a_now, arm_b_target, arm_b_now, gripper_a_target, gripper_a_now, gripper_b_target, gripper_b_now],
                 (electrical_a, electrical_b),
-                (target_state, command_complete, active_bolter, bolter_attempt, faults, mode),
+                (target_state, command_complete, active_bolter, bolter_attempt, faults, refusal, mode),
             )| HeartbeatRepr {
                 board,
                 hip_target,
@@ -311,6 +314,7 @@ arbitrary_boxed!(
                 active_bolter,
                 bolter_attempt,
                 faults,
+                refusal,
                 mode,
             }
         )

@@ -6,7 +6,8 @@
 //! definition: poly 0x1021, init 0xFFFF, MSB first, no final xor, stored low byte first); the
 //! same bitwise CRC lives in `common/` and is re-checked here against the catalogue check value
 //! and against each vector, so a wrong table in the library's `crc` configuration cannot hide.
-//! Every field of a vector holds a different value, so swapped or shifted fields show.
+//! Neighbouring fields hold different values wherever their domains allow, so swapped or
+//! shifted fields show.
 
 mod common;
 
@@ -16,6 +17,7 @@ use mmic::command::{BolterPair, Command, ServoTarget};
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
 use mmic::motion::State;
+use mmic::refusal::Refusal;
 use mmic::units::{Axis, BoardNumber, Electrical, Gravity, HipAngle, PulseWidth, Side, Sign};
 use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder, B_COMMAND_LEN};
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
@@ -94,7 +96,8 @@ fn golden_command_reconfigure() {
 }
 
 /// Robot 3, Operational, bolting pair 2 (attempt 1) after reconfiguring towards m, with the
-/// low-battery and arm-not-contracted faults latched.
+/// low-battery and arm-not-contracted faults latched, answering a command it refused for an
+/// invalid parameter.
 #[rustfmt::skip]
 const HEARTBEAT: [u8; HEARTBEAT_LEN] = [
     b'M', b'I', b'H', b'B', // 0-3 header
@@ -128,9 +131,10 @@ const HEARTBEAT: [u8; HEARTBEAT_LEN] = [
     0x02,       // 55 active bolter: pair 2
     0x01,       // 56 bolter attempt 1
     0x00, 0x00, 0x00, // 57-59 empty
-    0x02, 0x08, 0x00, // 60-62 faults: bit 1 (arm not contracted) | bit 11 (low battery)
+    0x02, 0x08, // 60-61 faults: bit 1 (arm not contracted) | bit 11 (low battery)
+    0x05,       // 62 refusal of the last command: 5, invalid parameter
     0x02,       // 63 mode: operational
-    0x4a, 0x84, // 64-65 CRC-16 0x844a
+    0xbf, 0x7b, // 64-65 CRC-16 0x7bbf
 ];
 
 #[test]
@@ -172,6 +176,7 @@ fn golden_heartbeat() {
         faults: Faults::EMPTY
             .with(Fault::ArmNotContracted)
             .with(Fault::LowBattery),
+        refusal: Some(Refusal::InvalidParameter),
         mode: Mode::Operational,
     };
     assert_crc(&HEARTBEAT);
@@ -179,8 +184,9 @@ fn golden_heartbeat() {
     assert_eq!(HeartbeatRepr::parse(&HEARTBEAT), Ok(repr));
 }
 
-/// Board B unbolting pair 3, in the rotate step, gravity along −Z, gripper and bolter
-/// currents over their limits, arm contracted; acknowledging A→B command 43.
+/// Board B unbolting pair 3, the rotate step timed out, gravity along −Z, gripper current over
+/// its idle limit, arm and bolter currents over their absolute limits; acknowledging A→B
+/// command 43. Neighbouring flags alternate, so two swapped flags show.
 #[rustfmt::skip]
 const INTERNAL_HEARTBEAT: [u8; INTERNAL_HEARTBEAT_LEN] = [
     b'M', b'I', b'i', b'h', // 0-3 header
@@ -201,7 +207,7 @@ const INTERNAL_HEARTBEAT: [u8; INTERNAL_HEARTBEAT_LEN] = [
     0x02,       // 29 direction: unbolt
     0x01,       // 30 threshold reached
     0x00,       // 31 not locked
-    0x00,       // 32 not timed out
+    0x01,       // 32 timed out
     0x00,       // 33 not at home
     0x01,       // 34 mux: A0 high, A1 low (pair 3)
     0x2b,       // 35 command received: 43
@@ -210,11 +216,11 @@ const INTERNAL_HEARTBEAT: [u8; INTERNAL_HEARTBEAT_LEN] = [
     0x00,       // 38 arm over idle
     0x01,       // 39 gripper over idle
     0x00,       // 40 bolter over idle
-    0x00,       // 41 arm overcurrent
+    0x01,       // 41 arm overcurrent
     0x00,       // 42 gripper overcurrent
     0x01,       // 43 bolter overcurrent
-    0x01,       // 44 arm contracted
-    0x45, 0xc8, // 45-46 CRC-16 0xc845
+    0x00,       // 44 arm not contracted
+    0xb3, 0xeb, // 45-46 CRC-16 0xebb3
 ];
 
 #[test]
@@ -240,7 +246,7 @@ fn golden_internal_heartbeat() {
             direction: Some(BolterDirection::Unbolt),
             threshold_reached: true,
             locked: false,
-            timed_out: false,
+            timed_out: true,
             at_home: false,
             mux: MuxLines::for_pair(BolterPair::P3),
         },
@@ -252,10 +258,10 @@ fn golden_internal_heartbeat() {
         arm_over_idle: false,
         gripper_over_idle: true,
         bolter_over_idle: false,
-        arm_overcurrent: false,
+        arm_overcurrent: true,
         gripper_overcurrent: false,
         bolter_overcurrent: true,
-        arm_contracted: true,
+        arm_contracted: false,
     };
     assert_crc(&INTERNAL_HEARTBEAT);
     assert_eq!(repr.to_bytes(), INTERNAL_HEARTBEAT);

@@ -220,6 +220,8 @@ fn repr_strategies_reach_both_sides_of_every_option_and_the_range_bounds() {
     assert!(hb
         .iter()
         .any(|h| h.faults.bits() == mmic::faults::Faults::DEFINED));
+    assert!(hb.iter().any(|h| h.refusal.is_none()));
+    assert!(hb.iter().any(|h| h.refusal.is_some()));
     assert!(hb.iter().any(|h| h.board.get() == 1));
     assert!(hb.iter().any(|h| h.board.get() == 255));
     assert!(hb.iter().any(|h| h.arm_a_target.micros() == 500));

@@ -214,6 +214,13 @@ pub fn seeds() -> Vec<SeedFile> {
     s.extend_from_slice(&cmd);
     s.extend_from_slice(b"MI");
     streams.push(("bad-checksum-good-packet-header-prefix", s));
+    // A header's first three bytes right before a packet: with the packet's first byte they
+    // form a false header, and the packet starts inside it.
+    let mut s = b"MIC".to_vec();
+    s.extend_from_slice(&cmd);
+    s.extend_from_slice(b"MI");
+    s.extend_from_slice(&packet(PacketKind::InternalHeartbeat));
+    streams.push(("partial-header-then-packet", s));
     for (name, stream) in streams {
         for (plan_name, plan) in [
             ("one-read", [69u8, 69, 69, 69]),

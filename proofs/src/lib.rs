@@ -34,6 +34,7 @@ use mmic::command::{for_each_variant_class, BolterPair, Command};
 use mmic::faults::Faults;
 use mmic::mode::Mode;
 use mmic::motion::State;
+use mmic::refusal::Refusal;
 use mmic::units::{Axis, BoardNumber, Electrical, Gravity, HipAngle, PulseWidth, Sign};
 use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder, B_COMMAND_LEN};
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
@@ -283,8 +284,9 @@ fn sample_heartbeat(s: &mut Seed<'_>) -> HeartbeatRepr {
         bolter_attempt: BolterAttempt::new(s.u8() % 4).expect("0..=3"),
         faults: {
             let raw = s.u16() as u32 & Faults::DEFINED;
-            Faults::from_wire([raw as u8, (raw >> 8) as u8, 0]).expect("defined bits")
+            Faults::from_wire([raw as u8, (raw >> 8) as u8]).expect("defined bits")
         },
+        refusal: Refusal::from_wire(s.u8() % 8),
         mode: s.pick(&Mode::ALL),
     }
 }
@@ -480,6 +482,9 @@ pub fn chunk_len(plan: &[u8], i: usize, rest: usize) -> usize {
 /// * every `Discarded(n)` has `n > 0`;
 /// * every frame is what the stream holds at its offset (the bytes consumed before it),
 ///   byte for byte, and passes the oracle's framing checks for its kind;
+/// * no packet is lost: every offset at which the stream holds a packet with sound framing
+///   (a header, then that packet's length of bytes whose checksum holds) is either delivered
+///   as a frame or lies inside a frame delivered before it;
 /// * at the end nothing is buffered: every byte was discarded or delivered.
 ///
 /// `on_frame(offset, frame)` sees each frame with its stream offset.
@@ -490,6 +495,8 @@ pub fn run_deframer<const N: usize>(
 ) -> DeframerRun {
     let mut d = Deframer::<N>::new();
     let mut run = DeframerRun::default();
+    // Stream offsets before this one are delivered or checked to hold no packet.
+    let mut covered = 0;
     let mut event = |e: Deframed, d: &Deframer<N>, run: &mut DeframerRun| {
         match e {
             Deframed::Discarded(n) => {
@@ -502,6 +509,8 @@ pub fn run_deframer<const N: usize>(
                 assert_eq!(bytes.len(), f.kind().len());
                 assert_eq!(framing(f.kind(), bytes), Framing::Sound);
                 assert_eq!(Some(bytes), stream.get(offset..offset + bytes.len()));
+                assert_no_packet_in(stream, covered..offset);
+                covered = offset + bytes.len();
                 on_frame(offset, &f);
                 run.frames += 1;
                 run.frame_bytes += bytes.len();
@@ -536,8 +545,29 @@ pub fn run_deframer<const N: usize>(
         event(e, &d, &mut run);
     }
     assert_eq!(d.buffered(), 0, "bytes left after resync");
+    assert_no_packet_in(stream, covered..stream.len());
     assert_eq!(run.pushed, stream.len());
     run
+}
+
+/// Asserts that no packet with sound framing starts at an offset in `range` of `stream`: the
+/// deframer dropped those bytes, so it must not have dropped a packet.
+fn assert_no_packet_in(stream: &[u8], range: core::ops::Range<usize>) {
+    for q in range {
+        let Some(kind) = stream
+            .get(q..q + HEADER_LEN)
+            .and_then(PacketKind::from_header)
+        else {
+            continue;
+        };
+        if let Some(packet) = stream.get(q..q + kind.len()) {
+            assert_ne!(
+                framing(kind, packet),
+                Framing::Sound,
+                "a {kind} packet at offset {q} was dropped"
+            );
+        }
+    }
 }
 
 /// Property: after any `garbage`, a packet with sound framing (`kind`, `body` sealed as in

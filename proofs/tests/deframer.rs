@@ -60,9 +60,9 @@ fn deframer_never_panics() {
 }
 
 /// For streams mixing garbage, packets with sound framing and near misses (see
-/// `build_stream`) in any chunking: bytes pushed = bytes discarded + bytes delivered in frames
-/// + bytes buffered after every call, every frame is the stream's bytes at its offset, and
-/// after `resync` nothing is left (see `run_deframer` for the full list).
+/// `build_stream`) in any chunking: after every call, the bytes pushed equal the bytes
+/// discarded plus the bytes delivered in frames plus the bytes buffered; every frame is the
+/// stream's bytes at its offset; after `resync` nothing is left (see `run_deframer`).
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(22))]
 fn deframer_conserves_bytes() {
