@@ -1,0 +1,138 @@
+//! JSON ⇄ packet bytes for the four packet kinds, and hex parsing with positioned errors.
+
+use mmic::wire::b_command::BCommandRepr;
+use mmic::wire::command::CommandRepr;
+use mmic::wire::heartbeat::HeartbeatRepr;
+use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
+use mmic::wire::{PacketKind, WireError};
+
+/// Why a codec call failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CodecError {
+    /// The JSON is not a valid `Repr` of the kind.
+    #[error("invalid {kind} JSON: {source}")]
+    Json {
+        /// Kind being encoded.
+        kind: PacketKind,
+        /// serde_json's message (line, column, field).
+        source: serde_json::Error,
+    },
+    /// The hex text is malformed.
+    #[error("invalid hex at character {position}: {reason}")]
+    Hex {
+        /// 0-based character index in the argument.
+        position: usize,
+        /// What is wrong.
+        reason: &'static str,
+    },
+    /// The bytes are not a valid packet: the failed check and its numbers.
+    #[error("{check} check failed: {source}")]
+    Packet {
+        /// length, header, checksum, field or command.
+        check: &'static str,
+        /// The wire error.
+        source: WireError,
+    },
+}
+
+impl CodecError {
+    /// Process exit code: 1 for an invalid packet, 2 for bad input (JSON, hex).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CodecError::Packet { .. } => 1,
+            _ => 2,
+        }
+    }
+}
+
+fn packet_err(source: WireError) -> CodecError {
+    CodecError::Packet {
+        check: source.check(),
+        source,
+    }
+}
+
+/// Encodes the JSON form of a `kind` packet to its bytes.
+pub fn encode(kind: PacketKind, json: &str) -> Result<Vec<u8>, CodecError> {
+    let err = |source| CodecError::Json { kind, source };
+    Ok(match kind {
+        PacketKind::Command => serde_json::from_str::<CommandRepr>(json)
+            .map_err(err)?
+            .to_bytes()
+            .to_vec(),
+        PacketKind::Heartbeat => serde_json::from_str::<HeartbeatRepr>(json)
+            .map_err(err)?
+            .to_bytes()
+            .to_vec(),
+        PacketKind::InternalHeartbeat => serde_json::from_str::<InternalHeartbeatRepr>(json)
+            .map_err(err)?
+            .to_bytes()
+            .to_vec(),
+        PacketKind::BCommand => serde_json::from_str::<BCommandRepr>(json)
+            .map_err(err)?
+            .to_bytes()
+            .to_vec(),
+    })
+}
+
+/// Decodes `bytes` as a `kind` packet to its JSON form (one line, every field).
+pub fn decode(kind: PacketKind, bytes: &[u8]) -> Result<String, CodecError> {
+    let json = match kind {
+        PacketKind::Command => {
+            serde_json::to_string(&CommandRepr::parse(bytes).map_err(packet_err)?)
+        }
+        PacketKind::Heartbeat => {
+            serde_json::to_string(&HeartbeatRepr::parse(bytes).map_err(packet_err)?)
+        }
+        PacketKind::InternalHeartbeat => {
+            serde_json::to_string(&InternalHeartbeatRepr::parse(bytes).map_err(packet_err)?)
+        }
+        PacketKind::BCommand => {
+            serde_json::to_string(&BCommandRepr::parse(bytes).map_err(packet_err)?)
+        }
+    };
+    Ok(json.unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}")))
+}
+
+/// Lowercase hex, no separators.
+pub fn to_hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Parses hex; accepts an optional `0x` prefix per byte group and spaces, colons, commas or
+/// dashes between bytes.
+pub fn from_hex(text: &str) -> Result<Vec<u8>, CodecError> {
+    let chars: Vec<char> = text.chars().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        if c.is_whitespace() || matches!(c, ':' | ',' | '-') {
+            i += 1;
+            continue;
+        }
+        if c == '0' && matches!(chars.get(i + 1), Some('x' | 'X')) {
+            i += 2;
+            continue;
+        }
+        let hi = c.to_digit(16).ok_or(CodecError::Hex {
+            position: i,
+            reason: "not a hex digit",
+        })?;
+        let lo = match chars.get(i + 1) {
+            None => {
+                return Err(CodecError::Hex {
+                    position: i,
+                    reason: "odd number of hex digits",
+                })
+            }
+            Some(d) => d.to_digit(16).ok_or(CodecError::Hex {
+                position: i + 1,
+                reason: "not a hex digit (bytes are two digits)",
+            })?,
+        };
+        out.push((hi * 16 + lo) as u8);
+        i += 2;
+    }
+    Ok(out)
+}
