@@ -53,6 +53,7 @@ struct Thresholds {
     low_battery_ms: u32,
     comm_timeout_ms: u32,
     comm_max_unacked: u8,
+    bolting_max_attempts: u8,
     idle: Limits,
     absolute: Limits,
     hip_home: u16,

@@ -227,12 +227,13 @@ pub fn faults() -> String {
     let _ = writeln!(
         s,
         "\nA fault in standby or safed is latched and reported only. Thresholds (defaults): low battery below {} mV for more than {} ms; \
-         comm loss after {} ms of silence or {} unacknowledged sends; idle limits {}/{}/{} mA and absolute limits {}/{}/{} mA \
+         comm loss after {} ms of silence or {} unacknowledged sends; bolting failure after {} failed attempts; idle limits {}/{}/{} mA and absolute limits {}/{}/{} mA \
          (locomotion/gripper/bolter); hip home {} (0.01°) ± {}.",
         c.low_battery_mv,
         c.low_battery_ms,
         c.comm_timeout_ms,
         c.comm_max_unacked,
+        c.bolting_max_attempts,
         c.idle.locomotion,
         c.idle.gripper,
         c.idle.bolter,

@@ -50,6 +50,8 @@ pub struct Config {
     /// Operational check, always: absolute limits. Defaults: locomotion 3000 mA, gripper
     /// 1500 mA, bolter 2000 mA.
     pub absolute: Limits,
+    /// (Un)bolting failure: this many consecutive failed attempts on one pair (Table 8: three).
+    pub bolting_max_attempts: u8,
     /// The hip angle of the contracted-gripped (home) configuration. Default 180.00°.
     pub hip_home: HipAngle,
     /// Hip mismatch when entering Operational: reading farther than this from `hip_home`
@@ -64,6 +66,7 @@ impl Default for Config {
             low_battery_ms: 500,
             comm_timeout_ms: 500,
             comm_max_unacked: 3,
+            bolting_max_attempts: 3,
             idle: Limits {
                 locomotion: 400,
                 gripper: 200,
@@ -265,6 +268,12 @@ pub const fn hip_at_home(cfg: &Config, hip_now: HipAngle) -> bool {
     hip_distance(hip_now, cfg.hip_home) <= cfg.hip_tolerance
 }
 
+/// (Un)bolting failure (Table 8): the bolter state machine has failed this many consecutive
+/// attempts on one pair. The bolter module counts attempts; this is the threshold it applies.
+pub const fn bolting_failure(cfg: &Config, consecutive_failed_attempts: u8) -> bool {
+    consecutive_failed_attempts >= cfg.bolting_max_attempts
+}
+
 /// Arm not fully contracted (Table 8): after a contraction finished, the switch is not pressed.
 pub const fn arm_contraction_fault(contraction_finished: bool, switch_pressed: bool) -> bool {
     contraction_finished && !switch_pressed
@@ -320,6 +329,15 @@ mod tests {
         assert!(c.lost(&cfg));
         c.heartbeat(700, 7);
         assert!(!c.lost(&cfg));
+    }
+
+    #[test]
+    fn bolting_failure_after_the_third_failed_attempt() {
+        let cfg = Config::default();
+        assert!(!bolting_failure(&cfg, 0) && !bolting_failure(&cfg, 2));
+        assert!(bolting_failure(&cfg, 3) && bolting_failure(&cfg, 4));
+        assert!(arm_contraction_fault(true, false));
+        assert!(!arm_contraction_fault(true, true) && !arm_contraction_fault(false, false));
     }
 
     #[test]
