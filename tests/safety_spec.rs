@@ -159,6 +159,7 @@ fn refusal_codes_and_thresholds_equal_spec() {
             t.hip_tolerance
         )
     );
+    assert_eq!(c.bolting_max_attempts, t.bolting_max_attempts);
     assert_eq!(
         (c.idle.locomotion, c.idle.gripper, c.idle.bolter),
         (t.idle.locomotion, t.idle.gripper, t.idle.bolter)
