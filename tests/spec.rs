@@ -270,7 +270,7 @@ fn decisions_match_code() {
         )
     );
     assert_eq!(crc16(b"123456789"), d.checksum.check);
-    assert_eq!(d.checksum.table_bytes, 256 * 2);
+    assert_eq!(d.checksum.table_bytes, mmic::wire::checksum::TABLE_BYTES);
 
     let pulse = &d.units["servo_pulse"];
     assert_eq!(

@@ -195,7 +195,7 @@ impl<const N: usize> Deframer<N> {
                 return None;
             }
             let (body, crc) = self.buf[..need].split_at(need - CHECKSUM_LEN);
-            if checksum::crc16(body) == u16::from_le_bytes([crc[0], crc[1]]) {
+            if checksum::packet_crc(kind, body) == u16::from_le_bytes([crc[0], crc[1]]) {
                 let mut bytes = [0u8; MAX_PACKET_LEN];
                 bytes[..need].copy_from_slice(&self.buf[..need]);
                 self.drop_front(need);

@@ -213,7 +213,7 @@ pub fn check<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
         });
     }
     let carried = u16::from_le_bytes([crc[0], crc[1]]);
-    let computed = checksum::crc16(body);
+    let computed = checksum::packet_crc(kind, body);
     if carried != computed {
         return Err(WireError::Checksum {
             kind,
