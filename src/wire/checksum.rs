@@ -76,8 +76,8 @@ mod tests {
             let mut body = [0u8; 64];
             body[..4].copy_from_slice(&kind.header());
             for len in 4..=64 {
-                for i in 4..len {
-                    body[i] = (i as u8).wrapping_mul(37) ^ len as u8;
+                for (i, b) in body.iter_mut().enumerate().take(len).skip(4) {
+                    *b = (i as u8).wrapping_mul(37) ^ len as u8;
                 }
                 assert_eq!(
                     packet_crc(kind, &body[..len]),
