@@ -273,7 +273,10 @@ fn decisions_match_code() {
     assert_eq!(crc16(b"123456789"), d.checksum.check);
     // Default build: slice-by-16; with the feature small-crc-table: one table.
     let t = mmic::wire::checksum::TABLE_BYTES;
-    assert!(t == d.checksum.table_bytes || t == d.checksum.table_bytes_small, "{t}");
+    assert!(
+        t == d.checksum.table_bytes || t == d.checksum.table_bytes_small,
+        "{t}"
+    );
 
     let pulse = &d.units["servo_pulse"];
     assert_eq!(

@@ -9,7 +9,7 @@
 //! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
 
-use super::layout::{span, FieldSpec, Unit};
+use super::layout::{span, ElectricalLayout, FieldSpec, Unit};
 use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
 use crate::command::BolterPair;
 use crate::faults::Faults;
@@ -43,20 +43,8 @@ pub struct HeartbeatPacket {
     pub gripper_a_now: U16,
     pub gripper_b_target: U16,
     pub gripper_b_now: U16,
-    pub v_bat_a: U16,
-    pub i_bat_a: U16,
-    pub i_loc_a: U16,
-    pub i_grip_a: U16,
-    pub i_3v3_a: U16,
-    pub v_reg_a: U16,
-    pub i_bo_a: U16,
-    pub v_bat_b: U16,
-    pub i_bat_b: U16,
-    pub i_loc_b: U16,
-    pub i_grip_b: U16,
-    pub i_3v3_b: U16,
-    pub v_reg_b: U16,
-    pub i_bo_b: U16,
+    pub electrical_a: ElectricalLayout,
+    pub electrical_b: ElectricalLayout,
     pub target_state: u8,
     pub command_complete: u8,
     pub active_bolter: u8,
@@ -75,10 +63,10 @@ impl Packet for HeartbeatPacket {
 const _: () = assert!(core::mem::size_of::<HeartbeatPacket>() == HEARTBEAT_LEN);
 
 macro_rules! f {
-    ($name:literal, $field:ident, $ty:ty, $unit:ident, $paper:literal) => {
+    ($name:literal, $($field:ident).+, $ty:ty, $unit:ident, $paper:literal) => {
         FieldSpec {
             name: $name,
-            range: span!(HeartbeatPacket, $field, $ty),
+            range: span!(HeartbeatPacket, $($field).+, $ty),
             unit: Unit::$unit,
             paper: $paper,
             cells: &[],
@@ -112,20 +100,104 @@ pub const FIELDS: &[FieldSpec] = &[
         "gripper B-target"
     ),
     f!("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
-    f!("electrical_a.v_bat", v_bat_a, U16, Millivolts, "V_{batA}"),
-    f!("electrical_a.i_bat", i_bat_a, U16, Milliamps, "I_{batA}"),
-    f!("electrical_a.i_loc", i_loc_a, U16, Milliamps, "I_{locA}"),
-    f!("electrical_a.i_grip", i_grip_a, U16, Milliamps, "I_{gripA}"),
-    f!("electrical_a.i_3v3", i_3v3_a, U16, Milliamps, "I_{3v3A}"),
-    f!("electrical_a.v_reg", v_reg_a, U16, Millivolts, "V_{regA}"),
-    f!("electrical_a.i_bo", i_bo_a, U16, Milliamps, "I_{boA}"),
-    f!("electrical_b.v_bat", v_bat_b, U16, Millivolts, "V_{batB}"),
-    f!("electrical_b.i_bat", i_bat_b, U16, Milliamps, "I_{batB}"),
-    f!("electrical_b.i_loc", i_loc_b, U16, Milliamps, "I_{locB}"),
-    f!("electrical_b.i_grip", i_grip_b, U16, Milliamps, "I_{gripB}"),
-    f!("electrical_b.i_3v3", i_3v3_b, U16, Milliamps, "I_{3v3B}"),
-    f!("electrical_b.v_reg", v_reg_b, U16, Millivolts, "V_{regB}"),
-    f!("electrical_b.i_bo", i_bo_b, U16, Milliamps, "I_{boB}"),
+    f!(
+        "electrical_a.v_bat",
+        electrical_a.v_bat,
+        U16,
+        Millivolts,
+        "V_{batA}"
+    ),
+    f!(
+        "electrical_a.i_bat",
+        electrical_a.i_bat,
+        U16,
+        Milliamps,
+        "I_{batA}"
+    ),
+    f!(
+        "electrical_a.i_loc",
+        electrical_a.i_loc,
+        U16,
+        Milliamps,
+        "I_{locA}"
+    ),
+    f!(
+        "electrical_a.i_grip",
+        electrical_a.i_grip,
+        U16,
+        Milliamps,
+        "I_{gripA}"
+    ),
+    f!(
+        "electrical_a.i_3v3",
+        electrical_a.i_3v3,
+        U16,
+        Milliamps,
+        "I_{3v3A}"
+    ),
+    f!(
+        "electrical_a.v_reg",
+        electrical_a.v_reg,
+        U16,
+        Millivolts,
+        "V_{regA}"
+    ),
+    f!(
+        "electrical_a.i_bo",
+        electrical_a.i_bo,
+        U16,
+        Milliamps,
+        "I_{boA}"
+    ),
+    f!(
+        "electrical_b.v_bat",
+        electrical_b.v_bat,
+        U16,
+        Millivolts,
+        "V_{batB}"
+    ),
+    f!(
+        "electrical_b.i_bat",
+        electrical_b.i_bat,
+        U16,
+        Milliamps,
+        "I_{batB}"
+    ),
+    f!(
+        "electrical_b.i_loc",
+        electrical_b.i_loc,
+        U16,
+        Milliamps,
+        "I_{locB}"
+    ),
+    f!(
+        "electrical_b.i_grip",
+        electrical_b.i_grip,
+        U16,
+        Milliamps,
+        "I_{gripB}"
+    ),
+    f!(
+        "electrical_b.i_3v3",
+        electrical_b.i_3v3,
+        U16,
+        Milliamps,
+        "I_{3v3B}"
+    ),
+    f!(
+        "electrical_b.v_reg",
+        electrical_b.v_reg,
+        U16,
+        Millivolts,
+        "V_{regB}"
+    ),
+    f!(
+        "electrical_b.i_bo",
+        electrical_b.i_bo,
+        U16,
+        Milliamps,
+        "I_{boB}"
+    ),
     f!(
         "target_state",
         target_state,
@@ -386,24 +458,8 @@ impl HeartbeatRepr {
                 p.gripper_b_target,
             )?,
             gripper_b_now: pulse(KIND, "gripper_b_now", at!(gripper_b_now), p.gripper_b_now)?,
-            electrical_a: Electrical {
-                v_bat: p.v_bat_a.get(),
-                i_bat: p.i_bat_a.get(),
-                i_loc: p.i_loc_a.get(),
-                i_grip: p.i_grip_a.get(),
-                i_3v3: p.i_3v3_a.get(),
-                v_reg: p.v_reg_a.get(),
-                i_bo: p.i_bo_a.get(),
-            },
-            electrical_b: Electrical {
-                v_bat: p.v_bat_b.get(),
-                i_bat: p.i_bat_b.get(),
-                i_loc: p.i_loc_b.get(),
-                i_grip: p.i_grip_b.get(),
-                i_3v3: p.i_3v3_b.get(),
-                v_reg: p.v_reg_b.get(),
-                i_bo: p.i_bo_b.get(),
-            },
+            electrical_a: Electrical::from(&p.electrical_a),
+            electrical_b: Electrical::from(&p.electrical_b),
             target_state,
             command_complete: get_bool(
                 KIND,
@@ -423,7 +479,6 @@ impl HeartbeatRepr {
     pub fn emit(&self, out: &mut [u8; HEARTBEAT_LEN]) {
         let u = |v: u16| U16::new(v);
         let pw = |v: PulseWidth| U16::new(v.micros());
-        let (ea, eb) = (&self.electrical_a, &self.electrical_b);
         let p = HeartbeatPacket {
             header: KIND.header(),
             board: self.board.get(),
@@ -437,20 +492,8 @@ impl HeartbeatRepr {
             gripper_a_now: pw(self.gripper_a_now),
             gripper_b_target: pw(self.gripper_b_target),
             gripper_b_now: pw(self.gripper_b_now),
-            v_bat_a: u(ea.v_bat),
-            i_bat_a: u(ea.i_bat),
-            i_loc_a: u(ea.i_loc),
-            i_grip_a: u(ea.i_grip),
-            i_3v3_a: u(ea.i_3v3),
-            v_reg_a: u(ea.v_reg),
-            i_bo_a: u(ea.i_bo),
-            v_bat_b: u(eb.v_bat),
-            i_bat_b: u(eb.i_bat),
-            i_loc_b: u(eb.i_loc),
-            i_grip_b: u(eb.i_grip),
-            i_3v3_b: u(eb.i_3v3),
-            v_reg_b: u(eb.v_reg),
-            i_bo_b: u(eb.i_bo),
+            electrical_a: ElectricalLayout::from(&self.electrical_a),
+            electrical_b: ElectricalLayout::from(&self.electrical_b),
             target_state: self.target_state.map_or(0, State::to_wire),
             command_complete: self.command_complete as u8,
             active_bolter: self.active_bolter.map_or(0, BolterPair::number),

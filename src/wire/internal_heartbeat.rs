@@ -10,7 +10,7 @@
 //! ```
 
 use super::heartbeat::pulse;
-use super::layout::{span, FieldSpec, Unit};
+use super::layout::{span, ElectricalLayout, FieldSpec, Unit};
 use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
 use crate::bolter::{BolterDirection, BolterPair, BolterStep, MuxLines};
 use crate::units::{Axis, Electrical, Gravity, PulseWidth, Sign};
@@ -34,13 +34,7 @@ pub struct InternalHeartbeatPacket {
     pub arm_b_now: U16,
     pub gripper_b_target: U16,
     pub gripper_b_now: U16,
-    pub v_bat_b: U16,
-    pub i_bat_b: U16,
-    pub i_loc_b: U16,
-    pub i_grip_b: U16,
-    pub i_3v3_b: U16,
-    pub v_reg_b: U16,
-    pub i_bo_b: U16,
+    pub electrical_b: ElectricalLayout,
     pub bolter_step: u8,
     pub bolter_seq: u8,
     pub bolter_pair: u8,
@@ -70,10 +64,10 @@ impl Packet for InternalHeartbeatPacket {
 const _: () = assert!(core::mem::size_of::<InternalHeartbeatPacket>() == INTERNAL_HEARTBEAT_LEN);
 
 macro_rules! f {
-    ($name:literal, $field:ident, $ty:ty, $unit:ident, $paper:literal) => {
+    ($name:literal, $($field:ident).+, $ty:ty, $unit:ident, $paper:literal) => {
         FieldSpec {
             name: $name,
-            range: span!(InternalHeartbeatPacket, $field, $ty),
+            range: span!(InternalHeartbeatPacket, $($field).+, $ty),
             unit: Unit::$unit,
             paper: $paper,
             cells: &[],
@@ -102,13 +96,55 @@ pub const FIELDS: &[FieldSpec] = &[
         "gripper B-target"
     ),
     f!("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
-    f!("electrical_b.v_bat", v_bat_b, U16, Millivolts, "V_{batB}"),
-    f!("electrical_b.i_bat", i_bat_b, U16, Milliamps, "I_{batB}"),
-    f!("electrical_b.i_loc", i_loc_b, U16, Milliamps, "I_{locB}"),
-    f!("electrical_b.i_grip", i_grip_b, U16, Milliamps, "I_{gripB}"),
-    f!("electrical_b.i_3v3", i_3v3_b, U16, Milliamps, "I_{3v3B}"),
-    f!("electrical_b.v_reg", v_reg_b, U16, Millivolts, "V_{regB}"),
-    f!("electrical_b.i_bo", i_bo_b, U16, Milliamps, "I_{boB}"),
+    f!(
+        "electrical_b.v_bat",
+        electrical_b.v_bat,
+        U16,
+        Millivolts,
+        "V_{batB}"
+    ),
+    f!(
+        "electrical_b.i_bat",
+        electrical_b.i_bat,
+        U16,
+        Milliamps,
+        "I_{batB}"
+    ),
+    f!(
+        "electrical_b.i_loc",
+        electrical_b.i_loc,
+        U16,
+        Milliamps,
+        "I_{locB}"
+    ),
+    f!(
+        "electrical_b.i_grip",
+        electrical_b.i_grip,
+        U16,
+        Milliamps,
+        "I_{gripB}"
+    ),
+    f!(
+        "electrical_b.i_3v3",
+        electrical_b.i_3v3,
+        U16,
+        Milliamps,
+        "I_{3v3B}"
+    ),
+    f!(
+        "electrical_b.v_reg",
+        electrical_b.v_reg,
+        U16,
+        Millivolts,
+        "V_{regB}"
+    ),
+    f!(
+        "electrical_b.i_bo",
+        electrical_b.i_bo,
+        U16,
+        Milliamps,
+        "I_{boB}"
+    ),
     FieldSpec {
         name: "bolter_aux.step",
         range: span!(InternalHeartbeatPacket, bolter_step, u8),
@@ -390,15 +426,7 @@ impl InternalHeartbeatRepr {
                 p.gripper_b_target,
             )?,
             gripper_b_now: pulse(KIND, "gripper_b_now", at!(gripper_b_now), p.gripper_b_now)?,
-            electrical_b: Electrical {
-                v_bat: p.v_bat_b.get(),
-                i_bat: p.i_bat_b.get(),
-                i_loc: p.i_loc_b.get(),
-                i_grip: p.i_grip_b.get(),
-                i_3v3: p.i_3v3_b.get(),
-                v_reg: p.v_reg_b.get(),
-                i_bo: p.i_bo_b.get(),
-            },
+            electrical_b: Electrical::from(&p.electrical_b),
             bolter_aux: BolterAux {
                 step,
                 seq: p.bolter_seq,
@@ -448,9 +476,7 @@ impl InternalHeartbeatRepr {
 
     /// Writes the packet, header and checksum included.
     pub fn emit(&self, out: &mut [u8; INTERNAL_HEARTBEAT_LEN]) {
-        let u = |v: u16| U16::new(v);
         let pw = |v: PulseWidth| U16::new(v.micros());
-        let e = &self.electrical_b;
         let a = &self.bolter_aux;
         let p = InternalHeartbeatPacket {
             header: KIND.header(),
@@ -458,13 +484,7 @@ impl InternalHeartbeatRepr {
             arm_b_now: pw(self.arm_b_now),
             gripper_b_target: pw(self.gripper_b_target),
             gripper_b_now: pw(self.gripper_b_now),
-            v_bat_b: u(e.v_bat),
-            i_bat_b: u(e.i_bat),
-            i_loc_b: u(e.i_loc),
-            i_grip_b: u(e.i_grip),
-            i_3v3_b: u(e.i_3v3),
-            v_reg_b: u(e.v_reg),
-            i_bo_b: u(e.i_bo),
+            electrical_b: ElectricalLayout::from(&self.electrical_b),
             bolter_step: a.step.map_or(0, BolterStep::to_wire),
             bolter_seq: a.seq,
             bolter_pair: a.pair.map_or(0, BolterPair::number),

@@ -2,12 +2,60 @@
 //! built from the zerocopy layouts so that the layout struct stays the one place a range is
 //! defined. spec/ is checked against these tables, and the review pages are rendered from them.
 
+use crate::units::Electrical;
 use core::ops::Range;
+use zerocopy::byteorder::little_endian::U16;
+use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
+
+/// One side's seven ADS7828 readings as they lie in both heartbeats (Table 3 bytes 25–38 and
+/// 39–52, Table 4 bytes 12–25): V_bat, I_bat, I_loc, I_grip, I_3v3, V_reg, I_bo.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+)]
+#[repr(C)]
+#[allow(missing_docs)] // the fields are those of `Electrical`
+pub struct ElectricalLayout {
+    pub v_bat: U16,
+    pub i_bat: U16,
+    pub i_loc: U16,
+    pub i_grip: U16,
+    pub i_3v3: U16,
+    pub v_reg: U16,
+    pub i_bo: U16,
+}
+
+impl From<&ElectricalLayout> for Electrical {
+    fn from(l: &ElectricalLayout) -> Electrical {
+        Electrical {
+            v_bat: l.v_bat.get(),
+            i_bat: l.i_bat.get(),
+            i_loc: l.i_loc.get(),
+            i_grip: l.i_grip.get(),
+            i_3v3: l.i_3v3.get(),
+            v_reg: l.v_reg.get(),
+            i_bo: l.i_bo.get(),
+        }
+    }
+}
+
+impl From<&Electrical> for ElectricalLayout {
+    fn from(e: &Electrical) -> ElectricalLayout {
+        ElectricalLayout {
+            v_bat: U16::new(e.v_bat),
+            i_bat: U16::new(e.i_bat),
+            i_loc: U16::new(e.i_loc),
+            i_grip: U16::new(e.i_grip),
+            i_3v3: U16::new(e.i_3v3),
+            v_reg: U16::new(e.v_reg),
+            i_bo: U16::new(e.i_bo),
+        }
+    }
+}
 
 /// Byte range of field `$f` (of type `$ft`) in layout `$t`.
 macro_rules! span {
-    ($t:ty, $f:ident, $ft:ty) => {
-        core::mem::offset_of!($t, $f)..core::mem::offset_of!($t, $f) + core::mem::size_of::<$ft>()
+    ($t:ty, $($f:ident).+, $ft:ty) => {
+        core::mem::offset_of!($t, $($f).+)..core::mem::offset_of!($t, $($f).+) + core::mem::size_of::<$ft>()
     };
 }
 pub(crate) use span;

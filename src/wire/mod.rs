@@ -26,7 +26,7 @@ pub mod heartbeat;
 pub mod internal_heartbeat;
 mod layout;
 
-pub use layout::{FieldSpec, Unit};
+pub use layout::{ElectricalLayout, FieldSpec, Unit};
 
 use crate::command::CommandError;
 
