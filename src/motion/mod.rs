@@ -1,5 +1,6 @@
-//! Motion generation (Section 6): the 15 configuration states of Table 5 and the 8 motion
-//! primitives of Table 6.
+//! Motion generation (Section 6): the 15 configuration states of Table 5, the 8 motion
+//! primitives of Table 6, the reconfiguration map of Figure 9 computed from a geometric model
+//! ([`geometry`], [`map`]), and shortest plans between states ([`plan`]).
 //!
 //! ```
 //! use mmic::motion::{State, StateKind, Primitive};
@@ -9,6 +10,9 @@
 //! assert_eq!(Primitive::from_number(4), Some(Primitive::BackExtend));
 //! ```
 
+pub mod geometry;
+pub mod map;
+pub mod plan;
 mod primitive;
 mod state;
 

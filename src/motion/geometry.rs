@@ -1,0 +1,143 @@
+//! The geometric model behind Figure 9: which face each side grips in each state, the direction
+//! of each arm, and which single-side moves exist. Everything here is `const fn`, so the
+//! reconfiguration map is computed at compile time, never typed in (spec/motion/model.md).
+
+use super::{Primitive, State};
+use crate::units::{Axis, Sign, Side};
+
+/// A face of the reference voxel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Face {
+    /// The axis the face is normal to.
+    pub axis: Axis,
+    /// Negative (X−, Y−, Z−) or positive face.
+    pub sign: Sign,
+}
+
+/// A unit vector along an axis, as integer components (x, y, z).
+pub type Vec3 = [i8; 3];
+
+const fn axis_index(a: Axis) -> usize {
+    match a {
+        Axis::X => 0,
+        Axis::Y => 1,
+        Axis::Z => 2,
+    }
+}
+
+const AXES: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
+
+/// Unit vector `sign · axis`.
+pub const fn unit(axis: Axis, sign: Sign) -> Vec3 {
+    let mut v = [0i8; 3];
+    v[axis_index(axis)] = match sign {
+        Sign::Positive => 1,
+        Sign::Negative => -1,
+    };
+    v
+}
+
+/// Cross product.
+pub const fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+const fn neg(a: Axis) -> Face {
+    Face { axis: a, sign: Sign::Negative }
+}
+
+const fn pos(a: Axis) -> Face {
+    Face { axis: a, sign: Sign::Positive }
+}
+
+/// The faces sides A and B grip in `s`. Two-face states (d–l): A on a negative face, B on a
+/// positive face ("Xneg Ypos": A on X−, B on Y+). Matched states: both on the one face.
+pub const fn faces(s: State) -> (Face, Face) {
+    match s {
+        State::A => (neg(Axis::X), neg(Axis::X)),
+        State::B => (neg(Axis::Y), neg(Axis::Y)),
+        State::C => (neg(Axis::Z), neg(Axis::Z)),
+        State::M => (pos(Axis::X), pos(Axis::X)),
+        State::N => (pos(Axis::Y), pos(Axis::Y)),
+        State::O => (pos(Axis::Z), pos(Axis::Z)),
+        _ => {
+            // d..l in Table 5 order: A's axis major, B's axis minor.
+            let i = s.index() - State::D.index();
+            (neg(AXES[i / 3]), pos(AXES[i % 3]))
+        }
+    }
+}
+
+/// Direction of `side`'s arm (hip → gripper) in state `s`. In a two-face state each arm points
+/// at its face (A: −axis of its negative face, B: +axis of its positive face). In a matched
+/// state the side inside the reference voxel points into it along the face normal: B (+axis)
+/// in a negative match, A (−axis) in a positive match; the outside side points the other way.
+///
+/// Both cases come to the same rule: A's arm points along −(axis of A's face), B's along
+/// +(axis of B's face).
+pub const fn arm_direction(s: State, side: Side) -> Vec3 {
+    let (fa, fb) = faces(s);
+    match side {
+        Side::A => unit(fa.axis, Sign::Negative),
+        Side::B => unit(fb.axis, Sign::Positive),
+    }
+}
+
+const fn same(x: Face, y: Face) -> bool {
+    axis_index(x.axis) == axis_index(y.axis) && x.sign as u8 == y.sign as u8
+}
+
+/// The single-primitive move from `from` to `to`, if one exists: exactly one side moves
+/// (the other keeps its face), by the rules of spec/motion/model.md.
+pub const fn single_move(from: State, to: State) -> Option<(Side, Primitive)> {
+    if from.index() == to.index() {
+        return None;
+    }
+    let (fa, fb) = faces(from);
+    let (ta, tb) = faces(to);
+    // Which side moves: the other one must keep its face.
+    let side = if same(fb, tb) && !same(fa, ta) {
+        Side::A
+    } else if same(fa, ta) && !same(fb, tb) {
+        Side::B
+    } else {
+        return None;
+    };
+    // Who may move where (the model's rules).
+    let allowed = match (from.is_matched(), side) {
+        // Negative match: B (inside) may go to any positive face. Positive match: A may go to
+        // any negative face.
+        (true, Side::B) => matches!(fa.sign, Sign::Negative) && matches!(tb.sign, Sign::Positive),
+        (true, Side::A) => matches!(fb.sign, Sign::Positive) && matches!(ta.sign, Sign::Negative),
+        // Two-face: A to B's face (positive match) or another negative face; B to A's face
+        // (negative match) or another positive face. `to` being a state already makes these the
+        // only possibilities.
+        (false, _) => true,
+    };
+    if !allowed {
+        return None;
+    }
+    let old = arm_direction(from, side);
+    let new = arm_direction(to, side);
+    let c = cross(old, new);
+    let fwd = matches!(side, Side::A);
+    let p = if c[0] == 0 && c[1] == 0 && c[2] == 0 {
+        // Same axis: extend from matched to stretch, contract from stretch to matched.
+        match (from.is_matched(), fwd) {
+            (true, true) => Primitive::FwdExtend,
+            (true, false) => Primitive::BackExtend,
+            (false, true) => Primitive::FwdContract,
+            (false, false) => Primitive::BackContract,
+        }
+    } else {
+        // CCW when old × new points along a positive axis (right-hand rule).
+        let ccw = c[0] + c[1] + c[2] > 0;
+        match (fwd, ccw) {
+            (true, false) => Primitive::FwdTurnCw,
+            (true, true) => Primitive::FwdTurnCcw,
+            (false, false) => Primitive::BackTurnCw,
+            (false, true) => Primitive::BackTurnCcw,
+        }
+    };
+    Some((side, p))
+}
