@@ -31,8 +31,10 @@ fn seventy_two_moves_each_with_its_inverse() {
         assert_eq!(side == Side::A, p.name().starts_with("fwd"), "{f} -> {t}");
         // Primitives 1-4 exactly between a matched and a stretch state (Section 6).
         let kinds = [f.kind(), t.kind()];
-        let matched_stretch = kinds.contains(&StateKind::Matched) && kinds.contains(&StateKind::Stretch);
-        let on_one_axis = matched_stretch && mmic::motion::geometry::faces(f).0.axis == mmic::motion::geometry::faces(t).1.axis;
+        let matched_stretch =
+            kinds.contains(&StateKind::Matched) && kinds.contains(&StateKind::Stretch);
+        let on_one_axis = matched_stretch
+            && mmic::motion::geometry::faces(f).0.axis == mmic::motion::geometry::faces(t).1.axis;
         assert_eq!(p.number() <= 4, on_one_axis, "{f} -> {t} by {p}");
     }
     // Every primitive is used.
@@ -93,17 +95,32 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
     for f in State::ALL {
         for t in State::ALL {
             let p = plan::lookup(f, t);
-            assert_eq!(plan::search(f, t), p, "{f} -> {t}: table and search disagree");
-            assert_eq!(p.len() as u32, d[f.index()][t.index()], "{f} -> {t}: not shortest");
+            assert_eq!(
+                plan::search(f, t),
+                p,
+                "{f} -> {t}: table and search disagree"
+            );
+            assert_eq!(
+                p.len() as u32,
+                d[f.index()][t.index()],
+                "{f} -> {t}: not shortest"
+            );
             let mut at = f;
             for (k, prim) in p.primitives().iter().enumerate() {
                 let next = p.states()[k];
-                assert_eq!(map::primitive(at, next), Some(*prim), "{f} -> {t}: step {k} invalid");
+                assert_eq!(
+                    map::primitive(at, next),
+                    Some(*prim),
+                    "{f} -> {t}: step {k} invalid"
+                );
                 at = next;
             }
             assert_eq!(at, t);
             if f != t {
-                let best = all_shortest(f, t, p.len() as u32).into_iter().min().unwrap();
+                let best = all_shortest(f, t, p.len() as u32)
+                    .into_iter()
+                    .min()
+                    .unwrap();
                 assert_eq!(p.states(), &best[..], "{f} -> {t}: tie-break");
                 histogram[p.len()] += 1;
                 if f.is_matched() && t.is_matched() {
@@ -112,8 +129,16 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
             }
         }
     }
-    assert_eq!(histogram, [0, 72, 126, 12], "plan lengths over the 210 ordered pairs");
-    assert_eq!(matched, [0, 0, 18, 12], "plan lengths between the 30 ordered pairs of matched states");
+    assert_eq!(
+        histogram,
+        [0, 72, 126, 12],
+        "plan lengths over the 210 ordered pairs"
+    );
+    assert_eq!(
+        matched,
+        [0, 0, 18, 12],
+        "plan lengths between the 30 ordered pairs of matched states"
+    );
     assert_eq!(plan::TABLE_BYTES, 450);
 }
 
@@ -129,6 +154,8 @@ fn rendered_grid_is_current_in_spec() {
     }
     assert_eq!(on_disk, grid, "spec/motion/map.txt is stale; regenerate with: MMIC_REGENERATE=1 cargo test --test motion_map");
     // 72 move cells, 15 diagonal cells; the asterisks are exactly the moves no matched plan uses.
-    let used = map::moves().filter(|(f, t, _)| map::used_between_matched(*f, *t)).count();
+    let used = map::moves()
+        .filter(|(f, t, _)| map::used_between_matched(*f, *t))
+        .count();
     assert_eq!(grid.matches('*').count(), 72 - used);
 }

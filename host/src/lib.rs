@@ -2,4 +2,5 @@
 //! the generated review pages of spec/), kept out of `main.rs` so tests can call it.
 
 pub mod codec;
+pub mod motion;
 pub mod pages;

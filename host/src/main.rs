@@ -5,7 +5,7 @@
 
 use clap::{Parser, Subcommand};
 use mmic::wire::PacketKind;
-use mmic_host::{codec, pages};
+use mmic_host::{codec, motion, pages};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -41,6 +41,24 @@ enum Cmd {
         kind: String,
         /// The packet bytes in hex.
         hex: String,
+    },
+    /// The shortest primitive sequence between two states (Table 5 letters a..o).
+    ///
+    /// Example: mmic plan a m
+    Plan {
+        /// Initial state, a..o.
+        from: String,
+        /// Target state, a..o.
+        to: String,
+        /// Print {"from":..,"to":..,"primitives":[..]} (numbers per Table 6).
+        #[arg(long)]
+        json: bool,
+    },
+    /// The reconfiguration map (Figure 9): which primitive takes one state to another.
+    Map {
+        /// Print {"moves":[{"from":..,"to":..,"primitive":..},..]}.
+        #[arg(long)]
+        json: bool,
     },
     /// Print the packet grids, field tables, opcodes and Tables 7/8; or write the review pages.
     Spec {
@@ -78,6 +96,30 @@ fn main() -> ExitCode {
                 Ok(json) => println!("{json}"),
                 Err(e) => return fail(e.exit_code(), &e.to_string()),
             }
+        }
+        Cmd::Plan { from, to, json } => {
+            let (f, t) = match (motion::state(&from), motion::state(&to)) {
+                (Ok(f), Ok(t)) => (f, t),
+                (Err(e), _) | (_, Err(e)) => return fail(2, &e),
+            };
+            println!(
+                "{}",
+                if json {
+                    motion::plan_json(f, t)
+                } else {
+                    motion::plan_text(f, t)
+                }
+            );
+        }
+        Cmd::Map { json } => {
+            print!(
+                "{}",
+                if json {
+                    motion::map_json() + "\n"
+                } else {
+                    motion::map_text()
+                }
+            );
         }
         Cmd::Spec { write: None } => {
             for (_, page) in pages::all() {

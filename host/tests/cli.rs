@@ -273,3 +273,38 @@ fn spec_prints_every_page() {
         assert!(out.contains(page.trim()));
     }
 }
+
+#[test]
+fn plan_and_map_commands() {
+    assert_eq!(
+        ok(&["plan", "a", "m", "--json"]),
+        r#"{"from":"a","to":"m","primitives":[4,1]}"#
+    );
+    let text = ok(&["plan", "a", "b"]);
+    assert!(
+        text.starts_with("a (Xneg match) -> b (Yneg match): 3 primitive(s)"),
+        "{text}"
+    );
+    assert!(text.contains("4 backExtend"));
+    assert_eq!(
+        ok(&["plan", "c", "c", "--json"]),
+        r#"{"from":"c","to":"c","primitives":[]}"#
+    );
+    fails(&["plan", "a", "z"], 2, "unknown state \"z\"");
+    let map: Value = serde_json::from_str(&ok(&["map", "--json"])).unwrap();
+    let moves = map["moves"].as_array().unwrap();
+    assert_eq!(moves.len(), 72);
+    assert_eq!(moves[0], json!({"from": "a", "to": "d", "primitive": 4}));
+    // Every plan printed by the CLI follows the map's moves.
+    for f in "abcdefghijklmno".chars() {
+        for t in "abcdefghijklmno".chars() {
+            let p: Value =
+                serde_json::from_str(&ok(&["plan", &f.to_string(), &t.to_string(), "--json"]))
+                    .unwrap();
+            let n = p["primitives"].as_array().unwrap().len();
+            assert!(n <= 3 && (n == 0) == (f == t), "{f}->{t}: {p}");
+        }
+    }
+    let grid = ok(&["map"]);
+    assert_eq!(grid.lines().count(), 16);
+}

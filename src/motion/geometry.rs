@@ -3,7 +3,7 @@
 //! reconfiguration map is computed at compile time, never typed in (spec/motion/model.md).
 
 use super::{Primitive, State};
-use crate::units::{Axis, Sign, Side};
+use crate::units::{Axis, Side, Sign};
 
 /// A face of the reference voxel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -39,15 +39,25 @@ pub const fn unit(axis: Axis, sign: Sign) -> Vec3 {
 
 /// Cross product.
 pub const fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 const fn neg(a: Axis) -> Face {
-    Face { axis: a, sign: Sign::Negative }
+    Face {
+        axis: a,
+        sign: Sign::Negative,
+    }
 }
 
 const fn pos(a: Axis) -> Face {
-    Face { axis: a, sign: Sign::Positive }
+    Face {
+        axis: a,
+        sign: Sign::Positive,
+    }
 }
 
 /// The faces sides A and B grip in `s`. Two-face states (d–l): A on a negative face, B on a

@@ -40,9 +40,11 @@ pub const fn primitive(from: State, to: State) -> Option<Primitive> {
 
 /// Every single-primitive move, as (from, to, primitive), rows and columns in Table 5 order.
 pub fn moves() -> impl Iterator<Item = (State, State, Primitive)> {
-    State::ALL
-        .into_iter()
-        .flat_map(|f| State::ALL.into_iter().filter_map(move |t| primitive(f, t).map(|p| (f, t, p))))
+    State::ALL.into_iter().flat_map(|f| {
+        State::ALL
+            .into_iter()
+            .filter_map(move |t| primitive(f, t).map(|p| (f, t, p)))
+    })
 }
 
 /// Whether the move `from → to` appears in a chosen plan between two matched states (the final

@@ -28,7 +28,11 @@ pub struct Plan {
 }
 
 impl Plan {
-    const EMPTY: Plan = Plan { len: 0, prims: [Primitive::FwdContract; MAX_LEN], states: [State::A; MAX_LEN] };
+    const EMPTY: Plan = Plan {
+        len: 0,
+        prims: [Primitive::FwdContract; MAX_LEN],
+        states: [State::A; MAX_LEN],
+    };
 
     /// The primitives in order.
     pub fn primitives(&self) -> &[Primitive] {
@@ -62,7 +66,11 @@ impl Eq for Plan {}
 /// Depth-limited search in Table 5 order: the first plan of exactly `depth` primitives.
 const fn dfs(at: State, to: State, depth: usize, mut acc: Plan) -> Option<Plan> {
     if depth == 0 {
-        return if at.index() == to.index() { Some(acc) } else { None };
+        return if at.index() == to.index() {
+            Some(acc)
+        } else {
+            None
+        };
     }
     let mut j = 0;
     while j < 15 {

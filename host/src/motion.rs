@@ -1,0 +1,74 @@
+//! `mmic plan` and `mmic map`: the motion library's plans and map, as text and JSON.
+
+use mmic::motion::{map, plan, State};
+use serde::Serialize;
+
+#[derive(Serialize)]
+struct PlanJson {
+    from: String,
+    to: String,
+    primitives: Vec<u8>,
+}
+
+#[derive(Serialize)]
+struct MoveJson {
+    from: String,
+    to: String,
+    primitive: u8,
+}
+
+#[derive(Serialize)]
+struct MapJson {
+    moves: Vec<MoveJson>,
+}
+
+/// A state from its Table 5 letter.
+pub fn state(s: &str) -> Result<State, String> {
+    let mut chars = s.chars();
+    match (chars.next(), chars.next()) {
+        (Some(c), None) => State::from_letter(c.to_ascii_lowercase()),
+        _ => None,
+    }
+    .ok_or_else(|| format!("unknown state {s:?}: expected a Table 5 letter a..o"))
+}
+
+/// `{"from":"a","to":"m","primitives":[4,1]}`.
+pub fn plan_json(from: State, to: State) -> String {
+    let p = plan::lookup(from, to);
+    let prims: Vec<u8> = p.primitives().iter().map(|p| p.number()).collect();
+    let v = PlanJson {
+        from: from.letter().to_string(),
+        to: to.letter().to_string(),
+        primitives: prims,
+    };
+    serde_json::to_string(&v).unwrap_or_default()
+}
+
+/// One line per primitive: number, name, and the state it reaches.
+pub fn plan_text(from: State, to: State) -> String {
+    let p = plan::lookup(from, to);
+    let mut s = format!("{from} -> {to}: {} primitive(s)", p.len());
+    for (prim, st) in p.primitives().iter().zip(p.states()) {
+        s += &format!("\n  {} {:<12} -> {st}", prim.number(), prim.name());
+    }
+    s
+}
+
+/// `{"moves":[{"from":"a","to":"d","primitive":4}, ...]}`.
+pub fn map_json() -> String {
+    let moves = map::moves()
+        .map(|(f, t, p)| MoveJson {
+            from: f.letter().to_string(),
+            to: t.letter().to_string(),
+            primitive: p.number(),
+        })
+        .collect();
+    serde_json::to_string(&MapJson { moves }).unwrap_or_default()
+}
+
+/// The Figure 9 grid as text.
+pub fn map_text() -> String {
+    let mut s = String::new();
+    let _ = map::render(&mut s);
+    s
+}
