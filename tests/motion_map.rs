@@ -1,6 +1,6 @@
 //! The reconfiguration map and plans, checked exhaustively against the numbers of the model
-#![allow(clippy::needless_range_loop)] // Floyd–Warshall reads best with indices
 //! (spec/motion/model.md) and an all-pairs shortest-path oracle.
+#![allow(clippy::needless_range_loop)] // Floyd–Warshall reads best with indices
 
 use mmic::motion::geometry::single_move;
 use mmic::motion::{map, plan, Primitive, State, StateKind};
