@@ -10,6 +10,7 @@
 //! assert_eq!(Primitive::from_number(4), Some(Primitive::BackExtend));
 //! ```
 
+pub mod estimate;
 pub mod geometry;
 pub mod map;
 pub mod plan;
