@@ -43,19 +43,18 @@ fn the_true_state_is_always_in_the_estimate() {
                 // Every reading has a gravity direction on both boards.
                 assert!(r.gravity_a.is_some() && r.gravity_b.is_some());
             }
-            assert_eq!(
-                n,
-                if s.kind() == mmic::motion::StateKind::Turn {
-                    2
-                } else {
-                    4
-                },
-                "{s}"
-            );
+            let hips = if s.kind() == mmic::motion::StateKind::Turn {
+                2
+            } else {
+                4
+            };
+            let arms = if s.is_matched() { 1 } else { 3 };
+            assert_eq!(n, hips * arms, "{s}");
         }
     }
-    // 6 ups × (9 in-line states × 4 + 6 turns × 2 hidden choices) × 4 gravity subsets.
-    assert_eq!(checked, 6 * (9 * 4 + 6 * 2) * 4);
+    // 6 ups × (6 matched × 4 hip axes + 3 stretches × 4 × 3 arm combinations + 6 turns × 2 × 3)
+    // × 4 gravity subsets.
+    assert_eq!(checked, 6 * (6 * 4 + 3 * 4 * 3 + 6 * 2 * 3) * 4);
 }
 
 fn classes(cfg: &Config) -> BTreeSet<StateSet> {

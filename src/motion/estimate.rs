@@ -6,7 +6,8 @@
 //! x along that side's arm (hip → gripper), z along the hip axis, y = z × x. Gravity is one of
 //! the six axis directions of the structure frame (`Config::up` is the structure axis that
 //! points up), so each reading is exactly one axis and sign. In a matched state both arms are
-//! contracted, in a two-face state both are extended. The hip angle is 180° when the arms are in
+//! contracted; in a two-face state at least one is extended (the sequencer extends only the
+//! moving arm). The hip angle is 180° when the arms are in
 //! line (matched and stretch states) and 90° or 270° in a turn; in a turn it also fixes the hip
 //! axis (h = dirA × dirB at 90°, −dirA × dirB at 270°), while in line the hip axis may be any of
 //! the four directions across the arms — the estimator tries them all.
@@ -161,17 +162,24 @@ fn gravity(cfg: &Config) -> Vec3 {
     neg(unit(cfg.up.0, cfg.up.1))
 }
 
-/// Every reading the model allows in state `s` (one per hidden hip-axis choice).
+/// Every reading the model allows in state `s` (per hidden hip-axis choice and, in a two-face
+/// state, per arm combination with at least one arm extended).
 pub fn predict(cfg: &Config, s: State) -> impl Iterator<Item = Readings> {
     let g = gravity(cfg);
     let (a, b) = (arm_direction(s, Side::A), arm_direction(s, Side::B));
-    let contracted = s.is_matched();
-    hip_options(s).map(move |(h, angle)| Readings {
-        gravity_a: read(g, a, h),
-        gravity_b: read(g, b, h),
-        arm_a_contracted: contracted,
-        arm_b_contracted: contracted,
-        hip: HipAngle::new(angle).unwrap_or(HipAngle::ZERO),
+    let arms: &'static [(bool, bool)] = if s.is_matched() {
+        &[(true, true)]
+    } else {
+        &[(false, false), (false, true), (true, false)]
+    };
+    hip_options(s).flat_map(move |(h, angle)| {
+        arms.iter().map(move |&(ca, cb)| Readings {
+            gravity_a: read(g, a, h),
+            gravity_b: read(g, b, h),
+            arm_a_contracted: ca,
+            arm_b_contracted: cb,
+            hip: HipAngle::new(angle).unwrap_or(HipAngle::ZERO),
+        })
     })
 }
 

@@ -15,6 +15,8 @@ pub mod geometry;
 pub mod map;
 pub mod plan;
 mod primitive;
+pub mod runner;
+pub mod sequencer;
 mod state;
 
 pub use primitive::Primitive;

@@ -1,0 +1,314 @@
+//! Primitive execution: a primitive as a sequence of module steps, run by a state machine that
+//! hands module targets to sides A and B and waits for completion signals, with a timeout per
+//! step that raises the matching Table 8 fault and then issues nothing more.
+//!
+//! Steps of one primitive, for the moving side S (A for fwd, B for back), the other side O
+//! holding its face throughout:
+//!
+//! 1. **Release** S's gripper (gripper S → contract); wait until S's gripper reports done.
+//! 2. **Move**: into a two-face state S's arm extends; into a matched state both arms contract
+//!    (the robot ends contracted on one face; O's arm contracting while O grips carries the hip
+//!    towards O's face). In a turn the hip also rotates ±90° (CCW +, CW −). Wait for the arms
+//!    and, in a turn, the hip in tolerance.
+//! 3. **Confirm** (only into a matched state): wait for both arm-contracted switches.
+//! 4. **Grip** S's gripper (gripper S → extend); wait until done.
+//!
+//! Only S's gripper is ever opened, and only after O's is closed, so the robot always holds the
+//! structure with at least one closed gripper (checked exhaustively in `tests/motion_sequencer.rs`).
+//!
+//! ```
+//! use mmic::motion::sequencer::{Config, Feedback, Sequencer, Status, Targets};
+//! use mmic::motion::State;
+//! let mut s = Sequencer::start(Config::default(), State::A, State::D, Targets::home(), 0).unwrap();
+//! assert_eq!(s.step(10, &Feedback::default()), Status::Running); // waits for the release
+//! let all = Feedback { arm_done: [true; 2], gripper_done: [true; 2], hip_done: true, arm_switch: [false; 2] };
+//! let mut t = 10;
+//! while s.status() == Status::Running { t += 10; s.step(t, &all); }
+//! assert_eq!(s.status(), Status::Done);
+//! ```
+
+use super::geometry::single_move;
+use super::{Primitive, State};
+use crate::command::ServoTarget;
+use crate::faults::Fault;
+use crate::safety::detect::elapsed;
+use crate::units::{HipAngle, Side};
+
+/// Per-step timeouts, ms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Config {
+    /// Release or grip: the gripper's interpolation. Default 3000 ms.
+    pub gripper_ms: u32,
+    /// Move: arm interpolation and a 90° hip turn at 10°/s (9 s). Default 15000 ms.
+    pub move_ms: u32,
+    /// Confirm: the arm-contracted switch after a contraction. Default 1000 ms.
+    pub confirm_ms: u32,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        Config {
+            gripper_ms: 3000,
+            move_ms: 15000,
+            confirm_ms: 1000,
+        }
+    }
+}
+
+/// Targets for every module; index 0 = side A, 1 = side B.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Targets {
+    /// Arm targets.
+    pub arm: [ServoTarget; 2],
+    /// Gripper targets: `Extend` = closed on a face, `Contract` = released.
+    pub gripper: [ServoTarget; 2],
+    /// Hip target.
+    pub hip: HipAngle,
+}
+
+impl Targets {
+    /// Contracted and gripped, hip straight: the home position of a matched state.
+    pub const fn home() -> Targets {
+        Targets {
+            arm: [ServoTarget::Contract; 2],
+            gripper: [ServoTarget::Extend; 2],
+            hip: match HipAngle::new(18000) {
+                Ok(a) => a,
+                Err(_) => HipAngle::ZERO,
+            },
+        }
+    }
+
+    /// Whether at least one gripper is commanded closed.
+    pub const fn holds(&self) -> bool {
+        matches!(self.gripper[0], ServoTarget::Extend)
+            || matches!(self.gripper[1], ServoTarget::Extend)
+    }
+}
+
+/// Completion signals, as of this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Feedback {
+    /// Arm interpolation finished (A: local; B: reported in the internal heartbeat).
+    pub arm_done: [bool; 2],
+    /// Gripper interpolation finished.
+    pub gripper_done: [bool; 2],
+    /// Hip within tolerance of its target.
+    pub hip_done: bool,
+    /// Arm-contracted switch pressed.
+    pub arm_switch: [bool; 2],
+}
+
+/// A step of a primitive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Step {
+    /// Open the moving side's gripper.
+    Release,
+    /// Move the arm (and the hip in a turn).
+    Move,
+    /// Check the arm-contracted switch.
+    Confirm,
+    /// Close the moving side's gripper.
+    Grip,
+}
+
+/// Where a sequencer is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Waiting for the current step.
+    Running,
+    /// The primitive completed: the robot is in the target state.
+    Done,
+    /// A step timed out: this fault is raised and no further step is issued.
+    Failed(Fault),
+}
+
+/// `from → to` is not a single-primitive move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("no single primitive takes {from} to {to}")]
+pub struct NotAMove {
+    /// Initial state.
+    pub from: State,
+    /// Target state.
+    pub to: State,
+}
+
+/// Runs one primitive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sequencer {
+    cfg: Config,
+    primitive: Primitive,
+    side: Side,
+    to: State,
+    steps: [Step; 4],
+    n_steps: u8,
+    at: u8,
+    last: u32,
+    waited_ms: u32,
+    targets: Targets,
+    status: Status,
+}
+
+const fn idx(s: Side) -> usize {
+    match s {
+        Side::A => 0,
+        Side::B => 1,
+    }
+}
+
+impl Sequencer {
+    /// Starts the primitive taking `from` to `to` at time `now` (ms), from the current module
+    /// targets. The first step is issued at once.
+    pub fn start(
+        cfg: Config,
+        from: State,
+        to: State,
+        targets: Targets,
+        now: u32,
+    ) -> Result<Sequencer, NotAMove> {
+        let (side, primitive) = single_move(from, to).ok_or(NotAMove { from, to })?;
+        let contracting = to.is_matched();
+        let (steps, n) = if contracting {
+            ([Step::Release, Step::Move, Step::Confirm, Step::Grip], 4)
+        } else {
+            ([Step::Release, Step::Move, Step::Grip, Step::Grip], 3)
+        };
+        let mut s = Sequencer {
+            cfg,
+            primitive,
+            side,
+            to,
+            steps,
+            n_steps: n,
+            at: 0,
+            last: now,
+            waited_ms: 0,
+            targets,
+            status: Status::Running,
+        };
+        s.issue();
+        Ok(s)
+    }
+
+    /// The primitive being run.
+    pub const fn primitive(&self) -> Primitive {
+        self.primitive
+    }
+
+    /// The side that moves.
+    pub const fn side(&self) -> Side {
+        self.side
+    }
+
+    /// The state the primitive ends in.
+    pub const fn target_state(&self) -> State {
+        self.to
+    }
+
+    /// Current status.
+    pub const fn status(&self) -> Status {
+        self.status
+    }
+
+    /// The current step while running.
+    pub fn current_step(&self) -> Option<Step> {
+        match self.status {
+            Status::Running => self.steps.get(self.at as usize).copied(),
+            _ => None,
+        }
+    }
+
+    /// The module targets to apply now.
+    pub const fn targets(&self) -> Targets {
+        self.targets
+    }
+
+    /// Sets the targets of the current step.
+    fn issue(&mut self) {
+        let s = idx(self.side);
+        match self.steps.get(self.at as usize) {
+            Some(Step::Release) => self.targets.gripper[s] = ServoTarget::Contract,
+            Some(Step::Move) => {
+                if self.to.is_matched() {
+                    self.targets.arm = [ServoTarget::Contract; 2];
+                } else {
+                    self.targets.arm[s] = ServoTarget::Extend;
+                }
+                let h = self.targets.hip.centidegrees() as u32;
+                let turned = match self.primitive {
+                    Primitive::FwdTurnCcw | Primitive::BackTurnCcw => Some((h + 9000) % 36000),
+                    Primitive::FwdTurnCw | Primitive::BackTurnCw => {
+                        Some((h + 36000 - 9000) % 36000)
+                    }
+                    _ => None,
+                };
+                if let Some(a) = turned.and_then(|a| HipAngle::new(a as u16).ok()) {
+                    self.targets.hip = a;
+                }
+            }
+            Some(Step::Grip) => self.targets.gripper[s] = ServoTarget::Extend,
+            Some(Step::Confirm) | None => {}
+        }
+    }
+
+    fn is_turn(&self) -> bool {
+        self.primitive.number() >= 5
+    }
+
+    /// One tick at time `now` (ms, wrapping) with this tick's feedback.
+    pub fn step(&mut self, now: u32, fb: &Feedback) -> Status {
+        if self.status != Status::Running {
+            return self.status;
+        }
+        self.waited_ms = self.waited_ms.saturating_add(elapsed(self.last, now));
+        self.last = now;
+        let s = idx(self.side);
+        let step = match self.steps.get(self.at as usize) {
+            Some(st) => *st,
+            None => {
+                self.status = Status::Done;
+                return self.status;
+            }
+        };
+        let (done, limit) = match step {
+            Step::Release | Step::Grip => (fb.gripper_done[s], self.cfg.gripper_ms),
+            Step::Move => {
+                let arms = if self.to.is_matched() {
+                    fb.arm_done[0] && fb.arm_done[1]
+                } else {
+                    fb.arm_done[s]
+                };
+                (arms && (!self.is_turn() || fb.hip_done), self.cfg.move_ms)
+            }
+            Step::Confirm => (fb.arm_switch[0] && fb.arm_switch[1], self.cfg.confirm_ms),
+        };
+        if done {
+            self.at += 1;
+            self.waited_ms = 0;
+            if self.at >= self.n_steps {
+                self.status = Status::Done;
+            } else {
+                self.issue();
+            }
+        } else if self.waited_ms > limit {
+            self.status = Status::Failed(self.timeout_fault(step, fb));
+        }
+        self.status
+    }
+
+    /// The Table 8 fault a timed-out step raises (spec/motion/sequencer.md).
+    fn timeout_fault(&self, step: Step, fb: &Feedback) -> Fault {
+        let b_moves = matches!(self.side, Side::B);
+        match step {
+            Step::Confirm => Fault::ArmNotContracted,
+            Step::Move if self.is_turn() && !fb.hip_done => Fault::HipMismatch,
+            // Side B's completion comes from B's heartbeat: silence there is a link problem.
+            Step::Move if (b_moves || self.to.is_matched()) && !fb.arm_done[1] => {
+                Fault::InternalCommLoss
+            }
+            Step::Move => Fault::LocomotionOvercurrent,
+            Step::Release | Step::Grip if b_moves => Fault::InternalCommLoss,
+            Step::Release | Step::Grip => Fault::GripperOvercurrent,
+        }
+    }
+}

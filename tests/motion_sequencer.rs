@@ -1,0 +1,214 @@
+//! The primitive sequencer and the reconfiguration runner, exhaustively: every one of the 72
+//! moves under every sequence of up to 7 ticks drawn from {the awaited signal arrives, only
+//! unrelated signals arrive, the step's time runs out, nothing happens}.
+//! Checked at every tick: at least one gripper closed; only the moving side's gripper and arm
+//! and the hip ever change; after a timeout the fault matches the step and nothing changes
+//! again; Done comes only after every step.
+
+use mmic::command::ServoTarget;
+use mmic::faults::Fault;
+use mmic::motion::runner::{RunStatus, Runner};
+use mmic::motion::sequencer::{Config, Feedback, Sequencer, Status, Step, Targets};
+use mmic::motion::{map, plan, State};
+use mmic::units::Side;
+
+#[derive(Clone, Copy, Debug)]
+enum Ev {
+    Done,
+    Unrelated,
+    Late,
+    Idle,
+}
+
+const EVS: [Ev; 4] = [Ev::Done, Ev::Unrelated, Ev::Late, Ev::Idle];
+
+fn feedback(side: Side, ev: Ev) -> Feedback {
+    let s = if side == Side::A { 0 } else { 1 };
+    match ev {
+        Ev::Done => Feedback {
+            arm_done: [true; 2],
+            gripper_done: [true; 2],
+            hip_done: true,
+            arm_switch: [true; 2],
+        },
+        Ev::Unrelated => {
+            // Everything of the holding side, nothing of the moving side; the hip moves only with S's arm.
+            let mut f = Feedback {
+                arm_done: [true; 2],
+                gripper_done: [true; 2],
+                hip_done: true,
+                arm_switch: [true; 2],
+            };
+            f.arm_done[s] = false;
+            f.gripper_done[s] = false;
+            f.arm_switch[s] = false;
+            f
+        }
+        Ev::Late | Ev::Idle => Feedback::default(),
+    }
+}
+
+/// The mapping of spec/motion/sequencer.md, for a timeout with no signal at all.
+fn expected_fault(step: Step, side: Side, turn: bool, into_matched: bool) -> Fault {
+    match (step, side) {
+        (Step::Confirm, _) => Fault::ArmNotContracted,
+        (Step::Move, _) if turn => Fault::HipMismatch,
+        (Step::Move, Side::B) => Fault::InternalCommLoss,
+        (Step::Move, Side::A) if into_matched => Fault::InternalCommLoss,
+        (Step::Move, Side::A) => Fault::LocomotionOvercurrent,
+        (_, Side::B) => Fault::InternalCommLoss,
+        (_, Side::A) => Fault::GripperOvercurrent,
+    }
+}
+
+#[test]
+fn every_move_under_every_signal_interleaving() {
+    let cfg = Config::default();
+    let depth = 7;
+    let mut runs = 0u64;
+    let mut outcomes = [0u64; 3];
+    for (from, to, prim) in map::moves() {
+        let n = 4usize.pow(depth);
+        for code in 0..n {
+            let mut s = Sequencer::start(cfg, from, to, Targets::home(), u32::MAX - 50).unwrap();
+            assert_eq!(s.primitive(), prim);
+            let side = s.side();
+            let o = if side == Side::A { 1 } else { 0 };
+            let turn = prim.number() >= 5;
+            let mut now = u32::MAX - 50; // across the clock's wrap
+            let mut c = code;
+            let mut frozen: Option<(Status, Targets)> = None;
+            let mut completed_steps = 0;
+            for _ in 0..depth {
+                let ev = EVS[c % 4];
+                c /= 4;
+                let step_before = s.current_step();
+                now = now.wrapping_add(match ev {
+                    Ev::Late => cfg.move_ms + 1,
+                    _ => 10,
+                });
+                let st = s.step(now, &feedback(side, ev));
+                let t = s.targets();
+                assert!(t.holds(), "{from}->{to} code {code}: no gripper closed");
+                assert_eq!(t.gripper[o], ServoTarget::Extend, "holding side released");
+                // The holding side's arm only ever contracts (it starts contracted here).
+                assert_eq!(
+                    t.arm[o],
+                    ServoTarget::Contract,
+                    "holding side's arm extended"
+                );
+                if !turn {
+                    assert_eq!(
+                        t.hip,
+                        Targets::home().hip,
+                        "hip moved in a straight primitive"
+                    );
+                }
+                if let Some((fs, ft)) = frozen {
+                    assert_eq!((st, t), (fs, ft), "changed after it ended");
+                }
+                match st {
+                    Status::Failed(f) if frozen.is_none() => {
+                        let step = step_before.expect("failed while running");
+                        assert!(matches!(ev, Ev::Late), "timed out without time passing");
+                        // A timeout in Move with the hip done (Unrelated never precedes Late in one tick).
+                        assert_eq!(
+                            f,
+                            expected_fault(step, side, turn, to.is_matched()),
+                            "{from}->{to} {step:?}"
+                        );
+                        frozen = Some((st, t));
+                    }
+                    Status::Done if frozen.is_none() => {
+                        completed_steps += 1;
+                        let steps = if to.is_matched() { 4 } else { 3 };
+                        assert_eq!(completed_steps, steps, "{from}->{to}: done early");
+                        assert_eq!(t.gripper, [ServoTarget::Extend; 2]);
+                        let want_arm = if to.is_matched() {
+                            ServoTarget::Contract
+                        } else {
+                            ServoTarget::Extend
+                        };
+                        assert_eq!(t.arm[1 - o], want_arm);
+                        if to.is_matched() {
+                            assert_eq!(t.arm, [ServoTarget::Contract; 2]);
+                        }
+                        frozen = Some((st, t));
+                    }
+                    Status::Running if s.current_step() != step_before => completed_steps += 1,
+                    _ => {}
+                }
+            }
+            runs += 1;
+            outcomes[match s.status() {
+                Status::Running => 0,
+                Status::Done => 1,
+                Status::Failed(_) => 2,
+            }] += 1;
+        }
+    }
+    assert_eq!(runs, 72 * 4u64.pow(depth));
+    assert!(outcomes.iter().all(|&n| n > 0), "{outcomes:?}");
+    println!("sequencer: {runs} runs of {depth} ticks (running/done/failed: {outcomes:?})");
+}
+
+#[test]
+fn every_reconfiguration_reaches_its_target() {
+    let all = Feedback {
+        arm_done: [true; 2],
+        gripper_done: [true; 2],
+        hip_done: true,
+        arm_switch: [true; 2],
+    };
+    for from in State::ALL {
+        for to in State::ALL {
+            let mut r = Runner::start(Config::default(), from, to, Targets::home(), 0);
+            let mut visited = vec![];
+            let mut t = 0u32;
+            let mut last = from;
+            while r.status() == RunStatus::Running {
+                t += 10;
+                r.step(t, &all);
+                assert!(r.targets().holds());
+                assert!(!r.command_complete() || r.status() == RunStatus::Complete);
+                if r.current_state() != last {
+                    last = r.current_state();
+                    visited.push(last);
+                }
+                assert!(t < 1_000_000, "{from}->{to} never ends");
+            }
+            assert_eq!(r.status(), RunStatus::Complete, "{from}->{to}");
+            assert_eq!(r.current_state(), to);
+            assert_eq!(visited, plan::lookup(from, to).states(), "{from}->{to}");
+            // A matched target ends contracted and gripped; turns add up so the hip is back
+            // where it started when the target is matched and the start was too.
+            if from.is_matched() && to.is_matched() {
+                assert_eq!(r.targets().arm, [ServoTarget::Contract; 2]);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_failed_primitive_stops_the_reconfiguration() {
+    let mut r = Runner::start(Config::default(), State::A, State::M, Targets::home(), 0);
+    // Release completes, then the move never finishes.
+    let all = Feedback {
+        arm_done: [true; 2],
+        gripper_done: [true; 2],
+        hip_done: true,
+        arm_switch: [true; 2],
+    };
+    r.step(10, &all);
+    // a -> d moves side B: its arm never reports done.
+    assert_eq!(
+        r.step(20_000, &Feedback::default()),
+        RunStatus::Failed(Fault::InternalCommLoss)
+    );
+    assert_eq!(r.current_state(), State::A);
+    assert!(!r.command_complete());
+    assert_eq!(
+        r.step(30_000, &all),
+        RunStatus::Failed(Fault::InternalCommLoss)
+    );
+}
