@@ -40,5 +40,6 @@ pub mod mode;
 pub mod motion;
 pub mod refusal;
 pub mod safety;
+pub mod sensors;
 pub mod units;
 pub mod wire;

@@ -1,0 +1,91 @@
+//! The ADS7828's eight channels and their scaling to mV and mA (spec/control/adc.toml).
+//!
+//! The ADS7828 returns 12-bit codes (0..=4095) against its 2.5 V internal reference. Each
+//! channel sees its quantity through a divider or a current-sense amplifier; its full-scale
+//! value (the quantity at code 4095) is a configuration value with the defaults below.
+//!
+//! ```
+//! use mmic::sensors::adc::{scale, Channel, Scaling};
+//! let s = Scaling::default();
+//! assert_eq!(scale(&s, Channel::VBat, 4095), 15_000); // full scale, mV
+//! assert_eq!(scale(&s, Channel::VBat, 2730), 10_000); // 10.0 V, the low-battery threshold
+//! ```
+
+use crate::units::Electrical;
+
+/// ADS7828 input channels, in channel order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Channel {
+    /// CH0: battery voltage V_bat (mV).
+    VBat,
+    /// CH1: battery current I_bat (mA).
+    IBat,
+    /// CH2: locomotion (arm and hip) current I_loc (mA).
+    ILoc,
+    /// CH3: gripper current I_grip (mA).
+    IGrip,
+    /// CH4: 3.3 V rail current I_3v3 (mA).
+    I3v3,
+    /// CH5: regulated voltage V_reg (mV).
+    VReg,
+    /// CH6: bolter current I_bo (mA).
+    IBo,
+    /// CH7: not connected.
+    Spare,
+}
+
+impl Channel {
+    /// All channels in ADS7828 order (CH0..CH7).
+    pub const ALL: [Channel; 8] = [
+        Channel::VBat,
+        Channel::IBat,
+        Channel::ILoc,
+        Channel::IGrip,
+        Channel::I3v3,
+        Channel::VReg,
+        Channel::IBo,
+        Channel::Spare,
+    ];
+}
+
+/// Full-scale value of each channel (the quantity at code 4095), in mV or mA.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Scaling {
+    /// Per channel, CH0..CH7.
+    pub full_scale: [u16; 8],
+}
+
+impl Default for Scaling {
+    /// V_bat 15 V (divider 6:1 on 2.5 V), I_bat 10 A, I_loc 5 A, I_grip 3 A, I_3v3 1 A,
+    /// V_reg 10 V (4:1), I_bo 5 A, spare 0.
+    fn default() -> Self {
+        Scaling {
+            full_scale: [15_000, 10_000, 5_000, 3_000, 1_000, 10_000, 5_000, 0],
+        }
+    }
+}
+
+/// Largest 12-bit code.
+pub const CODE_MAX: u16 = 4095;
+
+/// Scales a 12-bit code (codes above 4095 are clamped) to the channel's unit, rounding to
+/// nearest.
+pub const fn scale(s: &Scaling, ch: Channel, code: u16) -> u16 {
+    let c = if code > CODE_MAX { CODE_MAX } else { code } as u32;
+    let fs = s.full_scale[ch as usize] as u32;
+    ((c * fs + CODE_MAX as u32 / 2) / CODE_MAX as u32) as u16
+}
+
+/// One side's readings from the eight (filtered) codes.
+pub fn electrical(s: &Scaling, codes: [u16; 8]) -> Electrical {
+    let v = |ch: Channel| scale(s, ch, codes[ch as usize]);
+    Electrical {
+        v_bat: v(Channel::VBat),
+        i_bat: v(Channel::IBat),
+        i_loc: v(Channel::ILoc),
+        i_grip: v(Channel::IGrip),
+        i_3v3: v(Channel::I3v3),
+        v_reg: v(Channel::VReg),
+        i_bo: v(Channel::IBo),
+    }
+}

@@ -1,0 +1,30 @@
+//! Gravity direction from the MPU-6000's raw accelerations (Table 4 bytes 36–37).
+//!
+//! ```
+//! use mmic::sensors::imu::gravity;
+//! use mmic::units::{Axis, Gravity, Sign};
+//! assert_eq!(gravity([120, -16200, 300]), Some(Gravity { axis: Axis::Y, sign: Sign::Negative }));
+//! assert_eq!(gravity([0, 0, 0]), None);
+//! ```
+
+use crate::units::{Axis, Gravity, Sign};
+
+/// The axis with the largest |acceleration| and its sign; `None` when all three are zero.
+/// Ties go to the earlier axis (X, then Y, then Z) so the answer is deterministic.
+pub fn gravity(accel: [i16; 3]) -> Option<Gravity> {
+    let mut best: Option<(usize, u16)> = None;
+    for (i, &a) in accel.iter().enumerate() {
+        let m = a.unsigned_abs();
+        if m > 0 && best.is_none_or(|(_, b)| m > b) {
+            best = Some((i, m));
+        }
+    }
+    let (i, _) = best?;
+    let axis = Axis::ALL[i];
+    let sign = if accel[i] > 0 {
+        Sign::Positive
+    } else {
+        Sign::Negative
+    };
+    Some(Gravity { axis, sign })
+}
