@@ -35,6 +35,7 @@
 pub mod arbitrary;
 pub mod bolter;
 pub mod command;
+pub mod control;
 pub mod faults;
 pub mod mode;
 pub mod motion;

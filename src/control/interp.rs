@@ -1,0 +1,110 @@
+//! Arm and gripper interpolation: open loop, a fixed step per period towards the target,
+//! monotone, ending exactly on the target, never outside the servo range (the type
+//! [`PulseWidth`] cannot leave 500..=2500 µs). The heartbeat's "current PWM" is [`Interpolator::now`].
+
+use crate::command::ServoTarget;
+use crate::safety::detect::elapsed;
+use crate::units::PulseWidth;
+
+/// Interpolation rate: `step_us` every `period_ms`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Rate {
+    /// Pulse change per period, µs (≥ 1). Default 10 µs.
+    pub step_us: u16,
+    /// Period, ms (≥ 1). Default 20 ms (the servo frame), i.e. 500 µs/s.
+    pub period_ms: u32,
+}
+
+impl Default for Rate {
+    fn default() -> Rate {
+        Rate {
+            step_us: 10,
+            period_ms: 20,
+        }
+    }
+}
+
+/// The pulse widths that "totally contract" and "totally extend" mean for one servo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Travel {
+    /// Fully contracted (arm retracted / gripper open).
+    pub contracted: PulseWidth,
+    /// Fully extended (arm out / gripper closed on the face).
+    pub extended: PulseWidth,
+}
+
+impl Travel {
+    /// The pulse a command's target stands for; partial targets are taken as given.
+    pub const fn resolve(&self, t: ServoTarget) -> PulseWidth {
+        match t {
+            ServoTarget::Contract => self.contracted,
+            ServoTarget::Extend => self.extended,
+            ServoTarget::Position(p) => p,
+        }
+    }
+}
+
+/// One servo's interpolator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Interpolator {
+    now: PulseWidth,
+    target: PulseWidth,
+    rate: Rate,
+    last: u32,
+    banked_ms: u32,
+}
+
+impl Interpolator {
+    /// At rest at `now`.
+    pub const fn new(now: PulseWidth, rate: Rate) -> Interpolator {
+        Interpolator {
+            now,
+            target: now,
+            rate,
+            last: 0,
+            banked_ms: 0,
+        }
+    }
+
+    /// New target from time `t` (ms) on.
+    pub fn set_target(&mut self, target: PulseWidth, t: u32) {
+        self.target = target;
+        self.last = t;
+        self.banked_ms = 0;
+    }
+
+    /// Advances to time `t` (ms, wrapping): one step per whole period elapsed, stopping on the
+    /// target. Returns the pulse to send.
+    pub fn tick(&mut self, t: u32) -> PulseWidth {
+        let period = self.rate.period_ms.max(1);
+        self.banked_ms = self.banked_ms.saturating_add(elapsed(self.last, t));
+        self.last = t;
+        let periods = self.banked_ms / period;
+        self.banked_ms %= period;
+        let max_move = (periods as u64).saturating_mul(self.rate.step_us.max(1) as u64);
+        let (now, target) = (self.now.micros() as u64, self.target.micros() as u64);
+        let next = if target >= now {
+            now + max_move.min(target - now)
+        } else {
+            now - max_move.min(now - target)
+        };
+        // `next` lies between `now` and `target`, both in range.
+        self.now = PulseWidth::saturating(next as u16);
+        self.now
+    }
+
+    /// The last interpolated pulse ("current PWM").
+    pub const fn now(&self) -> PulseWidth {
+        self.now
+    }
+
+    /// The target.
+    pub const fn target(&self) -> PulseWidth {
+        self.target
+    }
+
+    /// Interpolation finished.
+    pub fn done(&self) -> bool {
+        self.now == self.target
+    }
+}

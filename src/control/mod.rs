@@ -1,0 +1,13 @@
+//! Controllers (Section 5): open-loop interpolation for the arms and grippers.
+//!
+//! ```
+//! use mmic::control::interp::{Interpolator, Rate};
+//! use mmic::units::PulseWidth;
+//! let mut i = Interpolator::new(PulseWidth::new(1000).unwrap(), Rate::default());
+//! i.set_target(PulseWidth::new(1050).unwrap(), 0);
+//! assert_eq!(i.tick(20).micros(), 1010); // 10 µs per 20 ms period
+//! assert_eq!(i.tick(200).micros(), 1050); // never past the target
+//! assert!(i.done());
+//! ```
+
+pub mod interp;
