@@ -198,6 +198,11 @@ impl HipAngle {
         }
     }
 
+    /// `cdeg` reduced modulo one turn.
+    pub const fn wrapping(cdeg: u16) -> Self {
+        HipAngle(cdeg % Self::TURN)
+    }
+
     /// Hundredths of a degree.
     pub const fn centidegrees(self) -> u16 {
         self.0

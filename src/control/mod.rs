@@ -10,4 +10,5 @@
 //! assert!(i.done());
 //! ```
 
+pub mod hip;
 pub mod interp;

@@ -1,0 +1,185 @@
+//! The hip's PI controller (Section 5): velocity mode at 10°/s while the hip is more than 3°
+//! from its target, position mode within 3°, velocity estimated from successive encoder
+//! readings with exponential smoothing. Fixed-point integers throughout (the ESP32-C3 has no
+//! FPU); the output is saturated to the configured pulse range and the integrator is clamped
+//! and frozen while the output saturates (anti-windup).
+//!
+//! Units: angles and angle errors in 0.01°, velocities in 0.01°/s, the output a pulse width in
+//! µs for the continuous-rotation hip servo (1500 µs = stop).
+//!
+//! ```
+//! use mmic::control::hip::{Config, HipController, Mode};
+//! use mmic::units::HipAngle;
+//! let mut c = HipController::new(Config::default());
+//! let target = HipAngle::new(9000).unwrap();
+//! let out = c.step(target, HipAngle::new(0).unwrap(), 0);
+//! assert_eq!(c.mode(), Mode::Velocity); // 90° away: turn at 10°/s
+//! assert!(out.micros() > 1500);
+//! ```
+
+use crate::safety::detect::elapsed;
+use crate::units::{HipAngle, PulseWidth};
+
+/// Controller settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Config {
+    /// Switch to position mode within this error, 0.01°. Paper: 3°.
+    pub position_band: i32,
+    /// Velocity-mode speed, 0.01°/s. Paper: 10°/s.
+    pub speed: i32,
+    /// Servo speed per µs away from the stop pulse, 0.01°/s per µs (feed-forward). Default 10.
+    pub servo_gain: i32,
+    /// Velocity mode: proportional gain, µs per (0.01°/s), Q8. Default 13/256 ≈ 0.05.
+    pub kp_velocity_q8: i32,
+    /// Velocity mode: integral gain, µs per (0.01°/s · s), Q8. Default 51/256 ≈ 0.2.
+    pub ki_velocity_q8: i32,
+    /// Position mode: proportional gain, µs per 0.01°, Q8. Default 85/256 ≈ 0.33.
+    pub kp_position_q8: i32,
+    /// Position mode: integral gain, µs per (0.01° · s), Q8. Default 128/256 = 0.5.
+    pub ki_position_q8: i32,
+    /// Largest pulse offset from the stop pulse, µs (≤ 1000). Default 300.
+    pub max_offset_us: i32,
+    /// Velocity smoothing: each reading moves the estimate by 1/2^shift of the difference. Default 2.
+    pub smoothing_shift: u32,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        Config {
+            position_band: 300,
+            speed: 1000,
+            servo_gain: 10,
+            kp_velocity_q8: 13,
+            ki_velocity_q8: 51,
+            kp_position_q8: 85,
+            ki_position_q8: 128,
+            max_offset_us: 300,
+            smoothing_shift: 2,
+        }
+    }
+}
+
+/// Which law is active.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// |error| > band: track ±speed.
+    Velocity,
+    /// |error| ≤ band: track the angle.
+    Position,
+}
+
+/// The controller's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HipController {
+    cfg: Config,
+    last: Option<(u32, HipAngle)>,
+    velocity: i32,
+    integral_q8: i32,
+    mode: Mode,
+}
+
+/// Signed shortest difference `to − from`, in (−18000, 18000].
+pub const fn angle_error(from: HipAngle, to: HipAngle) -> i32 {
+    let d = to.centidegrees() as i32 - from.centidegrees() as i32;
+    if d > 18000 {
+        d - 36000
+    } else if d <= -18000 {
+        d + 36000
+    } else {
+        d
+    }
+}
+
+const STOP_US: i32 = 1500;
+
+impl HipController {
+    /// At rest, no history.
+    pub const fn new(cfg: Config) -> HipController {
+        HipController {
+            cfg,
+            last: None,
+            velocity: 0,
+            integral_q8: 0,
+            mode: Mode::Position,
+        }
+    }
+
+    /// Current law.
+    pub const fn mode(&self) -> Mode {
+        self.mode
+    }
+
+    /// Smoothed velocity estimate, 0.01°/s.
+    pub const fn velocity(&self) -> i32 {
+        self.velocity
+    }
+
+    /// One control tick at time `now` (ms): the pulse to send to the hip servo.
+    pub fn step(&mut self, target: HipAngle, measured: HipAngle, now: u32) -> PulseWidth {
+        let c = &self.cfg;
+        let max = c.max_offset_us.clamp(0, 1000);
+        // Velocity estimate from successive readings.
+        let mut dt_ms = 0u32;
+        if let Some((t0, a0)) = self.last {
+            dt_ms = elapsed(t0, now).min(1000);
+            if dt_ms > 0 {
+                // |raw| ≤ 18000 × 1000: no overflow; the estimate stays within the same bound.
+                let raw = (angle_error(a0, measured) as i64 * 1000 / dt_ms as i64) as i32;
+                let shift = c.smoothing_shift.min(8);
+                self.velocity += (raw - self.velocity) >> shift;
+            }
+        }
+        self.last = Some((now, measured));
+        let e = angle_error(measured, target);
+        let band = c.position_band.max(0);
+        let mode = if e.abs() > band {
+            Mode::Velocity
+        } else {
+            Mode::Position
+        };
+        if mode != self.mode {
+            self.integral_q8 = 0;
+            self.mode = mode;
+        }
+        // Error and gains of the active law; velocity mode adds the servo feed-forward.
+        let (err, kp, ki, ff) = match mode {
+            Mode::Velocity => {
+                let v_ref = if e > 0 {
+                    c.speed
+                } else {
+                    c.speed.saturating_neg()
+                };
+                let ff = if c.servo_gain > 0 {
+                    v_ref / c.servo_gain
+                } else {
+                    0
+                };
+                (
+                    v_ref.saturating_sub(self.velocity),
+                    c.kp_velocity_q8,
+                    c.ki_velocity_q8,
+                    ff,
+                )
+            }
+            Mode::Position => (e, c.kp_position_q8, c.ki_position_q8, 0),
+        };
+        let p = (err as i64 * kp as i64) >> 8;
+        let unsat = (ff as i64)
+            .saturating_add(p)
+            .saturating_add(self.integral_q8 as i64 >> 8);
+        let out = unsat.clamp(-(max as i64), max as i64) as i32;
+        // Anti-windup: integrate only when not saturated, or when the error pulls back inward.
+        let saturated = unsat != out as i64;
+        if !saturated || (unsat > 0) != (err > 0) {
+            let di = (err as i64)
+                .saturating_mul(ki as i64)
+                .saturating_mul(dt_ms as i64)
+                / 1000;
+            let lim = (max as i64) << 8;
+            self.integral_q8 = (self.integral_q8 as i64)
+                .saturating_add(di)
+                .clamp(-lim, lim) as i32;
+        }
+        PulseWidth::saturating((STOP_US + out) as u16)
+    }
+}

@@ -1,0 +1,121 @@
+//! The hip PI controller on a servo plant model with a gravity load: from any start to any
+//! target it settles within tolerance, its overshoot stays under a bound, and it never leaves
+//! the pulse range.
+//!
+//! Plant (per 10 ms tick): the continuous servo turns at 10 (0.01°/s) per µs away from 1500 µs
+//! (so 100 µs ≈ 10°/s), through a first-order lag of 50 ms, minus a gravity term
+//! `load · sin(angle + phase)` (0.01°/s) from the robot's weight; the encoder quantises the
+//! angle to 4096 counts per turn.
+
+use mmic::control::hip::{angle_error, Config, HipController};
+use mmic::units::HipAngle;
+use proptest::prelude::*;
+
+const TOL: f64 = 50.0; // 0.50°
+const OVERSHOOT_MAX: f64 = 150.0; // 1.50°, documented in spec/control/hip.md
+
+struct Run {
+    settled_at: Option<u32>,
+    overshoot: f64,
+    min_pw: u16,
+    max_pw: u16,
+}
+
+fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run {
+    let mut c = HipController::new(Config::default());
+    let tgt = HipAngle::new(target).unwrap();
+    let mut angle = start;
+    let mut speed = 0.0f64; // 0.01°/s
+    let mut run = Run {
+        settled_at: None,
+        overshoot: 0.0,
+        min_pw: u16::MAX,
+        max_pw: 0,
+    };
+    let dir0 = angle_error(
+        HipAngle::new((start.rem_euclid(36000.0)) as u16 % 36000).unwrap(),
+        tgt,
+    )
+    .signum();
+    let dt = 0.01;
+    for tick in 0..(seconds * 100) {
+        let measured =
+            ((angle.rem_euclid(36000.0) / 36000.0 * 4096.0).floor() as u32 % 4096) as u32;
+        let m = HipAngle::new(((measured * 36000 + 2048) / 4096 % 36000) as u16).unwrap();
+        let pw = c.step(tgt, m, tick * 10);
+        run.min_pw = run.min_pw.min(pw.micros());
+        run.max_pw = run.max_pw.max(pw.micros());
+        let cmd = (pw.micros() as f64 - 1500.0) * 10.0;
+        speed += (cmd - speed) * (dt / 0.05);
+        let grav = load * ((angle / 36000.0 * std::f64::consts::TAU) + phase).sin();
+        angle += (speed - grav) * dt;
+        let true_err = {
+            let mut d = target as f64 - angle.rem_euclid(36000.0);
+            if d > 18000.0 {
+                d -= 36000.0
+            }
+            if d <= -18000.0 {
+                d += 36000.0
+            }
+            d
+        };
+        // Overshoot: error of the opposite sign to the initial direction.
+        if dir0 != 0 && (true_err * dir0 as f64) < 0.0 {
+            run.overshoot = run.overshoot.max(true_err.abs());
+        }
+        if true_err.abs() <= TOL {
+            run.settled_at.get_or_insert(tick);
+        } else if true_err.abs() > TOL + 30.0 {
+            run.settled_at = None; // left the band (beyond quantisation): not settled
+        }
+    }
+    run
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+    #[test]
+    fn reaches_any_target_without_large_overshoot(start in 0u16..36000, target in 0u16..36000, load in 0.0f64..300.0, phase in 0.0f64..6.3) {
+        // 180° at 10°/s takes 18 s; allow 30 s.
+        let r = simulate(start as f64, target, load, phase, 30);
+        prop_assert!(r.settled_at.is_some(), "never settled");
+        prop_assert!(r.overshoot <= OVERSHOOT_MAX, "overshoot {}", r.overshoot);
+        prop_assert!(r.min_pw >= 1200 && r.max_pw <= 1800);
+    }
+}
+
+#[test]
+fn turns_at_about_ten_degrees_per_second() {
+    // 90° with no load: velocity mode until 3°, so about 9 s plus the final approach.
+    let r = simulate(0.0, 9000, 0.0, 0.0, 30);
+    let t = r.settled_at.unwrap() as f64 / 100.0;
+    assert!((8.0..=12.0).contains(&t), "took {t} s");
+}
+
+#[test]
+fn sweep_reports_the_worst_case() {
+    let mut worst_overshoot: f64 = 0.0;
+    let mut worst_settle = 0u32;
+    let mut runs = 0;
+    for s in (0..36000).step_by(3000) {
+        for t in (0..36000u16).step_by(3000) {
+            for load in [0.0, 150.0, 300.0] {
+                for phase in [0.0, 1.57, 3.14, 4.71] {
+                    let r = simulate(s as f64 + 37.0, t, load, phase, 30);
+                    let settled = r
+                        .settled_at
+                        .unwrap_or_else(|| panic!("{s} -> {t} load {load} phase {phase}"));
+                    worst_settle = worst_settle.max(settled);
+                    worst_overshoot = worst_overshoot.max(r.overshoot);
+                    runs += 1;
+                }
+            }
+        }
+    }
+    println!(
+        "hip sweep: {runs} runs, worst settle {:.2} s, worst overshoot {:.1} (0.01 deg)",
+        worst_settle as f64 / 100.0,
+        worst_overshoot
+    );
+    assert!(worst_overshoot <= OVERSHOOT_MAX);
+}
