@@ -39,8 +39,7 @@ fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run
     .signum();
     let dt = 0.01;
     for tick in 0..(seconds * 100) {
-        let measured =
-            ((angle.rem_euclid(36000.0) / 36000.0 * 4096.0).floor() as u32 % 4096) as u32;
+        let measured = (angle.rem_euclid(36000.0) / 36000.0 * 4096.0).floor() as u32 % 4096;
         let m = HipAngle::new(((measured * 36000 + 2048) / 4096 % 36000) as u16).unwrap();
         let pw = c.step(tgt, m, tick * 10);
         run.min_pw = run.min_pw.min(pw.micros());
@@ -100,7 +99,8 @@ fn sweep_reports_the_worst_case() {
     for s in (0..36000).step_by(3000) {
         for t in (0..36000u16).step_by(3000) {
             for load in [0.0, 150.0, 300.0] {
-                for phase in [0.0, 1.57, 3.14, 4.71] {
+                for quarter in 0..4 {
+                    let phase = quarter as f64 * std::f64::consts::FRAC_PI_2;
                     let r = simulate(s as f64 + 37.0, t, load, phase, 30);
                     let settled = r
                         .settled_at
