@@ -1,5 +1,10 @@
-//! Bolter vocabulary shared by the packets: the steps of the bolter state machine (Figure 8),
-//! the direction of a run, and the multiplexer lines that select a pair.
+//! The bolter state machine (Section 5, Figure 8) and its vocabulary.
+//!
+//! The same [`BolterSide`] executor runs each side's bolter on boards A and B; board A's
+//! [`Coordinator`] orders both sides step by step (side B through the A→B command packet's
+//! bolter bytes, side B answering in the internal heartbeat's auxiliary bytes) and advances only
+//! when both sides report the same step, of the same order, complete. The handshake and its
+//! exhaustive check are described in spec/control/bolter.md.
 //!
 //! ```
 //! use mmic::bolter::{BolterStep, MuxLines};
@@ -9,6 +14,12 @@
 //! ```
 
 pub use crate::command::BolterPair;
+
+mod coordinator;
+mod side;
+
+pub use coordinator::{Config, Coordinator, Job, Output, Status};
+pub use side::{BolterSide, Drive, Signals};
 
 /// Bolting or unbolting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -54,9 +65,9 @@ pub enum BolterStep {
     DescendEngage,
     /// 4*: rotate the head until the current says locked (unlocked when unbolting).
     Rotate,
-    /// 5: counter-rotate to free the head.
+    /// 5: counter-rotate to free the head and go back to the initial configuration; ends at home.
     CounterRotate,
-    /// 6: return to the initial configuration.
+    /// 6: after a timed-out attempt, go back to the initial configuration; ends at home.
     ReturnHome,
     /// 7: run finished, pair (un)bolted.
     Done,

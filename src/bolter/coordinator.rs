@@ -1,0 +1,265 @@
+//! Board A's bolter coordinator: runs a bolt or unbolt job over one pair or all four, ordering
+//! both sides step by step and retrying a timed-out attempt up to three attempts in all.
+
+use super::side::{ended, SideConfig};
+use super::{BolterDirection, BolterPair, BolterStep};
+use crate::command::Fasteners;
+use crate::faults::Fault;
+use crate::safety::detect::elapsed;
+use crate::wire::b_command::BolterOrder;
+use crate::wire::heartbeat::BolterAttempt;
+use crate::wire::internal_heartbeat::BolterAux;
+
+/// Coordinator settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Config {
+    /// The sides' step timeouts.
+    pub side: SideConfig,
+    /// Extra time the coordinator waits for side B's report beyond the side timeout before it
+    /// gives up on the link (internal communication loss). Default 1000 ms.
+    pub link_margin_ms: u32,
+    /// Attempts per pair (Table 8: three).
+    pub max_attempts: u8,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        Config {
+            side: SideConfig::default(),
+            link_margin_ms: 1000,
+            max_attempts: 3,
+        }
+    }
+}
+
+/// A bolting job.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Job {
+    /// Bolt or unbolt.
+    pub direction: BolterDirection,
+    /// One pair, or 1–4 in order.
+    pub fasteners: Fasteners,
+}
+
+/// Where the coordinator is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// No job.
+    Idle,
+    /// Running.
+    Running,
+    /// Every pair of the job done.
+    Done,
+    /// Stopped on this fault: bolting failure after the last attempt, or internal
+    /// communication loss when side B stopped reporting.
+    Failed(Fault),
+}
+
+/// What the coordinator asks for this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Output {
+    /// The order for both sides and the sequence number it was first issued with (send to B
+    /// in every A→B command until it changes; apply to side A's executor).
+    pub order: Option<(u8, BolterOrder)>,
+    /// Heartbeat byte 55.
+    pub active: Option<BolterPair>,
+    /// Heartbeat byte 56.
+    pub attempt: BolterAttempt,
+    /// Status.
+    pub status: Status,
+}
+
+/// The coordinator.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Coordinator {
+    job: Option<Job>,
+    pair: BolterPair,
+    attempt: u8,
+    step: BolterStep,
+    retrying: bool,
+    seq: u8,
+    last: u32,
+    waited_ms: u32,
+    status: Status,
+}
+
+impl Default for Coordinator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+fn reported(aux: &BolterAux, seq: u8, o: &BolterOrder) -> bool {
+    aux.seq == seq
+        && aux.step == Some(o.step)
+        && aux.pair == Some(o.pair)
+        && aux.direction == Some(o.direction)
+}
+
+impl Coordinator {
+    /// Idle.
+    pub const fn new() -> Coordinator {
+        Coordinator {
+            job: None,
+            pair: BolterPair::P1,
+            attempt: 0,
+            step: BolterStep::Descend,
+            retrying: false,
+            seq: 0,
+            last: 0,
+            waited_ms: 0,
+            status: Status::Idle,
+        }
+    }
+
+    /// Starts a job at `now` (replacing any running one).
+    pub fn start(&mut self, job: Job, now: u32) {
+        let pair = match job.fasteners {
+            Fasteners::Pair(p) => p,
+            Fasteners::All => BolterPair::P1,
+        };
+        self.job = Some(job);
+        self.status = Status::Running;
+        self.begin_pair(pair, now);
+    }
+
+    /// Stops: the sides are ordered idle.
+    pub fn stop(&mut self) {
+        self.job = None;
+        self.status = Status::Idle;
+    }
+
+    fn begin_pair(&mut self, pair: BolterPair, now: u32) {
+        self.pair = pair;
+        self.attempt = 1;
+        self.goto(BolterStep::Descend, now);
+    }
+
+    fn goto(&mut self, step: BolterStep, now: u32) {
+        self.step = step;
+        self.seq = self.seq.wrapping_add(1);
+        self.last = now;
+        self.waited_ms = 0;
+    }
+
+    /// The current order.
+    pub fn order(&self) -> Option<(u8, BolterOrder)> {
+        match (self.status, self.job) {
+            (Status::Running, Some(j)) => Some((
+                self.seq,
+                BolterOrder {
+                    pair: self.pair,
+                    direction: j.direction,
+                    step: self.step,
+                },
+            )),
+            _ => None,
+        }
+    }
+
+    /// Status.
+    pub const fn status(&self) -> Status {
+        self.status
+    }
+
+    /// Attempt on the current pair, 1..=3 (meaningful while running).
+    pub const fn attempt(&self) -> u8 {
+        self.attempt
+    }
+
+    /// Step being run (meaningful while running).
+    pub const fn current_step(&self) -> BolterStep {
+        self.step
+    }
+
+    /// One tick: `a` is side A's executor report, `b` the latest side-B report received (if any).
+    pub fn step(&mut self, cfg: &Config, now: u32, a: &BolterAux, b: Option<&BolterAux>) -> Output {
+        if let (Status::Running, Some((seq, o))) = (self.status, self.order()) {
+            let limit = cfg
+                .side
+                .sensed_ms
+                .max(cfg.side.home_ms)
+                .saturating_add(cfg.link_margin_ms);
+            self.waited_ms = self
+                .waited_ms
+                .saturating_add(elapsed(self.last, now))
+                .min(limit.saturating_add(1));
+            self.last = now;
+            let side_done = |x: &BolterAux| {
+                reported(x, seq, &o) && ended(o.step, x.threshold_reached, x.locked, x.at_home)
+            };
+            let side_timed_out = |x: &BolterAux| reported(x, seq, &o) && x.timed_out;
+            let a_done = side_done(a);
+            let b_done = b.is_some_and(side_done);
+            let timed_out = side_timed_out(a) || b.is_some_and(side_timed_out);
+            if timed_out {
+                self.attempt_failed(cfg, now);
+            } else if a_done && b_done {
+                self.advance(cfg, now);
+            } else if self.waited_ms > limit {
+                // Side B never reported this step: the link, not the fastener, failed.
+                self.status = Status::Failed(Fault::InternalCommLoss);
+            }
+        }
+        Output {
+            order: self.order(),
+            active: if self.status == Status::Running {
+                Some(self.pair)
+            } else {
+                None
+            },
+            attempt: BolterAttempt::new(if self.status == Status::Running {
+                self.attempt
+            } else {
+                0
+            })
+            .unwrap_or(BolterAttempt::NONE),
+            status: self.status,
+        }
+    }
+
+    fn attempt_failed(&mut self, _cfg: &Config, now: u32) {
+        if !matches!(
+            self.step,
+            BolterStep::Descend | BolterStep::DescendEngage | BolterStep::Rotate
+        ) {
+            // A step that ends at home timed out: the bolter cannot even get back, so no further
+            // attempt makes sense.
+            self.status = Status::Failed(Fault::BoltingFailure);
+            return;
+        }
+        self.retrying = true;
+        self.goto(BolterStep::ReturnHome, now);
+    }
+
+    fn advance(&mut self, cfg: &Config, now: u32) {
+        let next = match self.step {
+            BolterStep::Descend => BolterStep::Retract,
+            BolterStep::Retract => BolterStep::DescendEngage,
+            BolterStep::DescendEngage => BolterStep::Rotate,
+            BolterStep::Rotate => BolterStep::CounterRotate,
+            BolterStep::ReturnHome if self.retrying => {
+                self.retrying = false;
+                if self.attempt >= cfg.max_attempts.clamp(1, BolterAttempt::MAX) {
+                    self.status = Status::Failed(Fault::BoltingFailure);
+                    return;
+                }
+                self.attempt += 1;
+                BolterStep::Descend
+            }
+            _ => BolterStep::Done,
+        };
+        if next != BolterStep::Done {
+            self.goto(next, now);
+            return;
+        }
+        // This pair is done: next pair of an "all four" job, or the end.
+        match (
+            self.job.map(|j| j.fasteners),
+            BolterPair::from_number(self.pair.number() + 1),
+        ) {
+            (Some(Fasteners::All), Some(p)) => self.begin_pair(p, now),
+            _ => self.status = Status::Done,
+        }
+    }
+}

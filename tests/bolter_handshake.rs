@@ -1,0 +1,204 @@
+//! The A/B bolter handshake, model-checked by explicit-state search: board A's coordinator and
+//! side-A executor, board B's executor, an A→B link and a B→A link that lose and duplicate
+//! messages (FIFO: a serial line does not reorder), both sides' sensor events in any order, and
+//! time that can jump past every timeout at any moment. Every reachable state is checked:
+//!
+//! - side B never runs a step A has not ordered, and is never more than one order behind;
+//! - when B is one order behind while A proceeds normally (not a retry), B's step is finished:
+//!   A moved on only on B's report that it had completed that same step;
+//! - from every reachable state the job can still end (Done or Failed): no stuck state;
+//! - a bolting failure is declared only on the last attempt (or when a bolter cannot get home).
+
+use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Signals, Status};
+use mmic::command::{BolterPair, Fasteners};
+use mmic::faults::Fault;
+use mmic::wire::b_command::BolterOrder;
+use mmic::wire::internal_heartbeat::BolterAux;
+use std::collections::{HashMap, VecDeque};
+
+#[derive(Clone, Copy, PartialEq, Eq, Hash, Debug)]
+struct World {
+    coord: Coordinator,
+    a: BolterSide,
+    b: BolterSide,
+    ab: Option<(u8, Option<BolterOrder>)>,
+    ba: Option<BolterAux>,
+    b_seen: Option<BolterAux>,
+    now: u32,
+}
+
+const JUMP: u32 = 1 << 30; // past every timeout, and the clock cycles through 4 values
+
+fn successors(cfg: &Config, w: &World) -> Vec<World> {
+    let all = Signals {
+        threshold: true,
+        locked: true,
+        at_home: true,
+    };
+    let mut out = Vec::new();
+    // A's control loop: coordinator tick, side A follows, a fresh snapshot goes on the link.
+    let mut x = *w;
+    let o = x.coord.step(cfg, x.now, &x.a.aux(), x.b_seen.as_ref());
+    let (seq, order) = match o.order {
+        Some((s, ord)) => (s, Some(ord)),
+        None => (x.a.aux().seq, None),
+    };
+    x.a.order(seq, order, x.now);
+    x.a.tick(&cfg.side, x.now, Signals::default());
+    x.ab = Some((seq, order));
+    out.push(x);
+    // Side A's end signal for its step.
+    let mut x = *w;
+    x.a.tick(&cfg.side, x.now, all);
+    out.push(x);
+    // Side B's end signal.
+    let mut x = *w;
+    x.b.tick(&cfg.side, x.now, all);
+    out.push(x);
+    // A→B delivered (kept on the link: it may be delivered again), or lost.
+    if let Some((seq, order)) = w.ab {
+        let mut x = *w;
+        x.b.order(seq, order, x.now);
+        out.push(x);
+        let mut x = *w;
+        x.ab = None;
+        out.push(x);
+    }
+    // B sends its heartbeat; B→A delivered (duplicable) or lost.
+    let mut x = *w;
+    x.b.tick(&cfg.side, x.now, Signals::default());
+    x.ba = Some(x.b.aux());
+    out.push(x);
+    if let Some(aux) = w.ba {
+        let mut x = *w;
+        x.b_seen = Some(aux);
+        out.push(x);
+        let mut x = *w;
+        x.ba = None;
+        out.push(x);
+    }
+    // Time jumps past every timeout.
+    let mut x = *w;
+    x.now = x.now.wrapping_add(JUMP);
+    out.push(x);
+    out
+}
+
+fn check(w: &World) {
+    use mmic::bolter::BolterStep;
+    let b = w.b.aux();
+    if let (Some((seq, o)), Some(step)) = (w.coord.order(), b.step) {
+        let lag = seq.wrapping_sub(b.seq);
+        assert!(
+            lag <= 1,
+            "B ahead of or more than one order behind A: {w:?}"
+        );
+        if lag == 0 {
+            assert_eq!(
+                (step, b.pair, b.direction),
+                (o.step, Some(o.pair), Some(o.direction))
+            );
+        } else if o.step != BolterStep::ReturnHome {
+            let ended = match step {
+                BolterStep::Descend | BolterStep::DescendEngage => b.threshold_reached,
+                BolterStep::Rotate => b.locked,
+                _ => b.at_home,
+            };
+            assert!(ended, "A moved on while B's step is unfinished: {w:?}");
+        }
+    }
+}
+
+fn explore(job: Job) -> (usize, usize, [usize; 3]) {
+    let cfg = Config::default();
+    let mut start = World {
+        coord: Coordinator::new(),
+        a: BolterSide::new(),
+        b: BolterSide::new(),
+        ab: None,
+        ba: None,
+        b_seen: None,
+        now: 0,
+    };
+    start.coord.start(job, 0);
+    let mut index: HashMap<World, usize> = HashMap::new();
+    let mut states = vec![start];
+    let mut edges: Vec<Vec<usize>> = vec![vec![]];
+    index.insert(start, 0);
+    let mut queue = VecDeque::from([0usize]);
+    let mut terminal = [0usize; 3]; // done, bolting failure, comm loss
+    while let Some(i) = queue.pop_front() {
+        let w = states[i];
+        check(&w);
+        match w.coord.status() {
+            Status::Done => terminal[0] += 1,
+            Status::Failed(Fault::BoltingFailure) => terminal[1] += 1,
+            Status::Failed(_) => terminal[2] += 1,
+            _ => {}
+        }
+        if matches!(w.coord.status(), Status::Done | Status::Failed(_)) {
+            continue;
+        }
+        for n in successors(&cfg, &w) {
+            let j = *index.entry(n).or_insert_with(|| {
+                states.push(n);
+                edges.push(vec![]);
+                queue.push_back(states.len() - 1);
+                states.len() - 1
+            });
+            edges[i].push(j);
+            if states[j].coord.status() == Status::Failed(Fault::BoltingFailure) {
+                use mmic::bolter::BolterStep::*;
+                let at = &states[i].coord;
+                let home_failed = !matches!(at.current_step(), Descend | DescendEngage | Rotate);
+                assert!(
+                    at.attempt() == 3 || home_failed,
+                    "bolting failure declared at attempt {}",
+                    at.attempt()
+                );
+            }
+        }
+        assert!(states.len() < 5_000_000, "state space too large");
+    }
+    // Liveness: every state reaches a terminal one (reverse reachability from terminals).
+    let mut rev: Vec<Vec<usize>> = vec![vec![]; states.len()];
+    for (i, es) in edges.iter().enumerate() {
+        for &j in es {
+            rev[j].push(i);
+        }
+    }
+    let mut can_end = vec![false; states.len()];
+    let mut q: VecDeque<usize> = (0..states.len())
+        .filter(|&i| matches!(states[i].coord.status(), Status::Done | Status::Failed(_)))
+        .collect();
+    for &i in &q {
+        can_end[i] = true;
+    }
+    while let Some(j) = q.pop_front() {
+        for &i in &rev[j] {
+            if !can_end[i] {
+                can_end[i] = true;
+                q.push_back(i);
+            }
+        }
+    }
+    let stuck = can_end.iter().filter(|c| !**c).count();
+    assert_eq!(stuck, 0, "{stuck} states cannot reach the end of the job");
+    let transitions = edges.iter().map(Vec::len).sum();
+    (states.len(), transitions, terminal)
+}
+
+#[test]
+fn handshake_single_pair_bolt_and_unbolt() {
+    for direction in [BolterDirection::Bolt, BolterDirection::Unbolt] {
+        let (n, t, term) = explore(Job {
+            direction,
+            fasteners: Fasteners::Pair(BolterPair::P2),
+        });
+        println!("bolter handshake ({direction:?}, one pair): {n} states, {t} transitions, terminal done/bolting-failure/comm-loss {term:?}");
+        assert!(
+            term.iter().all(|&c| c > 0),
+            "every outcome must be reachable: {term:?}"
+        );
+    }
+}
