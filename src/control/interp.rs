@@ -24,7 +24,17 @@ impl Default for Rate {
     }
 }
 
-/// The pulse widths that "totally contract" and "totally extend" mean for one servo.
+/// The pulse widths that "totally contract" and "totally extend" mean for one servo; a partial
+/// target from the command set is honoured as given.
+///
+/// ```
+/// use mmic::command::ServoTarget;
+/// use mmic::control::interp::Travel;
+/// use mmic::units::PulseWidth;
+/// let arm = Travel { contracted: PulseWidth::new(900).unwrap(), extended: PulseWidth::new(2100).unwrap() };
+/// assert_eq!(arm.resolve(ServoTarget::Extend).micros(), 2100);
+/// assert_eq!(arm.resolve(ServoTarget::Position(PulseWidth::new(1300).unwrap())).micros(), 1300);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Travel {
     /// Fully contracted (arm retracted / gripper open).
