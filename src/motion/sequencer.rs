@@ -8,8 +8,9 @@
 //! 1. **Release** S's gripper (gripper S → contract); wait until S's gripper reports done.
 //! 2. **Move**: into a two-face state S's arm extends; into a matched state both arms contract
 //!    (the robot ends contracted on one face; O's arm contracting while O grips carries the hip
-//!    towards O's face). In a turn the hip also rotates ±90° (CCW +, CW −). Wait for the arms
-//!    and, in a turn, the hip in tolerance.
+//!    towards O's face). In a turn the hip also goes to the angle of the target state's shape
+//!    ([`hip_goal`]): 180° when the arms end in line, 90° (CW) or 270° (CCW) when they end at a
+//!    right angle. Wait for the arms and, in a turn, the hip in tolerance.
 //! 3. **Confirm** (only into a matched state): wait for both arm-contracted switches.
 //! 4. **Grip** S's gripper (gripper S → extend); wait until done.
 //!
@@ -29,7 +30,7 @@
 
 use super::geometry::single_move;
 use super::{Primitive, State};
-use crate::command::ServoTarget;
+use crate::command::{preset_angle, HipTarget, ServoTarget};
 use crate::faults::Fault;
 use crate::safety::detect::elapsed;
 use crate::units::{HipAngle, Side};
@@ -133,12 +134,46 @@ pub struct NotAMove {
     pub to: State,
 }
 
+/// The hip angle a turn primitive drives to, from the shapes of its two states: `None` when the
+/// hip does not move.
+///
+/// The hip angle is the angle from arm A to arm B about the hip axis: 180° with the arms in
+/// line, 90° or 270° at a right angle (the two signs of the hip axis; spec/motion/estimation.md).
+/// So the goal is absolute, not the current angle ± 90°: a plan that turns twice the same way in
+/// the structure frame (a → e → n: B CCW, then A CCW) folds back to 180°, where adding +90° twice
+/// would have left the hip at 0°, a pose no state has.
+///
+/// - straight primitives (1–4) and turns between two right-angle states: `None`. A turn from one
+///   right-angle state to another (e → k: A swings from −X to −Z about B's arm, +Y) rotates
+///   about the holding arm, not about the hip axis; the model's map has 12 such moves and the
+///   hip keeps its angle through them (spec/motion/sequencer.md);
+/// - into a state with the arms in line (matched, stretch): [`HipTarget::Straight`], 180°;
+/// - from arms in line into a right angle: [`HipTarget::RightAngleCw`] (90°) for a CW
+///   primitive, [`HipTarget::RightAngleCcw`] (270°) for a CCW one. Either sign is a valid pose
+///   of the state (the hip axis is free while the arms are in line); naming it after the
+///   primitive keeps the choice deterministic.
+pub fn hip_goal(from: State, to: State, primitive: Primitive) -> Option<HipAngle> {
+    let in_line = |s: State| !matches!(s.kind(), super::StateKind::Turn);
+    let target = match primitive {
+        Primitive::FwdContract
+        | Primitive::BackContract
+        | Primitive::FwdExtend
+        | Primitive::BackExtend => return None,
+        _ if in_line(to) => HipTarget::Straight,
+        _ if !in_line(from) => return None,
+        Primitive::FwdTurnCw | Primitive::BackTurnCw => HipTarget::RightAngleCw,
+        Primitive::FwdTurnCcw | Primitive::BackTurnCcw => HipTarget::RightAngleCcw,
+    };
+    preset_angle(target)
+}
+
 /// Runs one primitive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Sequencer {
     cfg: Config,
     primitive: Primitive,
     side: Side,
+    from: State,
     to: State,
     steps: [Step; 4],
     n_steps: u8,
@@ -177,6 +212,7 @@ impl Sequencer {
             cfg,
             primitive,
             side,
+            from,
             to,
             steps,
             n_steps: n,
@@ -234,15 +270,7 @@ impl Sequencer {
                 } else {
                     self.targets.arm[s] = ServoTarget::Extend;
                 }
-                let h = self.targets.hip.centidegrees() as u32;
-                let turned = match self.primitive {
-                    Primitive::FwdTurnCcw | Primitive::BackTurnCcw => Some((h + 9000) % 36000),
-                    Primitive::FwdTurnCw | Primitive::BackTurnCw => {
-                        Some((h + 36000 - 9000) % 36000)
-                    }
-                    _ => None,
-                };
-                if let Some(a) = turned.and_then(|a| HipAngle::new(a as u16).ok()) {
+                if let Some(a) = hip_goal(self.from, self.to, self.primitive) {
                     self.targets.hip = a;
                 }
             }
