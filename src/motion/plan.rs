@@ -36,12 +36,13 @@ impl Plan {
 
     /// The primitives in order.
     pub fn primitives(&self) -> &[Primitive] {
-        &self.prims[..self.len as usize]
+        // `len` never exceeds MAX_LEN; `get` keeps even a broken invariant from panicking.
+        self.prims.get(..self.len as usize).unwrap_or(&[])
     }
 
     /// The state after each primitive (the last one is the target).
     pub fn states(&self) -> &[State] {
-        &self.states[..self.len as usize]
+        self.states.get(..self.len as usize).unwrap_or(&[])
     }
 
     /// Number of primitives (0 when from = to).
