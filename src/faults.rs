@@ -204,6 +204,14 @@ impl<'de> serde::Deserialize<'de> for Faults {
             fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Faults, A::Error> {
                 let mut set = Faults::EMPTY;
                 while let Some(f) = a.next_element::<Fault>()? {
+                    // A set: a name listed twice is an operator's slip, not a second fault.
+                    if set.contains(f) {
+                        return Err(serde::de::Error::custom(format_args!(
+                            "fault `{}` (bit {}) listed twice",
+                            f.name(),
+                            f.bit()
+                        )));
+                    }
                     set = set.with(f);
                 }
                 Ok(set)

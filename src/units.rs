@@ -357,6 +357,7 @@ impl Sign {
 /// (Table 4 bytes 36–37).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Gravity {
     /// Dominant axis.
     pub axis: Axis,

@@ -1,5 +1,6 @@
 //! JSON ⇄ packet bytes for the four packet kinds, and hex parsing with positioned errors.
 
+use crate::cli::{EXIT_INPUT, EXIT_INVALID_PACKET};
 use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
@@ -18,12 +19,20 @@ pub enum CodecError {
         source: serde_json::Error,
     },
     /// The hex text is malformed.
-    #[error("invalid hex at character {position}: {reason}")]
+    #[error("invalid hex at character {position} (counting from 0): {reason}")]
     Hex {
         /// 0-based character index in the argument.
         position: usize,
         /// What is wrong.
         reason: &'static str,
+    },
+    /// The packet could not be written as JSON (serde_json's message).
+    #[error("cannot print {kind} as JSON: {source}")]
+    Print {
+        /// Kind being decoded.
+        kind: PacketKind,
+        /// serde_json's message.
+        source: serde_json::Error,
     },
     /// The bytes are not a valid packet: the failed check and its numbers.
     #[error("{check} check failed: {source}")]
@@ -36,11 +45,14 @@ pub enum CodecError {
 }
 
 impl CodecError {
-    /// Process exit code: 1 for an invalid packet, 2 for bad input (JSON, hex).
+    /// Process exit code: [`EXIT_INVALID_PACKET`] (1) for an invalid packet, [`EXIT_INPUT`] (2)
+    /// for bad input (JSON, hex).
     pub fn exit_code(&self) -> u8 {
         match self {
-            CodecError::Packet { .. } => 1,
-            _ => 2,
+            CodecError::Packet { .. } => EXIT_INVALID_PACKET,
+            CodecError::Json { .. } | CodecError::Hex { .. } | CodecError::Print { .. } => {
+                EXIT_INPUT
+            }
         }
     }
 }
@@ -91,7 +103,7 @@ pub fn decode(kind: PacketKind, bytes: &[u8]) -> Result<String, CodecError> {
             serde_json::to_string(&BCommandRepr::parse(bytes).map_err(packet_err)?)
         }
     };
-    Ok(json.unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}")))
+    json.map_err(|source| CodecError::Print { kind, source })
 }
 
 /// Lowercase hex, no separators.

@@ -1,6 +1,8 @@
-//! Host side of mmic: the `mmic` command-line tool's logic (packet codec as JSON and hex, and
-//! the generated review pages of spec/), kept out of `main.rs` so tests can call it.
+//! Host side of mmic: the `mmic` command-line tool's logic (arguments and errors in [`cli`],
+//! packets as JSON and hex in [`codec`], motion plans in [`motion`], and the generated review
+//! pages of spec/ in [`pages`]), kept out of `main.rs` so tests can call it.
 
+pub mod cli;
 pub mod codec;
 pub mod motion;
 pub mod pages;

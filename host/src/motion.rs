@@ -1,5 +1,6 @@
 //! `mmic plan` and `mmic map`: the motion library's plans and map, as text and JSON.
 
+use crate::cli::CliError;
 use mmic::motion::{map, plan, State};
 use serde::Serialize;
 
@@ -22,14 +23,16 @@ struct MapJson {
     moves: Vec<MoveJson>,
 }
 
-/// A state from its Table 5 letter.
-pub fn state(s: &str) -> Result<State, String> {
+/// A state from its Table 5 letter (either case).
+pub fn state(s: &str) -> Result<State, CliError> {
     let mut chars = s.chars();
     match (chars.next(), chars.next()) {
         (Some(c), None) => State::from_letter(c.to_ascii_lowercase()),
         _ => None,
     }
-    .ok_or_else(|| format!("unknown state {s:?}: expected a Table 5 letter a..o"))
+    .ok_or_else(|| CliError::UnknownState {
+        text: s.to_string(),
+    })
 }
 
 /// `{"from":"a","to":"m","primitives":[4,1]}`.

@@ -3,7 +3,9 @@
 //! Regenerate with `cargo run -p mmic-host -- spec --write spec/pages`; a test fails when the
 //! committed pages differ from these renderings.
 
-use mmic::command::{for_each_variant_class, CommandKind, PARAM_LEN, PARAM_OFFSET};
+use mmic::command::{
+    for_each_variant_class, Command, CommandError, CommandKind, PARAM_LEN, PARAM_OFFSET,
+};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
 use mmic::refusal::Refusal;
@@ -118,10 +120,10 @@ pub fn commands() -> String {
         PulseWidth::CENTER,
         HipAngle::new(9000).unwrap_or(HipAngle::ZERO),
         |c| {
-            let (id, p) = c.encode();
-            let used: Vec<String> = (0..PARAM_LEN)
-                .filter(|&i| p[i] != 0)
-                .map(|i| (i + PARAM_OFFSET).to_string())
+            let (id, _) = c.encode();
+            let used: Vec<String> = param_bytes_used(c)
+                .into_iter()
+                .map(|i| i.to_string())
                 .collect();
             let json = serde_json::to_string(&c).unwrap_or_default();
             let used = if used.is_empty() {
@@ -137,6 +139,26 @@ pub fn commands() -> String {
         },
     );
     s
+}
+
+/// The packet bytes (6..=11) that `command`'s opcode reads, as the library's own decoder
+/// decides: a byte is unused exactly when making it nonzero in `command`'s encoding makes
+/// `Command::decode` refuse it as "unused, must be 0". (Not "the bytes that happen to be
+/// nonzero", which would miss a parameter whose value has a zero byte.)
+pub fn param_bytes_used(command: Command) -> Vec<usize> {
+    let (id, p) = command.encode();
+    (0..PARAM_LEN)
+        .filter(|&i| {
+            let mut probe = p;
+            probe[i] = p[i].wrapping_add(1) | 1;
+            let index = i + PARAM_OFFSET;
+            !matches!(
+                Command::decode(id, probe),
+                Err(CommandError::UnusedNotZero { index: at, .. }) if at == index
+            )
+        })
+        .map(|i| i + PARAM_OFFSET)
+        .collect()
 }
 
 fn modules(set: ModuleSet) -> String {

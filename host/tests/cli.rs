@@ -110,12 +110,17 @@ fn other_kinds_round_trip_with_non_default_values() {
     });
     round_trip("internal-heartbeat", &ihb);
     let bc = json!({
-        "seq": 42, "power": {"regulator": true, "arm": true, "gripper": false, "bolter": true}, "stop": true,
+        "seq": 42, "flags": {"regulator": true, "arm": true, "gripper": false, "bolter": true, "stop": true},
         "arm_target": 1500, "gripper_target": 2100, "bolter": {"pair": 4, "direction": "bolt", "step": "descend_engage"}
     });
     round_trip("b-command", &bc);
+    // Byte 5 = regulator | arm | bolter | stop = 0b1_1011, byte 4 = 42.
+    assert_eq!(
+        &ok(&["encode", "b-command", &bc.to_string()])[8..12],
+        "2a1b"
+    );
     let bc_idle = json!({
-        "seq": 0, "power": {"regulator": false, "arm": false, "gripper": false, "bolter": false}, "stop": false,
+        "seq": 0, "flags": {"regulator": false, "arm": false, "gripper": false, "bolter": false, "stop": false},
         "arm_target": 500, "gripper_target": 500, "bolter": null
     });
     round_trip("b-command", &bc_idle);
@@ -193,7 +198,17 @@ fn every_error_path_is_reported_with_its_check() {
     fails(
         &["decode", "command", "4d4z"],
         2,
-        "character 3: not a hex digit",
+        "invalid hex at character 3 (counting from 0): not a hex digit",
+    );
+    fails(
+        &["decode", "command", "4d 4"],
+        2,
+        "invalid hex at character 3 (counting from 0): odd number of hex digits",
+    );
+    fails(
+        &["decode", "command", "g0"],
+        2,
+        "invalid hex at character 0 (counting from 0): not a hex digit",
     );
     fails(
         &["decode", "command", &good[..26]],
@@ -307,4 +322,285 @@ fn plan_and_map_commands() {
     }
     let grid = ok(&["map"]);
     assert_eq!(grid.lines().count(), 16);
+}
+
+/// CRC-16/CCITT-FALSE bit by bit (poly 0x1021, init 0xffff, no reflection, no xor-out): an
+/// implementation independent of the library's table-driven one, for the golden vectors.
+fn crc16_bitwise(bytes: &[u8]) -> u16 {
+    let mut c: u16 = 0xffff;
+    for &b in bytes {
+        c ^= u16::from(b) << 8;
+        for _ in 0..8 {
+            c = if c & 0x8000 != 0 {
+                (c << 1) ^ 0x1021
+            } else {
+                c << 1
+            };
+        }
+    }
+    c
+}
+
+#[test]
+fn golden_reconfiguration_hex() {
+    // Table 2 by hand: "MICM" = 4d 49 43 4d; byte 4 board 1; byte 5 opcode 0x60 (reconfigure);
+    // bytes 6-7 hip slot unused = 00 00; byte 8 final state 'm' = 0x6d; byte 9 initial state
+    // 'a' = 0x61; bytes 10-11 arm B slot unused = 00 00; bytes 12-13 CRC-16/CCITT-FALSE of
+    // bytes 0..=11 = 0x885b, low byte first: 5b 88.
+    let body = [
+        0x4d, 0x49, 0x43, 0x4d, 0x01, 0x60, 0x00, 0x00, 0x6d, 0x61, 0x00, 0x00,
+    ];
+    assert_eq!(crc16_bitwise(&body), 0x885b);
+    let json = r#"{"board":1,"command":{"reconfigure":{"initial":"a","target":"m"}}}"#;
+    assert_eq!(
+        ok(&["encode", "command", json]),
+        "4d49434d016000006d6100005b88"
+    );
+    assert_eq!(
+        ok(&["decode", "command", "4d49434d016000006d6100005b88"]),
+        json
+    );
+    // The first golden vector's CRC, recomputed independently.
+    assert_eq!(
+        crc16_bitwise(&[0x4d, 0x49, 0x43, 0x4d, 0x01, 0x22, 0, 0, 0xb0, 0x04, 0, 0]),
+        0xd44a
+    );
+}
+
+/// A heartbeat with every field set, as JSON.
+fn heartbeat() -> Value {
+    json!({
+        "board": 3, "hip_target": 4500, "hip_now": 4490,
+        "arm_a_target": 1500, "arm_a_now": 1490, "arm_b_target": 1500, "arm_b_now": 1510,
+        "gripper_a_target": 900, "gripper_a_now": 910, "gripper_b_target": 2000, "gripper_b_now": 1990,
+        "electrical_a": electrical(7400), "electrical_b": electrical(7300),
+        "target_state": "a", "command_complete": false, "active_bolter": null, "bolter_attempt": 0,
+        "faults": [], "refusal": null, "mode": "operational"
+    })
+}
+
+fn with(mut v: Value, path: &[&str], new: Value) -> String {
+    let mut at = &mut v;
+    for k in path {
+        at = at
+            .get_mut(*k)
+            .unwrap_or_else(|| panic!("no {k} in {path:?}"));
+    }
+    *at = new;
+    v.to_string()
+}
+
+#[test]
+fn validated_values_are_refused_with_their_numbers() {
+    let cmd = |c: Value| json!({"board": 1, "command": c}).to_string();
+    let hb = heartbeat();
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("command", cmd(json!({"primitive": 9})), "primitive must be 1..=8 (Table 6), found 9"),
+        ("command", cmd(json!({"primitive": 0})), "found 0"),
+        (
+            "command",
+            cmd(json!({"gripper": {"side": "b", "target": {"position": 499}}})),
+            "500..=2500, found 499",
+        ),
+        (
+            "command",
+            cmd(json!({"reconfigure": {"initial": "p", "target": "m"}})),
+            "found 'p'",
+        ),
+        (
+            "command",
+            cmd(json!({"reconfigure": {"initial": "m", "target": "m"}})),
+            "not a reconfiguration",
+        ),
+        (
+            "command",
+            cmd(json!({"bolter": {"bolt": {"pair": 5}}})),
+            "bolter pair must be 1..=4, found 5",
+        ),
+        (
+            "command",
+            cmd(json!({"arm": {"side": "c", "target": "contract"}})),
+            "unknown variant `c`",
+        ),
+        ("command", cmd(json!("stopp")), "unknown variant `stopp`"),
+        (
+            "command",
+            cmd(json!({"arm": {"side": "a", "target": "contract", "speed": 2}})),
+            "unknown field `speed`",
+        ),
+        ("command", r#"{"board":256,"command":"stop"}"#.into(), "integer `256`"),
+        ("command", r#"{"board":1}"#.into(), "missing field `command`"),
+        ("heartbeat", with(hb.clone(), &["bolter_attempt"], json!(4)), "bolter attempt must be in 0..=3, found 4"),
+        ("heartbeat", with(hb.clone(), &["active_bolter"], json!(0)), "found 0"),
+        ("heartbeat", with(hb.clone(), &["hip_now"], json!(36000)), "0..=35999, found 36000"),
+        ("heartbeat", with(hb.clone(), &["arm_b_now"], json!(2501)), "500..=2500, found 2501"),
+        ("heartbeat", with(hb.clone(), &["target_state"], json!("q")), "found 'q'"),
+        ("heartbeat", with(hb.clone(), &["board"], json!(0)), "found 0"),
+        (
+            "heartbeat",
+            with(hb.clone(), &["faults"], json!(["low_battery", "low_battery"])),
+            "fault `low_battery` (bit 11) listed twice",
+        ),
+        ("heartbeat", with(hb.clone(), &["electrical_a", "v_bat"], json!(65536)), "integer `65536`"),
+        ("heartbeat", with(hb.clone(), &["electrical_b"], json!({"v_bat": 1})), "missing field `i_bat`"),
+        ("heartbeat", with(hb.clone(), &["mode"], json!("off")), "unknown variant `off`"),
+        (
+            "internal-heartbeat",
+            json!({"gravity": {"axis": "x", "sign": "+", "norm": 1}}).to_string(),
+            "unknown field `norm`",
+        ),
+        (
+            "b-command",
+            json!({"seq": 1, "flags": {"regulator": true, "arm": true, "gripper": true, "bolter": true, "stop": false, "hold": true}}).to_string(),
+            "unknown field `hold`",
+        ),
+        (
+            "b-command",
+            json!({"seq": 1, "power": {}}).to_string(),
+            "unknown field `power`",
+        ),
+    ];
+    for (kind, json, needle) in &cases {
+        fails(&["encode", kind, json], 2, needle);
+    }
+}
+
+/// Hex of `bytes` with the checksum recomputed, so that only the field check can fail.
+fn sealed(mut bytes: Vec<u8>) -> String {
+    let n = bytes.len();
+    let crc = crc16_bitwise(&bytes[..n - 2]).to_le_bytes();
+    bytes[n - 2..].copy_from_slice(&crc);
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+fn unhex(h: &str) -> Vec<u8> {
+    (0..h.len())
+        .step_by(2)
+        .map(|i| u8::from_str_radix(&h[i..i + 2], 16).unwrap())
+        .collect()
+}
+
+fn range_of(kind: mmic::wire::PacketKind, name: &str) -> std::ops::Range<usize> {
+    kind.fields()
+        .iter()
+        .find(|f| f.name == name)
+        .unwrap_or_else(|| panic!("{kind} has no field {name}"))
+        .range
+        .clone()
+}
+
+#[test]
+fn field_check_failures_name_the_field_and_the_numbers() {
+    use mmic::wire::PacketKind;
+    let mut hb = unhex(&ok(&["encode", "heartbeat", &heartbeat().to_string()]));
+    let r = range_of(PacketKind::Heartbeat, "arm_a_now");
+    hb[r.start] = 0x10; // 16 µs
+    hb[r.start + 1] = 0x00;
+    let o = mmic(&["decode", "heartbeat", &sealed(hb)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("field check failed"), "{err}");
+    assert!(
+        err.contains("byte 11 (arm_a_now)") && err.contains("500..=2500") && err.contains("0x10"),
+        "{err}"
+    );
+
+    let bc = json!({
+        "seq": 0, "flags": {"regulator": false, "arm": false, "gripper": false, "bolter": false, "stop": false},
+        "arm_target": 500, "gripper_target": 500, "bolter": null
+    });
+    let mut b = unhex(&ok(&["encode", "b-command", &bc.to_string()]));
+    b[range_of(PacketKind::BCommand, "flags").start] = 0x20; // bit 5 is reserved
+    let o = mmic(&["decode", "b-command", &sealed(b)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("field check failed: b-command packet: byte 5 (flags): expected bits 0..=4 only, found 0x20"),
+        "{err}"
+    );
+}
+
+#[test]
+fn help_explains_units_exit_codes_and_gives_examples() {
+    let top = ok(&["--help"]);
+    for needle in [
+        "µs",
+        "0.01°",
+        "mV",
+        "mA",
+        "Exit codes",
+        "mmic encode command",
+    ] {
+        assert!(top.contains(needle), "mmic --help lacks {needle:?}:\n{top}");
+    }
+    let enc = ok(&["encode", "--help"]);
+    for needle in [
+        "500..=2500 µs",
+        "0.01°",
+        "\"primitive\":4",
+        "\"reconfigure\"",
+        "b-command",
+    ] {
+        assert!(
+            enc.contains(needle),
+            "encode --help lacks {needle:?}:\n{enc}"
+        );
+    }
+    let dec = ok(&["decode", "--help"]);
+    // Every example in `decode --help` decodes to the JSON printed under it.
+    let lines: Vec<&str> = dec.lines().collect();
+    let mut examples = 0;
+    for w in lines.windows(2) {
+        if let Some(rest) = w[0].trim().strip_prefix("mmic decode command ") {
+            let hex = rest.trim_matches('\'');
+            assert_eq!(ok(&["decode", "command", hex]), w[1].trim());
+            examples += 1;
+        }
+    }
+    assert_eq!(examples, 2, "{dec}");
+    // And every `mmic encode` example in `encode --help` and `--help` is accepted.
+    let mut encoded = 0;
+    for line in enc.lines().chain(top.lines()) {
+        if let Some(rest) = line.trim().strip_prefix("mmic encode ") {
+            let (kind, json) = rest.split_once(' ').unwrap();
+            let json = json.split("'   (").next().unwrap().trim_matches('\'');
+            ok(&["encode", kind, json]);
+            encoded += 1;
+        }
+    }
+    assert!(encoded >= 8, "{encoded} examples");
+}
+
+#[test]
+fn spec_write_writes_every_page_into_a_fresh_directory() {
+    let dir = std::env::temp_dir().join(format!("mmic-spec-write-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let o = mmic(&["spec", "--write", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let pages = mmic_host::pages::all();
+    for (name, want) in &pages {
+        let got = std::fs::read_to_string(dir.join(name)).unwrap();
+        assert_eq!(&got, want, "{name}");
+        assert!(got.starts_with(mmic_host::pages::BANNER), "{name}");
+    }
+    for name in [
+        "command.md",
+        "heartbeat.md",
+        "internal-heartbeat.md",
+        "b-command.md",
+        "commands.md",
+    ] {
+        assert!(pages.iter().any(|(n, _)| n == name), "{name}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+    // A directory that cannot be created: exit 3 and the path in the message.
+    let file = std::env::temp_dir().join(format!("mmic-spec-file-{}", std::process::id()));
+    std::fs::write(&file, "x").unwrap();
+    let target = file.join("sub");
+    fails(
+        &["spec", "--write", target.to_str().unwrap()],
+        3,
+        &format!("cannot write {}", target.display()),
+    );
+    std::fs::remove_file(&file).unwrap();
 }

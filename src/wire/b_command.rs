@@ -147,9 +147,12 @@ pub struct BolterOrder {
 }
 
 /// What board A orders board B to do.
+///
+/// JSON (feature `serde`) follows [`FIELDS`]: byte 5 is one object, `flags`, holding the
+/// power switches and the stop bit:
+/// `{"seq":7,"flags":{"regulator":true,"arm":true,"gripper":true,"bolter":false,"stop":false},
+/// "arm_target":1000,"gripper_target":2000,"bolter":null}`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct BCommandRepr {
     /// Wrapping sequence number, echoed by B as the acknowledgement.
     pub seq: u8,
@@ -163,6 +166,73 @@ pub struct BCommandRepr {
     pub gripper_target: PulseWidth,
     /// Bolter order; none leaves the bolter idle (bytes 10–12 all zero).
     pub bolter: Option<BolterOrder>,
+}
+
+/// The JSON form of [`BCommandRepr`]: the field names of [`FIELDS`], byte 5 as `flags`.
+#[cfg(feature = "serde")]
+mod json {
+    use super::{BCommandRepr, BPower, BolterOrder};
+    use crate::units::PulseWidth;
+
+    /// Byte 5, bit by bit.
+    #[derive(serde::Serialize, serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Flags {
+        regulator: bool,
+        arm: bool,
+        gripper: bool,
+        bolter: bool,
+        stop: bool,
+    }
+
+    #[derive(serde::Serialize, serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Form {
+        seq: u8,
+        flags: Flags,
+        arm_target: PulseWidth,
+        gripper_target: PulseWidth,
+        bolter: Option<BolterOrder>,
+    }
+
+    impl serde::Serialize for BCommandRepr {
+        fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+            let p = self.power;
+            Form {
+                seq: self.seq,
+                flags: Flags {
+                    regulator: p.regulator,
+                    arm: p.arm,
+                    gripper: p.gripper,
+                    bolter: p.bolter,
+                    stop: self.stop,
+                },
+                arm_target: self.arm_target,
+                gripper_target: self.gripper_target,
+                bolter: self.bolter,
+            }
+            .serialize(s)
+        }
+    }
+
+    impl<'de> serde::Deserialize<'de> for BCommandRepr {
+        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+            let f = Form::deserialize(d)?;
+            Ok(BCommandRepr {
+                seq: f.seq,
+                power: BPower {
+                    regulator: f.flags.regulator,
+                    arm: f.flags.arm,
+                    gripper: f.flags.gripper,
+                    bolter: f.flags.bolter,
+                },
+                stop: f.flags.stop,
+                arm_target: f.arm_target,
+                gripper_target: f.gripper_target,
+                bolter: f.bolter,
+            })
+        }
+    }
 }
 
 impl BCommandRepr {

@@ -1,0 +1,251 @@
+//! The `mmic` command line: its arguments (clap derive), its errors and exit codes, and
+//! [`run`], which does the work and writes to the given streams, so that `main.rs` only parses
+//! the arguments and maps the error to an exit code.
+//!
+//! Exit codes: [`EXIT_OK`] 0; [`EXIT_INVALID_PACKET`] 1 when the bytes are not a valid packet
+//! (stderr names the failed check: length, header, checksum, field or command); [`EXIT_INPUT`] 2
+//! for bad input (unknown kind or state, invalid JSON, malformed hex) and usage errors (clap's
+//! own code); [`EXIT_IO`] 3 when a page cannot be written or stdout is closed.
+
+use crate::codec::{self, CodecError};
+use crate::{motion, pages};
+use clap::{Parser, Subcommand};
+use mmic::motion::State;
+use mmic::wire::PacketKind;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Success.
+pub const EXIT_OK: u8 = 0;
+/// The bytes are not a valid packet.
+pub const EXIT_INVALID_PACKET: u8 = 1;
+/// Bad input: unknown kind or state, invalid JSON, malformed hex, usage error.
+pub const EXIT_INPUT: u8 = 2;
+/// A file could not be written, or stdout is closed.
+pub const EXIT_IO: u8 = 3;
+
+const AFTER_HELP: &str = "\
+Units: servo pulse widths in µs (500..=2500), hip angles in 0.01° (0..=35999, 9000 = 90.00°),
+voltages in mV, currents in mA. JSON field names are the `name` column of the field tables
+(`mmic spec`, spec/pages/*.md); a dotted name such as `electrical_a.v_bat` is a nested object.
+
+Exit codes:
+  0  success
+  1  the bytes are not a valid packet; stderr names the failed check
+     (length, header, checksum, field or command) with expected and found values
+  2  bad input: unknown kind, invalid or out-of-range JSON, malformed hex, usage error
+  3  a file could not be written (spec --write), or stdout is closed
+
+Examples:
+  mmic encode command '{\"board\":1,\"command\":\"stop\"}'
+  mmic decode command 4d49434d0102000000000000ad97
+  mmic spec --write spec/pages";
+
+const ENCODE_HELP: &str = "\
+Encode a packet from its JSON form; prints the bytes as lowercase hex on one line.
+
+The JSON is exactly what `mmic decode` prints: every field, no others (an unknown or
+misspelt field is refused). Values are checked as the robot checks them: pulse widths
+500..=2500 µs, hip angles 0..=35999 (0.01°), boards 1..=255, states 'a'..='o' (Table 5),
+primitives 1..=8 (Table 6), bolter pairs 1..=4. `mmic spec` lists every command's JSON.";
+
+const ENCODE_AFTER: &str = "\
+Examples (command packet, Table 2):
+  mmic encode command '{\"board\":1,\"command\":\"stop\"}'
+  mmic encode command '{\"board\":1,\"command\":{\"arm\":{\"side\":\"a\",\"target\":\"contract\"}}}'
+  mmic encode command '{\"board\":1,\"command\":{\"arm\":{\"side\":\"a\",\"target\":{\"position\":1200}}}}'   (1200 µs)
+  mmic encode command '{\"board\":1,\"command\":{\"hip\":{\"angle\":9000}}}'   (90.00°)
+  mmic encode command '{\"board\":1,\"command\":{\"primitive\":4}}'
+  mmic encode command '{\"board\":1,\"command\":{\"reconfigure\":{\"initial\":\"a\",\"target\":\"m\"}}}'
+  mmic encode command '{\"board\":1,\"command\":{\"power\":{\"target\":{\"module\":\"hip\"},\"on\":true}}}'
+  mmic encode b-command '{\"seq\":1,\"flags\":{\"regulator\":true,\"arm\":true,\"gripper\":false,\"bolter\":false,\"stop\":false},\"arm_target\":1500,\"gripper_target\":500,\"bolter\":null}'
+
+Exit codes: 0 success, 2 bad kind or JSON (the message names the field and the allowed range).";
+
+const DECODE_HELP: &str = "\
+Decode a packet from hex; prints its JSON form on one line, every field included.
+
+The hex may contain spaces, colons, commas, dashes and 0x prefixes. Pulse widths are printed
+in µs, hip angles in 0.01°, voltages in mV, currents in mA; `null` is an empty optional field
+(no refusal, no bolter order, no gravity reading yet).";
+
+const DECODE_AFTER: &str = "\
+Examples:
+  mmic decode command 4d49434d0102000000000000ad97
+    {\"board\":1,\"command\":\"stop\"}
+  mmic decode command '4d:49:43:4d:01:22:00:00:b0:04:00:00:4a:d4'
+    {\"board\":1,\"command\":{\"arm\":{\"side\":\"a\",\"target\":{\"position\":1200}}}}
+
+Exit codes: 0 success; 1 not a valid packet, stderr names the failed check, e.g.
+  mmic: checksum check failed: command packet: checksum carried 0xd54a, computed 0xd44a
+2 bad kind or malformed hex (the message gives the 0-based character position).";
+
+/// `mmic`: encode and decode MMIC-I packets, print the spec tables.
+#[derive(Debug, Parser)]
+#[command(
+    name = "mmic",
+    version,
+    about = "MMIC-I packet codec (JSON ⇄ hex), motion plans and the paper's tables",
+    after_help = AFTER_HELP
+)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub cmd: Cmd,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Cmd {
+    /// Encode a packet from JSON; prints lowercase hex.
+    #[command(long_about = ENCODE_HELP, after_help = ENCODE_AFTER)]
+    Encode {
+        /// Packet kind: command | heartbeat | internal-heartbeat | b-command.
+        #[arg(value_parser = parse_kind)]
+        kind: PacketKind,
+        /// The packet as JSON (as `mmic decode` prints it).
+        json: String,
+    },
+    /// Decode a packet from hex; prints JSON with every field.
+    #[command(long_about = DECODE_HELP, after_help = DECODE_AFTER)]
+    Decode {
+        /// Packet kind: command | heartbeat | internal-heartbeat | b-command.
+        #[arg(value_parser = parse_kind)]
+        kind: PacketKind,
+        /// The packet bytes in hex.
+        hex: String,
+    },
+    /// The shortest primitive sequence between two states (Table 5 letters a..o).
+    #[command(
+        after_help = "Example: mmic plan a m --json\n  {\"from\":\"a\",\"to\":\"m\",\"primitives\":[4,1]}"
+    )]
+    Plan {
+        /// Initial state, a..o.
+        #[arg(value_parser = motion::state)]
+        from: State,
+        /// Target state, a..o.
+        #[arg(value_parser = motion::state)]
+        to: State,
+        /// Print {"from":..,"to":..,"primitives":[..]} (numbers per Table 6).
+        #[arg(long)]
+        json: bool,
+    },
+    /// The reconfiguration map (Figure 9): which primitive takes one state to another.
+    Map {
+        /// Print {"moves":[{"from":..,"to":..,"primitive":..},..]}.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print the packet grids, field tables, opcodes and Tables 7/8; or write the review pages.
+    #[command(
+        after_help = "Regenerate the committed pages (a test fails when they are stale):\n  \
+                            cargo run -p mmic-host -- spec --write spec/pages"
+    )]
+    Spec {
+        /// Write one Markdown page per packet, plus commands.md, modes.md and faults.md, into
+        /// this directory (the repository keeps them in spec/pages) instead of printing.
+        #[arg(long, value_name = "DIR")]
+        write: Option<PathBuf>,
+    },
+}
+
+/// A packet kind from its name ([`PacketKind::from_name`]).
+pub fn parse_kind(name: &str) -> Result<PacketKind, CliError> {
+    PacketKind::from_name(name).ok_or_else(|| CliError::UnknownKind {
+        name: name.to_string(),
+    })
+}
+
+/// Why `mmic` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// The packet kind is not one of the four names.
+    #[error(
+        "unknown packet kind {name:?}; expected one of: command, heartbeat, internal-heartbeat, b-command"
+    )]
+    UnknownKind {
+        /// What was given.
+        name: String,
+    },
+    /// The state is not a Table 5 letter.
+    #[error("unknown state {text:?}: expected a Table 5 letter a..o")]
+    UnknownState {
+        /// What was given.
+        text: String,
+    },
+    /// Encoding or decoding failed.
+    #[error(transparent)]
+    Codec(#[from] CodecError),
+    /// A page could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file or directory.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Standard output or error is closed.
+    #[error("cannot write output: {0}")]
+    Output(#[source] std::io::Error),
+}
+
+impl CliError {
+    /// The process exit code (see the module docs).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Codec(e) => e.exit_code(),
+            CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
+            CliError::Write { .. } | CliError::Output(_) => EXIT_IO,
+        }
+    }
+}
+
+/// Runs one command: results on `out`, progress notes (`spec --write`) on `log`.
+pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), CliError> {
+    match cli.cmd {
+        Cmd::Encode { kind, json } => {
+            let bytes = codec::encode(kind, &json)?;
+            writeln!(out, "{}", codec::to_hex(&bytes)).map_err(CliError::Output)?;
+        }
+        Cmd::Decode { kind, hex } => {
+            let json = codec::decode(kind, &codec::from_hex(&hex)?)?;
+            writeln!(out, "{json}").map_err(CliError::Output)?;
+        }
+        Cmd::Plan { from, to, json } => {
+            let text = if json {
+                motion::plan_json(from, to)
+            } else {
+                motion::plan_text(from, to)
+            };
+            writeln!(out, "{text}").map_err(CliError::Output)?;
+        }
+        Cmd::Map { json } => {
+            if json {
+                writeln!(out, "{}", motion::map_json())
+            } else {
+                write!(out, "{}", motion::map_text())
+            }
+            .map_err(CliError::Output)?;
+        }
+        Cmd::Spec { write: None } => {
+            for (_, page) in pages::all() {
+                writeln!(out, "{page}").map_err(CliError::Output)?;
+            }
+        }
+        Cmd::Spec { write: Some(dir) } => {
+            std::fs::create_dir_all(&dir).map_err(|source| CliError::Write {
+                path: dir.clone(),
+                source,
+            })?;
+            for (name, page) in pages::all() {
+                let path = dir.join(name);
+                std::fs::write(&path, page).map_err(|source| CliError::Write {
+                    path: path.clone(),
+                    source,
+                })?;
+                writeln!(log, "wrote {}", path.display()).map_err(CliError::Output)?;
+            }
+        }
+    }
+    Ok(())
+}
