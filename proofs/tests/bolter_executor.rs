@@ -1,0 +1,205 @@
+//! The bolter state machines under arbitrary inputs: any order bytes, any sensor signals, any
+//! side-B report (corrupted, stale or forged), any tick times with clock wrap. Random under
+//! `cargo test`, Kani-ready (`cargo kani --tests`: proofs over a few ticks; not run here).
+//!
+//! - `BolterSide`: never panics; reports exactly the order it adopted and the mux lines of that
+//!   pair; drives the motor only while its step is neither ended nor timed out; a current-sensed
+//!   step whose end signal never came is timed out once more than its limit has elapsed.
+//! - `Coordinator`: never panics; while running, the attempt is 1..=3 and the heartbeat's
+//!   attempt byte equals it; every new sequence number comes with an order whose content
+//!   differs from the previous one (the side executors' resend filter relies on it); a job ends
+//!   in Done, BoltingFailure or InternalCommLoss only, and stays ended.
+//!
+//! The sequence-level protocol (lossy links, every interleaving) is model-checked exhaustively
+//! in `tests/bolter_handshake.rs`.
+
+use mmic::bolter::{
+    BolterDirection, BolterSide, BolterStep, Config, Coordinator, Drive, Job, MuxLines, Signals,
+    Status,
+};
+use mmic::command::{BolterPair, Fasteners};
+use mmic::faults::Fault;
+use mmic::wire::b_command::BolterOrder;
+use mmic::wire::internal_heartbeat::BolterAux;
+
+#[cfg(not(kani))]
+const TICKS: usize = 24;
+#[cfg(kani)]
+const TICKS: usize = 6;
+
+fn order_from(bytes: (u8, u8, u8)) -> Option<BolterOrder> {
+    Some(BolterOrder {
+        pair: BolterPair::from_number(bytes.0 % 5)?,
+        direction: BolterDirection::from_wire(bytes.1 % 3)?,
+        step: BolterStep::from_wire(bytes.2 % 9)?,
+    })
+}
+
+fn aux_from(b: (u8, u8, u8, u8, u8)) -> BolterAux {
+    let o = order_from((b.0, b.1, b.2));
+    BolterAux {
+        step: o.map(|o| o.step),
+        seq: b.3,
+        pair: o.map(|o| o.pair),
+        direction: o.map(|o| o.direction),
+        threshold_reached: b.4 & 1 != 0,
+        locked: b.4 & 2 != 0,
+        timed_out: b.4 & 4 != 0,
+        at_home: b.4 & 8 != 0,
+        mux: MuxLines::from_wire(b.4 >> 4 & 3).unwrap_or_default(),
+    }
+}
+
+#[test]
+#[cfg_attr(kani, kani::proof, kani::unwind(8))]
+fn bolter_side_reports_what_it_runs() {
+    bolero::check!()
+        .with_type::<(u32, [(bool, u8, (u8, u8, u8), u8, u16); TICKS])>()
+        .for_each(|(t0, events)| {
+            let cfg = mmic::bolter::Config::default().side;
+            let mut side = BolterSide::new();
+            let mut now = *t0;
+            let mut adopted: Option<(u8, BolterOrder)> = None;
+            let mut since = now;
+            for &(new_order, seq, bytes, sig, dt) in events.iter() {
+                now = now.wrapping_add(dt as u32);
+                if new_order {
+                    let o = order_from(bytes);
+                    if adopted.map(|(_, a)| a) != o {
+                        adopted = o.map(|o| (seq, o));
+                        since = now;
+                    }
+                    side.order(seq, o, now);
+                }
+                let s = Signals {
+                    threshold: sig & 1 != 0,
+                    locked: sig & 2 != 0,
+                    at_home: sig & 4 != 0,
+                };
+                side.tick(&cfg, now, s);
+                let aux = side.aux();
+                assert_eq!(aux.step, adopted.map(|(_, o)| o.step));
+                assert_eq!(aux.seq, adopted.map_or(0, |(s, _)| s));
+                assert_eq!(aux.pair, adopted.map(|(_, o)| o.pair));
+                assert_eq!(aux.direction, adopted.map(|(_, o)| o.direction));
+                assert_eq!(
+                    aux.mux,
+                    adopted.map_or(MuxLines::default(), |(_, o)| MuxLines::for_pair(o.pair))
+                );
+                let Some((_, o)) = adopted else {
+                    assert_eq!(side.drive(), Drive::Idle);
+                    continue;
+                };
+                let ended = match o.step {
+                    BolterStep::Descend | BolterStep::DescendEngage => aux.threshold_reached,
+                    BolterStep::Rotate => aux.locked,
+                    BolterStep::Done | BolterStep::Failed => true,
+                    _ => aux.at_home,
+                };
+                assert_eq!(
+                    side.drive() == Drive::Idle,
+                    ended || aux.timed_out,
+                    "motor driven after the step ended, or idle while it runs: {aux:?}"
+                );
+                let sensed = matches!(
+                    o.step,
+                    BolterStep::Descend | BolterStep::DescendEngage | BolterStep::Rotate
+                );
+                // Every tick here is at most 65,535 ms after the last, so the elapsed total is
+                // exact while it stays below the clock's half range.
+                if sensed && !ended && now.wrapping_sub(since) > cfg.sensed_ms {
+                    assert!(aux.timed_out, "sensed step past its limit not timed out");
+                }
+                assert!(
+                    !(aux.timed_out && ended),
+                    "a timeout with the end signal latched"
+                );
+            }
+        });
+}
+
+#[test]
+#[cfg_attr(kani, kani::proof, kani::unwind(8))]
+fn coordinator_bounded_and_orders_change() {
+    bolero::check!()
+        .with_type::<(
+            (u8, bool, u32),
+            [((u8, u8, u8, u8, u8), (u8, u8, u8, u8, u8), u8, u16); TICKS],
+        )>()
+        .for_each(|((pair, unbolt, t0), ticks)| {
+            let cfg = Config::default();
+            let mut c = Coordinator::new();
+            let fasteners = match BolterPair::from_number(pair % 5) {
+                Some(p) => Fasteners::Pair(p),
+                None => Fasteners::All,
+            };
+            let direction = if *unbolt {
+                BolterDirection::Unbolt
+            } else {
+                BolterDirection::Bolt
+            };
+            let mut now = *t0;
+            c.start(
+                Job {
+                    direction,
+                    fasteners,
+                },
+                now,
+            );
+            let mut prev = c.order();
+            let mut ended: Option<Status> = None;
+            for &(a, b, sel, dt) in ticks.iter() {
+                now = now.wrapping_add(dt as u32);
+                // The selector picks the reports: 0 both sides report the current order ended,
+                // 1 side A reports it timed out, 2 arbitrary (stale, forged) reports, 3 no
+                // report from B. Directed this way, random runs reach every attempt.
+                let (mut a, mut b) = (aux_from(a), aux_from(b));
+                if let (Some((seq, o)), 0 | 1) = (c.order(), sel % 4) {
+                    for x in [&mut a, &mut b] {
+                        x.seq = seq;
+                        x.step = Some(o.step);
+                        x.pair = Some(o.pair);
+                        x.direction = Some(o.direction);
+                        x.threshold_reached = sel % 4 == 0;
+                        x.locked = sel % 4 == 0;
+                        x.at_home = sel % 4 == 0;
+                        x.timed_out = false;
+                    }
+                    a.timed_out = sel % 4 == 1;
+                }
+                let out = c.step(&cfg, now, &a, (sel % 4 != 3).then_some(&b));
+                if let Some(e) = ended {
+                    assert_eq!(out.status, e, "an ended job changed status");
+                    assert_eq!(out.order, None);
+                    continue;
+                }
+                match out.status {
+                    Status::Running => {
+                        let (seq, o) = out.order.expect("a running job orders a step");
+                        assert!((1..=3).contains(&c.attempt()));
+                        assert_eq!(out.attempt.get(), c.attempt());
+                        assert_eq!(out.active, Some(o.pair));
+                        assert_eq!(o.direction, direction);
+                        assert!(!matches!(o.step, BolterStep::Done | BolterStep::Failed));
+                        if let Some((pseq, po)) = prev {
+                            if pseq != seq {
+                                assert_ne!(po, o, "new sequence number, same order");
+                                assert_eq!(seq, pseq.wrapping_add(1));
+                            } else {
+                                assert_eq!(po, o, "order changed without a new number");
+                            }
+                        }
+                        prev = out.order;
+                    }
+                    Status::Done
+                    | Status::Failed(Fault::BoltingFailure)
+                    | Status::Failed(Fault::InternalCommLoss) => {
+                        assert_eq!(out.order, None);
+                        assert_eq!(out.active, None);
+                        ended = Some(out.status);
+                    }
+                    s => panic!("unexpected status {s:?}"),
+                }
+            }
+        });
+}
