@@ -45,6 +45,7 @@ fn samples() -> (
             side: Side::B,
             target: ServoTarget::Position(PulseWidth::new(1200).unwrap()),
         },
+        seq: 0,
     };
     let hb = HeartbeatRepr {
         target_state: Some(State::M),

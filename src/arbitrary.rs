@@ -261,8 +261,13 @@ arbitrary_boxed!(
 
 arbitrary_boxed!(
     CommandRepr,
-    (any::<BoardNumber>(), any::<Command>())
-        .prop_map(|(board, command)| CommandRepr { board, command })
+    (any::<BoardNumber>(), any::<Command>(), any::<u16>()).prop_map(|(board, command, seq)| {
+        CommandRepr {
+            board,
+            command,
+            seq,
+        }
+    })
 );
 arbitrary_boxed!(
     HeartbeatRepr,
@@ -278,7 +283,7 @@ arbitrary_boxed!(
             any::<PulseWidth>(),
             any::<PulseWidth>(),
         ],
-        (any::<Electrical>(), any::<Electrical>()),
+        (any::<Electrical>(), any::<Electrical>(), any::<u16>()),
         (
             option::of(any::<State>()),
             any::<bool>(),
@@ -293,7 +298,7 @@ arbitrary_boxed!(
             |(
                 (board, hip_target, hip_now),
                 [arm_a_target, arm_a_now, arm_b_target, arm_b_now, gripper_a_target, gripper_a_now, gripper_b_target, gripper_b_now],
-                (electrical_a, electrical_b),
+                (electrical_a, electrical_b, last_seq),
                 (target_state, command_complete, active_bolter, bolter_attempt, faults, refusal, mode),
             )| HeartbeatRepr {
                 board,
@@ -316,6 +321,7 @@ arbitrary_boxed!(
                 faults,
                 refusal,
                 mode,
+                last_seq,
             }
         )
 );

@@ -355,6 +355,19 @@ impl Slot {
     }
 }
 
+/// The parameter slot that carries a command's exactly-once sequence number
+/// (spec/protocol/README.md): bytes 10–11 (arm B), unless opcode `id` puts a pulse width there
+/// (arm B or gripper B to a position), then bytes 6–7 (hip), which those opcodes leave unused.
+/// Every opcode leaves at least one of the two free, so Table 2 keeps its 14 bytes.
+pub const fn seq_slot(id: u8) -> Slot {
+    const ARM_B_POSITION: u8 = opcode::ARM + 4 + 2;
+    const GRIPPER_B_POSITION: u8 = opcode::GRIPPER + 4 + 2;
+    match id {
+        ARM_B_POSITION | GRIPPER_B_POSITION => Slot::Hip,
+        _ => Slot::ArmB,
+    }
+}
+
 /// A parameter block that does not decode to a command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 pub enum CommandError {
@@ -848,6 +861,19 @@ mod tests {
         });
         // 61 classes; 4 positional servo classes × 2001 widths, 36000 angles, 84 reconfigurations.
         assert_eq!(n, 61 - 4 - 1 - 1 + 4 * 2001 + 36000 + (15 * 6 - 6));
+    }
+
+    #[test]
+    fn no_command_uses_its_sequence_slot() {
+        // The exactly-once sequence number may take `seq_slot(id)`: exhaustive over all commands.
+        let mut n = 0;
+        for_each_command(|c| {
+            let (id, p) = c.encode();
+            let at = seq_slot(id).offset();
+            assert_eq!((p[at], p[at + 1]), (0, 0), "{c:?}");
+            n += 1;
+        });
+        assert_eq!(n, 44_143);
     }
 
     #[test]

@@ -15,6 +15,7 @@
 //! let repr = CommandRepr {
 //!     board: BoardNumber::new(1).unwrap(),
 //!     command: Command::Arm { side: Side::A, target: ServoTarget::Contract },
+//!     seq: 0, // 0: unsequenced, as in the paper
 //! };
 //! let mut bytes = [0u8; COMMAND_LEN];
 //! repr.emit(&mut bytes);

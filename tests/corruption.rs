@@ -94,6 +94,7 @@ fn every_1_2_3_bit_error_in_a_command_packet_is_refused() {
     let packet = CommandRepr {
         board: BoardNumber::new(7).unwrap(),
         command: Command::reconfigure(mmic::motion::State::H, mmic::motion::State::N).unwrap(),
+        seq: 0,
     }
     .to_bytes();
     let got = corrupt_all("command", &packet, CommandRepr::parse);

@@ -66,6 +66,7 @@ fn golden_command_arm_position() {
             side: Side::B,
             target: ServoTarget::Position(pw(1200)),
         },
+        seq: 0,
     };
     assert_crc(&COMMAND_ARM);
     assert_eq!(repr.to_bytes(), COMMAND_ARM);
@@ -89,15 +90,66 @@ fn golden_command_reconfigure() {
     let repr = CommandRepr {
         board: BoardNumber::new(255).unwrap(),
         command: Command::reconfigure(State::H, State::N).unwrap(),
+        seq: 0,
     };
     assert_crc(&COMMAND_RECONFIGURE);
     assert_eq!(repr.to_bytes(), COMMAND_RECONFIGURE);
     assert_eq!(CommandRepr::parse(&COMMAND_RECONFIGURE), Ok(repr));
 }
 
+/// Exactly-once commanding (spec/protocol/README.md): the arm-B command above as sequenced
+/// command 0x0102. Its pulse width holds bytes 10–11, so the sequence number takes the hip slot.
+const COMMAND_ARM_SEQUENCED: [u8; COMMAND_LEN] = [
+    b'M', b'I', b'C', b'M', // 0-3 header
+    0x07, // 4 board 7
+    0x26, // 5 opcode: arm B to a position
+    0x02, 0x01, // 6-7 sequence number 0x0102 (the hip slot, unused by this opcode)
+    0x00, 0x00, // 8-9 arm A: unused, zero
+    0xb0, 0x04, // 10-11 arm B: 1200 µs
+    0xce, 0xc7, // 12-13 CRC-16 0xc7ce
+];
+
+/// The reconfiguration above as sequenced command 65534: the sequence number takes bytes 10–11.
+const COMMAND_RECONFIGURE_SEQUENCED: [u8; COMMAND_LEN] = [
+    b'M', b'I', b'C', b'M', // 0-3 header
+    0xff, // 4 board 255
+    0x60, // 5 opcode: reconfigure
+    0x00, 0x00, // 6-7 hip: unused, zero
+    b'n', // 8 final (target) state
+    b'h', // 9 initial state
+    0xfe, 0xff, // 10-11 sequence number 65534
+    0xb4, 0x70, // 12-13 CRC-16 0x70b4
+];
+
+#[test]
+fn golden_command_sequenced() {
+    let arm = CommandRepr {
+        board: BoardNumber::new(7).unwrap(),
+        command: Command::Arm {
+            side: Side::B,
+            target: ServoTarget::Position(pw(1200)),
+        },
+        seq: 0x0102,
+    };
+    assert_crc(&COMMAND_ARM_SEQUENCED);
+    assert_eq!(arm.to_bytes(), COMMAND_ARM_SEQUENCED);
+    assert_eq!(CommandRepr::parse(&COMMAND_ARM_SEQUENCED), Ok(arm));
+    let reconf = CommandRepr {
+        board: BoardNumber::new(255).unwrap(),
+        command: Command::reconfigure(State::H, State::N).unwrap(),
+        seq: 65534,
+    };
+    assert_crc(&COMMAND_RECONFIGURE_SEQUENCED);
+    assert_eq!(reconf.to_bytes(), COMMAND_RECONFIGURE_SEQUENCED);
+    assert_eq!(
+        CommandRepr::parse(&COMMAND_RECONFIGURE_SEQUENCED),
+        Ok(reconf)
+    );
+}
+
 /// Robot 3, Operational, bolting pair 2 (attempt 1) after reconfiguring towards m, with the
 /// low-battery and arm-not-contracted faults latched, answering a command it refused for an
-/// invalid parameter.
+/// invalid parameter: the sequenced command 0x1234.
 #[rustfmt::skip]
 const HEARTBEAT: [u8; HEARTBEAT_LEN] = [
     b'M', b'I', b'H', b'B', // 0-3 header
@@ -130,11 +182,12 @@ const HEARTBEAT: [u8; HEARTBEAT_LEN] = [
     0x01,       // 54 command complete
     0x02,       // 55 active bolter: pair 2
     0x01,       // 56 bolter attempt 1
-    0x00, 0x00, 0x00, // 57-59 empty
+    0x34, 0x12, // 57-58 last sequenced command 0x1234 (paper: empty)
+    0x00,       // 59 empty
     0x02, 0x08, // 60-61 faults: bit 1 (arm not contracted) | bit 11 (low battery)
     0x05,       // 62 refusal of the last command: 5, invalid parameter
     0x02,       // 63 mode: operational
-    0xbf, 0x7b, // 64-65 CRC-16 0x7bbf
+    0x30, 0x72, // 64-65 CRC-16 0x7230
 ];
 
 #[test]
@@ -178,6 +231,7 @@ fn golden_heartbeat() {
             .with(Fault::LowBattery),
         refusal: Some(Refusal::InvalidParameter),
         mode: Mode::Operational,
+        last_seq: 0x1234,
     };
     assert_crc(&HEARTBEAT);
     assert_eq!(repr.to_bytes(), HEARTBEAT);

@@ -91,7 +91,7 @@ fn packets_match_spec_field_by_field_and_cell_by_cell() {
             }
         }
     }
-    assert_eq!(checked_fields, 7 + 35 + 32 + 9);
+    assert_eq!(checked_fields, 7 + 36 + 32 + 9);
     assert_eq!(checked_cells, 14 + 66 + 47);
 }
 

@@ -70,7 +70,13 @@ pub fn valid_packets() -> Vec<(PacketKind, &'static str, Vec<u8>)> {
         (
             PacketKind::Command,
             name,
-            CommandRepr { board, command }.to_bytes().to_vec(),
+            CommandRepr {
+                board,
+                command,
+                seq: 0,
+            }
+            .to_bytes()
+            .to_vec(),
         )
     };
     vec![

@@ -58,6 +58,7 @@ Examples (command packet, Table 2):
   mmic encode command '{\"board\":1,\"command\":{\"primitive\":4}}'
   mmic encode command '{\"board\":1,\"command\":{\"reconfigure\":{\"initial\":\"a\",\"target\":\"m\"}}}'
   mmic encode command '{\"board\":1,\"command\":{\"power\":{\"target\":{\"module\":\"hip\"},\"on\":true}}}'
+  mmic encode command '{\"board\":1,\"command\":\"stop\",\"seq\":258}'   (exactly-once sequence number; omitted = 0)
   mmic encode b-command '{\"seq\":1,\"flags\":{\"regulator\":true,\"arm\":true,\"gripper\":false,\"bolter\":false,\"stop\":false},\"arm_target\":1500,\"gripper_target\":500,\"bolter\":null}'
 
 Exit codes: 0 success, 2 bad kind or JSON (the message names the field and the allowed range).";
@@ -72,9 +73,11 @@ in µs, hip angles in 0.01°, voltages in mV, currents in mA; `null` is an empty
 const DECODE_AFTER: &str = "\
 Examples:
   mmic decode command 4d49434d0102000000000000ad97
-    {\"board\":1,\"command\":\"stop\"}
+    {\"board\":1,\"command\":\"stop\",\"seq\":0}
   mmic decode command '4d:49:43:4d:01:22:00:00:b0:04:00:00:4a:d4'
-    {\"board\":1,\"command\":{\"arm\":{\"side\":\"a\",\"target\":{\"position\":1200}}}}
+    {\"board\":1,\"command\":{\"arm\":{\"side\":\"a\",\"target\":{\"position\":1200}}},\"seq\":0}
+  mmic decode command 4d49434d0102000000000201eee1
+    {\"board\":1,\"command\":\"stop\",\"seq\":258}
 
 Exit codes: 0 success; 1 not a valid packet, stderr names the failed check, e.g.
   mmic: checksum check failed: command packet: checksum carried 0xd54a, computed 0xd44a

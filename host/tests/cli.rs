@@ -53,6 +53,7 @@ fn every_command_variant_class_round_trips_through_the_binary() {
                 let repr = CommandRepr {
                     board: BoardNumber::new(7).unwrap(),
                     command: c,
+                    seq: 0,
                 };
                 let v = serde_json::to_value(repr).unwrap();
                 round_trip("command", &v);
@@ -75,6 +76,7 @@ fn every_command_variant_class_round_trips_through_the_binary() {
                 let repr = CommandRepr {
                     board: BoardNumber::ONE,
                     command: Command::Reconfigure(r),
+                    seq: 0,
                 };
                 round_trip("command", &serde_json::to_value(repr).unwrap());
                 n += 1;
@@ -96,7 +98,8 @@ fn other_kinds_round_trip_with_non_default_values() {
         "gripper_a_target": 1000, "gripper_a_now": 1100, "gripper_b_target": 1200, "gripper_b_now": 1300,
         "electrical_a": electrical(11000), "electrical_b": electrical(10500),
         "target_state": "n", "command_complete": true, "active_bolter": 3, "bolter_attempt": 2,
-        "faults": ["hip_mismatch", "low_battery"], "refusal": "not_allowed_in_mode", "mode": "safed"
+        "faults": ["hip_mismatch", "low_battery"], "refusal": "not_allowed_in_mode", "mode": "safed",
+        "last_seq": 65535
     });
     round_trip("heartbeat", &hb);
     let ihb = json!({
@@ -133,7 +136,7 @@ fn golden_command_hex() {
     let hex = ok(&[
         "encode",
         "command",
-        r#"{"board":1,"command":{"arm":{"side":"a","target":{"position":1200}}}}"#,
+        r#"{"board":1,"command":{"arm":{"side":"a","target":{"position":1200}}},"seq":0}"#,
     ]);
     assert_eq!(hex, "4d49434d01220000b00400004ad4");
     // Separators and 0x prefixes are accepted on decode.
@@ -144,7 +147,7 @@ fn golden_command_hex() {
     ]);
     assert_eq!(
         v,
-        r#"{"board":1,"command":{"arm":{"side":"a","target":{"position":1200}}}}"#
+        r#"{"board":1,"command":{"arm":{"side":"a","target":{"position":1200}}},"seq":0}"#
     );
 }
 
@@ -351,7 +354,7 @@ fn golden_reconfiguration_hex() {
         0x4d, 0x49, 0x43, 0x4d, 0x01, 0x60, 0x00, 0x00, 0x6d, 0x61, 0x00, 0x00,
     ];
     assert_eq!(crc16_bitwise(&body), 0x885b);
-    let json = r#"{"board":1,"command":{"reconfigure":{"initial":"a","target":"m"}}}"#;
+    let json = r#"{"board":1,"command":{"reconfigure":{"initial":"a","target":"m"}},"seq":0}"#;
     assert_eq!(
         ok(&["encode", "command", json]),
         "4d49434d016000006d6100005b88"
@@ -557,7 +560,7 @@ fn help_explains_units_exit_codes_and_gives_examples() {
             examples += 1;
         }
     }
-    assert_eq!(examples, 2, "{dec}");
+    assert_eq!(examples, 3, "{dec}");
     // And every `mmic encode` example in `encode --help` and `--help` is accepted.
     let mut encoded = 0;
     for line in enc.lines().chain(top.lines()) {

@@ -21,6 +21,7 @@
 //! let stop = mmic::wire::command::CommandRepr {
 //!     board: mmic::units::BoardNumber::ONE,
 //!     command: mmic::command::Command::Stop,
+//!     seq: 0,
 //! };
 //! assert!(check_parse::<CommandRepr>(&Repr::to_bytes(&stop))); // accepted, canonical
 //! ```
@@ -260,6 +261,7 @@ fn sample_command(s: &mut Seed<'_>) -> CommandRepr {
     CommandRepr {
         board: BoardNumber::new(1 + s.u8() % 255).expect("1..=255"),
         command: s.command(),
+        seq: s.u16(),
     }
 }
 
@@ -288,6 +290,7 @@ fn sample_heartbeat(s: &mut Seed<'_>) -> HeartbeatRepr {
         },
         refusal: Refusal::from_wire(s.u8() % 8),
         mode: s.pick(&Mode::ALL),
+        last_seq: s.u16(),
     }
 }
 

@@ -6,17 +6,18 @@
 //! use mmic::units::BoardNumber;
 //! use mmic::wire::command::CommandRepr;
 //!
-//! let repr = CommandRepr { board: BoardNumber::ONE, command: Command::reconfigure(State::A, State::M).unwrap() };
+//! let repr = CommandRepr { board: BoardNumber::ONE, command: Command::reconfigure(State::A, State::M).unwrap(), seq: 7 };
 //! let bytes = repr.to_bytes();
 //! assert_eq!(&bytes[..4], b"MICM");
 //! assert_eq!(bytes[5], 0x60);            // reconfigure opcode
 //! assert_eq!((bytes[8], bytes[9]), (b'm', b'a')); // final, initial state
+//! assert_eq!((bytes[10], bytes[11]), (7, 0));     // exactly-once sequence number
 //! assert_eq!(CommandRepr::parse(&bytes), Ok(repr));
 //! ```
 
 use super::layout::{span, FieldSpec, Unit};
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
-use crate::command::{Command, PARAM_LEN, PARAM_OFFSET};
+use crate::command::{seq_slot, Command, PARAM_LEN, PARAM_OFFSET};
 use crate::units::BoardNumber;
 use zerocopy::byteorder::little_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -140,6 +141,11 @@ pub struct CommandRepr {
     pub board: BoardNumber,
     /// The command.
     pub command: Command,
+    /// Exactly-once sequence number, 1..=65535, carried in the parameter slot
+    /// [`seq_slot`](crate::command::seq_slot) leaves free; 0 = unsequenced, the paper's
+    /// behaviour (board A executes every copy). See spec/protocol/README.md.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub seq: u16,
 }
 
 impl CommandRepr {
@@ -157,13 +163,23 @@ impl CommandRepr {
         })?;
         let mut params = [0u8; PARAM_LEN];
         params.copy_from_slice(&bytes[PARAM_OFFSET..PARAM_OFFSET + PARAM_LEN]);
+        let at = seq_slot(p.command).offset();
+        let seq = u16::from_le_bytes([params[at], params[at + 1]]);
+        params[at] = 0;
+        params[at + 1] = 0;
         let command = Command::decode(p.command, params)?;
-        Ok(CommandRepr { board, command })
+        Ok(CommandRepr {
+            board,
+            command,
+            seq,
+        })
     }
 
     /// Writes the packet, header and checksum included.
     pub fn emit(&self, out: &mut [u8; COMMAND_LEN]) {
-        let (id, params) = self.command.encode();
+        let (id, mut params) = self.command.encode();
+        let at = seq_slot(id).offset();
+        params[at..at + 2].copy_from_slice(&self.seq.to_le_bytes());
         out[field::BOARD.start] = self.board.get();
         out[field::COMMAND.start] = id;
         out[PARAM_OFFSET..PARAM_OFFSET + PARAM_LEN].copy_from_slice(&params);

@@ -17,7 +17,7 @@
 //! use mmic::command::Command;
 //! use mmic::units::BoardNumber;
 //!
-//! let pkt = CommandRepr { board: BoardNumber::ONE, command: Command::Stop }.to_bytes();
+//! let pkt = CommandRepr { board: BoardNumber::ONE, command: Command::Stop, seq: 0 }.to_bytes();
 //! let mut d = Deframer::<128>::new();
 //! let mut seen = Vec::new();
 //! // Garbage, then the packet split across two reads.
@@ -263,6 +263,7 @@ mod tests {
         let pkt = CommandRepr {
             board: BoardNumber::ONE,
             command: Command::Reset,
+            seq: 0,
         }
         .to_bytes();
         // A heartbeat header (66-byte candidate) whose span covers a whole valid command.
@@ -299,6 +300,7 @@ mod tests {
         let a = CommandRepr {
             board: BoardNumber::ONE,
             command: Command::Stop,
+            seq: 0,
         }
         .to_bytes();
         let b = HeartbeatRepr::default().to_bytes();

@@ -5,7 +5,9 @@
 //! let hb = HeartbeatRepr::default();
 //! let bytes = hb.to_bytes();
 //! assert_eq!(bytes.len(), HEARTBEAT_LEN);
-//! assert_eq!(&bytes[57..60], &[0, 0, 0]); // the "empty" bytes
+//! assert_eq!(&bytes[57..60], &[0, 0, 0]); // the paper's "empty" bytes: no sequenced command yet
+//! let acked = HeartbeatRepr { last_seq: 0x0102, ..hb };
+//! assert_eq!(&acked.to_bytes()[57..60], &[2, 1, 0]); // bytes 57–58 acknowledge command 0x0102
 //! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
 
@@ -49,7 +51,8 @@ pub struct HeartbeatPacket {
     pub command_complete: u8,
     pub active_bolter: u8,
     pub bolter_attempt: u8,
-    pub empty: [u8; 3],
+    pub last_seq: U16,
+    pub empty: u8,
     pub faults: [u8; 2],
     pub refusal: u8,
     pub mode: u8,
@@ -214,7 +217,14 @@ pub const FIELDS: &[FieldSpec] = &[
     ),
     f!("active_bolter", active_bolter, u8, Enum, "active bolter"),
     f!("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
-    f!("empty", empty, [u8; 3], Reserved, "empty"),
+    FieldSpec {
+        name: "last_seq",
+        range: span!(HeartbeatPacket, last_seq, U16),
+        unit: Unit::Sequence16,
+        paper: "empty",
+        cells: &["empty", "empty"],
+    },
+    f!("empty", empty, u8, Reserved, "empty"),
     FieldSpec {
         name: "faults",
         range: span!(HeartbeatPacket, faults, [u8; 2]),
@@ -320,6 +330,11 @@ pub struct HeartbeatRepr {
     pub refusal: Option<Refusal>,
     /// Operating mode.
     pub mode: Mode,
+    /// Bytes 57–58 (paper: "empty"): sequence number of the last sequenced command board A
+    /// has taken (executed or refused), 0 before the first; `refusal` then tells its outcome.
+    /// The ground's acknowledgement for exactly-once commanding (spec/protocol/README.md).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub last_seq: u16,
 }
 
 impl Default for HeartbeatRepr {
@@ -350,6 +365,7 @@ impl Default for HeartbeatRepr {
             faults: Faults::EMPTY,
             refusal: None,
             mode: Mode::Standby,
+            last_seq: 0,
         }
     }
 }
@@ -408,10 +424,8 @@ impl HeartbeatRepr {
                 p.bolter_attempt as u32,
             )
         })?;
-        for (i, &b) in p.empty.iter().enumerate() {
-            if b != 0 {
-                return Err(field_err(KIND, at!(empty) + i, "empty", "0", b as u32));
-            }
+        if p.empty != 0 {
+            return Err(field_err(KIND, at!(empty), "empty", "0", p.empty as u32));
         }
         let faults = Faults::from_wire(p.faults)
             .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=12 only", e.reserved))?;
@@ -472,6 +486,7 @@ impl HeartbeatRepr {
             faults,
             refusal,
             mode,
+            last_seq: p.last_seq.get(),
         })
     }
 
@@ -498,7 +513,8 @@ impl HeartbeatRepr {
             command_complete: self.command_complete as u8,
             active_bolter: self.active_bolter.map_or(0, BolterPair::number),
             bolter_attempt: self.bolter_attempt.get(),
-            empty: [0; 3],
+            last_seq: U16::new(self.last_seq),
+            empty: 0,
             faults: self.faults.to_wire(),
             refusal: self.refusal.map_or(0, Refusal::to_wire),
             mode: self.mode.to_wire(),

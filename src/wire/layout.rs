@@ -87,6 +87,8 @@ pub enum Unit {
     Bits,
     /// Wrapping 8-bit sequence number.
     Sequence,
+    /// 16-bit sequence number, little-endian (exactly-once commanding).
+    Sequence16,
     /// Zero on emit; refused unless zero on parse.
     Reserved,
     /// Parameter bytes whose meaning depends on the opcode.
@@ -111,6 +113,7 @@ impl Unit {
             Unit::Enum => "enum",
             Unit::Bits => "bits",
             Unit::Sequence => "seq",
+            Unit::Sequence16 => "seq16",
             Unit::Reserved => "reserved",
             Unit::Parameter => "param",
             Unit::Crc16 => "crc16",
