@@ -40,6 +40,7 @@ pub mod control;
 pub mod faults;
 pub mod mode;
 pub mod motion;
+pub mod node;
 pub mod refusal;
 pub mod safety;
 pub mod sensors;

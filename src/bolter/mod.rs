@@ -19,7 +19,7 @@ mod coordinator;
 mod side;
 
 pub use coordinator::{Config, Coordinator, Job, Output, Status};
-pub use side::{BolterSide, Drive, Signals};
+pub use side::{BolterSide, Drive, SideConfig, Signals};
 
 /// Bolting or unbolting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -1,0 +1,816 @@
+//! Board A: the robot's primary board as one pure tick.
+//!
+//! Each tick takes what the shell gathered since the last one — at most one command packet
+//! from the WiFi hand-off queue, at most one internal heartbeat from board B's serial line,
+//! and side A's filtered sensors — and returns side A's module outputs, the A→B command to
+//! send (if one is due), the 66-byte heartbeat answering the command (if one came), and what
+//! happened, as [`Event`]s for logs. Inside, the pieces of the earlier modules are joined in
+//! the order the paper gives: fault detection, then the mode supervisor (Tables 7 and 8),
+//! then the command (exactly-once log, supervisor, dispatch), then motion (reconfiguration
+//! runner, single-module moves), bolting (coordinator and side A's executor), and finally the
+//! servo and hip outputs.
+//!
+//! ```
+//! use mmic::command::Command;
+//! use mmic::mode::Mode;
+//! use mmic::node::board_a::{BoardA, Config, Inputs};
+//! use mmic::units::BoardNumber;
+//! use mmic::wire::command::CommandRepr;
+//! use mmic::wire::heartbeat::HeartbeatRepr;
+//!
+//! let mut a = BoardA::new(Config::default());
+//! let cmd = CommandRepr { board: BoardNumber::ONE, command: Command::Mode(Mode::Operational), seq: 1 };
+//! let out = a.tick(0, &Inputs { command: Some(cmd.to_bytes()), ..Inputs::at_home() });
+//! let hb = HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
+//! assert_eq!((hb.mode, hb.last_seq, hb.refusal), (Mode::Operational, 1, None));
+//! // The same packet again (its heartbeat was lost): answered, not run again.
+//! let out = a.tick(10, &Inputs { command: Some(cmd.to_bytes()), ..Inputs::at_home() });
+//! assert_eq!(HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap().last_seq, 1);
+//! assert!(out.events.iter().any(|e| matches!(e, mmic::node::board_a::Event::Duplicate { seq: 1 })));
+//! ```
+
+use super::exactly_once::{Admission, CommandLog};
+use crate::bolter::{self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals};
+use crate::command::{
+    preset_angle, seq_slot, BolterCommand, Command, CommandKind, HipTarget, ServoTarget,
+};
+use crate::control::hip::{self, HipController};
+use crate::control::interp::{Interpolator, Rate, Travel};
+use crate::faults::{Fault, Faults};
+use crate::mode::Mode;
+use crate::motion::estimate::{self, initial_state_consistent, Readings};
+use crate::motion::runner::{RunStatus, Runner};
+use crate::motion::sequencer::{self, Feedback, Targets};
+use crate::motion::{map, State};
+use crate::refusal::Refusal;
+use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
+use crate::safety::ModuleSet;
+use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
+use crate::units::{BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth};
+use crate::wire::b_command::{BCommandRepr, BPower, B_COMMAND_LEN};
+use crate::wire::command::{CommandRepr, COMMAND_LEN};
+use crate::wire::heartbeat::{BolterAttempt, HeartbeatRepr, HEARTBEAT_LEN};
+use crate::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
+use crate::wire::WireError;
+
+/// Board A's settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Config {
+    /// This robot's number.
+    pub board: BoardNumber,
+    /// Fault thresholds and timeouts (Table 8).
+    pub safety: detect::Config,
+    /// Primitive step timing.
+    pub motion: sequencer::Config,
+    /// Bolting.
+    pub bolter: coordinator::Config,
+    /// Servo interpolation rate (both sides).
+    pub rate: Rate,
+    /// What contract/extend mean for the arms.
+    pub arm: Travel,
+    /// What contract/extend mean for the grippers (extend = closed on a face).
+    pub gripper: Travel,
+    /// Hip PI controller.
+    pub hip: hip::Config,
+    /// A hip move is done within this distance of its target, 0.01°.
+    pub hip_done_tolerance: u16,
+    /// State estimation.
+    pub estimate: estimate::Config,
+    /// A→B command period, ms (sent sooner when its content changes).
+    pub b_period_ms: u32,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        let pw = |us| match PulseWidth::new(us) {
+            Ok(p) => p,
+            Err(_) => PulseWidth::CENTER,
+        };
+        Config {
+            board: BoardNumber::ONE,
+            safety: detect::Config::default(),
+            motion: sequencer::Config::default(),
+            bolter: coordinator::Config::default(),
+            rate: Rate::default(),
+            arm: Travel {
+                contracted: pw(900),
+                extended: pw(2100),
+            },
+            gripper: Travel {
+                contracted: pw(1000),
+                extended: pw(2000),
+            },
+            hip: hip::Config::default(),
+            hip_done_tolerance: 150,
+            estimate: estimate::Config::default(),
+            b_period_ms: 50,
+        }
+    }
+}
+
+/// One tick's inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Inputs {
+    /// A command packet from the WiFi hand-off queue.
+    pub command: Option<[u8; COMMAND_LEN]>,
+    /// An internal heartbeat from board B.
+    pub from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
+    /// Side A's filtered voltages and currents.
+    pub electrical: Electrical,
+    /// Hip encoder angle.
+    pub hip: HipAngle,
+    /// Gravity in A's IMU frame.
+    pub gravity: Option<Gravity>,
+    /// Arm A's contraction switch.
+    pub arm_contracted: bool,
+    /// Bolter A's signals.
+    pub bolter: Signals,
+}
+
+impl Inputs {
+    /// Nothing received; a full battery, no current; hip at the default home angle (180°),
+    /// arm A contracted.
+    pub const fn at_home() -> Inputs {
+        Inputs {
+            command: None,
+            from_b: None,
+            electrical: Electrical {
+                v_bat: 12_000,
+                i_bat: 0,
+                i_loc: 0,
+                i_grip: 0,
+                i_3v3: 0,
+                v_reg: 7_400,
+                i_bo: 0,
+            },
+            hip: match HipAngle::new(18000) {
+                Ok(a) => a,
+                Err(_) => HipAngle::ZERO,
+            },
+            gravity: None,
+            arm_contracted: true,
+            bolter: Signals {
+                threshold: false,
+                locked: false,
+                at_home: true,
+            },
+        }
+    }
+}
+
+/// Something that happened in a tick, for logs and tests.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Event {
+    /// A command was taken and run (or refused) — once per sequence number.
+    Executed {
+        /// Its sequence number (0 = unsequenced).
+        seq: u16,
+        /// The command.
+        command: Command,
+        /// Refused, and why; none = accepted.
+        refusal: Option<Refusal>,
+    },
+    /// A copy of the last command taken: answered, not run.
+    Duplicate {
+        /// Its sequence number.
+        seq: u16,
+    },
+    /// A late copy of an older command: answered, not run.
+    Stale {
+        /// Its sequence number.
+        seq: u16,
+    },
+    /// A packet failed its length, header or checksum check: dropped unanswered (the ground
+    /// resends it).
+    Rejected(WireError),
+    /// A command for another robot: dropped unanswered.
+    OtherRobot {
+        /// The robot it was for.
+        board: BoardNumber,
+    },
+    /// Faults latched this tick.
+    Faults(Faults),
+    /// The mode changed.
+    Mode {
+        /// Before.
+        from: Mode,
+        /// After.
+        to: Mode,
+    },
+    /// A reconfiguration or primitive reached its target state.
+    Reached(State),
+    /// A bolting job ended: done (`None`) or failed with this fault.
+    Bolting(Option<Fault>),
+}
+
+/// Events per tick (more are counted in [`Outputs::events_lost`]).
+pub const EVENTS: usize = 6;
+
+/// One tick's outputs.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Outputs {
+    /// Hip servo pulse; none = unpowered.
+    pub hip: Option<PulseWidth>,
+    /// Arm A pulse; none = unpowered.
+    pub arm: Option<PulseWidth>,
+    /// Gripper A pulse; none = unpowered.
+    pub gripper: Option<PulseWidth>,
+    /// 7.4 V regulator.
+    pub regulator: bool,
+    /// Bolter A motor.
+    pub bolter: Drive,
+    /// Bolter A multiplexer lines.
+    pub mux: MuxLines,
+    /// A→B command to send now.
+    pub to_b: Option<[u8; B_COMMAND_LEN]>,
+    /// Heartbeat answering this tick's command.
+    pub heartbeat: Option<[u8; HEARTBEAT_LEN]>,
+    /// What happened.
+    pub events: heapless::Vec<Event, EVENTS>,
+    /// Events that did not fit (never expected; counted so none is lost silently).
+    pub events_lost: u8,
+}
+
+impl Outputs {
+    fn push(&mut self, e: Event) {
+        if self.events.push(e).is_err() {
+            self.events_lost = self.events_lost.saturating_add(1);
+        }
+    }
+}
+
+/// Board A's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BoardA {
+    cfg: Config,
+    sup: Supervisor,
+    log: CommandLog,
+    comm: CommMonitor,
+    battery: LowBattery,
+    runner: Option<Runner>,
+    tracked: Option<State>,
+    target_state: Option<State>,
+    complete: bool,
+    coord: Coordinator,
+    side_a: BolterSide,
+    waiting_job: Option<Job>,
+    targets: Targets,
+    arm: Interpolator,
+    gripper: Interpolator,
+    hip_ctl: HipController,
+    b: InternalHeartbeatRepr,
+    b_heard: bool,
+    b_sent: Option<(u32, BCommandRepr)>,
+    contracting: bool,
+    refusal: Option<Refusal>,
+    moving: bool,
+}
+
+/// Commands that move something.
+const fn moves(kind: CommandKind) -> bool {
+    matches!(
+        kind,
+        CommandKind::Arm
+            | CommandKind::Gripper
+            | CommandKind::Hip
+            | CommandKind::Bolter
+            | CommandKind::Primitive
+            | CommandKind::Reconfiguration
+    )
+}
+
+impl BoardA {
+    /// Startup: Standby, no state known, servos at their home pulses.
+    pub fn new(cfg: Config) -> BoardA {
+        let home = Targets::home();
+        BoardA {
+            cfg,
+            sup: Supervisor::new(),
+            log: CommandLog::new(),
+            comm: CommMonitor::default(),
+            battery: LowBattery::default(),
+            runner: None,
+            tracked: None,
+            target_state: None,
+            complete: false,
+            coord: Coordinator::new(),
+            side_a: BolterSide::new(),
+            waiting_job: None,
+            targets: Targets {
+                hip: cfg.safety.hip_home,
+                ..home
+            },
+            arm: Interpolator::new(cfg.arm.contracted, cfg.rate),
+            gripper: Interpolator::new(cfg.gripper.extended, cfg.rate),
+            hip_ctl: HipController::new(cfg.hip),
+            b: InternalHeartbeatRepr::default(),
+            b_heard: false,
+            b_sent: None,
+            contracting: false,
+            refusal: None,
+            moving: false,
+        }
+    }
+
+    /// Starts knowing the state the robot is in (the host simulator's initial pose).
+    pub fn in_state(cfg: Config, state: State) -> BoardA {
+        let mut a = BoardA::new(cfg);
+        a.tracked = Some(state);
+        a
+    }
+
+    /// Mode.
+    pub const fn mode(&self) -> Mode {
+        self.sup.mode()
+    }
+
+    /// Latched faults.
+    pub const fn faults(&self) -> Faults {
+        self.sup.faults()
+    }
+
+    /// The state last reached, if known.
+    pub const fn state(&self) -> Option<State> {
+        self.tracked
+    }
+
+    /// The exactly-once log: last sequenced command and its outcome.
+    pub const fn last_command(&self) -> (u16, Option<Refusal>) {
+        self.log.last()
+    }
+
+    /// A motion or bolting job was running at the last tick (a reconfiguration, a bolting
+    /// job, or a module still moving to its target).
+    pub const fn in_motion(&self) -> bool {
+        self.moving
+    }
+
+    fn moving_now(&self, fb: &Feedback) -> bool {
+        self.runner.is_some_and(|r| r.status() == RunStatus::Running)
+            || self.coord.status() == coordinator::Status::Running
+            || self.waiting_job.is_some()
+            || !(fb.arm_done[0] && fb.arm_done[1])
+            || !(fb.gripper_done[0] && fb.gripper_done[1])
+            || !fb.hip_done
+    }
+
+    fn feedback(&self, hip_now: HipAngle, arm_a_switch: bool) -> Feedback {
+        let b_ok = |now: PulseWidth, target: PulseWidth, want: PulseWidth| {
+            now == target && target == want
+        };
+        Feedback {
+            arm_done: [
+                self.arm.done(),
+                b_ok(
+                    self.b.arm_b_now,
+                    self.b.arm_b_target,
+                    self.cfg.arm.resolve(self.targets.arm[1]),
+                ),
+            ],
+            gripper_done: [
+                self.gripper.done(),
+                b_ok(
+                    self.b.gripper_b_now,
+                    self.b.gripper_b_target,
+                    self.cfg.gripper.resolve(self.targets.gripper[1]),
+                ),
+            ],
+            hip_done: hip_distance(hip_now, self.targets.hip) <= self.cfg.hip_done_tolerance,
+            arm_switch: [arm_a_switch, self.b.arm_contracted],
+        }
+    }
+
+    /// One tick at `now` (ms, wrapping).
+    pub fn tick(&mut self, now: u32, inp: &Inputs) -> Outputs {
+        let mut out = Outputs {
+            hip: None,
+            arm: None,
+            gripper: None,
+            regulator: false,
+            bolter: Drive::Idle,
+            mux: MuxLines::default(),
+            to_b: None,
+            heartbeat: None,
+            events: heapless::Vec::new(),
+            events_lost: 0,
+        };
+        // Board B's report.
+        self.comm.tick(now);
+        if let Some(bytes) = inp.from_b {
+            match InternalHeartbeatRepr::parse(&bytes) {
+                Ok(hb) => {
+                    self.comm.heartbeat(now, hb.command_received);
+                    self.b = hb;
+                    self.b_heard = true;
+                }
+                Err(e) => out.push(Event::Rejected(e)),
+            }
+        }
+        let fb = self.feedback(inp.hip, inp.arm_contracted);
+
+        // Motion and bolting advance first, so the supervisor sees whether they still run.
+        let mut events_faults = Faults::EMPTY;
+        if let Some(mut r) = self.runner {
+            match r.step(now, &fb) {
+                RunStatus::Running => {
+                    self.targets = r.targets();
+                    self.runner = Some(r);
+                }
+                RunStatus::Complete => {
+                    self.targets = r.targets();
+                    self.tracked = Some(r.current_state());
+                    self.complete = true;
+                    self.runner = None;
+                    out.push(Event::Reached(r.current_state()));
+                }
+                RunStatus::Failed(f) => {
+                    self.tracked = None;
+                    self.runner = None;
+                    events_faults = events_faults.with(f);
+                }
+            }
+        }
+        self.bolting(now, &mut out, &mut events_faults);
+        // Arm contraction check (Table 8): when a commanded contraction of arm A ends.
+        if self.contracting && self.arm.done() {
+            self.contracting = false;
+            if detect::arm_contraction_fault(true, inp.arm_contracted) {
+                events_faults = events_faults.with(Fault::ArmNotContracted);
+            }
+        }
+
+        // Conditions holding now.
+        let e_b = self.b.electrical_b;
+        let mut conditions = detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, &e_b);
+        let in_motion = self.moving_now(&self.feedback(inp.hip, inp.arm_contracted));
+        self.moving = in_motion;
+        if !in_motion {
+            conditions =
+                conditions.union(detect::idle_overcurrent(&self.cfg.safety, &inp.electrical, &e_b));
+        }
+        if self.battery.update(&self.cfg.safety, now, inp.electrical.v_bat, e_b.v_bat) {
+            conditions = conditions.with(Fault::LowBattery);
+        }
+        if self.comm.lost(&self.cfg.safety) {
+            conditions = conditions.with(Fault::InternalCommLoss);
+        }
+
+        // The command, through the exactly-once log.
+        let mut incoming = None;
+        let mut answer_seq = None;
+        if let Some(bytes) = inp.command {
+            match self.receive(&bytes, in_motion) {
+                Received::Ignore(e) => out.push(e),
+                Received::Answer(ev) => {
+                    out.push(ev);
+                    answer_seq = Some(0);
+                }
+                Received::Run(seq, inc) => {
+                    incoming = Some(inc);
+                    answer_seq = Some(seq);
+                }
+                Received::Refuse(seq, command, r) => {
+                    self.log.record(seq, Some(r));
+                    self.refusal = Some(r);
+                    out.push(Event::Executed {
+                        seq,
+                        command,
+                        refusal: Some(r),
+                    });
+                    answer_seq = Some(seq);
+                }
+            }
+        }
+        let before = (self.sup.mode(), self.sup.faults());
+        let initial_state_ok = match incoming {
+            Some(Incoming::Command(Command::Reconfigure(r))) => {
+                let sensed = estimate::consistent(&self.cfg.estimate, &self.readings(inp));
+                initial_state_consistent(r.initial(), self.tracked, sensed)
+            }
+            _ => true,
+        };
+        let s = self.sup.step(&Input {
+            faults: conditions.union(events_faults),
+            command: incoming,
+            in_motion,
+            hip_at_home: detect::hip_at_home(&self.cfg.safety, inp.hip),
+            initial_state_ok,
+        });
+        if s.stop_motion {
+            self.stop_all(now);
+        }
+        if s.go_home {
+            self.go_home(now);
+        }
+        if let (Some(seq), Some(a)) = (answer_seq, s.answer) {
+            let (command, refusal) = match a {
+                Answer::Accepted(c) => (c, None),
+                Answer::Refused(r) => (
+                    match incoming {
+                        Some(Incoming::Command(c)) => c,
+                        _ => Command::Heartbeat,
+                    },
+                    Some(r),
+                ),
+            };
+            self.log.record(seq, refusal);
+            self.refusal = refusal;
+            if let Answer::Accepted(c) = a {
+                self.dispatch(c, now);
+            }
+            out.push(Event::Executed {
+                seq,
+                command,
+                refusal,
+            });
+        }
+        if s.mode != before.0 {
+            out.push(Event::Mode {
+                from: before.0,
+                to: s.mode,
+            });
+        }
+        let new_faults = Faults::from_iter(s.faults.iter().filter(|f| !before.1.contains(*f)));
+        if !new_faults.is_empty() {
+            out.push(Event::Faults(new_faults));
+        }
+
+        // Outputs.
+        let live = s.mode != Mode::Standby;
+        let p = s.powered;
+        self.arm_targets(now);
+        let arm_now = self.arm.tick(now);
+        let gripper_now = self.gripper.tick(now);
+        let hip_pulse = self.hip_ctl.step(self.targets.hip, inp.hip, now);
+        out.regulator = s.regulator;
+        out.hip = (live && p.contains(Module::Hip)).then_some(hip_pulse);
+        out.arm = (live && p.contains(Module::ArmA)).then_some(arm_now);
+        out.gripper = (live && p.contains(Module::GripperA)).then_some(gripper_now);
+        self.side_a.tick(&self.cfg.bolter.side, now, inp.bolter);
+        if live && p.contains(Module::BolterA) {
+            out.bolter = self.side_a.drive();
+        }
+        out.mux = self.side_a.mux();
+        out.to_b = self.b_command(now, p, s.regulator);
+        if answer_seq.is_some() {
+            out.heartbeat = Some(self.heartbeat(inp, &s.faults).to_bytes());
+        }
+        out
+    }
+
+    fn receive(&mut self, bytes: &[u8], in_motion: bool) -> Received {
+        let repr = match CommandRepr::parse(bytes) {
+            Ok(r) => r,
+            // Header and checksum held but the opcode or parameters are no command: ours to
+            // answer (with its sequence number, so the ground stops resending it).
+            Err(WireError::Command(ce)) if bytes.get(4) == Some(&self.cfg.board.get()) => {
+                let at = 6 + seq_slot(bytes[5]).offset();
+                let seq = u16::from_le_bytes([bytes[at], bytes[at + 1]]);
+                return match self.log.admit(seq) {
+                    Admission::Execute => Received::Refuse(
+                        seq,
+                        Command::Heartbeat,
+                        Refusal::for_command_error(&ce),
+                    ),
+                    Admission::Duplicate => Received::Answer(Event::Duplicate { seq }),
+                    Admission::Stale => Received::Answer(Event::Stale { seq }),
+                };
+            }
+            Err(e) => return Received::Ignore(Event::Rejected(e)),
+        };
+        if repr.board != self.cfg.board {
+            return Received::Ignore(Event::OtherRobot {
+                board: repr.board,
+            });
+        }
+        match self.log.admit(repr.seq) {
+            Admission::Duplicate => return Received::Answer(Event::Duplicate { seq: repr.seq }),
+            Admission::Stale => return Received::Answer(Event::Stale { seq: repr.seq }),
+            Admission::Execute => {}
+        }
+        let c = repr.command;
+        let kind = c.kind();
+        // Board-level checks the supervisor does not make: one motion at a time, and a
+        // primitive must be a move from the state the robot is in.
+        if moves(kind) && in_motion && self.sup.mode() == Mode::Operational {
+            return Received::Refuse(repr.seq, c, Refusal::Busy);
+        }
+        if let Command::Primitive(pr) = c {
+            if self.sup.mode() == Mode::Operational && self.primitive_target(pr).is_none() {
+                return Received::Refuse(repr.seq, c, Refusal::InitialStateMismatch);
+            }
+        }
+        Received::Run(repr.seq, Incoming::Command(c))
+    }
+
+    fn primitive_target(&self, pr: crate::motion::Primitive) -> Option<State> {
+        let from = self.tracked?;
+        State::ALL
+            .into_iter()
+            .find(|&to| map::primitive(from, to) == Some(pr))
+    }
+
+    fn readings(&self, inp: &Inputs) -> Readings {
+        Readings {
+            gravity_a: inp.gravity,
+            gravity_b: self.b.gravity,
+            arm_a_contracted: inp.arm_contracted,
+            arm_b_contracted: self.b.arm_contracted,
+            hip: inp.hip,
+        }
+    }
+
+    fn dispatch(&mut self, c: Command, now: u32) {
+        match c {
+            Command::Arm { side, target } => {
+                self.targets.arm[side as usize] = target;
+                self.contracting = side as usize == 0 && target == ServoTarget::Contract;
+            }
+            Command::Gripper { side, target } => self.targets.gripper[side as usize] = target,
+            Command::Hip(h) => {
+                self.targets.hip = match (h, preset_angle(h)) {
+                    (_, Some(a)) => a,
+                    (HipTarget::Angle(a), None) => a,
+                    _ => self.cfg.safety.hip_home,
+                }
+            }
+            Command::Bolter(b) => {
+                let job = match b {
+                    BolterCommand::Bolt(f) => Job {
+                        direction: BolterDirection::Bolt,
+                        fasteners: f,
+                    },
+                    BolterCommand::Unbolt(f) => Job {
+                        direction: BolterDirection::Unbolt,
+                        fasteners: f,
+                    },
+                    // Both bolters down: the first step of a bolting run on the selected pair.
+                    BolterCommand::Down => Job {
+                        direction: BolterDirection::Bolt,
+                        fasteners: crate::command::Fasteners::Pair(crate::command::BolterPair::P1),
+                    },
+                };
+                self.waiting_job = Some(job);
+                self.bolting_start(now);
+            }
+            Command::Primitive(pr) => {
+                if let (Some(from), Some(to)) = (self.tracked, self.primitive_target(pr)) {
+                    self.start_run(from, to, now);
+                }
+            }
+            Command::Reconfigure(r) => {
+                let from = self.tracked.unwrap_or(r.initial());
+                self.start_run(from, r.target(), now);
+            }
+            _ => {}
+        }
+    }
+
+    fn start_run(&mut self, from: State, to: State, now: u32) {
+        self.target_state = Some(to);
+        self.complete = from == to;
+        if from != to {
+            self.runner = Some(Runner::start(self.cfg.motion, from, to, self.targets, now));
+            if let Some(r) = self.runner {
+                self.targets = r.targets();
+            }
+        }
+    }
+
+    /// A new job waits until B reports idle, so that B's executor cannot mistake the job's
+    /// first order for its previous one (spec/control/bolter.md).
+    fn bolting_start(&mut self, now: u32) {
+        if let Some(job) = self.waiting_job {
+            if self.b.bolter_aux.step.is_none() || !self.b_heard {
+                self.coord.start(job, now);
+                self.waiting_job = None;
+            }
+        }
+    }
+
+    fn bolting(&mut self, now: u32, out: &mut Outputs, faults: &mut Faults) {
+        self.bolting_start(now);
+        let was = self.coord.status();
+        let b = self.b_heard.then_some(&self.b.bolter_aux);
+        let o = self.coord.step(&self.cfg.bolter, now, &self.side_a.aux(), b);
+        let order = o.order;
+        self.side_a.order(order.map_or(0, |(s, _)| s), order.map(|(_, o)| o), now);
+        if was == coordinator::Status::Running && o.status != coordinator::Status::Running {
+            match o.status {
+                coordinator::Status::Failed(f) => {
+                    *faults = faults.with(f);
+                    out.push(Event::Bolting(Some(f)));
+                }
+                _ => out.push(Event::Bolting(None)),
+            }
+        }
+    }
+
+    fn stop_all(&mut self, now: u32) {
+        self.runner = None;
+        self.coord.stop();
+        self.waiting_job = None;
+        self.side_a.order(0, None, now);
+        self.targets.arm = [
+            ServoTarget::Position(self.arm.now()),
+            ServoTarget::Position(self.b.arm_b_now),
+        ];
+        self.targets.gripper = [
+            ServoTarget::Position(self.gripper.now()),
+            ServoTarget::Position(self.b.gripper_b_now),
+        ];
+        self.contracting = false;
+    }
+
+    fn go_home(&mut self, now: u32) {
+        let _ = now;
+        self.targets = Targets {
+            hip: self.cfg.safety.hip_home,
+            ..Targets::home()
+        };
+    }
+
+    fn arm_targets(&mut self, now: u32) {
+        let arm = self.cfg.arm.resolve(self.targets.arm[0]);
+        if self.arm.target() != arm {
+            self.arm.set_target(arm, now);
+        }
+        let gripper = self.cfg.gripper.resolve(self.targets.gripper[0]);
+        if self.gripper.target() != gripper {
+            self.gripper.set_target(gripper, now);
+        }
+    }
+
+    fn b_command(&mut self, now: u32, p: ModuleSet, regulator: bool) -> Option<[u8; B_COMMAND_LEN]> {
+        let order = self.coord.order();
+        let last_seq = self.b_sent.map_or(0, |(_, c)| c.seq);
+        let live = self.sup.mode() != Mode::Standby;
+        let cmd = BCommandRepr {
+            // The coordinator's order number while an order runs (B records the packet's
+            // number with the order); otherwise the last number sent.
+            seq: order.map_or(last_seq, |(s, _)| s),
+            power: BPower {
+                regulator,
+                arm: live && p.contains(Module::ArmB),
+                gripper: live && p.contains(Module::GripperB),
+                bolter: live && p.contains(Module::BolterB),
+            },
+            stop: self.sup.stopped() || self.sup.mode() == Mode::Safed,
+            arm_target: self.cfg.arm.resolve(self.targets.arm[1]),
+            gripper_target: self.cfg.gripper.resolve(self.targets.gripper[1]),
+            bolter: order.map(|(_, o)| o),
+        };
+        let due = match self.b_sent {
+            None => true,
+            Some((t, last)) => last != cmd || detect::elapsed(t, now) >= self.cfg.b_period_ms,
+        };
+        if !due {
+            return None;
+        }
+        self.b_sent = Some((now, cmd));
+        self.comm.sent(cmd.seq);
+        Some(cmd.to_bytes())
+    }
+
+    fn heartbeat(&self, inp: &Inputs, faults: &Faults) -> HeartbeatRepr {
+        let (last_seq, _) = self.log.last();
+        let o = self.coord.order();
+        HeartbeatRepr {
+            board: self.cfg.board,
+            hip_target: self.targets.hip,
+            hip_now: inp.hip,
+            arm_a_target: self.arm.target(),
+            arm_a_now: self.arm.now(),
+            arm_b_target: self.b.arm_b_target,
+            arm_b_now: self.b.arm_b_now,
+            gripper_a_target: self.gripper.target(),
+            gripper_a_now: self.gripper.now(),
+            gripper_b_target: self.b.gripper_b_target,
+            gripper_b_now: self.b.gripper_b_now,
+            electrical_a: inp.electrical,
+            electrical_b: self.b.electrical_b,
+            target_state: self.target_state,
+            command_complete: self.complete,
+            active_bolter: o.map(|(_, o)| o.pair),
+            bolter_attempt: match (o, BolterAttempt::new(self.coord.attempt())) {
+                (Some(_), Ok(a)) => a,
+                _ => BolterAttempt::NONE,
+            },
+            faults: *faults,
+            refusal: self.refusal,
+            mode: self.sup.mode(),
+            last_seq,
+        }
+    }
+}
+
+enum Received {
+    /// Not for us, or not a packet: no answer.
+    Ignore(Event),
+    /// A copy: answer with the log's record.
+    Answer(Event),
+    /// Hand to the supervisor.
+    Run(u16, Incoming),
+    /// Refused by board A itself.
+    Refuse(u16, Command, Refusal),
+}

@@ -1,0 +1,227 @@
+//! Board B: executes board A's commands on side B, acknowledges them, and reports.
+//!
+//! Each tick takes at most one A→B command packet (from the serial deframer) and side B's
+//! filtered sensors; it returns side B's module outputs and, every `heartbeat_period_ms`, the
+//! 47-byte internal heartbeat of Table 4, whose byte 35 echoes the last command's sequence
+//! number (the acknowledgement). If A falls silent for `link_timeout_ms`, B holds its servos
+//! where they are and idles its bolter until A speaks again: B never moves on stale orders.
+//!
+//! ```
+//! use mmic::node::board_b::{BoardB, Config, Inputs};
+//! use mmic::wire::b_command::{BCommandRepr, BPower};
+//! use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
+//! use mmic::units::PulseWidth;
+//!
+//! let mut b = BoardB::new(Config::default());
+//! let cmd = BCommandRepr {
+//!     seq: 7, power: BPower { regulator: true, arm: true, gripper: true, bolter: false },
+//!     stop: false, arm_target: PulseWidth::new(2000).unwrap(),
+//!     gripper_target: PulseWidth::CENTER, bolter: None,
+//! };
+//! let out = b.tick(0, &Inputs { command: Some(cmd.to_bytes()), ..Inputs::default() });
+//! let hb = InternalHeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
+//! assert_eq!(hb.command_received, 7);              // acknowledged
+//! assert_eq!(hb.arm_b_target.micros(), 2000);
+//! let out = b.tick(400, &Inputs::default());       // arm moving at 500 µs/s
+//! assert_eq!(out.arm.unwrap().micros(), 1700);
+//! let out = b.tick(901, &Inputs::default());       // A silent for over 500 ms: hold
+//! assert!(out.link_lost);
+//! assert_eq!(out.arm.unwrap().micros(), 1700);
+//! ```
+
+use crate::bolter::{BolterSide, Drive, MuxLines, Signals, SideConfig};
+use crate::control::interp::{Interpolator, Rate};
+use crate::safety::detect::{self, elapsed};
+use crate::units::{Electrical, Gravity, PulseWidth};
+use crate::wire::b_command::{BCommandRepr, B_COMMAND_LEN};
+use crate::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
+use crate::wire::WireError;
+
+/// Board B's settings.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Config {
+    /// Internal heartbeat period, ms. Default 50.
+    pub heartbeat_period_ms: u32,
+    /// Silence from A after which B holds everything, ms. Default 500 (A's own timeout).
+    pub link_timeout_ms: u32,
+    /// Servo interpolation rate.
+    pub rate: Rate,
+    /// Bolter step timeouts.
+    pub bolter: SideConfig,
+    /// Current limits for the over-idle and overcurrent flags (Table 4 bytes 38–43).
+    pub limits: detect::Config,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        Config {
+            heartbeat_period_ms: 50,
+            link_timeout_ms: 500,
+            rate: Rate::default(),
+            bolter: SideConfig::default(),
+            limits: detect::Config::default(),
+        }
+    }
+}
+
+/// One tick's inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Inputs {
+    /// An A→B command packet received since the last tick.
+    pub command: Option<[u8; B_COMMAND_LEN]>,
+    /// Side B's filtered voltages and currents.
+    pub electrical: Electrical,
+    /// Gravity in B's IMU frame.
+    pub gravity: Option<Gravity>,
+    /// Arm B's contraction switch.
+    pub arm_contracted: bool,
+    /// Bolter B's signals.
+    pub bolter: Signals,
+}
+
+/// One tick's outputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Outputs {
+    /// Arm B pulse; none = unpowered.
+    pub arm: Option<PulseWidth>,
+    /// Gripper B pulse; none = unpowered.
+    pub gripper: Option<PulseWidth>,
+    /// 7.4 V regulator.
+    pub regulator: bool,
+    /// Bolter B motor (idle when unpowered).
+    pub bolter: Drive,
+    /// Bolter B multiplexer lines.
+    pub mux: MuxLines,
+    /// Internal heartbeat to send now.
+    pub heartbeat: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
+    /// A has been silent past the timeout: holding.
+    pub link_lost: bool,
+    /// The packet received this tick was refused (it is ignored).
+    pub rejected: Option<WireError>,
+}
+
+/// Board B's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BoardB {
+    cfg: Config,
+    arm: Interpolator,
+    gripper: Interpolator,
+    bolter: BolterSide,
+    last: Option<BCommandRepr>,
+    heard: Option<u32>,
+    sent: Option<u32>,
+    holding: bool,
+}
+
+impl BoardB {
+    /// Startup: servos centred, nothing received.
+    pub const fn new(cfg: Config) -> BoardB {
+        BoardB {
+            cfg,
+            arm: Interpolator::new(PulseWidth::CENTER, cfg.rate),
+            gripper: Interpolator::new(PulseWidth::CENTER, cfg.rate),
+            bolter: BolterSide::new(),
+            last: None,
+            heard: None,
+            sent: None,
+            holding: false,
+        }
+    }
+
+    /// Starts with the servos at these pulses (the host simulator's initial pose).
+    pub const fn with_pose(cfg: Config, arm: PulseWidth, gripper: PulseWidth) -> BoardB {
+        let mut b = BoardB::new(cfg);
+        b.arm = Interpolator::new(arm, cfg.rate);
+        b.gripper = Interpolator::new(gripper, cfg.rate);
+        b
+    }
+
+    fn hold(&mut self, now: u32) {
+        self.arm.set_target(self.arm.now(), now);
+        self.gripper.set_target(self.gripper.now(), now);
+        self.bolter.order(0, None, now);
+    }
+
+    /// One tick at `now` (ms).
+    pub fn tick(&mut self, now: u32, inp: &Inputs) -> Outputs {
+        let mut rejected = None;
+        if let Some(bytes) = inp.command {
+            match BCommandRepr::parse(&bytes) {
+                Ok(c) => {
+                    self.heard = Some(now);
+                    self.holding = false;
+                    if c.stop {
+                        self.hold(now);
+                    } else {
+                        if self.arm.target() != c.arm_target {
+                            self.arm.set_target(c.arm_target, now);
+                        }
+                        if self.gripper.target() != c.gripper_target {
+                            self.gripper.set_target(c.gripper_target, now);
+                        }
+                        self.bolter.order(c.seq, c.bolter, now);
+                    }
+                    self.last = Some(c);
+                }
+                Err(e) => rejected = Some(e),
+            }
+        }
+        let silent = match self.heard {
+            Some(t) => elapsed(t, now) > self.cfg.link_timeout_ms,
+            None => false,
+        };
+        if silent && !self.holding {
+            self.holding = true;
+            self.hold(now);
+        }
+        self.bolter.tick(&self.cfg.bolter, now, inp.bolter);
+        let arm_now = self.arm.tick(now);
+        let gripper_now = self.gripper.tick(now);
+        let power = self.last.map(|c| c.power).unwrap_or_default();
+        let live = power.regulator && !self.holding;
+        let heartbeat = match self.sent {
+            Some(t) if elapsed(t, now) < self.cfg.heartbeat_period_ms => None,
+            _ => {
+                self.sent = Some(now);
+                Some(self.report(inp).to_bytes())
+            }
+        };
+        Outputs {
+            arm: (power.regulator && power.arm).then_some(arm_now),
+            gripper: (power.regulator && power.gripper).then_some(gripper_now),
+            regulator: power.regulator,
+            bolter: if live && power.bolter {
+                self.bolter.drive()
+            } else {
+                Drive::Idle
+            },
+            mux: self.bolter.mux(),
+            heartbeat,
+            link_lost: self.holding,
+            rejected,
+        }
+    }
+
+    /// The internal heartbeat for the current state.
+    pub fn report(&self, inp: &Inputs) -> InternalHeartbeatRepr {
+        let e = &inp.electrical;
+        let (idle, abs) = (&self.cfg.limits.idle, &self.cfg.limits.absolute);
+        InternalHeartbeatRepr {
+            arm_b_target: self.arm.target(),
+            arm_b_now: self.arm.now(),
+            gripper_b_target: self.gripper.target(),
+            gripper_b_now: self.gripper.now(),
+            electrical_b: *e,
+            bolter_aux: self.bolter.aux(),
+            command_received: self.last.map_or(0, |c| c.seq),
+            gravity: inp.gravity,
+            arm_over_idle: e.i_loc > idle.locomotion,
+            gripper_over_idle: e.i_grip > idle.gripper,
+            bolter_over_idle: e.i_bo > idle.bolter,
+            arm_overcurrent: e.i_loc > abs.locomotion,
+            gripper_overcurrent: e.i_grip > abs.gripper,
+            bolter_overcurrent: e.i_bo > abs.bolter,
+            arm_contracted: inp.arm_contracted,
+        }
+    }
+}

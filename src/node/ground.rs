@@ -1,0 +1,356 @@
+//! The opsUI's command uplink for one robot: the sending half of exactly-once commanding.
+//!
+//! Section 4: the ground sends the next command every 1.2 s, counts a heartbeat not received
+//! within 0.7 s as a failed attempt, resends until acknowledged, and shows the WiFi efficiency
+//! over the last 100 attempts (Figure 11). Here each command carries a sequence number; a
+//! heartbeat acknowledges it when its bytes 57–58 carry that number, and its byte 62 then tells
+//! whether board A accepted or refused it. A command is *done* when acknowledged, or when
+//! `max_attempts` attempts went unanswered: it is then reported as unacknowledged (it may or
+//! may not have run, never twice), never silently dropped.
+//!
+//! ```
+//! use mmic::command::Command;
+//! use mmic::node::ground::{Config, Outcome, Uplink};
+//! use mmic::units::BoardNumber;
+//! use mmic::wire::heartbeat::HeartbeatRepr;
+//!
+//! let mut up = Uplink::new(Config::default(), BoardNumber::ONE);
+//! let seq = up.submit(Command::Stop).unwrap();
+//! let sent = up.tick(0).send.unwrap();           // first attempt at t = 0
+//! assert_eq!((sent.command, sent.seq), (Command::Stop, seq));
+//! assert!(up.tick(700).send.is_none());           // not yet timed out
+//! let t = up.tick(701);                           // 0.7 s without a heartbeat: failed attempt
+//! assert_eq!(t.attempt, Some(false));
+//! let resent = up.tick(1200).send.unwrap();       // the next slot: resend, same number
+//! assert_eq!(resent, sent);
+//! let hb = HeartbeatRepr { last_seq: seq, ..HeartbeatRepr::default() };
+//! let done = up.heartbeat(1300, &hb).done.unwrap();
+//! assert_eq!((done.seq, done.outcome, done.attempts), (seq, Outcome::Accepted, 2));
+//! assert_eq!(up.efficiency().percent(), Some(50));
+//! ```
+
+use crate::command::Command;
+use crate::refusal::Refusal;
+use crate::safety::detect::elapsed;
+use crate::units::BoardNumber;
+use crate::wire::command::CommandRepr;
+use crate::wire::heartbeat::HeartbeatRepr;
+
+/// Timing of the uplink.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Config {
+    /// Time between transmissions (first attempts and resends), ms. Paper: 1200.
+    pub period_ms: u32,
+    /// An attempt not answered within this is failed, ms. Paper: 700.
+    pub timeout_ms: u32,
+    /// Attempts before a command is reported unacknowledged (≥ 1). The paper resends forever.
+    pub max_attempts: u8,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        Config {
+            period_ms: 1200,
+            timeout_ms: 700,
+            max_attempts: 10,
+        }
+    }
+}
+
+/// How a command ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum Outcome {
+    /// Board A took and accepted it (it ran exactly once).
+    Accepted,
+    /// Board A took and refused it, with the reason (it did not run).
+    Refused(Refusal),
+    /// No acknowledgement after every attempt: it ran once or not at all.
+    Unacknowledged,
+}
+
+/// A finished command.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Done {
+    /// Its sequence number.
+    pub seq: u16,
+    /// The command.
+    pub command: Command,
+    /// How it ended.
+    pub outcome: Outcome,
+    /// Attempts made (transmissions).
+    pub attempts: u8,
+}
+
+/// What one call asks the ground to do or report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Tick {
+    /// Transmit this packet now.
+    pub send: Option<CommandRepr>,
+    /// An attempt closed: answered in time (`true`) or not (`false`).
+    pub attempt: Option<bool>,
+    /// A command finished.
+    pub done: Option<Done>,
+}
+
+/// The last 100 attempts, for the efficiency of Figure 11.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Efficiency {
+    bits: u128,
+    len: u8,
+}
+
+impl Efficiency {
+    /// Window length.
+    pub const WINDOW: u8 = 100;
+
+    /// Adds an attempt's result, forgetting the oldest beyond the window.
+    pub fn push(&mut self, ok: bool) {
+        let mask = (1u128 << Self::WINDOW) - 1;
+        self.bits = ((self.bits << 1) | ok as u128) & mask;
+        self.len = (self.len + 1).min(Self::WINDOW);
+    }
+
+    /// Successful attempts and attempts in the window.
+    pub const fn counts(&self) -> (u8, u8) {
+        (self.bits.count_ones() as u8, self.len)
+    }
+
+    /// Successful attempts as a whole percentage of the window; none before the first.
+    pub const fn percent(&self) -> Option<u8> {
+        let (ok, n) = self.counts();
+        if n == 0 {
+            None
+        } else {
+            Some(((ok as u32 * 100 + n as u32 / 2) / n as u32) as u8)
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct Outstanding {
+    command: Command,
+    seq: u16,
+    attempts: u8,
+    /// When the open attempt was sent; none once it closed.
+    open_since: Option<u32>,
+}
+
+/// The uplink's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Uplink {
+    cfg: Config,
+    board: BoardNumber,
+    next_seq: u16,
+    out: Option<Outstanding>,
+    last_send: Option<u32>,
+    eff: Efficiency,
+}
+
+/// [`Uplink::submit`] while a command is outstanding: the command is handed back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("command {outstanding} is still outstanding; {command:?} not taken")]
+pub struct Busy {
+    /// The outstanding command's number.
+    pub outstanding: u16,
+    /// The command not taken.
+    pub command: Command,
+}
+
+impl Uplink {
+    /// No command yet; numbering starts at 1.
+    pub const fn new(cfg: Config, board: BoardNumber) -> Uplink {
+        Uplink::starting_at(cfg, board, 1)
+    }
+
+    /// Numbering starts after `last`, e.g. the `last_seq` a heartbeat reported after the ground
+    /// restarted, so that board A does not take new commands for stale ones.
+    pub const fn starting_at(cfg: Config, board: BoardNumber, next: u16) -> Uplink {
+        Uplink {
+            cfg,
+            board,
+            next_seq: if next == 0 { 1 } else { next },
+            out: None,
+            last_send: None,
+            eff: Efficiency { bits: 0, len: 0 },
+        }
+    }
+
+    /// Queues `command` as the next one; returns its number. Refused while one is outstanding.
+    pub fn submit(&mut self, command: Command) -> Result<u16, Busy> {
+        if let Some(o) = self.out {
+            return Err(Busy {
+                outstanding: o.seq,
+                command,
+            });
+        }
+        let seq = self.next_seq;
+        self.next_seq = match seq.wrapping_add(1) {
+            0 => 1,
+            s => s,
+        };
+        self.out = Some(Outstanding {
+            command,
+            seq,
+            attempts: 0,
+            open_since: None,
+        });
+        Ok(seq)
+    }
+
+    /// No command outstanding.
+    pub const fn is_idle(&self) -> bool {
+        self.out.is_none()
+    }
+
+    /// The outstanding command's number.
+    pub fn outstanding(&self) -> Option<u16> {
+        self.out.map(|o| o.seq)
+    }
+
+    /// Efficiency over the last 100 attempts.
+    pub const fn efficiency(&self) -> Efficiency {
+        self.eff
+    }
+
+    /// When [`tick`](Self::tick) next has something to do, if anything is outstanding.
+    pub fn next_deadline(&self) -> Option<u32> {
+        let o = self.out?;
+        Some(match (o.open_since, self.last_send) {
+            (Some(t), _) => t.wrapping_add(self.cfg.timeout_ms).wrapping_add(1),
+            (None, Some(t)) => t.wrapping_add(self.cfg.period_ms),
+            (None, None) => 0,
+        })
+    }
+
+    /// Advances to `now` (ms): closes a timed-out attempt, transmits when a slot is due.
+    pub fn tick(&mut self, now: u32) -> Tick {
+        let mut t = Tick::default();
+        let Some(mut o) = self.out else { return t };
+        if let Some(sent) = o.open_since {
+            if elapsed(sent, now) > self.cfg.timeout_ms {
+                o.open_since = None;
+                self.eff.push(false);
+                t.attempt = Some(false);
+            }
+        }
+        let slot_due = self
+            .last_send
+            .is_none_or(|l| elapsed(l, now) >= self.cfg.period_ms);
+        if o.open_since.is_none() && slot_due {
+            if o.attempts >= self.cfg.max_attempts.max(1) {
+                self.out = None;
+                t.done = Some(Done {
+                    seq: o.seq,
+                    command: o.command,
+                    outcome: Outcome::Unacknowledged,
+                    attempts: o.attempts,
+                });
+                return t;
+            }
+            o.attempts += 1;
+            o.open_since = Some(now);
+            self.last_send = Some(now);
+            t.send = Some(CommandRepr {
+                board: self.board,
+                command: o.command,
+                seq: o.seq,
+            });
+        }
+        self.out = Some(o);
+        t
+    }
+
+    /// A heartbeat arrived at `now`. It acknowledges the outstanding command when it is from
+    /// this robot and its bytes 57–58 carry the command's number.
+    pub fn heartbeat(&mut self, now: u32, hb: &HeartbeatRepr) -> Tick {
+        let mut t = Tick::default();
+        let Some(o) = self.out else { return t };
+        if hb.board != self.board || hb.last_seq != o.seq || o.attempts == 0 {
+            return t;
+        }
+        if let Some(sent) = o.open_since {
+            let ok = elapsed(sent, now) <= self.cfg.timeout_ms;
+            self.eff.push(ok);
+            t.attempt = Some(ok);
+        }
+        self.out = None;
+        t.done = Some(Done {
+            seq: o.seq,
+            command: o.command,
+            outcome: match hb.refusal {
+                None => Outcome::Accepted,
+                Some(r) => Outcome::Refused(r),
+            },
+            attempts: o.attempts,
+        });
+        t
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gives_up_after_max_attempts_and_reports_it() {
+        let cfg = Config {
+            max_attempts: 3,
+            ..Config::default()
+        };
+        let mut up = Uplink::new(cfg, BoardNumber::ONE);
+        let seq = up.submit(Command::Reset).ok();
+        let mut sends = 0;
+        let mut done = None;
+        for now in (0..10_000).step_by(100) {
+            let t = up.tick(now);
+            sends += t.send.is_some() as u32;
+            if t.done.is_some() {
+                done = t.done;
+                break;
+            }
+        }
+        assert_eq!(sends, 3);
+        assert_eq!(done.map(|d| d.seq), seq);
+        assert_eq!(done.map(|d| d.outcome), Some(Outcome::Unacknowledged));
+        assert_eq!(up.efficiency().counts(), (0, 3));
+        assert!(up.is_idle());
+    }
+
+    #[test]
+    fn stale_heartbeats_do_not_acknowledge() {
+        let mut up = Uplink::new(Config::default(), BoardNumber::ONE);
+        let first = up.submit(Command::Stop).ok();
+        up.tick(0);
+        let hb = HeartbeatRepr {
+            last_seq: first.map_or(0, |s| s),
+            ..HeartbeatRepr::default()
+        };
+        assert!(up.heartbeat(10, &hb).done.is_some());
+        let second = up.submit(Command::Reset).ok();
+        assert_ne!(first, second);
+        assert!(up.tick(20).send.is_none(), "one transmission per period");
+        assert!(up.tick(1200).send.is_some());
+        // A late copy of the first heartbeat does not acknowledge the second command.
+        assert!(up.heartbeat(1250, &hb).done.is_none());
+        assert_eq!(up.outstanding(), second);
+    }
+
+    #[test]
+    fn efficiency_window_forgets_beyond_100() {
+        let mut e = Efficiency::default();
+        assert_eq!(e.percent(), None);
+        for _ in 0..100 {
+            e.push(false);
+        }
+        for _ in 0..50 {
+            e.push(true);
+        }
+        assert_eq!(e.counts(), (50, 100));
+        for _ in 0..100 {
+            e.push(true);
+        }
+        assert_eq!(e.percent(), Some(100));
+    }
+}

@@ -1,0 +1,216 @@
+//! The server board (Figure 4): one pending command per robot, delivered by visiting robots
+//! in turn.
+//!
+//! The server reads 14-byte commands from the opsUI's serial line and keeps each one — the
+//! paper's "command byte" — until its packet has reached the robot it is addressed to. Each
+//! loop it connects to one robot with a pending command, sends it, forwards the heartbeat that
+//! comes back, and disconnects, so one server serves several robots. This module is that
+//! bookkeeping; the shell does the connecting.
+//!
+//! A pending command is never dropped silently: it leaves its slot only when delivered
+//! ([`Server::delivered`]) or when the ground replaces it with another command for the same
+//! robot, which [`Server::accept`] reports as [`Accepted::Superseded`]. The ground sends one
+//! command at a time per robot, so it replaces a command only after it has finished with it
+//! (acknowledged, or reported unacknowledged); the stateright model in
+//! host/tests/protocol_exactly_once.rs checks exactly that.
+//!
+//! ```
+//! use mmic::command::Command;
+//! use mmic::node::server::{Accepted, Server};
+//! use mmic::units::BoardNumber;
+//! use mmic::wire::command::CommandRepr;
+//!
+//! let two = BoardNumber::new(2).unwrap();
+//! let mut server: Server<4> = Server::new();
+//! let stop = CommandRepr { board: two, command: Command::Stop, seq: 1 }.to_bytes();
+//! assert_eq!(server.accept(&stop), Ok(Accepted::Queued));
+//! assert_eq!(server.accept(&stop), Ok(Accepted::Resend)); // the ground resent it
+//! let (robot, packet) = server.next_visit().unwrap();
+//! assert_eq!((robot, packet), (two, stop));
+//! server.delivered(robot, &packet);
+//! assert_eq!(server.next_visit(), None);
+//! ```
+
+use crate::units::BoardNumber;
+use crate::wire::command::{CommandRepr, COMMAND_LEN};
+use crate::wire::WireError;
+
+/// A command packet.
+pub type Packet = [u8; COMMAND_LEN];
+
+/// What became of an accepted packet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Accepted {
+    /// Now pending for its robot.
+    Queued,
+    /// The same packet was already pending (a resend from the ground).
+    Resend,
+    /// It replaced a different pending packet for the same robot, handed back here.
+    Superseded(Packet),
+}
+
+/// Why the server refused a packet from the ground.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum ServerError {
+    /// Not a valid command packet.
+    #[error("not a command packet: {0}")]
+    Invalid(#[from] WireError),
+    /// Every robot slot is taken by other robots; the packet is handed back.
+    #[error("no slot for robot {n}: all {capacity} slots serve other robots", n = board.get())]
+    Full {
+        /// The robot addressed.
+        board: BoardNumber,
+        /// Slots.
+        capacity: usize,
+        /// The packet.
+        packet: Packet,
+    },
+}
+
+/// Pending commands for up to `N` robots.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Server<const N: usize> {
+    slots: [Option<(BoardNumber, Option<Packet>)>; N],
+    cursor: usize,
+}
+
+impl<const N: usize> Default for Server<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> Server<N> {
+    /// No robot known.
+    pub const fn new() -> Server<N> {
+        Server {
+            slots: [None; N],
+            cursor: 0,
+        }
+    }
+
+    /// Takes a packet from the ground's serial line.
+    pub fn accept(&mut self, packet: &Packet) -> Result<Accepted, ServerError> {
+        let board = CommandRepr::parse(packet)?.board;
+        let slot = match self.slot_of(board) {
+            Some(i) => i,
+            None => match self.slots.iter().position(|s| s.is_none_or(|(_, p)| p.is_none())) {
+                Some(i) => {
+                    self.slots[i] = Some((board, None));
+                    i
+                }
+                None => {
+                    return Err(ServerError::Full {
+                        board,
+                        capacity: N,
+                        packet: *packet,
+                    })
+                }
+            },
+        };
+        let pending = self.slots[slot].and_then(|(_, p)| p);
+        self.slots[slot] = Some((board, Some(*packet)));
+        Ok(match pending {
+            None => Accepted::Queued,
+            Some(old) if old == *packet => Accepted::Resend,
+            Some(old) => Accepted::Superseded(old),
+        })
+    }
+
+    fn slot_of(&self, board: BoardNumber) -> Option<usize> {
+        self.slots
+            .iter()
+            .position(|s| matches!(s, Some((b, _)) if *b == board))
+    }
+
+    /// The next robot to visit and the packet to deliver, round robin over robots with a
+    /// pending command. The packet stays pending until [`delivered`](Self::delivered).
+    pub fn next_visit(&mut self) -> Option<(BoardNumber, Packet)> {
+        for k in 0..N {
+            let i = (self.cursor + k) % N;
+            if let Some((b, Some(p))) = self.slots[i] {
+                self.cursor = (i + 1) % N;
+                return Some((b, p));
+            }
+        }
+        None
+    }
+
+    /// The packet reached `board` (written to its connection). Clears the slot only if that
+    /// packet is still the pending one (a newer one stays).
+    pub fn delivered(&mut self, board: BoardNumber, packet: &Packet) {
+        if let Some(i) = self.slot_of(board) {
+            if let Some((b, Some(p))) = self.slots[i] {
+                if p == *packet {
+                    self.slots[i] = Some((b, None));
+                }
+            }
+        }
+    }
+
+    /// The packet pending for `board`.
+    pub fn pending(&self, board: BoardNumber) -> Option<Packet> {
+        self.slot_of(board).and_then(|i| self.slots[i].and_then(|(_, p)| p))
+    }
+
+    /// Robots with a pending packet.
+    pub fn pending_count(&self) -> usize {
+        self.slots
+            .iter()
+            .filter(|s| matches!(s, Some((_, Some(_)))))
+            .count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::command::Command;
+
+    fn packet(board: u8, seq: u16) -> Packet {
+        match BoardNumber::new(board) {
+            Ok(board) => CommandRepr {
+                board,
+                command: Command::Heartbeat,
+                seq,
+            }
+            .to_bytes(),
+            Err(_) => [0; COMMAND_LEN],
+        }
+    }
+
+    #[test]
+    fn full_hands_the_packet_back_and_free_slots_are_reused() {
+        let mut s: Server<2> = Server::new();
+        assert_eq!(s.accept(&packet(1, 1)), Ok(Accepted::Queued));
+        assert_eq!(s.accept(&packet(2, 1)), Ok(Accepted::Queued));
+        let third = packet(3, 1);
+        assert!(matches!(s.accept(&third), Err(ServerError::Full { packet, capacity: 2, .. }) if packet == third));
+        let visit = s.next_visit();
+        assert!(visit.is_some());
+        if let Some((b, p)) = visit {
+            s.delivered(b, &p);
+        }
+        assert_eq!(s.accept(&third), Ok(Accepted::Queued));
+        assert_eq!(s.pending_count(), 2);
+    }
+
+    #[test]
+    fn supersession_is_reported_and_visits_alternate() {
+        let mut s: Server<4> = Server::new();
+        s.accept(&packet(1, 1)).ok();
+        s.accept(&packet(2, 1)).ok();
+        assert_eq!(s.accept(&packet(1, 2)), Ok(Accepted::Superseded(packet(1, 1))));
+        let a = s.next_visit().map(|(b, _)| b.get());
+        let b = s.next_visit().map(|(b, _)| b.get());
+        assert_eq!((a, b), (Some(1), Some(2)));
+        // Delivery of a packet that is no longer pending keeps the newer one.
+        if let Ok(one) = BoardNumber::new(1) {
+            s.delivered(one, &packet(1, 1));
+            assert_eq!(s.pending(one), Some(packet(1, 2)));
+        }
+        let mut bad = packet(1, 3);
+        bad[13] ^= 1;
+        assert!(matches!(s.accept(&bad), Err(ServerError::Invalid(_))));
+    }
+}
