@@ -123,7 +123,7 @@ impl BolterPair {
 }
 
 /// A pair number outside 1..=4.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[error("bolter pair must be 1..=4, found {0}")]
 pub struct BolterPairError(pub u8);
 
@@ -221,7 +221,7 @@ impl<'de> serde::Deserialize<'de> for Reconfiguration {
 }
 
 /// A reconfiguration that cannot be executed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 pub enum ReconfigurationError {
     /// Only matched states are final states (Section 6).
     #[error("target state {target} is not a matched (final) state")]
@@ -326,7 +326,7 @@ pub mod opcode {
 }
 
 /// A parameter slot of Table 2, as a range of the 6 parameter bytes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Slot {
     /// Bytes 6–7: hip target.
     Hip,
@@ -369,7 +369,7 @@ pub const fn seq_slot(id: u8) -> Slot {
 }
 
 /// A parameter block that does not decode to a command.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 pub enum CommandError {
     /// Byte 5 holds no assigned opcode.
     #[error("byte 5: unknown command id {id:#04x}")]

@@ -104,7 +104,7 @@ impl fmt::Display for Fault {
 pub struct Faults(u32);
 
 /// Bits set in the fault bytes that name no fault.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[error("fault bytes set reserved bits {reserved:#06x} (only bits 0..=12 name faults)")]
 pub struct ReservedFaultBits {
     /// The reserved bits that were set.

@@ -12,7 +12,7 @@
 use core::fmt;
 
 /// Out-of-range value handed to a unit constructor; carries the offending value and the range.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[error("{quantity} must be in {min}..={max}, found {found}")]
 pub struct RangeError {
     /// Which quantity was being built.

@@ -11,7 +11,7 @@ use crate::wire::heartbeat::BolterAttempt;
 use crate::wire::internal_heartbeat::BolterAux;
 
 /// Coordinator settings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Config {
     /// The sides' step timeouts.
     pub side: SideConfig,
@@ -56,7 +56,7 @@ pub enum Status {
 }
 
 /// What the coordinator asks for this tick.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Output {
     /// The order for both sides and the sequence number it was first issued with (send to B
     /// in every A→B command until it changes; apply to side A's executor).

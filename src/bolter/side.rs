@@ -7,7 +7,7 @@ use crate::wire::b_command::BolterOrder;
 use crate::wire::internal_heartbeat::BolterAux;
 
 /// What the side's bolter hardware reports this tick (from the filtered I_bo and the position).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Signals {
     /// The bolter current passed its push threshold.
     pub threshold: bool,
@@ -18,7 +18,7 @@ pub struct Signals {
 }
 
 /// What the side's bolter motor must do now.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Drive {
     /// Nothing: idle, or the current step is finished or timed out.
     Idle,
@@ -33,7 +33,7 @@ pub enum Drive {
 }
 
 /// Step timeouts, ms.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct SideConfig {
     /// Current-sensed steps (the paper's asterisks): Descend, DescendEngage, Rotate.
     pub sensed_ms: u32,

@@ -21,7 +21,7 @@ use crate::safety::detect::elapsed;
 use crate::units::{HipAngle, PulseWidth};
 
 /// Controller settings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Config {
     /// Switch to position mode within this error, 0.01°. Paper: 3°.
     pub position_band: i32,
@@ -60,7 +60,7 @@ impl Default for Config {
 }
 
 /// Which law is active.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Mode {
     /// |error| > band: track ±speed.
     Velocity,
@@ -69,7 +69,7 @@ pub enum Mode {
 }
 
 /// The controller's state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct HipController {
     cfg: Config,
     last: Option<(u32, HipAngle)>,

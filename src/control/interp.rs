@@ -7,7 +7,7 @@ use crate::safety::detect::elapsed;
 use crate::units::PulseWidth;
 
 /// Interpolation rate: `step_us` every `period_ms`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Rate {
     /// Pulse change per period, µs (≥ 1). Default 10 µs.
     pub step_us: u16,
@@ -35,7 +35,7 @@ impl Default for Rate {
 /// assert_eq!(arm.resolve(ServoTarget::Extend).micros(), 2100);
 /// assert_eq!(arm.resolve(ServoTarget::Position(PulseWidth::new(1300).unwrap())).micros(), 1300);
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Travel {
     /// Fully contracted (arm retracted / gripper open).
     pub contracted: PulseWidth,
@@ -55,7 +55,7 @@ impl Travel {
 }
 
 /// One servo's interpolator.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Interpolator {
     now: PulseWidth,
     target: PulseWidth,

@@ -65,7 +65,7 @@ impl StateSet {
 }
 
 /// Estimation settings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Config {
     /// The structure axis pointing up (gravity points the other way). Default: +Z.
     pub up: (Axis, Sign),
@@ -83,7 +83,7 @@ impl Default for Config {
 }
 
 /// What the sensors say, already filtered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Readings {
     /// Gravity in board A's IMU frame; none = no reading (not used).
     pub gravity_a: Option<Gravity>,

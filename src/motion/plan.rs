@@ -64,6 +64,14 @@ impl PartialEq for Plan {
 
 impl Eq for Plan {}
 
+impl core::hash::Hash for Plan {
+    // Consistent with `PartialEq`: only the used prefix counts.
+    fn hash<H: core::hash::Hasher>(&self, h: &mut H) {
+        self.primitives().hash(h);
+        self.states().hash(h);
+    }
+}
+
 /// Depth-limited search in Table 5 order: the first plan of exactly `depth` primitives.
 const fn dfs(at: State, to: State, depth: usize, mut acc: Plan) -> Option<Plan> {
     if depth == 0 {

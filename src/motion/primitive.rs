@@ -78,7 +78,7 @@ impl fmt::Display for Primitive {
 }
 
 /// A number that is not a Table 6 primitive.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[error("primitive must be 1..=8 (Table 6), found {0}")]
 pub struct PrimitiveNumberError(pub u8);
 

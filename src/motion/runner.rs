@@ -20,7 +20,7 @@ use super::State;
 use crate::faults::Fault;
 
 /// Where a reconfiguration is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum RunStatus {
     /// A primitive is running.
     Running,
@@ -32,7 +32,7 @@ pub enum RunStatus {
 }
 
 /// Runs a reconfiguration plan.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Runner {
     cfg: Config,
     plan: Plan,

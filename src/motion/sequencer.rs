@@ -36,7 +36,7 @@ use crate::safety::detect::elapsed;
 use crate::units::{HipAngle, Side};
 
 /// Per-step timeouts, ms.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Config {
     /// Release or grip: the gripper's interpolation. Default 3000 ms.
     pub gripper_ms: u32,
@@ -57,7 +57,7 @@ impl Default for Config {
 }
 
 /// Targets for every module; index 0 = side A, 1 = side B.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Targets {
     /// Arm targets.
     pub arm: [ServoTarget; 2],
@@ -88,7 +88,7 @@ impl Targets {
 }
 
 /// Completion signals, as of this tick.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Feedback {
     /// Arm interpolation finished (A: local; B: reported in the internal heartbeat).
     pub arm_done: [bool; 2],
@@ -101,7 +101,7 @@ pub struct Feedback {
 }
 
 /// A step of a primitive.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Step {
     /// Open the moving side's gripper.
     Release,
@@ -114,7 +114,7 @@ pub enum Step {
 }
 
 /// Where a sequencer is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Status {
     /// Waiting for the current step.
     Running,
@@ -125,7 +125,7 @@ pub enum Status {
 }
 
 /// `from → to` is not a single-primitive move.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[error("no single primitive takes {from} to {to}")]
 pub struct NotAMove {
     /// Initial state.
@@ -168,7 +168,7 @@ pub fn hip_goal(from: State, to: State, primitive: Primitive) -> Option<HipAngle
 }
 
 /// Runs one primitive.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Sequencer {
     cfg: Config,
     primitive: Primitive,

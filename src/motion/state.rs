@@ -155,7 +155,7 @@ impl fmt::Display for State {
 }
 
 /// A character that is not a Table 5 letter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[error("state must be a letter 'a'..='o' (Table 5), found {0:?}")]
 pub struct StateLetterError(pub char);
 

@@ -30,7 +30,9 @@
 //! ```
 
 use super::exactly_once::{Admission, CommandLog};
-use crate::bolter::{self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals};
+use crate::bolter::{
+    self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals,
+};
 use crate::command::{
     preset_angle, seq_slot, BolterCommand, Command, CommandKind, HipTarget, ServoTarget,
 };
@@ -44,8 +46,8 @@ use crate::motion::sequencer::{self, Feedback, Targets};
 use crate::motion::{map, State};
 use crate::refusal::Refusal;
 use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
-use crate::safety::ModuleSet;
 use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
+use crate::safety::ModuleSet;
 use crate::units::{BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth};
 use crate::wire::b_command::{BCommandRepr, BPower, B_COMMAND_LEN};
 use crate::wire::command::{CommandRepr, COMMAND_LEN};
@@ -54,7 +56,7 @@ use crate::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_
 use crate::wire::WireError;
 
 /// Board A's settings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Config {
     /// This robot's number.
     pub board: BoardNumber,
@@ -109,7 +111,7 @@ impl Default for Config {
 }
 
 /// One tick's inputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Inputs {
     /// A command packet from the WiFi hand-off queue.
     pub command: Option<[u8; COMMAND_LEN]>,
@@ -159,7 +161,7 @@ impl Inputs {
 }
 
 /// Something that happened in a tick, for logs and tests.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Event {
     /// A command was taken and run (or refused) — once per sequence number.
     Executed {
@@ -207,7 +209,7 @@ pub enum Event {
 pub const EVENTS: usize = 6;
 
 /// One tick's outputs.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct Outputs {
     /// Hip servo pulse; none = unpowered.
     pub hip: Option<PulseWidth>,
@@ -240,7 +242,7 @@ impl Outputs {
 }
 
 /// Board A's state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct BoardA {
     cfg: Config,
     sup: Supervisor,
@@ -346,7 +348,8 @@ impl BoardA {
     }
 
     fn moving_now(&self, fb: &Feedback) -> bool {
-        self.runner.is_some_and(|r| r.status() == RunStatus::Running)
+        self.runner
+            .is_some_and(|r| r.status() == RunStatus::Running)
             || self.coord.status() == coordinator::Status::Running
             || self.waiting_job.is_some()
             || !(fb.arm_done[0] && fb.arm_done[1])
@@ -355,9 +358,8 @@ impl BoardA {
     }
 
     fn feedback(&self, hip_now: HipAngle, arm_a_switch: bool) -> Feedback {
-        let b_ok = |now: PulseWidth, target: PulseWidth, want: PulseWidth| {
-            now == target && target == want
-        };
+        let b_ok =
+            |now: PulseWidth, target: PulseWidth, want: PulseWidth| now == target && target == want;
         Feedback {
             arm_done: [
                 self.arm.done(),
@@ -441,14 +443,21 @@ impl BoardA {
 
         // Conditions holding now.
         let e_b = self.b.electrical_b;
-        let mut conditions = detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, &e_b);
+        let mut conditions =
+            detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, &e_b);
         let in_motion = self.moving_now(&self.feedback(inp.hip, inp.arm_contracted));
         self.moving = in_motion;
         if !in_motion {
-            conditions =
-                conditions.union(detect::idle_overcurrent(&self.cfg.safety, &inp.electrical, &e_b));
+            conditions = conditions.union(detect::idle_overcurrent(
+                &self.cfg.safety,
+                &inp.electrical,
+                &e_b,
+            ));
         }
-        if self.battery.update(&self.cfg.safety, now, inp.electrical.v_bat, e_b.v_bat) {
+        if self
+            .battery
+            .update(&self.cfg.safety, now, inp.electrical.v_bat, e_b.v_bat)
+        {
             conditions = conditions.with(Fault::LowBattery);
         }
         if self.comm.lost(&self.cfg.safety) {
@@ -567,11 +576,9 @@ impl BoardA {
                 let at = 6 + seq_slot(bytes[5]).offset();
                 let seq = u16::from_le_bytes([bytes[at], bytes[at + 1]]);
                 return match self.log.admit(seq) {
-                    Admission::Execute => Received::Refuse(
-                        seq,
-                        Command::Heartbeat,
-                        Refusal::for_command_error(&ce),
-                    ),
+                    Admission::Execute => {
+                        Received::Refuse(seq, Command::Heartbeat, Refusal::for_command_error(&ce))
+                    }
                     Admission::Duplicate => Received::Answer(Event::Duplicate { seq }),
                     Admission::Stale => Received::Answer(Event::Stale { seq }),
                 };
@@ -579,9 +586,7 @@ impl BoardA {
             Err(e) => return Received::Ignore(Event::Rejected(e)),
         };
         if repr.board != self.cfg.board {
-            return Received::Ignore(Event::OtherRobot {
-                board: repr.board,
-            });
+            return Received::Ignore(Event::OtherRobot { board: repr.board });
         }
         match self.log.admit(repr.seq) {
             Admission::Duplicate => return Received::Answer(Event::Duplicate { seq: repr.seq }),
@@ -692,9 +697,12 @@ impl BoardA {
         self.bolting_start(now);
         let was = self.coord.status();
         let b = self.b_heard.then_some(&self.b.bolter_aux);
-        let o = self.coord.step(&self.cfg.bolter, now, &self.side_a.aux(), b);
+        let o = self
+            .coord
+            .step(&self.cfg.bolter, now, &self.side_a.aux(), b);
         let order = o.order;
-        self.side_a.order(order.map_or(0, |(s, _)| s), order.map(|(_, o)| o), now);
+        self.side_a
+            .order(order.map_or(0, |(s, _)| s), order.map(|(_, o)| o), now);
         if was == coordinator::Status::Running && o.status != coordinator::Status::Running {
             match o.status {
                 coordinator::Status::Failed(f) => {
@@ -741,7 +749,12 @@ impl BoardA {
         }
     }
 
-    fn b_command(&mut self, now: u32, p: ModuleSet, regulator: bool) -> Option<[u8; B_COMMAND_LEN]> {
+    fn b_command(
+        &mut self,
+        now: u32,
+        p: ModuleSet,
+        regulator: bool,
+    ) -> Option<[u8; B_COMMAND_LEN]> {
         let order = self.coord.order();
         let last_seq = self.b_sent.map_or(0, |(_, c)| c.seq);
         let live = self.sup.mode() != Mode::Standby;

@@ -29,7 +29,7 @@
 //! assert_eq!(out.arm.unwrap().micros(), 1700);
 //! ```
 
-use crate::bolter::{BolterSide, Drive, MuxLines, Signals, SideConfig};
+use crate::bolter::{BolterSide, Drive, MuxLines, SideConfig, Signals};
 use crate::control::interp::{Interpolator, Rate};
 use crate::safety::detect::{self, elapsed};
 use crate::units::{Electrical, Gravity, PulseWidth};
@@ -38,7 +38,7 @@ use crate::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_
 use crate::wire::WireError;
 
 /// Board B's settings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Config {
     /// Internal heartbeat period, ms. Default 50.
     pub heartbeat_period_ms: u32,
@@ -65,7 +65,7 @@ impl Default for Config {
 }
 
 /// One tick's inputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Inputs {
     /// An A→B command packet received since the last tick.
     pub command: Option<[u8; B_COMMAND_LEN]>,
@@ -80,7 +80,7 @@ pub struct Inputs {
 }
 
 /// One tick's outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Outputs {
     /// Arm B pulse; none = unpowered.
     pub arm: Option<PulseWidth>,
@@ -101,7 +101,7 @@ pub struct Outputs {
 }
 
 /// Board B's state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct BoardB {
     cfg: Config,
     arm: Interpolator,

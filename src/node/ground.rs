@@ -84,7 +84,7 @@ pub struct Done {
 }
 
 /// What one call asks the ground to do or report.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Tick {
     /// Transmit this packet now.
     pub send: Option<CommandRepr>,
@@ -149,7 +149,7 @@ pub struct Uplink {
 }
 
 /// [`Uplink::submit`] while a command is outstanding: the command is handed back.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[error("command {outstanding} is still outstanding; {command:?} not taken")]
 pub struct Busy {
     /// The outstanding command's number.

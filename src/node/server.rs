@@ -50,7 +50,7 @@ pub enum Accepted {
 }
 
 /// Why the server refused a packet from the ground.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 pub enum ServerError {
     /// Not a valid command packet.
     #[error("not a command packet: {0}")]
@@ -94,7 +94,11 @@ impl<const N: usize> Server<N> {
         let board = CommandRepr::parse(packet)?.board;
         let slot = match self.slot_of(board) {
             Some(i) => i,
-            None => match self.slots.iter().position(|s| s.is_none_or(|(_, p)| p.is_none())) {
+            None => match self
+                .slots
+                .iter()
+                .position(|s| s.is_none_or(|(_, p)| p.is_none()))
+            {
                 Some(i) => {
                     self.slots[i] = Some((board, None));
                     i
@@ -150,7 +154,8 @@ impl<const N: usize> Server<N> {
 
     /// The packet pending for `board`.
     pub fn pending(&self, board: BoardNumber) -> Option<Packet> {
-        self.slot_of(board).and_then(|i| self.slots[i].and_then(|(_, p)| p))
+        self.slot_of(board)
+            .and_then(|i| self.slots[i].and_then(|(_, p)| p))
     }
 
     /// Robots with a pending packet.
@@ -185,7 +190,9 @@ mod tests {
         assert_eq!(s.accept(&packet(1, 1)), Ok(Accepted::Queued));
         assert_eq!(s.accept(&packet(2, 1)), Ok(Accepted::Queued));
         let third = packet(3, 1);
-        assert!(matches!(s.accept(&third), Err(ServerError::Full { packet, capacity: 2, .. }) if packet == third));
+        assert!(
+            matches!(s.accept(&third), Err(ServerError::Full { packet, capacity: 2, .. }) if packet == third)
+        );
         let visit = s.next_visit();
         assert!(visit.is_some());
         if let Some((b, p)) = visit {
@@ -200,7 +207,10 @@ mod tests {
         let mut s: Server<4> = Server::new();
         s.accept(&packet(1, 1)).ok();
         s.accept(&packet(2, 1)).ok();
-        assert_eq!(s.accept(&packet(1, 2)), Ok(Accepted::Superseded(packet(1, 1))));
+        assert_eq!(
+            s.accept(&packet(1, 2)),
+            Ok(Accepted::Superseded(packet(1, 1)))
+        );
         let a = s.next_visit().map(|(b, _)| b.get());
         let b = s.next_visit().map(|(b, _)| b.get());
         assert_eq!((a, b), (Some(1), Some(2)));

@@ -44,7 +44,7 @@ pub const fn regulator_on(mode: Mode) -> bool {
 }
 
 /// What a fault does when it is detected in Operational (Table 8).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct FaultAction {
     /// Mode the robot enters.
     pub mode: Mode,

@@ -41,7 +41,7 @@ use crate::mode::Mode;
 use crate::refusal::Refusal;
 
 /// What reached the supervisor from the command link in this tick.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Incoming {
     /// A well-formed command.
     Command(Command),
@@ -50,7 +50,7 @@ pub enum Incoming {
 }
 
 /// One tick's inputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Input {
     /// Faults detected in this tick: conditions holding now and events raised now.
     pub faults: Faults,
@@ -80,7 +80,7 @@ impl Input {
 }
 
 /// The answer to a command, reported in the heartbeat that follows it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Answer {
     /// Accepted: the motion and module layers execute it.
     Accepted(Command),
@@ -99,7 +99,7 @@ impl Answer {
 }
 
 /// One tick's outputs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Output {
     /// Mode after this tick.
     pub mode: Mode,
@@ -120,7 +120,7 @@ pub struct Output {
 }
 
 /// The supervisor's state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Supervisor {
     mode: Mode,
     enabled: ModuleSet,

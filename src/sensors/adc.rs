@@ -49,7 +49,7 @@ impl Channel {
 }
 
 /// Full-scale value of each channel (the quantity at code 4095), in mV or mA.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Scaling {
     /// Per channel, CH0..CH7.
     pub full_scale: [u16; 8],

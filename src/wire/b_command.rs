@@ -36,7 +36,7 @@ const KIND: PacketKind = PacketKind::BCommand;
 
 /// The A→B command, byte for byte.
 #[derive(
-    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+    Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
 #[allow(missing_docs)] // each field is described in FIELDS and spec/packets/b-command.toml

@@ -35,7 +35,7 @@
 use super::{checksum, PacketKind, CHECKSUM_LEN, HEADER_LEN, MAX_PACKET_LEN};
 
 /// A packet whose header and checksum hold (its fields are checked by the `Repr` parsers).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Frame {
     kind: PacketKind,
     bytes: [u8; MAX_PACKET_LEN],
@@ -54,7 +54,7 @@ impl Frame {
 }
 
 /// What the deframer found next in the stream.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Deframed {
     /// This many bytes were dropped: no header, or a header whose checksum failed.
     Discarded(usize),

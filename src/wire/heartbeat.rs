@@ -28,7 +28,7 @@ const KIND: PacketKind = PacketKind::Heartbeat;
 
 /// Table 3, byte for byte.
 #[derive(
-    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+    Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
 #[allow(missing_docs)] // each field is described in FIELDS and spec/packets/heartbeat.toml

@@ -24,7 +24,7 @@ const KIND: PacketKind = PacketKind::InternalHeartbeat;
 /// Table 4, byte for byte. Bytes 26–34, "bolter B operation auxiliary variables" in the
 /// paper, are laid out here as nine one-byte fields (see [`BolterAux`]).
 #[derive(
-    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+    Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
 #[allow(missing_docs)] // each field is described in FIELDS and spec/packets/internal-heartbeat.toml

@@ -10,7 +10,7 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
 /// One side's seven ADS7828 readings as they lie in both heartbeats (Table 3 bytes 25–38 and
 /// 39–52, Table 4 bytes 12–25): V_bat, I_bat, I_loc, I_grip, I_3v3, V_reg, I_bo.
 #[derive(
-    Debug, Clone, Copy, PartialEq, Eq, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
+    Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
 #[allow(missing_docs)] // the fields are those of `Electrical`
@@ -61,7 +61,7 @@ macro_rules! span {
 pub(crate) use span;
 
 /// Unit or encoding of a field, as spec/ names it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Unit {
     /// Fixed ASCII bytes.
     Header,
@@ -122,7 +122,7 @@ impl Unit {
 }
 
 /// One field of a packet.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct FieldSpec {
     /// Field name (spec/ and JSON).
     pub name: &'static str,

@@ -122,7 +122,7 @@ impl fmt::Display for PacketKind {
 
 /// Why bytes are not a valid packet. Checks run in this order: length, header, checksum,
 /// fields; the first failure is reported with the numbers that explain it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 pub enum WireError {
     /// Wrong number of bytes.
     #[error("{kind} packet: length must be {expected} bytes, found {found}")]
