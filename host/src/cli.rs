@@ -139,6 +139,21 @@ pub enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Run the host simulator: opsUI, server board, boards A and B and a plant model over
+    /// real transports, driving a plan (the built-in demo without --plan).
+    #[command(long_about = SIM_HELP, after_help = SIM_AFTER)]
+    Sim(SimArgs),
+    /// Scale benchmark: N simulated robots, each with its own server link, against one ground
+    /// process; reports the largest N for which every heartbeat arrives within the timeout.
+    #[command(after_help = "Example: mmic bench --max 64 --seconds 30")]
+    Bench {
+        /// Largest number of robots to try (doubling from 1, then bisecting).
+        #[arg(long, default_value_t = 64)]
+        max: u8,
+        /// Simulated (= wall, scale 1) seconds per trial.
+        #[arg(long, default_value_t = 30)]
+        seconds: u32,
+    },
     /// Print the packet grids, field tables, opcodes and Tables 7/8; or write the review pages.
     #[command(
         after_help = "Regenerate the committed pages (a test fails when they are stale):\n  \
@@ -150,6 +165,77 @@ pub enum Cmd {
         #[arg(long, value_name = "DIR")]
         write: Option<PathBuf>,
     },
+}
+
+const SIM_HELP: &str = "\
+Run the host simulator. The four nodes of the paper's Figure 3 run the real mmic library:
+the opsUI plan runner and the server board talk over an OS pipe (the RS232 line), the server
+board connects to board A over TCP on loopback for each command (the WiFi link), boards A and
+B talk over OS pipes (the wired serial line), and a plant model moves the servos, draws
+currents, drains the battery and locks fasteners with the paper's Figure 10 probabilities.
+
+Live progress goes to stderr; at the end a summary is printed, the JSON-lines log of every
+packet and event is written (OUT/sim.jsonl), and two SVG plots: OUT/wifi-efficiency.svg
+(Figure 11 analogue) and OUT/bolting-attempts.svg (Figure 10 analogue).";
+
+const SIM_AFTER: &str = "\
+Examples:
+  mmic sim                                   the built-in demo plan (host/plans/demo.plan)
+  mmic sim --plan my.plan --scale 20
+  mmic sim --wifi-loss 0.3                   30 % of WiFi packets lost, each way
+  mmic sim --low-battery-at 40 --overcurrent-at 25 --cut-b-at 60   (seconds)
+
+Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
+2 bad arguments or a malformed plan file (line and column are given); 3 an I/O error.";
+
+/// Arguments of `mmic sim`.
+#[derive(Debug, clap::Args)]
+pub struct SimArgs {
+    /// Plan file (format: see host/plans/demo.plan); the built-in demo without it.
+    #[arg(long, value_name = "FILE")]
+    pub plan: Option<PathBuf>,
+    /// Simulated seconds per wall second.
+    #[arg(long, default_value_t = 10.0)]
+    pub scale: f64,
+    /// Seed for losses and fastener locks.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// WiFi packet loss, each direction, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub wifi_loss: f64,
+    /// opsUI <-> server serial packet loss, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub serial_loss: f64,
+    /// Board A <-> board B serial packet loss, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub ab_loss: f64,
+    /// The battery sags below 10 V from this simulated second on.
+    #[arg(long, value_name = "S")]
+    pub low_battery_at: Option<f64>,
+    /// Arm A hits an obstacle (3.5 A for 0.5 s) at this simulated second.
+    #[arg(long, value_name = "S")]
+    pub overcurrent_at: Option<f64>,
+    /// Board B is cut off from board A at this simulated second.
+    #[arg(long, value_name = "S")]
+    pub cut_b_at: Option<f64>,
+    /// Give up after this many simulated seconds.
+    #[arg(long, default_value_t = 900.0)]
+    pub max_seconds: f64,
+    /// Directory for the log and the plots.
+    #[arg(long, value_name = "DIR", default_value = "target/sim")]
+    pub out: PathBuf,
+    /// No live progress.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+fn probability(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not a probability in 0..=1"))
+    }
 }
 
 /// A packet kind from its name ([`PacketKind::from_name`]).
@@ -187,6 +273,28 @@ pub enum CliError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// The plan file could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The plan file is malformed.
+    #[error("{}: {error}", path.display())]
+    Plan {
+        /// The file.
+        path: PathBuf,
+        /// Where and why.
+        error: crate::plan::PlanError,
+    },
+    /// The simulation failed (transport set-up).
+    #[error("simulation failed: {0}")]
+    Sim(#[source] std::io::Error),
+    /// The plan did not complete.
+    #[error("the plan did not complete: {0}")]
+    Incomplete(String),
     /// Standard output or error is closed.
     #[error("cannot write output: {0}")]
     Output(#[source] std::io::Error),
@@ -198,7 +306,12 @@ impl CliError {
         match self {
             CliError::Codec(e) => e.exit_code(),
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
-            CliError::Write { .. } | CliError::Output(_) => EXIT_IO,
+            CliError::Plan { .. } => EXIT_INPUT,
+            CliError::Incomplete(_) => 1,
+            CliError::Write { .. }
+            | CliError::Output(_)
+            | CliError::Read { .. }
+            | CliError::Sim(_) => EXIT_IO,
         }
     }
 }
@@ -230,6 +343,8 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
             }
             .map_err(CliError::Output)?;
         }
+        Cmd::Sim(args) => crate::simcli::sim(args, out)?,
+        Cmd::Bench { max, seconds } => crate::simcli::bench(max, seconds, out)?,
         Cmd::Spec { write: None } => {
             for (_, page) in pages::all() {
                 writeln!(out, "{page}").map_err(CliError::Output)?;

@@ -106,6 +106,12 @@ pub fn decode(kind: PacketKind, bytes: &[u8]) -> Result<String, CodecError> {
     json.map_err(|source| CodecError::Print { kind, source })
 }
 
+/// Decodes a packet of whichever kind its header names; none if it is no valid packet.
+pub fn decode_any(bytes: &[u8]) -> Option<String> {
+    let kind = PacketKind::from_header(bytes.get(..mmic::wire::HEADER_LEN)?)?;
+    decode(kind, bytes).ok()
+}
+
 /// Lowercase hex, no separators.
 pub fn to_hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()

@@ -6,3 +6,7 @@ pub mod cli;
 pub mod codec;
 pub mod motion;
 pub mod pages;
+pub mod plan;
+pub mod plot;
+pub mod sim;
+pub mod simcli;

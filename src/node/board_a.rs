@@ -80,6 +80,8 @@ pub struct Config {
     pub estimate: estimate::Config,
     /// A→B command period, ms (sent sooner when its content changes).
     pub b_period_ms: u32,
+    /// The idle overcurrent check starts this long after the last motion ended, ms.
+    pub idle_settle_ms: u32,
 }
 
 impl Default for Config {
@@ -106,6 +108,7 @@ impl Default for Config {
             hip_done_tolerance: 150,
             estimate: estimate::Config::default(),
             b_period_ms: 50,
+            idle_settle_ms: 200,
         }
     }
 }
@@ -203,6 +206,15 @@ pub enum Event {
     Reached(State),
     /// A bolting job ended: done (`None`) or failed with this fault.
     Bolting(Option<Fault>),
+    /// A pair of a bolting job finished: fastened (or released) at attempt `attempts`, or not.
+    Pair {
+        /// The pair.
+        pair: crate::command::BolterPair,
+        /// Attempts made, 1..=3.
+        attempts: u8,
+        /// Whether the pair succeeded.
+        ok: bool,
+    },
 }
 
 /// Events per tick (more are counted in [`Outputs::events_lost`]).
@@ -266,6 +278,8 @@ pub struct BoardA {
     contracting: bool,
     refusal: Option<Refusal>,
     moving: bool,
+    pair: Option<(crate::command::BolterPair, u8)>,
+    still_since: Option<u32>,
 }
 
 /// Commands that move something.
@@ -311,6 +325,8 @@ impl BoardA {
             contracting: false,
             refusal: None,
             moving: false,
+            pair: None,
+            still_since: None,
         }
     }
 
@@ -447,7 +463,17 @@ impl BoardA {
             detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, &e_b);
         let in_motion = self.moving_now(&self.feedback(inp.hip, inp.arm_contracted));
         self.moving = in_motion;
-        if !in_motion {
+        // The idle check waits until the robot has been still for `idle_settle_ms`: currents
+        // sampled while the last motion ended (B's report is up to a period old) are no fault.
+        if in_motion {
+            self.still_since = None;
+        } else if self.still_since.is_none() {
+            self.still_since = Some(now);
+        }
+        let settled = self
+            .still_since
+            .is_some_and(|t| detect::elapsed(t, now) >= self.cfg.idle_settle_ms);
+        if settled {
             conditions = conditions.union(detect::idle_overcurrent(
                 &self.cfg.safety,
                 &inp.electrical,
@@ -703,7 +729,21 @@ impl BoardA {
         let order = o.order;
         self.side_a
             .order(order.map_or(0, |(s, _)| s), order.map(|(_, o)| o), now);
+        if let (Some(p), coordinator::Status::Running) = (o.active, o.status) {
+            if let Some((q, attempts)) = self.pair.filter(|(q, _)| *q != p) {
+                out.push(Event::Pair {
+                    pair: q,
+                    attempts,
+                    ok: true,
+                });
+            }
+            self.pair = Some((p, o.attempt.get()));
+        }
         if was == coordinator::Status::Running && o.status != coordinator::Status::Running {
+            let ok = o.status == coordinator::Status::Done;
+            if let Some((pair, attempts)) = self.pair.take() {
+                out.push(Event::Pair { pair, attempts, ok });
+            }
             match o.status {
                 coordinator::Status::Failed(f) => {
                     *faults = faults.with(f);
@@ -716,6 +756,8 @@ impl BoardA {
 
     fn stop_all(&mut self, now: u32) {
         self.runner = None;
+        self.pair = None;
+        self.pair = None;
         self.coord.stop();
         self.waiting_job = None;
         self.side_a.order(0, None, now);

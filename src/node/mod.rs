@@ -33,4 +33,5 @@ pub mod exactly_once;
 pub mod ground;
 #[cfg(any(target_has_atomic = "ptr", feature = "portable-atomic"))]
 pub mod handoff;
+pub mod plan;
 pub mod server;

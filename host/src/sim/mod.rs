@@ -1,0 +1,397 @@
+//! The host simulator: the four nodes of Figure 3 run the real library over real transports —
+//! the opsUI and the server board over an OS pipe (the RS232-over-USB line), the server and
+//! board A over TCP on loopback (the WiFi link, connected and disconnected each server loop),
+//! board A and board B over OS pipes (the wired serial line) — around a plant model
+//! ([`plant`]). Time is wall time multiplied by a scale, so a two-minute plan runs in seconds.
+//!
+//! ```no_run
+//! use mmic_host::sim::{run, SimConfig};
+//! let cfg = SimConfig::demo();
+//! let summary = run(&cfg).expect("simulation ran");
+//! assert!(summary.completed());
+//! ```
+//!
+//! Losses are injected per link ([`SimConfig::wifi_loss`], …): a lost packet is logged with
+//! fate `lost` and never written. Board B can be cut off at a time (both serial directions
+//! stop), the battery can be made to sag and arm A can hit an obstacle ([`PlantConfig`]).
+
+pub mod bench;
+pub mod clock;
+pub mod log;
+pub mod nodes;
+pub mod plant;
+pub mod report;
+
+use clock::Clock;
+use mmic::motion::State;
+use mmic::node::board_a::{self, BoardA};
+use mmic::node::board_b::{self, BoardB};
+use mmic::node::ground;
+use mmic::node::handoff::PacketQueue;
+use mmic::node::plan::{PlanEnd, PlanRunner, PlanStep};
+use mmic::units::BoardNumber;
+use mmic::wire::heartbeat::HeartbeatRepr;
+use nodes::Lossy;
+pub use plant::PlantConfig;
+use serde_json::{json, Value};
+use std::io::Write;
+use std::net::TcpListener;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// A step of the plan with where it came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimStep {
+    /// Line in the plan file (1-based).
+    pub line: usize,
+    /// The line's text.
+    pub text: String,
+    /// The step.
+    pub step: PlanStep,
+}
+
+/// What to simulate.
+#[derive(Debug, Clone)]
+pub struct SimConfig {
+    /// The plan every robot runs.
+    pub steps: Vec<SimStep>,
+    /// Robots (each with its own server board and serial line to the one ground process).
+    pub robots: u8,
+    /// Simulated seconds per wall second.
+    pub scale: f64,
+    /// Seed for every random choice (losses, fastener locks).
+    pub seed: u64,
+    /// Packet loss on the WiFi link, each direction, 0..1.
+    pub wifi_loss: f64,
+    /// Packet loss on the opsUI ↔ server serial line.
+    pub serial_loss: f64,
+    /// Packet loss on the board A ↔ board B serial line.
+    pub ab_loss: f64,
+    /// Board B is cut off (both directions) from this time, ms.
+    pub cut_b_at: Option<u32>,
+    /// Plant parameters and injected faults.
+    pub plant: PlantConfig,
+    /// The state the robot starts in (and board A knows it is in).
+    pub start_state: State,
+    /// The ground's uplink timing.
+    pub ground: ground::Config,
+    /// Stop after this much simulated time, ms.
+    pub max_sim_ms: u32,
+    /// How long the server waits for a heartbeat before disconnecting, ms.
+    pub visit_ms: u32,
+    /// Write the JSON-lines log here (none: keep only the summary).
+    pub log_path: Option<PathBuf>,
+    /// Log every packet (off for large scale runs).
+    pub log_packets: bool,
+    /// Print live progress to stderr.
+    pub progress: bool,
+}
+
+impl SimConfig {
+    /// The built-in demo plan at the default settings.
+    pub fn demo() -> SimConfig {
+        SimConfig::with_steps(crate::sim::report::demo_steps())
+    }
+
+    /// Default settings for these steps.
+    pub fn with_steps(steps: Vec<SimStep>) -> SimConfig {
+        SimConfig {
+            steps,
+            robots: 1,
+            scale: 10.0,
+            seed: 1,
+            wifi_loss: 0.0,
+            serial_loss: 0.0,
+            ab_loss: 0.0,
+            cut_b_at: None,
+            plant: PlantConfig::default(),
+            start_state: State::A,
+            ground: ground::Config::default(),
+            max_sim_ms: 900_000,
+            visit_ms: 500,
+            log_path: None,
+            log_packets: true,
+            progress: false,
+        }
+    }
+}
+
+/// What a run produced.
+#[derive(Debug, Clone)]
+pub struct Summary {
+    /// How each robot's plan ended (none: the time limit came first).
+    pub ends: Vec<Option<PlanEnd>>,
+    /// Steps.
+    pub steps: usize,
+    /// Simulated time, ms.
+    pub sim_ms: u32,
+    /// Wall time.
+    pub wall: Duration,
+    /// Every log record.
+    pub records: Vec<Value>,
+    /// (simulated s, efficiency % over the last 100 attempts) after each attempt, robot 1.
+    pub efficiency: Vec<(f64, f64)>,
+    /// Attempts answered in time and attempts made, all robots.
+    pub attempts: (u64, u64),
+    /// Longest command-to-heartbeat time observed, ms.
+    pub max_latency_ms: u32,
+    /// Board A's final status (mode, faults, state), robot 1.
+    pub status: Value,
+}
+
+impl Summary {
+    /// Every robot's plan completed.
+    pub fn completed(&self) -> bool {
+        self.ends.iter().all(|e| *e == Some(PlanEnd::Completed))
+    }
+
+    /// Board A's events of this type (robot 1 or any robot).
+    pub fn events<'a>(&'a self, ty: &'a str) -> impl Iterator<Item = &'a Value> + 'a {
+        self.records
+            .iter()
+            .filter(move |r| r["kind"] == "event" && r["event"]["type"] == ty)
+    }
+}
+
+struct Robot {
+    addr: std::net::SocketAddr,
+    listener: TcpListener,
+}
+
+/// Runs the simulation to the end of every robot's plan (or the time limit).
+pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
+    let n = cfg.robots.max(1) as usize;
+    let steps: Vec<PlanStep> = cfg.steps.iter().map(|s| s.step).collect();
+    let (logger, log_rx) = log::Log::new();
+    let log = Some(logger.clone());
+    let plog = if cfg.log_packets { log.clone() } else { None };
+    let stop = AtomicBool::new(false);
+    let mut robots = Vec::new();
+    for _ in 0..n {
+        let listener = TcpListener::bind("127.0.0.1:0")?;
+        robots.push(Robot {
+            addr: listener.local_addr()?,
+            listener,
+        });
+    }
+    let mut cmd_queues: Vec<PacketQueue<14, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
+    let mut hb_queues: Vec<PacketQueue<66, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
+    let clock = Clock::start(cfg.scale);
+    let statuses: Vec<Arc<Mutex<Value>>> = (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
+    let writer_path = cfg.log_path.clone();
+    let writer = std::thread::spawn(move || -> std::io::Result<Vec<Value>> {
+        match writer_path {
+            Some(p) => {
+                let f = std::fs::File::create(p)?;
+                log::write_all(log_rx, &mut std::io::BufWriter::new(f))
+            }
+            None => log::write_all(log_rx, &mut std::io::sink()),
+        }
+    });
+    let mut ground_links = Vec::new();
+    let result = std::thread::scope(|scope| -> std::io::Result<(Vec<Option<PlanEnd>>, GroundStats)> {
+        let stop = &stop;
+        for (i, (robot, (cq, hq))) in robots
+            .into_iter()
+            .zip(cmd_queues.iter_mut().zip(hb_queues.iter_mut()))
+            .enumerate()
+        {
+            let board = BoardNumber::new(i as u8 + 1).unwrap_or(BoardNumber::ONE);
+            let name_a = format!("board_a{}", i + 1);
+            let name_b = format!("board_b{}", i + 1);
+            let name_s = format!("server{}", i + 1);
+            let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
+            let plant = Arc::new(Mutex::new(plant::Plant::new(
+                PlantConfig {
+                    seed,
+                    ..cfg.plant.clone()
+                },
+                cfg.start_state,
+            )));
+            let (cmd_p, cmd_c) = cq.split();
+            let (hb_p, hb_c) = hq.split();
+            // Serial A <-> B.
+            let (ab_r, ab_w) = std::io::pipe()?;
+            let (ba_r, ba_w) = std::io::pipe()?;
+            let (ab_tx, ab_rx) = std::sync::mpsc::channel();
+            let (ba_tx, ba_rx) = std::sync::mpsc::channel();
+            scope.spawn(move || nodes::reader(ab_r, ab_tx));
+            scope.spawn(move || nodes::reader(ba_r, ba_tx));
+            // Serial ground <-> server.
+            let (gs_r, gs_w) = std::io::pipe()?;
+            let (sg_r, sg_w) = std::io::pipe()?;
+            let (gs_tx, gs_rx) = std::sync::mpsc::channel();
+            let (sg_tx, sg_rx) = std::sync::mpsc::channel();
+            scope.spawn(move || nodes::reader(gs_r, gs_tx));
+            scope.spawn(move || nodes::reader(sg_r, sg_tx));
+            let a_cfg = board_a::Config {
+                board,
+                ..board_a::Config::default()
+            };
+            let a = BoardA::in_state(a_cfg, cfg.start_state);
+            let b = BoardB::new(board_b::Config::default());
+            let lossy = |out, link, from: &str, to: &str, loss, cut_at, k: u64| Lossy {
+                out,
+                link,
+                from: from.to_string(),
+                to: to.to_string(),
+                loss,
+                cut_at,
+                rng: fastrand::Rng::with_seed(seed.wrapping_add(k * 7919)),
+                log: plog.clone(),
+            };
+            let to_b = lossy(ab_w, "serial_ab", &name_a, &name_b, cfg.ab_loss, cfg.cut_b_at, 1);
+            let to_a = lossy(ba_w, "serial_ab", &name_b, &name_a, cfg.ab_loss, cfg.cut_b_at, 2);
+            let to_ground = lossy(sg_w, "serial_ground", &name_s, "ground", cfg.serial_loss, None, 3);
+            ground_links.push((
+                lossy(gs_w, "serial_ground", "ground", &name_s, cfg.serial_loss, None, 4),
+                sg_rx,
+                board,
+            ));
+            let (l1, l2, l3, l4) = (log.clone(), log.clone(), plog.clone(), log.clone());
+            let (p1, p2) = (plant.clone(), plant);
+            let wifi_loss = cfg.wifi_loss;
+            let status = statuses[i].clone();
+            let (na, na2) = (name_a.clone(), name_a);
+            scope.spawn(move || {
+                nodes::board_a_wifi(robot.listener, cmd_p, hb_c, wifi_loss, seed ^ 0x5eed, clock, l3, stop, na)
+            });
+            scope.spawn(move || {
+                nodes::board_a_control(a, cmd_c, hb_p, ba_rx, to_b, p1, clock, l1, stop, na2, status)
+            });
+            scope.spawn(move || nodes::board_b(b, ab_rx, to_a, p2, clock, l2, stop, name_b));
+            let robots = vec![(board, robot.addr)];
+            let visit = cfg.visit_ms;
+            scope.spawn(move || nodes::server(gs_rx, to_ground, robots, visit, clock, l4, stop, name_s));
+        }
+        let out = ground_loop(cfg, &steps, ground_links, clock, log.clone(), &statuses);
+        stop.store(true, Ordering::Relaxed);
+        Ok(out)
+    });
+    drop(log);
+    drop(plog);
+    drop(logger);
+    let (ends, stats) = result?;
+    let records = writer
+        .join()
+        .map_err(|_| std::io::Error::other("log writer panicked"))??;
+    let status = statuses[0].lock().map(|s| s.clone()).unwrap_or(Value::Null);
+    Ok(Summary {
+        ends,
+        steps: cfg.steps.len(),
+        sim_ms: stats.sim_ms,
+        wall: clock.wall_elapsed(),
+        records,
+        efficiency: stats.efficiency,
+        attempts: stats.attempts,
+        max_latency_ms: stats.max_latency_ms,
+        status,
+    })
+}
+
+struct GroundStats {
+    sim_ms: u32,
+    efficiency: Vec<(f64, f64)>,
+    attempts: (u64, u64),
+    max_latency_ms: u32,
+}
+
+type GroundLink = (Lossy<std::io::PipeWriter>, std::sync::mpsc::Receiver<Vec<u8>>, BoardNumber);
+
+/// The opsUI: one plan runner per robot, in one thread (one ground process).
+fn ground_loop(
+    cfg: &SimConfig,
+    steps: &[PlanStep],
+    mut links: Vec<GroundLink>,
+    clock: Clock,
+    log: Option<log::Log>,
+    statuses: &[Arc<Mutex<Value>>],
+) -> (Vec<Option<PlanEnd>>, GroundStats) {
+    let mut runners: Vec<PlanRunner> = links
+        .iter()
+        .map(|(_, _, b)| PlanRunner::new(cfg.ground, *b))
+        .collect();
+    let mut ends: Vec<Option<PlanEnd>> = vec![None; runners.len()];
+    let mut sent_at: Vec<Option<u32>> = vec![None; runners.len()];
+    let mut last_hb: Vec<Option<HeartbeatRepr>> = vec![None; runners.len()];
+    let mut stats = GroundStats {
+        sim_ms: 0,
+        efficiency: Vec::new(),
+        attempts: (0, 0),
+        max_latency_ms: 0,
+    };
+    let mut progress = report::Progress::new(cfg.progress, cfg.steps.clone());
+    loop {
+        let now = clock.now_ms();
+        stats.sim_ms = now;
+        if now > cfg.max_sim_ms || ends.iter().all(|e| e.is_some()) {
+            break;
+        }
+        for (i, ((writer, rx, _), run)) in links.iter_mut().zip(runners.iter_mut()).enumerate() {
+            if ends[i].is_some() {
+                continue;
+            }
+            let mut ticks = vec![run.tick(steps, now)];
+            while let Ok(bytes) = rx.try_recv() {
+                if let Ok(hb) = HeartbeatRepr::parse(&bytes) {
+                    let t = clock.now_ms();
+                    if let Some(s) = sent_at[i] {
+                        if hb.last_seq == run.uplink().outstanding().unwrap_or(0) {
+                            stats.max_latency_ms = stats.max_latency_ms.max(t.saturating_sub(s));
+                        }
+                    }
+                    ticks.push(run.heartbeat(steps, t, &hb));
+                    last_hb[i] = Some(hb);
+                }
+            }
+            for t in ticks {
+                if let Some(p) = t.send {
+                    sent_at[i] = Some(now);
+                    writer.send(now, &p.to_bytes());
+                }
+                if let Some(ok) = t.attempt {
+                    stats.attempts.1 += 1;
+                    stats.attempts.0 += ok as u64;
+                    if i == 0 {
+                        let e = run.uplink().efficiency().percent().unwrap_or(0);
+                        stats.efficiency.push((now as f64 / 1000.0, e as f64));
+                    }
+                    if let Some(l) = &log {
+                        l.event(now, "ground", json!({"type": "attempt", "robot": i + 1, "ok": ok}));
+                    }
+                }
+                if let Some(d) = t.done {
+                    if let Some(l) = &log {
+                        l.event(now, "ground", json!({
+                            "type": "done", "robot": i + 1, "seq": d.seq, "command": d.command,
+                            "outcome": d.outcome, "attempts": d.attempts,
+                        }));
+                    }
+                }
+                if let (Some(k), 0) = (t.started, i) {
+                    progress.step(now, k);
+                    if let Some(l) = &log {
+                        l.event(now, "ground", json!({"type": "step", "robot": 1, "step": k + 1,
+                            "line": cfg.steps[k].line, "text": cfg.steps[k].text}));
+                    }
+                }
+                if let Some(e) = t.end {
+                    ends[i] = Some(e);
+                    if let Some(l) = &log {
+                        l.event(now, "ground", json!({"type": "plan_end", "robot": i + 1, "end": format!("{e:?}")}));
+                    }
+                }
+            }
+        }
+        if let Some(hb) = &last_hb[0] {
+            let eff = runners[0].uplink().efficiency();
+            progress.status(now, runners[0].step(), hb, eff, &statuses[0]);
+        }
+        std::thread::sleep(Duration::from_micros(500));
+    }
+    progress.finish();
+    let _ = std::io::stderr().flush();
+    (ends, stats)
+}

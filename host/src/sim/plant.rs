@@ -1,0 +1,278 @@
+//! The robot's physics, as much as the firmware can notice: servos that move at a limited
+//! speed, a continuous hip servo with lag, currents that rise while something moves, pushes
+//! or hits an obstacle, a battery that sags with current and time, fasteners that lock with a
+//! probability, and gravity readings that follow the state the robot is in.
+//!
+//! Simplifications, stated: the gravity readings are those the paper's model predicts for the
+//! state the robot last reached (the plant does not integrate the kinematics); both sides'
+//! bolters share one lock roll per attempt (a face's fastener pair locks or does not);
+//! the lock probability of consecutive attempts on one pair follows Figure 10's demo
+//! (2307/2524, then 103/217, then 28/114).
+
+use mmic::bolter::{Drive, MuxLines, Signals};
+use mmic::motion::estimate::{self, predict};
+use mmic::motion::State;
+use mmic::units::{Electrical, Gravity, HipAngle, PulseWidth};
+
+/// Plant parameters and injected faults.
+#[derive(Debug, Clone)]
+pub struct PlantConfig {
+    /// Probability that the fastener locks at the 1st, 2nd, 3rd consecutive attempt on a pair.
+    pub lock_probability: [f64; 3],
+    /// Battery voltage at rest, full, mV.
+    pub battery_mv: f64,
+    /// Battery internal resistance, Ω (mV per mA).
+    pub internal_ohm: f64,
+    /// Discharge, mV per simulated second.
+    pub drain_mv_per_s: f64,
+    /// From this time on (ms) the battery is nearly empty (rest voltage 9.6 V).
+    pub low_battery_at: Option<u32>,
+    /// At this time (ms) arm A hits an obstacle: its current jumps to 3.5 A for 500 ms.
+    pub overcurrent_at: Option<u32>,
+    /// RNG seed (fastener locks).
+    pub seed: u64,
+    /// Pulse at which an arm's contraction switch closes (the firmware's "contracted").
+    pub arm_contracted: PulseWidth,
+}
+
+impl Default for PlantConfig {
+    fn default() -> PlantConfig {
+        PlantConfig {
+            lock_probability: [2307.0 / 2524.0, 103.0 / 217.0, 28.0 / 114.0],
+            battery_mv: 12_600.0,
+            internal_ohm: 0.3,
+            drain_mv_per_s: 2.0,
+            low_battery_at: None,
+            overcurrent_at: None,
+            seed: 1,
+            arm_contracted: mmic::node::board_a::Config::default().arm.contracted,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Bolter {
+    pos: f64,
+    rotating_ms: f64,
+    drive: Option<Drive>,
+}
+
+/// What one board drives.
+#[derive(Debug, Clone, Copy)]
+pub struct Drives {
+    /// Arm servo pulse; none = unpowered.
+    pub arm: Option<PulseWidth>,
+    /// Gripper servo pulse.
+    pub gripper: Option<PulseWidth>,
+    /// Regulator.
+    pub regulator: bool,
+    /// Bolter motor.
+    pub bolter: Drive,
+    /// Bolter multiplexer.
+    pub mux: MuxLines,
+}
+
+/// What one side's sensors read.
+#[derive(Debug, Clone, Copy)]
+pub struct Senses {
+    /// Voltages and currents.
+    pub electrical: Electrical,
+    /// Gravity in the side's IMU frame.
+    pub gravity: Option<Gravity>,
+    /// Arm contraction switch.
+    pub arm_contracted: bool,
+    /// Bolter signals.
+    pub bolter: Signals,
+}
+
+/// The plant.
+pub struct Plant {
+    cfg: PlantConfig,
+    rng: fastrand::Rng,
+    last: u32,
+    arm: [f64; 2],
+    gripper: [f64; 2],
+    drives: [Option<Drives>; 2],
+    arm_moving: [bool; 2],
+    gripper_moving: [bool; 2],
+    hip: f64,
+    hip_speed: f64,
+    hip_cmd: Option<PulseWidth>,
+    bolter: [Bolter; 2],
+    lock: Option<bool>,
+    tries: usize,
+    pair: Option<MuxLines>,
+    /// The state the robot last reached (drives the gravity readings).
+    pub state: State,
+    gravity: (Option<Gravity>, Option<Gravity>),
+}
+
+const SERVO_US_PER_S: f64 = 2000.0;
+const BOLTER_TRAVEL_MS: f64 = 800.0;
+const ROTATE_MS: f64 = 1000.0;
+
+impl Plant {
+    /// The robot at rest in `state`, arms contracted, grippers closed, hip at 180°.
+    pub fn new(cfg: PlantConfig, state: State) -> Plant {
+        let a = mmic::node::board_a::Config::default();
+        let mut p = Plant {
+            rng: fastrand::Rng::with_seed(cfg.seed),
+            last: 0,
+            arm: [a.arm.contracted.micros() as f64; 2],
+            gripper: [a.gripper.extended.micros() as f64; 2],
+            drives: [None; 2],
+            arm_moving: [false; 2],
+            gripper_moving: [false; 2],
+            hip: 18000.0,
+            hip_speed: 0.0,
+            hip_cmd: None,
+            bolter: [Bolter::default(); 2],
+            lock: None,
+            tries: 0,
+            pair: None,
+            state,
+            gravity: (None, None),
+            cfg,
+        };
+        p.set_state(state);
+        p
+    }
+
+    /// The robot reached `s`: its IMUs now read what the model predicts there.
+    pub fn set_state(&mut self, s: State) {
+        self.state = s;
+        let r = predict(&estimate::Config::default(), s).next();
+        self.gravity = (r.and_then(|r| r.gravity_a), r.and_then(|r| r.gravity_b));
+    }
+
+    /// Board A's outputs (side A and the hip).
+    pub fn drive_a(&mut self, d: Drives, hip: Option<PulseWidth>) {
+        self.drives[0] = Some(d);
+        self.hip_cmd = hip;
+    }
+
+    /// Board B's outputs.
+    pub fn drive_b(&mut self, d: Drives) {
+        self.drives[1] = Some(d);
+    }
+
+    /// Advances the physics to `now` (ms).
+    pub fn advance(&mut self, now: u32) {
+        let dt = now.saturating_sub(self.last) as f64;
+        self.last = now.max(self.last);
+        if dt <= 0.0 {
+            return;
+        }
+        for side in 0..2 {
+            let d = self.drives[side];
+            let step = SERVO_US_PER_S * dt / 1000.0;
+            let follow = |x: &mut f64, cmd: Option<PulseWidth>| -> bool {
+                match cmd {
+                    Some(c) if d.is_some_and(|d| d.regulator) => {
+                        let target = c.micros() as f64;
+                        let before = *x;
+                        *x += (target - *x).clamp(-step, step);
+                        (*x - before).abs() > 1e-9
+                    }
+                    _ => false,
+                }
+            };
+            self.arm_moving[side] = follow(&mut self.arm[side], d.and_then(|d| d.arm));
+            self.gripper_moving[side] = follow(&mut self.gripper[side], d.and_then(|d| d.gripper));
+            let drive = d.map_or(Drive::Idle, |d| d.bolter);
+            let b = &mut self.bolter[side];
+            match drive {
+                Drive::Down => b.pos = (b.pos + dt / BOLTER_TRAVEL_MS).min(1.0),
+                Drive::Up | Drive::CounterRotateUp => b.pos = (b.pos - dt / BOLTER_TRAVEL_MS).max(0.0),
+                Drive::Rotate => b.rotating_ms += dt,
+                Drive::Idle => {}
+            }
+            if drive != Drive::Rotate {
+                b.rotating_ms = 0.0;
+            }
+            b.drive = Some(drive);
+        }
+        // One lock roll per attempt, shared by both sides of the pair.
+        let mux = self.drives[0].map(|d| d.mux);
+        if mux != self.pair {
+            self.pair = mux;
+            self.tries = 0;
+        }
+        let rotating = self.bolter.iter().any(|b| b.drive == Some(Drive::Rotate));
+        if rotating && self.lock.is_none() {
+            let p = self.cfg.lock_probability[self.tries.min(2)];
+            let ok = self.rng.f64() < p;
+            self.lock = Some(ok);
+            self.tries = if ok { 0 } else { self.tries + 1 };
+        }
+        if !rotating {
+            self.lock = None;
+        }
+        // The continuous hip servo: 10 (0.01°/s) per µs off 1500, 50 ms lag.
+        let cmd = match self.hip_cmd {
+            Some(p) if self.drives[0].is_some_and(|d| d.regulator) => (p.micros() as f64 - 1500.0) * 10.0,
+            _ => 0.0,
+        };
+        self.hip_speed += (cmd - self.hip_speed) * (dt / 50.0).min(1.0);
+        self.hip = (self.hip + self.hip_speed * dt / 1000.0).rem_euclid(36000.0);
+    }
+
+    /// The hip encoder (4096 counts per turn).
+    pub fn hip(&self) -> HipAngle {
+        let counts = (self.hip / 36000.0 * 4096.0).floor() as u32 % 4096;
+        HipAngle::new(((counts * 36000 + 2048) / 4096 % 36000) as u16).unwrap_or(HipAngle::ZERO)
+    }
+
+    /// What side `side` (0 = A, 1 = B) reads at `now`.
+    pub fn sense(&self, side: usize, now: u32) -> Senses {
+        let d = self.drives[side];
+        let reg = d.is_some_and(|d| d.regulator);
+        let b = self.bolter[side];
+        let drive = b.drive.unwrap_or(Drive::Idle);
+        let threshold = drive == Drive::Down && b.pos >= 1.0;
+        let locked = drive == Drive::Rotate && b.rotating_ms >= ROTATE_MS && self.lock == Some(true);
+        let hip_moving = side == 0 && self.hip_speed.abs() > 50.0;
+        let obstacle = side == 0
+            && self
+                .cfg
+                .overcurrent_at
+                .is_some_and(|t| now >= t && now < t + 500);
+        // Moving draws more, but stays under the idle limits (400 mA locomotion, 200 mA
+        // gripper): a servo still settling when the firmware's idle check starts is no fault.
+        let i_loc = if reg { 120.0 } else { 0.0 }
+            + if self.arm_moving[side] { 150.0 } else { 0.0 }
+            + if hip_moving { 100.0 } else { 0.0 }
+            + if obstacle { 3500.0 } else { 0.0 };
+        let i_grip = if reg { 60.0 } else { 0.0 } + if self.gripper_moving[side] { 100.0 } else { 0.0 };
+        let i_bo = match drive {
+            Drive::Idle => 40.0,
+            _ => 450.0,
+        } + if threshold { 900.0 } else { 0.0 };
+        let i_3v3 = 80.0;
+        let i_bat = i_loc + i_grip + i_bo + i_3v3;
+        let rest = match self.cfg.low_battery_at {
+            Some(t) if now >= t => 9_600.0,
+            _ => self.cfg.battery_mv - self.cfg.drain_mv_per_s * now as f64 / 1000.0,
+        };
+        let v_bat = rest - i_bat * self.cfg.internal_ohm;
+        let clamp = |x: f64| x.clamp(0.0, 65_535.0) as u16;
+        Senses {
+            electrical: Electrical {
+                v_bat: clamp(v_bat),
+                i_bat: clamp(i_bat),
+                i_loc: clamp(i_loc),
+                i_grip: clamp(i_grip),
+                i_3v3: clamp(i_3v3),
+                v_reg: if reg { 7_400 } else { 0 },
+                i_bo: clamp(i_bo),
+            },
+            gravity: if side == 0 { self.gravity.0 } else { self.gravity.1 },
+            arm_contracted: self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
+            bolter: Signals {
+                threshold,
+                locked,
+                at_home: b.pos <= 0.0,
+            },
+        }
+    }
+}
