@@ -319,12 +319,15 @@ fn state(l: &mut Line<'_>) -> Result<State, PlanError> {
     let t = l.next("reconfigure", "`<from> -> <to>` (states a..o)")?;
     let mut cs = t.text.chars();
     match (cs.next(), cs.next()) {
-        (Some(c), None) => State::from_letter(c.to_ascii_lowercase()).ok_or_else(|| l.bad(t, STATE)),
+        (Some(c), None) => {
+            State::from_letter(c.to_ascii_lowercase()).ok_or_else(|| l.bad(t, STATE))
+        }
         _ => Err(l.bad(t, STATE)),
     }
 }
 
-const MODULE: &str = "a module (hip, arm-a, arm-b, gripper-a, gripper-b, bolter-a, bolter-b) or `all`";
+const MODULE: &str =
+    "a module (hip, arm-a, arm-b, gripper-a, gripper-b, bolter-a, bolter-b) or `all`";
 
 /// The plan-file name of a module.
 pub fn module_name(m: Module) -> &'static str {
@@ -371,7 +374,9 @@ fn step(l: &mut Line<'_>, first: Tok<'_>) -> Result<Action, PlanError> {
         }
         "hip" => c(Command::Hip(hip(l)?)),
         "bolt" => c(Command::Bolter(BolterCommand::Bolt(fasteners(l, "bolt")?))),
-        "unbolt" => c(Command::Bolter(BolterCommand::Unbolt(fasteners(l, "unbolt")?))),
+        "unbolt" => c(Command::Bolter(BolterCommand::Unbolt(fasteners(
+            l, "unbolt",
+        )?))),
         "bolters" => {
             let t = l.next("bolters", "`down`")?;
             if lower(t) != "down" {
@@ -400,7 +405,12 @@ fn step(l: &mut Line<'_>, first: Tok<'_>) -> Result<Action, PlanError> {
             let to = state(l)?;
             Command::reconfigure(from, to)
                 .map(Action::Command)
-                .map_err(|e| l.err(from_tok.map_or(first.col, |t| t.col), PlanErrorKind::Reconfiguration(e)))
+                .map_err(|e| {
+                    l.err(
+                        from_tok.map_or(first.col, |t| t.col),
+                        PlanErrorKind::Reconfiguration(e),
+                    )
+                })
         }
         "power" => {
             const ON: &str = "`on` or `off`";

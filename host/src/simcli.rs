@@ -54,7 +54,11 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
         Ok(())
     } else {
         Err(CliError::Incomplete(
-            report::text(&summary).lines().next().unwrap_or_default().to_string(),
+            report::text(&summary)
+                .lines()
+                .next()
+                .unwrap_or_default()
+                .to_string(),
         ))
     }
 }

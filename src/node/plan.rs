@@ -36,6 +36,8 @@
 
 use super::ground::{self, Done, Outcome, Uplink};
 use crate::command::{Command, CommandKind};
+use crate::faults::Faults;
+use crate::mode::Mode;
 use crate::refusal::Refusal;
 use crate::safety::detect::{elapsed, hip_distance};
 use crate::units::BoardNumber;
@@ -71,6 +73,16 @@ pub enum PlanEnd {
         /// The step.
         step: usize,
     },
+    /// Step `step`'s motion was cut short: the robot left Operational (a fault, or a mode
+    /// command from elsewhere).
+    Interrupted {
+        /// The step.
+        step: usize,
+        /// The mode the robot reported.
+        mode: Mode,
+        /// Its latched faults.
+        faults: Faults,
+    },
 }
 
 /// What one call asks for or reports.
@@ -96,7 +108,11 @@ enum Phase {
     Sending,
     /// Step `next`'s motion is running; polling. A settled answer counts once `polls`
     /// reaches `need` (a bolting job may start a tick late, after board B reports idle).
-    Settling { polls: u16, need: u16 },
+    Settling {
+        polls: u16,
+        need: u16,
+        mode_step: bool,
+    },
     /// Step `next` is a wait until this time.
     Waiting { until: u32 },
     /// Done.
@@ -233,7 +249,9 @@ impl PlanRunner {
     fn finished(&mut self, d: Done, hb: Option<&HeartbeatRepr>) {
         let step = self.next;
         match (self.phase, d.outcome) {
-            (_, Outcome::Unacknowledged) => self.phase = Phase::Ended(PlanEnd::Unacknowledged { step }),
+            (_, Outcome::Unacknowledged) => {
+                self.phase = Phase::Ended(PlanEnd::Unacknowledged { step })
+            }
             (Phase::Sending, Outcome::Refused(Refusal::Busy)) => self.phase = Phase::Ready,
             (Phase::Sending, Outcome::Refused(refusal)) => {
                 self.phase = Phase::Ended(PlanEnd::Refused { step, refusal })
@@ -241,20 +259,39 @@ impl PlanRunner {
             (Phase::Sending, Outcome::Accepted) => {
                 if moves(&d.command) {
                     let need = matches!(d.command.kind(), CommandKind::Bolter) as u16;
-                    self.phase = Phase::Settling { polls: 0, need };
+                    let mode_step = matches!(d.command.kind(), CommandKind::Mode);
+                    self.phase = Phase::Settling {
+                        polls: 0,
+                        need,
+                        mode_step,
+                    };
                 } else {
                     self.next += 1;
                     self.phase = Phase::Ready;
                 }
             }
-            (Phase::Settling { polls, need }, _) => {
-                if polls >= need && hb.is_some_and(settled) {
+            (
+                Phase::Settling {
+                    polls,
+                    need,
+                    mode_step,
+                },
+                _,
+            ) => {
+                if let Some(h) = hb.filter(|h| !mode_step && h.mode != Mode::Operational) {
+                    self.phase = Phase::Ended(PlanEnd::Interrupted {
+                        step,
+                        mode: h.mode,
+                        faults: h.faults,
+                    });
+                } else if polls >= need && hb.is_some_and(settled) {
                     self.next += 1;
                     self.phase = Phase::Ready;
                 } else {
                     self.phase = Phase::Settling {
                         polls: polls.saturating_add(1),
                         need,
+                        mode_step,
                     };
                 }
             }

@@ -43,9 +43,7 @@ pub fn trial(robots: u8, seconds: u32) -> std::io::Result<Trial> {
     let mut cfg = SimConfig::with_steps(vec![SimStep {
         line: 1,
         text: format!("wait {seconds}s"),
-        step: PlanStep::Wait {
-            ms: seconds * 1000,
-        },
+        step: PlanStep::Wait { ms: seconds * 1000 },
     }]);
     cfg.robots = robots;
     cfg.scale = 1.0;

@@ -108,9 +108,15 @@ impl SimConfig {
             cut_b_at: None,
             plant: PlantConfig::default(),
             start_state: State::A,
-            ground: ground::Config::default(),
+            // The paper resends until acknowledged; 20 attempts make an unacknowledged command
+            // unlikely even at 30 % loss each way (0.51^20 < 2e-6) while still ending a run
+            // whose link is gone.
+            ground: ground::Config {
+                max_attempts: 20,
+                ..ground::Config::default()
+            },
             max_sim_ms: 900_000,
-            visit_ms: 500,
+            visit_ms: 250,
             log_path: None,
             log_packets: true,
             progress: false,
@@ -179,7 +185,8 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     let mut cmd_queues: Vec<PacketQueue<14, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
     let mut hb_queues: Vec<PacketQueue<66, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
     let clock = Clock::start(cfg.scale);
-    let statuses: Vec<Arc<Mutex<Value>>> = (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
+    let statuses: Vec<Arc<Mutex<Value>>> =
+        (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
     let writer_path = cfg.log_path.clone();
     let writer = std::thread::spawn(move || -> std::io::Result<Vec<Value>> {
         match writer_path {
@@ -191,85 +198,133 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         }
     });
     let mut ground_links = Vec::new();
-    let result = std::thread::scope(|scope| -> std::io::Result<(Vec<Option<PlanEnd>>, GroundStats)> {
-        let stop = &stop;
-        for (i, (robot, (cq, hq))) in robots
-            .into_iter()
-            .zip(cmd_queues.iter_mut().zip(hb_queues.iter_mut()))
-            .enumerate()
-        {
-            let board = BoardNumber::new(i as u8 + 1).unwrap_or(BoardNumber::ONE);
-            let name_a = format!("board_a{}", i + 1);
-            let name_b = format!("board_b{}", i + 1);
-            let name_s = format!("server{}", i + 1);
-            let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
-            let plant = Arc::new(Mutex::new(plant::Plant::new(
-                PlantConfig {
-                    seed,
-                    ..cfg.plant.clone()
-                },
-                cfg.start_state,
-            )));
-            let (cmd_p, cmd_c) = cq.split();
-            let (hb_p, hb_c) = hq.split();
-            // Serial A <-> B.
-            let (ab_r, ab_w) = std::io::pipe()?;
-            let (ba_r, ba_w) = std::io::pipe()?;
-            let (ab_tx, ab_rx) = std::sync::mpsc::channel();
-            let (ba_tx, ba_rx) = std::sync::mpsc::channel();
-            scope.spawn(move || nodes::reader(ab_r, ab_tx));
-            scope.spawn(move || nodes::reader(ba_r, ba_tx));
-            // Serial ground <-> server.
-            let (gs_r, gs_w) = std::io::pipe()?;
-            let (sg_r, sg_w) = std::io::pipe()?;
-            let (gs_tx, gs_rx) = std::sync::mpsc::channel();
-            let (sg_tx, sg_rx) = std::sync::mpsc::channel();
-            scope.spawn(move || nodes::reader(gs_r, gs_tx));
-            scope.spawn(move || nodes::reader(sg_r, sg_tx));
-            let a_cfg = board_a::Config {
-                board,
-                ..board_a::Config::default()
-            };
-            let a = BoardA::in_state(a_cfg, cfg.start_state);
-            let b = BoardB::new(board_b::Config::default());
-            let lossy = |out, link, from: &str, to: &str, loss, cut_at, k: u64| Lossy {
-                out,
-                link,
-                from: from.to_string(),
-                to: to.to_string(),
-                loss,
-                cut_at,
-                rng: fastrand::Rng::with_seed(seed.wrapping_add(k * 7919)),
-                log: plog.clone(),
-            };
-            let to_b = lossy(ab_w, "serial_ab", &name_a, &name_b, cfg.ab_loss, cfg.cut_b_at, 1);
-            let to_a = lossy(ba_w, "serial_ab", &name_b, &name_a, cfg.ab_loss, cfg.cut_b_at, 2);
-            let to_ground = lossy(sg_w, "serial_ground", &name_s, "ground", cfg.serial_loss, None, 3);
-            ground_links.push((
-                lossy(gs_w, "serial_ground", "ground", &name_s, cfg.serial_loss, None, 4),
-                sg_rx,
-                board,
-            ));
-            let (l1, l2, l3, l4) = (log.clone(), log.clone(), plog.clone(), log.clone());
-            let (p1, p2) = (plant.clone(), plant);
-            let wifi_loss = cfg.wifi_loss;
-            let status = statuses[i].clone();
-            let (na, na2) = (name_a.clone(), name_a);
-            scope.spawn(move || {
-                nodes::board_a_wifi(robot.listener, cmd_p, hb_c, wifi_loss, seed ^ 0x5eed, clock, l3, stop, na)
-            });
-            scope.spawn(move || {
-                nodes::board_a_control(a, cmd_c, hb_p, ba_rx, to_b, p1, clock, l1, stop, na2, status)
-            });
-            scope.spawn(move || nodes::board_b(b, ab_rx, to_a, p2, clock, l2, stop, name_b));
-            let robots = vec![(board, robot.addr)];
-            let visit = cfg.visit_ms;
-            scope.spawn(move || nodes::server(gs_rx, to_ground, robots, visit, clock, l4, stop, name_s));
-        }
-        let out = ground_loop(cfg, &steps, ground_links, clock, log.clone(), &statuses);
-        stop.store(true, Ordering::Relaxed);
-        Ok(out)
-    });
+    let result = std::thread::scope(
+        |scope| -> std::io::Result<(Vec<Option<PlanEnd>>, GroundStats)> {
+            let stop = &stop;
+            for (i, (robot, (cq, hq))) in robots
+                .into_iter()
+                .zip(cmd_queues.iter_mut().zip(hb_queues.iter_mut()))
+                .enumerate()
+            {
+                let board = BoardNumber::new(i as u8 + 1).unwrap_or(BoardNumber::ONE);
+                let name_a = format!("board_a{}", i + 1);
+                let name_b = format!("board_b{}", i + 1);
+                let name_s = format!("server{}", i + 1);
+                let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
+                let plant = Arc::new(Mutex::new(plant::Plant::new(
+                    PlantConfig {
+                        seed,
+                        ..cfg.plant.clone()
+                    },
+                    cfg.start_state,
+                )));
+                let (cmd_p, cmd_c) = cq.split();
+                let (hb_p, hb_c) = hq.split();
+                // Serial A <-> B.
+                let (ab_r, ab_w) = std::io::pipe()?;
+                let (ba_r, ba_w) = std::io::pipe()?;
+                let (ab_tx, ab_rx) = std::sync::mpsc::channel();
+                let (ba_tx, ba_rx) = std::sync::mpsc::channel();
+                scope.spawn(move || nodes::reader(ab_r, ab_tx));
+                scope.spawn(move || nodes::reader(ba_r, ba_tx));
+                // Serial ground <-> server.
+                let (gs_r, gs_w) = std::io::pipe()?;
+                let (sg_r, sg_w) = std::io::pipe()?;
+                let (gs_tx, gs_rx) = std::sync::mpsc::channel();
+                let (sg_tx, sg_rx) = std::sync::mpsc::channel();
+                scope.spawn(move || nodes::reader(gs_r, gs_tx));
+                scope.spawn(move || nodes::reader(sg_r, sg_tx));
+                let a_cfg = board_a::Config {
+                    board,
+                    ..board_a::Config::default()
+                };
+                let a = BoardA::in_state(a_cfg, cfg.start_state);
+                let b = BoardB::new(board_b::Config::default());
+                let lossy = |out, link, from: &str, to: &str, loss, cut_at, k: u64| Lossy {
+                    out,
+                    link,
+                    from: from.to_string(),
+                    to: to.to_string(),
+                    loss,
+                    cut_at,
+                    rng: fastrand::Rng::with_seed(seed.wrapping_add(k * 7919)),
+                    log: plog.clone(),
+                };
+                let to_b = lossy(
+                    ab_w,
+                    "serial_ab",
+                    &name_a,
+                    &name_b,
+                    cfg.ab_loss,
+                    cfg.cut_b_at,
+                    1,
+                );
+                let to_a = lossy(
+                    ba_w,
+                    "serial_ab",
+                    &name_b,
+                    &name_a,
+                    cfg.ab_loss,
+                    cfg.cut_b_at,
+                    2,
+                );
+                let to_ground = lossy(
+                    sg_w,
+                    "serial_ground",
+                    &name_s,
+                    "ground",
+                    cfg.serial_loss,
+                    None,
+                    3,
+                );
+                ground_links.push((
+                    lossy(
+                        gs_w,
+                        "serial_ground",
+                        "ground",
+                        &name_s,
+                        cfg.serial_loss,
+                        None,
+                        4,
+                    ),
+                    sg_rx,
+                    board,
+                ));
+                let (l1, l2, l3, l4) = (log.clone(), log.clone(), plog.clone(), log.clone());
+                let (p1, p2) = (plant.clone(), plant);
+                let wifi_loss = cfg.wifi_loss;
+                let status = statuses[i].clone();
+                let (na, na2) = (name_a.clone(), name_a);
+                scope.spawn(move || {
+                    nodes::board_a_wifi(
+                        robot.listener,
+                        cmd_p,
+                        hb_c,
+                        wifi_loss,
+                        seed ^ 0x5eed,
+                        clock,
+                        l3,
+                        stop,
+                        na,
+                    )
+                });
+                scope.spawn(move || {
+                    nodes::board_a_control(
+                        a, cmd_c, hb_p, ba_rx, to_b, p1, clock, l1, stop, na2, status,
+                    )
+                });
+                scope.spawn(move || nodes::board_b(b, ab_rx, to_a, p2, clock, l2, stop, name_b));
+                let robots = vec![(board, robot.addr)];
+                let visit = cfg.visit_ms;
+                scope.spawn(move || {
+                    nodes::server(gs_rx, to_ground, robots, visit, clock, l4, stop, name_s)
+                });
+            }
+            let out = ground_loop(cfg, &steps, ground_links, clock, log.clone(), &statuses);
+            stop.store(true, Ordering::Relaxed);
+            Ok(out)
+        },
+    );
     drop(log);
     drop(plog);
     drop(logger);
@@ -298,7 +353,11 @@ struct GroundStats {
     max_latency_ms: u32,
 }
 
-type GroundLink = (Lossy<std::io::PipeWriter>, std::sync::mpsc::Receiver<Vec<u8>>, BoardNumber);
+type GroundLink = (
+    Lossy<std::io::PipeWriter>,
+    std::sync::mpsc::Receiver<Vec<u8>>,
+    BoardNumber,
+);
 
 /// The opsUI: one plan runner per robot, in one thread (one ground process).
 fn ground_loop(
@@ -359,28 +418,44 @@ fn ground_loop(
                         stats.efficiency.push((now as f64 / 1000.0, e as f64));
                     }
                     if let Some(l) = &log {
-                        l.event(now, "ground", json!({"type": "attempt", "robot": i + 1, "ok": ok}));
+                        l.event(
+                            now,
+                            "ground",
+                            json!({"type": "attempt", "robot": i + 1, "ok": ok}),
+                        );
                     }
                 }
                 if let Some(d) = t.done {
                     if let Some(l) = &log {
-                        l.event(now, "ground", json!({
-                            "type": "done", "robot": i + 1, "seq": d.seq, "command": d.command,
-                            "outcome": d.outcome, "attempts": d.attempts,
-                        }));
+                        l.event(
+                            now,
+                            "ground",
+                            json!({
+                                "type": "done", "robot": i + 1, "seq": d.seq, "command": d.command,
+                                "outcome": d.outcome, "attempts": d.attempts,
+                            }),
+                        );
                     }
                 }
                 if let (Some(k), 0) = (t.started, i) {
                     progress.step(now, k);
                     if let Some(l) = &log {
-                        l.event(now, "ground", json!({"type": "step", "robot": 1, "step": k + 1,
-                            "line": cfg.steps[k].line, "text": cfg.steps[k].text}));
+                        l.event(
+                            now,
+                            "ground",
+                            json!({"type": "step", "robot": 1, "step": k + 1,
+                            "line": cfg.steps[k].line, "text": cfg.steps[k].text}),
+                        );
                     }
                 }
                 if let Some(e) = t.end {
                     ends[i] = Some(e);
                     if let Some(l) = &log {
-                        l.event(now, "ground", json!({"type": "plan_end", "robot": i + 1, "end": format!("{e:?}")}));
+                        l.event(
+                            now,
+                            "ground",
+                            json!({"type": "plan_end", "robot": i + 1, "end": format!("{e:?}")}),
+                        );
                     }
                 }
             }

@@ -45,7 +45,12 @@ impl<W: Write> Lossy<W> {
             "cut"
         } else if self.loss > 0.0 && self.rng.f64() < self.loss {
             "lost"
-        } else if self.out.write_all(bytes).and_then(|_| self.out.flush()).is_ok() {
+        } else if self
+            .out
+            .write_all(bytes)
+            .and_then(|_| self.out.flush())
+            .is_ok()
+        {
             "delivered"
         } else {
             "closed"
@@ -107,11 +112,9 @@ pub fn event_json(e: &Event) -> Value {
         Event::Mode { from, to } => json!({"type": "mode", "from": from, "to": to}),
         Event::Reached(s) => json!({"type": "reached", "state": s}),
         Event::Bolting(f) => json!({"type": "bolting", "fault": f}),
-        Event::Pair {
-            pair,
-            attempts,
-            ok,
-        } => json!({"type": "pair", "pair": pair.number(), "attempts": attempts, "ok": ok}),
+        Event::Pair { pair, attempts, ok } => {
+            json!({"type": "pair", "pair": pair.number(), "attempts": attempts, "ok": ok})
+        }
     }
 }
 
@@ -274,7 +277,11 @@ pub fn board_a_control(
         if let Some(hb) = out.heartbeat {
             if let Err(full) = heartbeats.push(hb) {
                 if let Some(l) = &log {
-                    l.event(now, &name, json!({"type": "handoff_full", "hex": super::log::hex(&full.0)}));
+                    l.event(
+                        now,
+                        &name,
+                        json!({"type": "handoff_full", "hex": super::log::hex(&full.0)}),
+                    );
                 }
                 heartbeats.give_up(full);
             }
@@ -324,17 +331,24 @@ pub fn board_b(
                 bolter: s.bolter,
             },
         );
-        plant.lock().unwrap_or_else(|e| e.into_inner()).drive_b(Drives {
-            arm: out.arm,
-            gripper: out.gripper,
-            regulator: out.regulator,
-            bolter: out.bolter,
-            mux: out.mux,
-        });
+        plant
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .drive_b(Drives {
+                arm: out.arm,
+                gripper: out.gripper,
+                regulator: out.regulator,
+                bolter: out.bolter,
+                mux: out.mux,
+            });
         if out.link_lost != was_lost {
             was_lost = out.link_lost;
             if let Some(l) = &log {
-                l.event(now, &name, json!({"type": "link_lost", "holding": was_lost}));
+                l.event(
+                    now,
+                    &name,
+                    json!({"type": "link_lost", "holding": was_lost}),
+                );
             }
         }
         if let Some(hb) = out.heartbeat {

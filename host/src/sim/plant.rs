@@ -183,7 +183,9 @@ impl Plant {
             let b = &mut self.bolter[side];
             match drive {
                 Drive::Down => b.pos = (b.pos + dt / BOLTER_TRAVEL_MS).min(1.0),
-                Drive::Up | Drive::CounterRotateUp => b.pos = (b.pos - dt / BOLTER_TRAVEL_MS).max(0.0),
+                Drive::Up | Drive::CounterRotateUp => {
+                    b.pos = (b.pos - dt / BOLTER_TRAVEL_MS).max(0.0)
+                }
                 Drive::Rotate => b.rotating_ms += dt,
                 Drive::Idle => {}
             }
@@ -210,7 +212,9 @@ impl Plant {
         }
         // The continuous hip servo: 10 (0.01°/s) per µs off 1500, 50 ms lag.
         let cmd = match self.hip_cmd {
-            Some(p) if self.drives[0].is_some_and(|d| d.regulator) => (p.micros() as f64 - 1500.0) * 10.0,
+            Some(p) if self.drives[0].is_some_and(|d| d.regulator) => {
+                (p.micros() as f64 - 1500.0) * 10.0
+            }
             _ => 0.0,
         };
         self.hip_speed += (cmd - self.hip_speed) * (dt / 50.0).min(1.0);
@@ -230,7 +234,8 @@ impl Plant {
         let b = self.bolter[side];
         let drive = b.drive.unwrap_or(Drive::Idle);
         let threshold = drive == Drive::Down && b.pos >= 1.0;
-        let locked = drive == Drive::Rotate && b.rotating_ms >= ROTATE_MS && self.lock == Some(true);
+        let locked =
+            drive == Drive::Rotate && b.rotating_ms >= ROTATE_MS && self.lock == Some(true);
         let hip_moving = side == 0 && self.hip_speed.abs() > 50.0;
         let obstacle = side == 0
             && self
@@ -243,7 +248,12 @@ impl Plant {
             + if self.arm_moving[side] { 150.0 } else { 0.0 }
             + if hip_moving { 100.0 } else { 0.0 }
             + if obstacle { 3500.0 } else { 0.0 };
-        let i_grip = if reg { 60.0 } else { 0.0 } + if self.gripper_moving[side] { 100.0 } else { 0.0 };
+        let i_grip = if reg { 60.0 } else { 0.0 }
+            + if self.gripper_moving[side] {
+                100.0
+            } else {
+                0.0
+            };
         let i_bo = match drive {
             Drive::Idle => 40.0,
             _ => 450.0,
@@ -266,7 +276,11 @@ impl Plant {
                 v_reg: if reg { 7_400 } else { 0 },
                 i_bo: clamp(i_bo),
             },
-            gravity: if side == 0 { self.gravity.0 } else { self.gravity.1 },
+            gravity: if side == 0 {
+                self.gravity.0
+            } else {
+                self.gravity.1
+            },
             arm_contracted: self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
             bolter: Signals {
                 threshold,

@@ -100,7 +100,11 @@ impl Progress {
                 (step + 1).min(self.steps.len()),
                 self.steps.len(),
                 hb.mode,
-                if faults.is_empty() { "none".to_string() } else { faults.join(", ") },
+                if faults.is_empty() {
+                    "none".to_string()
+                } else {
+                    faults.join(", ")
+                },
                 eff.percent().unwrap_or(100),
             );
             self.last_key = key;
@@ -145,8 +149,20 @@ pub fn text(s: &Summary) -> String {
     let mut t = String::new();
     let end = match s.ends.first().copied().flatten() {
         Some(PlanEnd::Completed) => "completed".to_string(),
-        Some(PlanEnd::Refused { step, refusal }) => format!("stopped: step {} refused ({refusal})", step + 1),
-        Some(PlanEnd::Unacknowledged { step }) => format!("stopped: step {} unacknowledged", step + 1),
+        Some(PlanEnd::Refused { step, refusal }) => {
+            format!("stopped: step {} refused ({refusal})", step + 1)
+        }
+        Some(PlanEnd::Unacknowledged { step }) => {
+            format!("stopped: step {} unacknowledged", step + 1)
+        }
+        Some(PlanEnd::Interrupted { step, mode, faults }) => {
+            let f: Vec<String> = faults.iter().map(|f| f.to_string()).collect();
+            format!(
+                "stopped: step {} interrupted, robot in {mode} (faults: {})",
+                step + 1,
+                f.join(", ")
+            )
+        }
         None => "time limit reached".to_string(),
     };
     let _ = writeln!(t, "plan: {end} ({} steps)", s.steps);
@@ -161,7 +177,11 @@ pub fn text(s: &Summary) -> String {
     let _ = writeln!(
         t,
         "wifi: {ok}/{n} attempts answered within the timeout ({:.1}%), longest answer {} ms",
-        if n == 0 { 100.0 } else { ok as f64 * 100.0 / n as f64 },
+        if n == 0 {
+            100.0
+        } else {
+            ok as f64 * 100.0 / n as f64
+        },
         s.max_latency_ms
     );
     let executed = s.events("executed").count();

@@ -1,0 +1,226 @@
+//! The host simulator end to end (issue 6, item 5): real threads, pipes and TCP on loopback,
+//! scaled time. Each test reads the JSON-lines log the run wrote, as a user would.
+
+use mmic::mode::Mode;
+use mmic::node::plan::PlanEnd;
+use mmic_host::plan;
+use mmic_host::sim::{report, run, SimConfig, Summary};
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+fn out_dir(name: &str) -> PathBuf {
+    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(name);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Runs `cfg`, writing the log to target/tmp/<name>/sim.jsonl; returns the summary and the
+/// log's records as read back from the file.
+fn simulate(name: &str, mut cfg: SimConfig) -> (Summary, Vec<Value>) {
+    let dir = out_dir(name);
+    let path = dir.join("sim.jsonl");
+    cfg.log_path = Some(path.clone());
+    let s = run(&cfg).unwrap();
+    report::plots(&s, &dir).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let records: Vec<Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(
+        records.len(),
+        s.records.len(),
+        "every record reached the file"
+    );
+    eprintln!("{name}:\n{}", report::text(&s));
+    (s, records)
+}
+
+fn events<'a>(records: &'a [Value], ty: &'a str) -> impl Iterator<Item = &'a Value> + 'a {
+    records
+        .iter()
+        .filter(move |r| r["kind"] == "event" && r["event"]["type"] == ty)
+}
+
+/// Board A's executions per sequence number, from the log.
+fn executions(records: &[Value]) -> BTreeMap<u64, u32> {
+    let mut m = BTreeMap::new();
+    for e in events(records, "executed") {
+        *m.entry(e["event"]["seq"].as_u64().unwrap()).or_insert(0) += 1;
+    }
+    m
+}
+
+fn steps(text: &str) -> Vec<mmic_host::sim::SimStep> {
+    report::steps_of(&plan::parse(text).unwrap())
+}
+
+#[test]
+fn the_demo_plan_completes_with_no_fault() {
+    let (s, records) = simulate("demo", SimConfig::demo());
+    assert!(s.completed(), "{}", report::text(&s));
+    assert!(
+        events(&records, "faults").next().is_none(),
+        "no fault latched"
+    );
+    assert_eq!(s.status["faults"], serde_json::json!([]));
+    let reached: Vec<&str> = events(&records, "reached")
+        .map(|e| e["event"]["state"].as_str().unwrap())
+        .collect();
+    assert_eq!(reached, ["m", "b", "n"], "several voxels");
+    let pairs = events(&records, "pair").count();
+    assert_eq!(pairs, 4 + 2 + 4 + 1, "every pair of every bolt/unbolt step");
+    assert!(executions(&records).values().all(|&n| n == 1));
+    // The plots exist and have content.
+    let svg = std::fs::read_to_string(out_dir("demo").join("wifi-efficiency.svg")).unwrap();
+    assert!(svg.contains("<polyline"));
+    // Every packet on every link is logged, decoded.
+    for link in ["wifi", "serial_ground", "serial_ab"] {
+        assert!(records
+            .iter()
+            .any(|r| r["kind"] == "packet" && r["link"] == link && r["packet"].is_object()));
+    }
+}
+
+#[test]
+fn thirty_percent_wifi_loss_still_completes_and_runs_nothing_twice() {
+    let cfg = SimConfig {
+        wifi_loss: 0.3,
+        seed: 7,
+        ..SimConfig::demo()
+    };
+    let (s, records) = simulate("loss30", cfg);
+    assert!(s.completed(), "{}", report::text(&s));
+    let lost = records
+        .iter()
+        .filter(|r| r["kind"] == "packet" && r["link"] == "wifi" && r["fate"] == "lost")
+        .count();
+    assert!(lost > 20, "the link did lose packets ({lost})");
+    let copies = events(&records, "duplicate").count() + events(&records, "stale").count();
+    assert!(
+        copies > 0,
+        "resends reached board A and were answered without running"
+    );
+    let twice: Vec<_> = executions(&records)
+        .into_iter()
+        .filter(|&(seq, n)| seq != 0 && n > 1)
+        .collect();
+    assert_eq!(twice, vec![], "no command executed twice");
+    // Every command the ground reports accepted ran exactly once.
+    let runs = executions(&records);
+    for d in events(&records, "done") {
+        if d["event"]["outcome"] == "accepted" {
+            assert_eq!(runs.get(&d["event"]["seq"].as_u64().unwrap()), Some(&1));
+        }
+    }
+}
+
+#[test]
+fn cutting_board_b_off_gives_internal_comm_loss_and_safed_within_the_timeout() {
+    let cut = 6_000;
+    let cfg = SimConfig {
+        cut_b_at: Some(cut),
+        scale: 10.0,
+        ..SimConfig::with_steps(steps("mode operational\nreconfigure a -> m\nwait 5s\n"))
+    };
+    let (s, records) = simulate("cut_b", cfg);
+    assert!(
+        matches!(
+            s.ends[0],
+            Some(PlanEnd::Interrupted {
+                mode: Mode::Safed,
+                ..
+            })
+        ),
+        "{:?}",
+        s.ends
+    );
+    let fault = events(&records, "faults")
+        .find(|e| {
+            e["event"]["faults"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|f| f == "internal_comm_loss")
+        })
+        .expect("internal communication loss raised");
+    let safed = events(&records, "mode")
+        .find(|e| e["event"]["to"] == "safed")
+        .expect("Safed entered");
+    let t_fault = fault["t_ms"].as_u64().unwrap();
+    let t_safed = safed["t_ms"].as_u64().unwrap();
+    let timeout = mmic::safety::detect::Config::default().comm_timeout_ms as u64;
+    assert!(t_fault >= cut as u64, "not before the cut");
+    assert!(
+        t_safed - cut as u64 <= timeout,
+        "Safed {} ms after the cut (timeout {timeout} ms)",
+        t_safed - cut as u64
+    );
+    // No A->B packet crossed after the cut.
+    assert!(records.iter().all(|r| !(r["kind"] == "packet"
+        && r["link"] == "serial_ab"
+        && r["fate"] == "delivered"
+        && r["t_ms"].as_u64().unwrap() >= cut as u64)));
+}
+
+#[test]
+fn low_battery_during_a_motion_enters_standby_only_after_the_motion_completes() {
+    let low = 8_000;
+    let mut cfg = SimConfig::with_steps(steps("mode operational\nreconfigure a -> m\nwait 3s\n"));
+    cfg.plant.low_battery_at = Some(low);
+    let (_, records) = simulate("low_battery", cfg);
+    let latched = events(&records, "faults")
+        .find(|e| {
+            e["event"]["faults"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|f| f == "low_battery")
+        })
+        .expect("low battery latched")["t_ms"]
+        .as_u64()
+        .unwrap();
+    let reached = events(&records, "reached")
+        .next()
+        .expect("motion completed")["t_ms"]
+        .as_u64()
+        .unwrap();
+    let standby = events(&records, "mode")
+        .find(|e| e["event"]["to"] == "standby")
+        .expect("Standby entered")["t_ms"]
+        .as_u64()
+        .unwrap();
+    assert!(
+        latched >= low as u64 && latched < reached,
+        "latched during the motion"
+    );
+    assert!(standby >= reached, "Standby only once the motion completed");
+    assert!(
+        standby - reached <= 100,
+        "and at once then ({} ms)",
+        standby - reached
+    );
+    assert!(
+        events(&records, "mode").all(|e| e["event"]["to"] != "safed"),
+        "low battery is not a Safed fault"
+    );
+}
+
+#[test]
+fn a_malformed_plan_file_is_refused_with_line_and_column() {
+    let dir = out_dir("bad_plan");
+    let path = dir.join("bad.plan");
+    std::fs::write(&path, "# ok so far\nmode operational\nreconfigure a -> q\n").unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mmic"))
+        .args(["sim", "--quiet", "--plan"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("line 3, column 18: expected a Table 5 state a..o, found \"q\""),
+        "{err}"
+    );
+}
