@@ -565,7 +565,11 @@ pub fn command_text(c: &Command) -> String {
         Command::Bolter(BolterCommand::Unbolt(f)) => format!("unbolt {}", fasteners_text(f)),
         Command::Bolter(BolterCommand::Down) => "bolters down".into(),
         Command::Primitive(p) => format!("primitive {}", p.number()),
-        Command::Reconfigure(r) => format!("reconfigure {} -> {}", r.initial(), r.target()),
+        Command::Reconfigure(r) => format!(
+            "reconfigure {} -> {}",
+            r.initial().letter(),
+            r.target().letter()
+        ),
         Command::Power { target, on } => format!(
             "power {} {}",
             if on { "on" } else { "off" },
