@@ -51,8 +51,16 @@ fn all_84_reconfigurations_and_the_spellings_users_write() {
             if let Ok(c) = Command::reconfigure(a, b) {
                 for text in [
                     format!("reconfigure {} -> {}", a.letter(), b.letter()),
-                    format!("RECONFIGURE {}->{}", a.letter().to_ascii_uppercase(), b.letter()),
-                    format!("  reconfigure\t{}  ->  {}   # comment", a.letter(), b.letter()),
+                    format!(
+                        "RECONFIGURE {}->{}",
+                        a.letter().to_ascii_uppercase(),
+                        b.letter()
+                    ),
+                    format!(
+                        "  reconfigure\t{}  ->  {}   # comment",
+                        a.letter(),
+                        b.letter()
+                    ),
                 ] {
                     let p = parse(&text).unwrap();
                     assert_eq!(p.steps[0].action, Action::Command(c), "{text}");
@@ -62,12 +70,20 @@ fn all_84_reconfigurations_and_the_spellings_users_write() {
         }
     }
     assert_eq!(n, 84);
-    let p = parse("wait 500ms\nwait 2s\nwait 1.25s\nhip 45.5deg\narm b 1500us\npower off gripper-b\n")
-        .unwrap();
+    let p =
+        parse("wait 500ms\nwait 2s\nwait 1.25s\nhip 45.5deg\narm b 1500us\npower off gripper-b\n")
+            .unwrap();
     let actions: Vec<String> = p.steps.iter().map(|s| s.action.describe()).collect();
     assert_eq!(
         actions,
-        ["wait 500ms", "wait 2000ms", "wait 1250ms", "hip 45.50", "arm b 1500us", "power off gripper-b"]
+        [
+            "wait 500ms",
+            "wait 2000ms",
+            "wait 1250ms",
+            "hip 45.50",
+            "arm b 1500us",
+            "power off gripper-b"
+        ]
     );
     assert_eq!(p.steps[3].line, 4);
     assert_eq!(p.steps[3].text, "hip 45.5deg");
@@ -180,24 +196,57 @@ fn balanced(svg: &str) {
 #[test]
 fn plots_are_well_formed_for_empty_single_and_many_points() {
     let many: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, (i % 7) as f64 * 10.0)).collect();
-    for points in [&[][..], &[(3.0, 3.0)][..], &many[..], &[(0.0, f64::NAN), (1.0, 2.0)][..]] {
+    for points in [
+        &[][..],
+        &[(3.0, 3.0)][..],
+        &many[..],
+        &[(0.0, f64::NAN), (1.0, 2.0)][..],
+    ] {
         let svg = line_chart("a <b> & c", "x", "y", None, &[Series { name: "s", points }]);
         balanced(&svg);
         assert!(svg.contains("a &lt;b&gt; &amp; c"));
     }
-    let svg = line_chart("t", "x", "y", Some((0.0, 100.0)), &[Series { name: "s", points: &many }]);
-    let poly = svg.split("points=\"").nth(1).unwrap().split('"').next().unwrap();
+    let svg = line_chart(
+        "t",
+        "x",
+        "y",
+        Some((0.0, 100.0)),
+        &[Series {
+            name: "s",
+            points: &many,
+        }],
+    );
+    let poly = svg
+        .split("points=\"")
+        .nth(1)
+        .unwrap()
+        .split('"')
+        .next()
+        .unwrap();
     assert_eq!(poly.split(' ').count(), 50);
     let two = line_chart(
         "t",
         "x",
         "y",
         None,
-        &[Series { name: "one", points: &many }, Series { name: "two", points: &many }],
+        &[
+            Series {
+                name: "one",
+                points: &many,
+            },
+            Series {
+                name: "two",
+                points: &many,
+            },
+        ],
     );
     balanced(&two);
     assert!(two.contains(">one<") && two.contains(">two<"), "legend");
-    let bars = bar_chart("b", "n", &[("1st", 10.0), ("2nd", 0.0), ("x&y", f64::INFINITY)]);
+    let bars = bar_chart(
+        "b",
+        "n",
+        &[("1st", 10.0), ("2nd", 0.0), ("x&y", f64::INFINITY)],
+    );
     balanced(&bars);
     assert!(bars.contains(">10<") && bars.contains("x&amp;y"));
     balanced(&bar_chart("empty", "n", &[]));

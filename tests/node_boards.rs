@@ -1,0 +1,204 @@
+//! Board A and board B as pure nodes: every command class is answered by a heartbeat that
+//! acknowledges its sequence number, runs once however often it arrives, and the A–B link's
+//! loss takes an Operational robot to Safed within the timeout.
+
+use mmic::command::{for_each_variant_class, Command};
+use mmic::faults::Fault;
+use mmic::mode::Mode;
+use mmic::motion::State;
+use mmic::node::board_a::{self, BoardA, Event, Inputs};
+use mmic::node::board_b::{self, BoardB};
+use mmic::refusal::Refusal;
+use mmic::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
+use mmic::wire::command::CommandRepr;
+use mmic::wire::heartbeat::HeartbeatRepr;
+
+fn send(
+    a: &mut BoardA,
+    now: u32,
+    command: Command,
+    seq: u16,
+) -> (Option<HeartbeatRepr>, Vec<Event>) {
+    let packet = CommandRepr {
+        board: BoardNumber::ONE,
+        command,
+        seq,
+    }
+    .to_bytes();
+    let out = a.tick(
+        now,
+        &Inputs {
+            command: Some(packet),
+            ..Inputs::at_home()
+        },
+    );
+    let hb = out.heartbeat.map(|b| HeartbeatRepr::parse(&b).unwrap());
+    (hb, out.events.iter().copied().collect())
+}
+
+fn executed(events: &[Event]) -> Vec<u16> {
+    events
+        .iter()
+        .filter_map(|e| match e {
+            Event::Executed { seq, .. } => Some(*seq),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn every_command_class_in_every_starting_mode_runs_once_and_is_acknowledged() {
+    let mut cases = 0;
+    for start in [Mode::Standby, Mode::Operational, Mode::Safed] {
+        for_each_variant_class(PulseWidth::CENTER, HipAngle::new(9000).unwrap(), |c| {
+            let mut a = BoardA::in_state(board_a::Config::default(), State::A);
+            if start != Mode::Standby {
+                send(&mut a, 0, Command::Mode(Mode::Operational), 1);
+            }
+            if start == Mode::Safed {
+                send(&mut a, 5, Command::Mode(Mode::Safed), 2);
+            }
+            assert_eq!(a.mode(), start);
+            let (hb, ev) = send(&mut a, 10, c, 10);
+            let hb = hb.expect("answered");
+            assert_eq!(hb.last_seq, 10, "{c:?}");
+            assert_eq!(executed(&ev), [10], "{c:?} ran once");
+            let first = hb.refusal;
+            assert_eq!(a.last_command(), (10, first));
+            // The same packet again, and again later: answered alike, never run.
+            for t in [20, 700] {
+                let (hb, ev) = send(&mut a, t, c, 10);
+                let hb = hb.expect("answered");
+                assert_eq!((hb.last_seq, hb.refusal), (10, first), "{c:?}");
+                assert!(executed(&ev).is_empty());
+                assert!(ev.contains(&Event::Duplicate { seq: 10 }));
+            }
+            // A late copy of an older command.
+            let (hb, ev) = send(&mut a, 30, Command::Stop, 9);
+            assert_eq!(hb.map(|h| h.last_seq), Some(10));
+            assert!(ev.contains(&Event::Stale { seq: 9 }) && executed(&ev).is_empty());
+            cases += 1;
+        });
+    }
+    assert_eq!(cases, 3 * 61);
+}
+
+#[test]
+fn packets_for_others_or_broken_get_no_answer_and_malformed_ones_a_refusal() {
+    let mut a = BoardA::new(board_a::Config::default());
+    let other = CommandRepr {
+        board: BoardNumber::new(2).unwrap(),
+        command: Command::Stop,
+        seq: 1,
+    }
+    .to_bytes();
+    let out = a.tick(
+        0,
+        &Inputs {
+            command: Some(other),
+            ..Inputs::at_home()
+        },
+    );
+    assert!(out.heartbeat.is_none());
+    assert!(matches!(out.events[0], Event::OtherRobot { .. }));
+    let mut broken = CommandRepr {
+        board: BoardNumber::ONE,
+        command: Command::Stop,
+        seq: 1,
+    }
+    .to_bytes();
+    broken[13] ^= 0x40;
+    let out = a.tick(
+        10,
+        &Inputs {
+            command: Some(broken),
+            ..Inputs::at_home()
+        },
+    );
+    assert!(out.heartbeat.is_none());
+    assert!(matches!(out.events[0], Event::Rejected(_)));
+    // Opcode 0xff with sequence number 77 in bytes 10-11, sealed: no command, but ours.
+    let mut unknown = CommandRepr {
+        board: BoardNumber::ONE,
+        command: Command::Stop,
+        seq: 77,
+    }
+    .to_bytes();
+    unknown[5] = 0xff;
+    let c = mmic::wire::checksum::crc16(&unknown[..12]).to_le_bytes();
+    unknown[12..].copy_from_slice(&c);
+    let out = a.tick(
+        20,
+        &Inputs {
+            command: Some(unknown),
+            ..Inputs::at_home()
+        },
+    );
+    let hb = HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
+    assert_eq!(
+        (hb.last_seq, hb.refusal),
+        (77, Some(Refusal::UnknownCommand))
+    );
+}
+
+fn b_inputs() -> board_b::Inputs {
+    board_b::Inputs {
+        electrical: Electrical {
+            v_bat: 12_000,
+            v_reg: 7_400,
+            ..Electrical::default()
+        },
+        arm_contracted: true,
+        ..board_b::Inputs::default()
+    }
+}
+
+#[test]
+fn a_and_b_run_together_without_fault_and_link_loss_is_safed_within_the_timeout() {
+    let mut a = BoardA::in_state(board_a::Config::default(), State::A);
+    let mut b = BoardB::with_pose(
+        board_b::Config::default(),
+        board_a::Config::default().arm.contracted,
+        board_a::Config::default().gripper.extended,
+    );
+    send(&mut a, 0, Command::Mode(Mode::Operational), 1);
+    let (mut to_b, mut to_a) = (None, None);
+    let cut = 5_000;
+    let mut safed_at = None;
+    for t in (10..8_000).step_by(10) {
+        let linked = t < cut;
+        let out_a = a.tick(
+            t,
+            &Inputs {
+                from_b: if linked { to_a } else { None },
+                ..Inputs::at_home()
+            },
+        );
+        let out_b = b.tick(
+            t,
+            &board_b::Inputs {
+                command: if linked { to_b } else { None },
+                ..b_inputs()
+            },
+        );
+        to_b = out_a.to_b;
+        to_a = out_b.heartbeat;
+        if t < cut {
+            assert!(
+                a.faults().is_empty(),
+                "no fault while linked (t = {t}): {:?}",
+                a.faults()
+            );
+            assert_eq!(a.mode(), Mode::Operational);
+        } else if safed_at.is_none() && a.mode() == Mode::Safed {
+            safed_at = Some(t);
+            assert!(a.faults().contains(Fault::InternalCommLoss));
+        }
+    }
+    let latency = safed_at.expect("Safed") - cut;
+    assert!(
+        latency <= mmic::safety::detect::Config::default().comm_timeout_ms,
+        "{latency} ms"
+    );
+    eprintln!("Safed {latency} ms after the A-B link was cut");
+}
