@@ -24,7 +24,7 @@
 //! harness against a `VecDeque` model (proofs/tests/node_handoff.rs).
 //!
 //! Needs atomic loads and stores: available on targets with atomics (ESP32, ESP32-C6, hosts);
-//! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic`.
+//! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`.
 
 use heapless::spsc;
 
