@@ -30,8 +30,12 @@ use stateright::{Checker, Model, Property};
 
 // ---------------------------------------------------------------- model 1: ground → robot
 
-/// The commands of a run: two non-idempotent ones (each changes the robot's state).
-const COMMANDS: [Command; 2] = [Command::Mode(Mode::Operational), Command::Stop];
+/// The commands of a run: three non-idempotent ones (each changes the robot's state).
+const COMMANDS: [Command; 3] = [
+    Command::Mode(Mode::Operational),
+    Command::Stop,
+    Command::Reset,
+];
 const MAX_IN_FLIGHT: usize = 3;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -60,13 +64,13 @@ struct Ground {
     up: Uplink,
     now: u32,
     submitted: usize,
-    outcomes: [Option<Outcome>; 2],
+    outcomes: [Option<Outcome>; COMMANDS.len()],
     server: Server<1>,
     wifi: Vec<Packet>,
     duplicates: u8,
     a: BoardA,
     a_now: u32,
-    executed: [u8; 2],
+    executed: [u8; COMMANDS.len()],
     silent_drop: bool,
 }
 
@@ -136,13 +140,13 @@ impl Model for GroundModel {
             up: Uplink::new(cfg, BoardNumber::ONE),
             now: 0,
             submitted: 0,
-            outcomes: [None; 2],
+            outcomes: [None; COMMANDS.len()],
             server: Server::new(),
             wifi: vec![],
             duplicates: 0,
             a: BoardA::new(board_a::Config::default()),
             a_now: 0,
-            executed: [0; 2],
+            executed: [0; COMMANDS.len()],
             silent_drop: false,
         }]
     }

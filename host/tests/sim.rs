@@ -152,6 +152,11 @@ fn cutting_board_b_off_gives_internal_comm_loss_and_safed_within_the_timeout() {
     let t_safed = safed["t_ms"].as_u64().unwrap();
     let timeout = mmic::safety::detect::Config::default().comm_timeout_ms as u64;
     assert!(t_fault >= cut as u64, "not before the cut");
+    eprintln!(
+        "cut at {cut} ms: internal comm loss after {} ms, Safed after {} ms",
+        t_fault - cut as u64,
+        t_safed - cut as u64
+    );
     assert!(
         t_safed - cut as u64 <= timeout,
         "Safed {} ms after the cut (timeout {timeout} ms)",

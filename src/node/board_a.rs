@@ -497,7 +497,9 @@ impl BoardA {
             match self.receive(&bytes, in_motion) {
                 Received::Ignore(e) => out.push(e),
                 Received::Answer(ev) => {
+                    // A copy: byte 62 reports the outcome of the command bytes 57-58 name.
                     out.push(ev);
+                    self.refusal = self.log.last().1;
                     answer_seq = Some(0);
                 }
                 Received::Run(seq, inc) => {

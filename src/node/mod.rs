@@ -31,7 +31,10 @@ pub mod board_a;
 pub mod board_b;
 pub mod exactly_once;
 pub mod ground;
-#[cfg(any(target_has_atomic = "ptr", feature = "portable-atomic-critical-section"))]
+#[cfg(any(
+    target_has_atomic = "ptr",
+    feature = "portable-atomic-critical-section"
+))]
 pub mod handoff;
 pub mod plan;
 pub mod server;
