@@ -1,36 +1,69 @@
-//! Plan files: what the simulated opsUI sends, one step per line.
+//! Plan files: the steps the ground software (opsUI) sends to one robot, as text a person can
+//! write, review and diff.
 //!
 //! ```
-//! use mmic_host::plan::{parse, Action};
-//! let plan = parse("robot 2\nmode operational   # power up\nreconfigure a -> m\nwait 1.5s\n").unwrap();
+//! use mmic::command::{Command, ServoTarget};
+//! use mmic::units::Side;
+//! use mmic_host::plan::{self, Action};
+//!
+//! let plan = plan::parse(
+//!     "robot 2              # board A's client number\n\
+//!      mode operational\n\
+//!      arm a extend\n\
+//!      wait 1.5s\n\
+//!      reconfigure a -> m\n",
+//! )?;
 //! assert_eq!(plan.robot.get(), 2);
-//! assert_eq!(plan.steps.len(), 3);
+//! assert_eq!(plan.steps.len(), 4);
+//! assert_eq!(
+//!     plan.steps[1].action,
+//!     Action::Command(Command::Arm { side: Side::A, target: ServoTarget::Extend })
+//! );
 //! assert_eq!(plan.steps[2].action, Action::Wait { ms: 1500 });
-//! let err = parse("mode operational\nbolt 5\n").unwrap_err();
-//! assert_eq!((err.line, err.column), (2, 6));
-//! assert_eq!(err.to_string(), "line 2, column 6: expected a bolter pair 1..=4 or `all`, found \"5\"");
+//! assert_eq!(plan.steps[2].line, 4);
+//!
+//! // Errors point at the offending token, 1-based line and column.
+//! let e = plan::parse("mode operational\nbolt 5\n").unwrap_err();
+//! assert_eq!((e.line, e.column), (2, 6));
+//! assert_eq!(e.to_string(), "line 2, column 6: bolter pair must be 1..=4, found 5");
+//!
+//! // The canonical text parses back to the same plan.
+//! assert_eq!(plan::parse(&plan.to_text())?.steps[3].action, plan.steps[3].action);
+//! # Ok::<(), plan::PlanError>(())
 //! ```
+//!
+//! # Why a text format
+//!
+//! A plan is reviewed before it is flown: a line-oriented file reads in a code review, diffs
+//! line by line, takes comments, and every error can name the line and column to fix. Each step
+//! maps onto exactly one [`Command`] (or a wait), so what the file says is what goes on the
+//! wire; nothing is guessed or clamped. A value out of range is an error, not a saturation,
+//! because a silently moved servo target is worse than a refused file.
 //!
 //! # Format
 //!
-//! UTF-8 text. `#` starts a comment; blank lines are skipped; keywords are case-insensitive
-//! and separated by spaces or tabs. An optional first step-less line `robot N` (1..=255,
-//! default 1) names the robot. Each other line is one step:
+//! UTF-8 text, one step per line. `#` starts a comment that runs to the end of the line; blank
+//! lines are ignored; tokens are separated by whitespace (`->` is a token of its own, so
+//! `a->m` reads as `a -> m`). Keywords, side letters, state letters and units are
+//! case-insensitive. Columns count characters (a tab is one column).
 //!
-//! | step | meaning (Table 1) |
-//! |---|---|
-//! | `heartbeat`, `stop`, `reset`, `system-fault`, `clear-faults` | those commands |
-//! | `mode standby\|operational\|safed` | operating mode (Table 7) |
-//! | `arm a\|b contract\|extend\|<µs>` | arm servo; a pulse width 500..=2500, `1500` or `1500us` |
-//! | `gripper a\|b contract\|extend\|<µs>` | gripper servo |
-//! | `hip home\|straight\|cw\|ccw\|<degrees>` | hip; degrees 0 ≤ d < 360, up to 2 decimals, `45`, `45.5deg` |
-//! | `bolt 1..4\|all`, `unbolt 1..4\|all`, `bolters down` | bolters |
-//! | `primitive 1..8` | a motion primitive (Table 6) |
-//! | `reconfigure <from> -> <to>` | a reconfiguration between Table 5 states a..o |
-//! | `power on\|off <module>\|all` | modules: `hip`, `arm-a`, `arm-b`, `gripper-a`, `gripper-b`, `bolter-a`, `bolter-b` |
-//! | `wait <duration>` | `500ms`, `2s`, `1.5s`; at most one hour |
+//! An optional header `robot N` (N in 1..=255, default 1) may come before the first step, once.
 //!
-//! Errors name the line and the column (1-based, in characters) of the offending token.
+//! | Step | Command |
+//! |------|---------|
+//! | `heartbeat`, `stop`, `reset`, `system-fault`, `clear-faults` | the argument-less commands |
+//! | `mode standby\|operational\|safed` | [`Command::Mode`] |
+//! | `arm a\|b contract\|extend\|<µs>` | [`Command::Arm`]; pulse `1500`, `1500us` or `1500µs`, 500..=2500 |
+//! | `gripper a\|b contract\|extend\|<µs>` | [`Command::Gripper`], as for `arm` |
+//! | `hip home\|straight\|cw\|ccw\|<degrees>` | [`Command::Hip`]; `45`, `45.5`, `45deg` or `45°`, 0..=359.99, at most 2 decimals |
+//! | `bolt 1\|2\|3\|4\|all`, `unbolt 1\|2\|3\|4\|all`, `bolters down` | [`Command::Bolter`] |
+//! | `primitive 1..8` (or a Table 6 name, e.g. `fwdContract`) | [`Command::Primitive`] |
+//! | `reconfigure <initial> -> <target>`, states `a`..`o` | [`Command::Reconfigure`] |
+//! | `power on\|off <module>\|all` | [`Command::Power`] |
+//! | `wait <duration>`: `500ms`, `2s`, `1.5s`; at most 1 hour, whole milliseconds | [`Action::Wait`] |
+//!
+//! The module keywords of `power` are those of [`module_keyword`]: `hip`, `arm-a`, `arm-b`,
+//! `gripper-a`, `gripper-b`, `bolter-a`, `bolter-b`.
 
 use mmic::command::{
     BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, ReconfigurationError,
@@ -39,298 +72,141 @@ use mmic::command::{
 use mmic::mode::Mode;
 use mmic::motion::{Primitive, State};
 use mmic::units::{BoardNumber, HipAngle, Module, PulseWidth, Side};
-use std::fmt::Write as _;
+use std::fmt;
 
-/// A parsed plan.
+/// Longest wait a step may ask for: one hour, in milliseconds. Longer pauses belong to the
+/// operator, not to a plan that keeps a robot waiting unattended.
+pub const MAX_WAIT_MS: u32 = 3_600_000;
+
+/// Every step keyword, in the order of the module docs (for error messages and tools).
+pub const STEP_KEYWORDS: [&str; 16] = [
+    "heartbeat",
+    "stop",
+    "reset",
+    "system-fault",
+    "clear-faults",
+    "mode",
+    "arm",
+    "gripper",
+    "hip",
+    "bolt",
+    "unbolt",
+    "bolters",
+    "primitive",
+    "reconfigure",
+    "power",
+    "wait",
+];
+
+/// A parsed plan: which robot it addresses and its steps in order.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Plan {
-    /// The robot it is for.
+    /// Robot (board A's WiFi client number) the steps are sent to.
     pub robot: BoardNumber,
-    /// The steps, in order.
+    /// The steps, in file order.
     pub steps: Vec<Step>,
 }
 
-/// One step.
+/// One step of a plan, with where it came from so that progress and errors can show it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Step {
-    /// Line number, 1-based.
+    /// 1-based line number in the source text.
     pub line: usize,
-    /// The line without its comment, trimmed (for progress output).
-    pub text: String,
     /// What to do.
     pub action: Action,
+    /// The source line, trimmed (comment included), for progress display.
+    pub text: String,
 }
 
-/// What a step does.
+/// What a step does: send a command, or pause before the next step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Action {
-    /// Send a command.
+    /// Send this command to the robot.
     Command(Command),
-    /// Wait.
+    /// Wait this long before the next step.
     Wait {
-        /// Milliseconds.
+        /// Milliseconds, at most [`MAX_WAIT_MS`].
         ms: u32,
     },
 }
 
-/// A malformed plan: where, and why.
+/// A plan that does not parse: where (1-based line and column of the offending token, the
+/// column counted in characters) and why.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("line {line}, column {column}: {kind}")]
 pub struct PlanError {
-    /// Line, 1-based.
+    /// 1-based line.
     pub line: usize,
-    /// Column of the offending token, 1-based, in characters.
+    /// 1-based column, in characters.
     pub column: usize,
     /// What is wrong.
     pub kind: PlanErrorKind,
 }
 
-/// What is wrong with a plan.
+/// Why a plan does not parse.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum PlanErrorKind {
-    /// The first word is no step.
-    #[error("unknown step {found:?}; expected one of: {STEPS}")]
+    /// The first token of a line is no step keyword.
+    #[error("unknown step {found:?}; expected one of: {}", STEP_KEYWORDS.join(", "))]
     UnknownStep {
-        /// The word.
+        /// The token found.
         found: String,
     },
-    /// The line ends too early.
-    #[error("`{step}` needs {expected}")]
-    Missing {
-        /// The step.
+    /// The line ends before the step is complete. The column is the one just past the line's
+    /// last token.
+    #[error("{step}: missing {expected}")]
+    MissingArgument {
+        /// The step keyword.
         step: &'static str,
-        /// What it needs next.
+        /// What should follow.
         expected: &'static str,
     },
-    /// A word is not what the step takes.
+    /// An argument is not one of the accepted words or numbers.
     #[error("expected {expected}, found {found:?}")]
-    Bad {
-        /// What was expected.
+    BadArgument {
+        /// What is accepted there.
         expected: &'static str,
-        /// The word.
+        /// The token found.
         found: String,
     },
-    /// More words than the step takes.
+    /// A number outside its range (never clamped).
+    #[error("{quantity} must be {min}..={max}, found {found}")]
+    OutOfRange {
+        /// The quantity.
+        quantity: &'static str,
+        /// Smallest accepted value, with its unit.
+        min: &'static str,
+        /// Largest accepted value, with its unit.
+        max: &'static str,
+        /// The token found.
+        found: String,
+    },
+    /// A token after a complete step.
     #[error("unexpected {found:?} after a complete step")]
-    Trailing {
-        /// The word.
+    TrailingToken {
+        /// The token found.
         found: String,
     },
-    /// `robot` after the first step, or twice.
-    #[error("`robot` must come once, before the first step")]
+    /// A `robot` header after the first step: the robot must be known before anything is sent.
+    #[error("`robot` must come before the first step")]
     RobotAfterSteps,
-    /// The reconfiguration is not one.
+    /// A second `robot` header.
+    #[error("`robot` given twice (first on line {first})")]
+    RobotTwice {
+        /// Line of the first header.
+        first: usize,
+    },
+    /// A reconfiguration the library refuses.
     #[error("{0}")]
     Reconfiguration(ReconfigurationError),
-    /// No step at all.
-    #[error("the plan has no step")]
+    /// No step at all: an empty plan is more likely a wrong file than an intent. Reported at
+    /// line 1, column 1.
+    #[error("the plan has no steps")]
     Empty,
 }
 
-const STEPS: &str = "heartbeat, stop, reset, system-fault, clear-faults, mode, arm, gripper, hip, bolt, unbolt, bolters, primitive, reconfigure, power, wait";
-
-/// A word and its 1-based column.
-#[derive(Debug, Clone, Copy)]
-struct Tok<'a> {
-    text: &'a str,
-    col: usize,
-}
-
-fn tokens(line: &str) -> Vec<Tok<'_>> {
-    let mut out = Vec::new();
-    let mut start: Option<(usize, usize)> = None; // (byte, column)
-    let mut col = 0;
-    let chars: Vec<(usize, char)> = line.char_indices().collect();
-    let mut i = 0;
-    while i < chars.len() {
-        let (b, c) = chars[i];
-        col += 1;
-        let arrow = c == '-' && chars.get(i + 1).is_some_and(|&(_, n)| n == '>');
-        if c.is_whitespace() || arrow {
-            if let Some((s, sc)) = start.take() {
-                out.push(Tok {
-                    text: &line[s..b],
-                    col: sc,
-                });
-            }
-            if arrow {
-                out.push(Tok {
-                    text: &line[b..b + 2],
-                    col,
-                });
-                col += 1;
-                i += 1;
-            }
-        } else if start.is_none() {
-            start = Some((b, col));
-        }
-        i += 1;
-    }
-    if let Some((s, sc)) = start {
-        out.push(Tok {
-            text: &line[s..],
-            col: sc,
-        });
-    }
-    out
-}
-
-struct Line<'a> {
-    n: usize,
-    toks: Vec<Tok<'a>>,
-    at: usize,
-    end_col: usize,
-}
-
-impl<'a> Line<'a> {
-    fn err(&self, col: usize, kind: PlanErrorKind) -> PlanError {
-        PlanError {
-            line: self.n,
-            column: col,
-            kind,
-        }
-    }
-
-    fn next(&mut self, step: &'static str, expected: &'static str) -> Result<Tok<'a>, PlanError> {
-        match self.toks.get(self.at) {
-            Some(t) => {
-                self.at += 1;
-                Ok(*t)
-            }
-            None => Err(self.err(self.end_col, PlanErrorKind::Missing { step, expected })),
-        }
-    }
-
-    fn bad(&self, t: Tok<'_>, expected: &'static str) -> PlanError {
-        self.err(
-            t.col,
-            PlanErrorKind::Bad {
-                expected,
-                found: t.text.to_string(),
-            },
-        )
-    }
-
-    fn done(&self) -> Result<(), PlanError> {
-        match self.toks.get(self.at) {
-            None => Ok(()),
-            Some(t) => Err(self.err(
-                t.col,
-                PlanErrorKind::Trailing {
-                    found: t.text.to_string(),
-                },
-            )),
-        }
-    }
-}
-
-fn lower(t: Tok<'_>) -> String {
-    t.text.to_ascii_lowercase()
-}
-
-fn side(l: &mut Line<'_>, step: &'static str) -> Result<Side, PlanError> {
-    let t = l.next(step, "a side, `a` or `b`")?;
-    match lower(t).as_str() {
-        "a" => Ok(Side::A),
-        "b" => Ok(Side::B),
-        _ => Err(l.bad(t, "a side, `a` or `b`")),
-    }
-}
-
-const SERVO: &str = "`contract`, `extend` or a pulse width 500..=2500 us";
-
-fn servo(l: &mut Line<'_>, step: &'static str) -> Result<ServoTarget, PlanError> {
-    let t = l.next(step, SERVO)?;
-    let w = lower(t);
-    match w.as_str() {
-        "contract" => Ok(ServoTarget::Contract),
-        "extend" => Ok(ServoTarget::Extend),
-        _ => {
-            let digits = w.strip_suffix("us").unwrap_or(&w);
-            digits
-                .parse::<u16>()
-                .ok()
-                .and_then(|v| PulseWidth::new(v).ok())
-                .map(ServoTarget::Position)
-                .ok_or_else(|| l.bad(t, SERVO))
-        }
-    }
-}
-
-const HIP: &str = "`home`, `straight`, `cw`, `ccw` or an angle 0 <= degrees < 360 (2 decimals)";
-
-fn hip(l: &mut Line<'_>) -> Result<HipTarget, PlanError> {
-    let t = l.next("hip", HIP)?;
-    let w = lower(t);
-    Ok(match w.as_str() {
-        "home" => HipTarget::Home,
-        "straight" => HipTarget::Straight,
-        "cw" => HipTarget::RightAngleCw,
-        "ccw" => HipTarget::RightAngleCcw,
-        _ => {
-            let num = w.strip_suffix("deg").unwrap_or(&w);
-            let centi = decimal(num, 2).ok_or_else(|| l.bad(t, HIP))?;
-            let a = u16::try_from(centi)
-                .ok()
-                .and_then(|c| HipAngle::new(c).ok())
-                .ok_or_else(|| l.bad(t, HIP))?;
-            HipTarget::Angle(a)
-        }
-    })
-}
-
-/// `s` as an integer number of 10^-`places` units (no sign, at most `places` decimals).
-fn decimal(s: &str, places: u32) -> Option<u64> {
-    let (int, frac) = s.split_once('.').unwrap_or((s, ""));
-    if int.is_empty() || !int.bytes().all(|b| b.is_ascii_digit()) {
-        return None;
-    }
-    if frac.len() > places as usize || !frac.bytes().all(|b| b.is_ascii_digit()) {
-        return None;
-    }
-    let scale = 10u64.pow(places);
-    let i: u64 = int.parse().ok()?;
-    let f: u64 = if frac.is_empty() {
-        0
-    } else {
-        frac.parse::<u64>().ok()? * 10u64.pow(places - frac.len() as u32)
-    };
-    i.checked_mul(scale)?.checked_add(f)
-}
-
-const PAIR: &str = "a bolter pair 1..=4 or `all`";
-
-fn fasteners(l: &mut Line<'_>, step: &'static str) -> Result<Fasteners, PlanError> {
-    let t = l.next(step, PAIR)?;
-    if lower(t) == "all" {
-        return Ok(Fasteners::All);
-    }
-    t.text
-        .parse::<u8>()
-        .ok()
-        .and_then(BolterPair::from_number)
-        .map(Fasteners::Pair)
-        .ok_or_else(|| l.bad(t, PAIR))
-}
-
-const STATE: &str = "a Table 5 state a..o";
-
-fn state(l: &mut Line<'_>) -> Result<State, PlanError> {
-    let t = l.next("reconfigure", "`<from> -> <to>` (states a..o)")?;
-    let mut cs = t.text.chars();
-    match (cs.next(), cs.next()) {
-        (Some(c), None) => {
-            State::from_letter(c.to_ascii_lowercase()).ok_or_else(|| l.bad(t, STATE))
-        }
-        _ => Err(l.bad(t, STATE)),
-    }
-}
-
-const MODULE: &str =
-    "a module (hip, arm-a, arm-b, gripper-a, gripper-b, bolter-a, bolter-b) or `all`";
-
-/// The plan-file name of a module.
-pub fn module_name(m: Module) -> &'static str {
+/// The keyword of a module in `power` steps: the variant name in kebab case.
+pub const fn module_keyword(m: Module) -> &'static str {
     match m {
         Module::Hip => "hip",
         Module::ArmA => "arm-a",
@@ -342,252 +218,659 @@ pub fn module_name(m: Module) -> &'static str {
     }
 }
 
-const WAIT: &str = "a duration such as `500ms`, `2s` or `1.5s` (at most 1 h)";
-
-fn step(l: &mut Line<'_>, first: Tok<'_>) -> Result<Action, PlanError> {
-    let c = |c: Command| Ok(Action::Command(c));
-    match lower(first).as_str() {
-        "heartbeat" => c(Command::Heartbeat),
-        "stop" => c(Command::Stop),
-        "reset" => c(Command::Reset),
-        "system-fault" => c(Command::SystemFault),
-        "clear-faults" => c(Command::ClearFaults),
-        "mode" => {
-            const M: &str = "`standby`, `operational` or `safed`";
-            let t = l.next("mode", M)?;
-            c(Command::Mode(match lower(t).as_str() {
-                "standby" => Mode::Standby,
-                "operational" => Mode::Operational,
-                "safed" => Mode::Safed,
-                _ => return Err(l.bad(t, M)),
-            }))
-        }
-        "arm" => {
-            let side = side(l, "arm")?;
-            let target = servo(l, "arm")?;
-            c(Command::Arm { side, target })
-        }
-        "gripper" => {
-            let side = side(l, "gripper")?;
-            let target = servo(l, "gripper")?;
-            c(Command::Gripper { side, target })
-        }
-        "hip" => c(Command::Hip(hip(l)?)),
-        "bolt" => c(Command::Bolter(BolterCommand::Bolt(fasteners(l, "bolt")?))),
-        "unbolt" => c(Command::Bolter(BolterCommand::Unbolt(fasteners(
-            l, "unbolt",
-        )?))),
-        "bolters" => {
-            let t = l.next("bolters", "`down`")?;
-            if lower(t) != "down" {
-                return Err(l.bad(t, "`down`"));
-            }
-            c(Command::Bolter(BolterCommand::Down))
-        }
-        "primitive" => {
-            const P: &str = "a primitive number 1..=8 (Table 6)";
-            let t = l.next("primitive", P)?;
-            let p = t
-                .text
-                .parse::<u8>()
-                .ok()
-                .and_then(Primitive::from_number)
-                .ok_or_else(|| l.bad(t, P))?;
-            c(Command::Primitive(p))
-        }
-        "reconfigure" => {
-            let from_tok = l.toks.get(l.at).copied();
-            let from = state(l)?;
-            let arrow = l.next("reconfigure", "`->` between the two states")?;
-            if arrow.text != "->" {
-                return Err(l.bad(arrow, "`->` between the two states"));
-            }
-            let to = state(l)?;
-            Command::reconfigure(from, to)
-                .map(Action::Command)
-                .map_err(|e| {
-                    l.err(
-                        from_tok.map_or(first.col, |t| t.col),
-                        PlanErrorKind::Reconfiguration(e),
-                    )
-                })
-        }
-        "power" => {
-            const ON: &str = "`on` or `off`";
-            let t = l.next("power", ON)?;
-            let on = match lower(t).as_str() {
-                "on" => true,
-                "off" => false,
-                _ => return Err(l.bad(t, ON)),
-            };
-            let t = l.next("power", MODULE)?;
-            let w = lower(t);
-            let target = if w == "all" {
-                PowerTarget::All
-            } else {
-                PowerTarget::Module(
-                    Module::ALL
-                        .into_iter()
-                        .find(|m| module_name(*m) == w)
-                        .ok_or_else(|| l.bad(t, MODULE))?,
-                )
-            };
-            c(Command::Power { target, on })
-        }
-        "wait" => {
-            let t = l.next("wait", WAIT)?;
-            let w = lower(t);
-            let ms = if let Some(v) = w.strip_suffix("ms") {
-                decimal(v, 0)
-            } else if let Some(v) = w.strip_suffix('s') {
-                decimal(v, 3)
-            } else {
-                None
-            };
-            match ms {
-                Some(ms) if ms <= 3_600_000 => Ok(Action::Wait { ms: ms as u32 }),
-                _ => Err(l.bad(t, WAIT)),
-            }
-        }
-        _ => Err(l.err(
-            first.col,
-            PlanErrorKind::UnknownStep {
-                found: first.text.to_string(),
-            },
-        )),
-    }
+/// The module with keyword `word` (case-insensitive).
+pub fn module_from_keyword(word: &str) -> Option<Module> {
+    Module::ALL
+        .into_iter()
+        .find(|m| module_keyword(*m).eq_ignore_ascii_case(word))
 }
 
-/// Parses a plan file.
+/// What `power` accepts after `on`/`off`; a test checks it names every [`module_keyword`].
+const POWER_TARGETS: &str =
+    "a module (hip, arm-a, arm-b, gripper-a, gripper-b, bolter-a, bolter-b) or all";
+
+/// Parses a plan; see the module docs for the format.
 pub fn parse(text: &str) -> Result<Plan, PlanError> {
-    let mut robot = None;
+    // A byte-order mark is not part of the first line as an editor shows it.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut robot: Option<(BoardNumber, usize)> = None;
     let mut steps = Vec::new();
-    let mut last_line = 0;
     for (i, raw) in text.lines().enumerate() {
-        let n = i + 1;
-        last_line = n;
-        let code = raw.split('#').next().unwrap_or("");
-        let toks = tokens(code);
-        let Some(&first) = toks.first() else { continue };
-        let mut l = Line {
-            n,
-            end_col: code.trim_end().chars().count() + 1,
-            toks,
-            at: 1,
+        let line = i + 1;
+        let tokens = tokenize(raw);
+        let Some(first) = tokens.first() else {
+            continue;
         };
-        if lower(first) == "robot" {
-            if robot.is_some() || !steps.is_empty() {
-                return Err(l.err(first.col, PlanErrorKind::RobotAfterSteps));
+        let mut cur = Cursor {
+            line,
+            tokens: &tokens,
+            next: 1,
+        };
+        if first.text.eq_ignore_ascii_case("robot") {
+            if !steps.is_empty() {
+                return Err(cur.error_at(first, PlanErrorKind::RobotAfterSteps));
             }
-            const R: &str = "a robot number 1..=255";
-            let t = l.next("robot", R)?;
-            robot = Some(
-                t.text
-                    .parse::<u8>()
-                    .ok()
-                    .and_then(|v| BoardNumber::new(v).ok())
-                    .ok_or_else(|| l.bad(t, R))?,
-            );
-            l.done()?;
+            if let Some((_, first_line)) = robot {
+                return Err(cur.error_at(first, PlanErrorKind::RobotTwice { first: first_line }));
+            }
+            let tok = cur.next("robot", "a robot number 1..=255")?;
+            let n = cur.integer(tok, "a robot number 1..=255")?;
+            let n = u8::try_from(n)
+                .ok()
+                .and_then(|n| BoardNumber::new(n).ok())
+                .ok_or_else(|| cur.out_of_range(tok, "robot number", "1", "255"))?;
+            cur.finish()?;
+            robot = Some((n, line));
             continue;
         }
-        let action = step(&mut l, first)?;
-        l.done()?;
+        let action = step(&mut cur, first)?;
+        cur.finish()?;
         steps.push(Step {
-            line: n,
-            text: code.trim().to_string(),
+            line,
             action,
+            text: raw.trim().to_string(),
         });
     }
     if steps.is_empty() {
         return Err(PlanError {
-            line: last_line.max(1),
+            line: 1,
             column: 1,
             kind: PlanErrorKind::Empty,
         });
     }
     Ok(Plan {
-        robot: robot.unwrap_or(BoardNumber::ONE),
+        robot: robot.map_or(BoardNumber::ONE, |(r, _)| r),
         steps,
     })
 }
 
+impl Plan {
+    /// Canonical text: a `robot` header and one canonical step per line (see [`Action`]'s
+    /// `Display`). It parses back to a plan with the same robot and actions, so tools can
+    /// rewrite plans and tests can round-trip them.
+    pub fn to_text(&self) -> String {
+        let mut s = format!("robot {}\n", self.robot.get());
+        for step in &self.steps {
+            s += &step.action.to_string();
+            s.push('\n');
+        }
+        s
+    }
+}
+
 impl Action {
-    /// The step as a plan-file line.
+    /// A short description for people (progress lines, logs), e.g. `arm A to 1500 µs`.
     pub fn describe(&self) -> String {
-        match self {
-            Action::Wait { ms } => format!("wait {ms}ms"),
-            Action::Command(c) => command_text(c),
+        let c = match self {
+            Action::Wait { ms } => return format!("wait {}", duration(*ms, " ")),
+            Action::Command(c) => c,
+        };
+        match c {
+            Command::Heartbeat => "request a heartbeat".into(),
+            Command::Stop => "emergency stop".into(),
+            Command::Reset => "resume after a stop".into(),
+            Command::SystemFault => "trigger the system fault".into(),
+            Command::ClearFaults => "clear latched faults".into(),
+            Command::Mode(m) => format!("switch to {m} mode"),
+            Command::Arm { side, target } => servo_description("arm", *side, *target),
+            Command::Gripper { side, target } => servo_description("gripper", *side, *target),
+            Command::Hip(HipTarget::Home) => "hip home".into(),
+            Command::Hip(HipTarget::Straight) => "hip straight (180°)".into(),
+            Command::Hip(HipTarget::RightAngleCw) => "hip 90° clockwise".into(),
+            Command::Hip(HipTarget::RightAngleCcw) => "hip 90° counter-clockwise".into(),
+            Command::Hip(HipTarget::Angle(a)) => format!("hip to {}°", degrees(*a)),
+            Command::Bolter(BolterCommand::Bolt(f)) => format!("bolt {}", fasteners(*f)),
+            Command::Bolter(BolterCommand::Unbolt(f)) => format!("unbolt {}", fasteners(*f)),
+            Command::Bolter(BolterCommand::Down) => "lower both bolters".into(),
+            Command::Primitive(p) => format!("primitive {} ({})", p.number(), p.name()),
+            Command::Reconfigure(r) => format!("reconfigure {} -> {}", r.initial(), r.target()),
+            Command::Power { target, on } => format!(
+                "power {} {}",
+                if *on { "on" } else { "off" },
+                match target {
+                    PowerTarget::Module(m) => module_keyword(*m),
+                    PowerTarget::All => "all modules",
+                }
+            ),
         }
     }
 }
 
-fn servo_text(t: ServoTarget) -> String {
+/// The canonical step text, as [`Plan::to_text`] writes it: lowercase keywords, pulse widths in
+/// `us`, angles in degrees with at most 2 decimals, waits in `s` when whole seconds else `ms`.
+impl fmt::Display for Action {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let c = match self {
+            Action::Wait { ms } => return write!(f, "wait {}", duration(*ms, "")),
+            Action::Command(c) => c,
+        };
+        match c {
+            Command::Heartbeat => f.write_str("heartbeat"),
+            Command::Stop => f.write_str("stop"),
+            Command::Reset => f.write_str("reset"),
+            Command::SystemFault => f.write_str("system-fault"),
+            Command::ClearFaults => f.write_str("clear-faults"),
+            Command::Mode(m) => write!(f, "mode {}", m.name()),
+            Command::Arm { side, target } => {
+                write!(f, "arm {} {}", side_word(*side), servo(*target))
+            }
+            Command::Gripper { side, target } => {
+                write!(f, "gripper {} {}", side_word(*side), servo(*target))
+            }
+            Command::Hip(h) => match h {
+                HipTarget::Home => f.write_str("hip home"),
+                HipTarget::Straight => f.write_str("hip straight"),
+                HipTarget::RightAngleCw => f.write_str("hip cw"),
+                HipTarget::RightAngleCcw => f.write_str("hip ccw"),
+                HipTarget::Angle(a) => write!(f, "hip {}", degrees(*a)),
+            },
+            Command::Bolter(BolterCommand::Bolt(w)) => write!(f, "bolt {}", fastener_word(*w)),
+            Command::Bolter(BolterCommand::Unbolt(w)) => write!(f, "unbolt {}", fastener_word(*w)),
+            Command::Bolter(BolterCommand::Down) => f.write_str("bolters down"),
+            Command::Primitive(p) => write!(f, "primitive {}", p.number()),
+            Command::Reconfigure(r) => write!(
+                f,
+                "reconfigure {} -> {}",
+                r.initial().letter(),
+                r.target().letter()
+            ),
+            Command::Power { target, on } => write!(
+                f,
+                "power {} {}",
+                if *on { "on" } else { "off" },
+                match target {
+                    PowerTarget::Module(m) => module_keyword(*m),
+                    PowerTarget::All => "all",
+                }
+            ),
+        }
+    }
+}
+
+fn side_word(s: Side) -> &'static str {
+    match s {
+        Side::A => "a",
+        Side::B => "b",
+    }
+}
+
+fn servo(t: ServoTarget) -> String {
     match t {
         ServoTarget::Contract => "contract".into(),
         ServoTarget::Extend => "extend".into(),
-        ServoTarget::Position(p) => format!("{}us", p.micros()),
+        ServoTarget::Position(pw) => format!("{}us", pw.micros()),
     }
 }
 
-fn fasteners_text(f: Fasteners) -> String {
+fn servo_description(what: &str, side: Side, t: ServoTarget) -> String {
+    match t {
+        ServoTarget::Contract => format!("{what} {side}: contract"),
+        ServoTarget::Extend => format!("{what} {side}: extend"),
+        ServoTarget::Position(pw) => format!("{what} {side} to {} µs", pw.micros()),
+    }
+}
+
+fn fastener_word(f: Fasteners) -> String {
     match f {
-        Fasteners::All => "all".into(),
         Fasteners::Pair(p) => p.number().to_string(),
+        Fasteners::All => "all".into(),
     }
 }
 
-/// A command as a plan-file line.
-pub fn command_text(c: &Command) -> String {
-    let side = |s: Side| if s == Side::A { "a" } else { "b" };
-    match *c {
-        Command::Heartbeat => "heartbeat".into(),
-        Command::Stop => "stop".into(),
-        Command::Reset => "reset".into(),
-        Command::SystemFault => "system-fault".into(),
-        Command::ClearFaults => "clear-faults".into(),
-        Command::Mode(m) => format!("mode {}", m.name()),
-        Command::Arm { side: s, target } => format!("arm {} {}", side(s), servo_text(target)),
-        Command::Gripper { side: s, target } => {
-            format!("gripper {} {}", side(s), servo_text(target))
-        }
-        Command::Hip(h) => match h {
-            HipTarget::Home => "hip home".into(),
-            HipTarget::Straight => "hip straight".into(),
-            HipTarget::RightAngleCw => "hip cw".into(),
-            HipTarget::RightAngleCcw => "hip ccw".into(),
-            HipTarget::Angle(a) => {
-                let c = a.centidegrees();
-                format!("hip {}.{:02}", c / 100, c % 100)
-            }
-        },
-        Command::Bolter(BolterCommand::Bolt(f)) => format!("bolt {}", fasteners_text(f)),
-        Command::Bolter(BolterCommand::Unbolt(f)) => format!("unbolt {}", fasteners_text(f)),
-        Command::Bolter(BolterCommand::Down) => "bolters down".into(),
-        Command::Primitive(p) => format!("primitive {}", p.number()),
-        Command::Reconfigure(r) => format!(
-            "reconfigure {} -> {}",
-            r.initial().letter(),
-            r.target().letter()
-        ),
-        Command::Power { target, on } => format!(
-            "power {} {}",
-            if on { "on" } else { "off" },
-            match target {
-                PowerTarget::All => "all",
-                PowerTarget::Module(m) => module_name(m),
-            }
-        ),
+fn fasteners(f: Fasteners) -> String {
+    match f {
+        Fasteners::Pair(p) => format!("pair {}", p.number()),
+        Fasteners::All => "all pairs".into(),
     }
 }
 
-impl Plan {
-    /// The plan as canonical text; parses back to an equal plan (line numbers aside).
-    pub fn to_text(&self) -> String {
-        let mut t = format!("robot {}\n", self.robot.get());
-        for s in &self.steps {
-            let _ = writeln!(t, "{}", s.action.describe());
+/// `45`, `45.5`, `123.45`: centidegrees as degrees without trailing zeros.
+fn degrees(a: HipAngle) -> String {
+    let c = a.centidegrees();
+    let (whole, frac) = (c / 100, c % 100);
+    match frac {
+        0 => whole.to_string(),
+        f if f % 10 == 0 => format!("{whole}.{}", f / 10),
+        f => format!("{whole}.{f:02}"),
+    }
+}
+
+/// `2s`, `1.5s`, `500ms` (with `sep` between number and unit).
+fn duration(ms: u32, sep: &str) -> String {
+    if ms >= 1000 && ms.is_multiple_of(1000) {
+        format!("{}{sep}s", ms / 1000)
+    } else if ms >= 1000 && ms.is_multiple_of(100) {
+        format!("{}.{}{sep}s", ms / 1000, (ms % 1000) / 100)
+    } else {
+        format!("{ms}{sep}ms")
+    }
+}
+
+/// A token and its 1-based character column.
+#[derive(Debug, Clone, Copy)]
+struct Token<'a> {
+    text: &'a str,
+    column: usize,
+}
+
+/// The tokens of one line: comment stripped, split at whitespace, `->` a token of its own.
+fn tokenize(line: &str) -> Vec<Token<'_>> {
+    let code = line.split_once('#').map_or(line, |(code, _)| code);
+    let mut out = Vec::new();
+    let mut start: Option<(usize, usize)> = None; // byte offset, column
+    let mut chars = code.char_indices().enumerate().peekable();
+    while let Some((i, (b, c))) = chars.next() {
+        let column = i + 1;
+        let arrow = c == '-' && matches!(chars.peek(), Some((_, (_, '>'))));
+        if c.is_whitespace() || arrow {
+            if let Some((s, col)) = start.take() {
+                out.push(Token {
+                    text: &code[s..b],
+                    column: col,
+                });
+            }
+            if arrow {
+                chars.next();
+                out.push(Token {
+                    text: &code[b..b + 2],
+                    column,
+                });
+            }
+        } else if start.is_none() {
+            start = Some((b, column));
         }
-        t
+    }
+    if let Some((s, col)) = start {
+        out.push(Token {
+            text: &code[s..],
+            column: col,
+        });
+    }
+    out
+}
+
+/// The tokens of one line being consumed.
+struct Cursor<'t, 'a> {
+    line: usize,
+    tokens: &'t [Token<'a>],
+    next: usize,
+}
+
+impl<'a> Cursor<'_, 'a> {
+    fn error_at(&self, t: &Token<'_>, kind: PlanErrorKind) -> PlanError {
+        PlanError {
+            line: self.line,
+            column: t.column,
+            kind,
+        }
+    }
+
+    fn bad(&self, t: Token<'_>, expected: &'static str) -> PlanError {
+        self.error_at(
+            &t,
+            PlanErrorKind::BadArgument {
+                expected,
+                found: t.text.to_string(),
+            },
+        )
+    }
+
+    fn out_of_range(
+        &self,
+        t: Token<'_>,
+        quantity: &'static str,
+        min: &'static str,
+        max: &'static str,
+    ) -> PlanError {
+        self.error_at(
+            &t,
+            PlanErrorKind::OutOfRange {
+                quantity,
+                min,
+                max,
+                found: t.text.to_string(),
+            },
+        )
+    }
+
+    /// The next token, or a [`PlanErrorKind::MissingArgument`] just past the last one.
+    fn next(&mut self, step: &'static str, expected: &'static str) -> Result<Token<'a>, PlanError> {
+        match self.tokens.get(self.next) {
+            Some(t) => {
+                self.next += 1;
+                Ok(*t)
+            }
+            None => {
+                let column = self
+                    .tokens
+                    .last()
+                    .map_or(1, |t| t.column + t.text.chars().count());
+                Err(PlanError {
+                    line: self.line,
+                    column,
+                    kind: PlanErrorKind::MissingArgument { step, expected },
+                })
+            }
+        }
+    }
+
+    fn finish(&self) -> Result<(), PlanError> {
+        match self.tokens.get(self.next) {
+            None => Ok(()),
+            Some(t) => Err(self.error_at(
+                t,
+                PlanErrorKind::TrailingToken {
+                    found: t.text.to_string(),
+                },
+            )),
+        }
+    }
+
+    /// An integer token (optionally negative); too large a magnitude saturates, which every
+    /// caller then refuses as out of range.
+    fn integer(&self, t: Token<'_>, expected: &'static str) -> Result<i64, PlanError> {
+        integer(t.text).ok_or_else(|| self.bad(t, expected))
+    }
+}
+
+/// `-?[0-9]+` as an i64, saturating.
+fn integer(s: &str) -> Option<i64> {
+    fixed(s, 0).and_then(Result::ok)
+}
+
+/// `-?[0-9]+(\.[0-9]+)?` scaled by 10^`decimals`, saturating; `Some(Err(()))` when the fraction
+/// has non-zero digits beyond `decimals`.
+fn fixed(s: &str, decimals: u32) -> Option<Result<i64, ()>> {
+    let (neg, s) = match s.strip_prefix('-') {
+        Some(rest) => (true, rest),
+        None => (false, s),
+    };
+    let (whole, frac) = s.split_once('.').unwrap_or((s, ""));
+    let digits = |d: &str| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit());
+    if !digits(whole) || (s.contains('.') && !digits(frac)) {
+        return None;
+    }
+    let mut v: i64 = 0;
+    for b in whole.bytes() {
+        v = v.saturating_mul(10).saturating_add(i64::from(b - b'0'));
+    }
+    for i in 0..decimals as usize {
+        let d = frac.as_bytes().get(i).map_or(0, |b| b - b'0');
+        v = v.saturating_mul(10).saturating_add(i64::from(d));
+    }
+    if frac.bytes().skip(decimals as usize).any(|b| b != b'0') {
+        return Some(Err(()));
+    }
+    Some(Ok(if neg { -v } else { v }))
+}
+
+fn strip_suffix_ci<'s>(s: &'s str, suffix: &str) -> Option<&'s str> {
+    let cut = s.len().checked_sub(suffix.len())?;
+    if s.is_char_boundary(cut) && s[cut..].eq_ignore_ascii_case(suffix) {
+        Some(&s[..cut])
+    } else {
+        None
+    }
+}
+
+const SIDE: &str = "a side: a or b";
+const SERVO: &str = "contract, extend or a pulse width 500..=2500 us";
+const HIP: &str = "home, straight, cw, ccw or an angle in degrees (e.g. 45.5)";
+const PAIR: &str = "a bolter pair 1..=4 or all";
+const PRIMITIVE: &str = "a primitive number 1..=8 or a Table 6 name";
+const STATE: &str = "a state letter a..o (Table 5)";
+const DURATION: &str = "a duration with unit ms or s (e.g. 500ms, 1.5s)";
+
+fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Action, PlanError> {
+    let kw = first.text.to_ascii_lowercase();
+    let cmd = match kw.as_str() {
+        "heartbeat" => Command::Heartbeat,
+        "stop" => Command::Stop,
+        "reset" => Command::Reset,
+        "system-fault" => Command::SystemFault,
+        "clear-faults" => Command::ClearFaults,
+        "mode" => {
+            const MODES: &str = "a mode: standby, operational or safed";
+            let t = cur.next("mode", MODES)?;
+            let m = Mode::ALL
+                .into_iter()
+                .find(|m| m.name().eq_ignore_ascii_case(t.text))
+                .ok_or_else(|| cur.bad(t, MODES))?;
+            Command::Mode(m)
+        }
+        "arm" | "gripper" => {
+            let step = if kw == "arm" { "arm" } else { "gripper" };
+            let side = side(cur, step)?;
+            let target = servo_target(cur, step)?;
+            if step == "arm" {
+                Command::Arm { side, target }
+            } else {
+                Command::Gripper { side, target }
+            }
+        }
+        "hip" => Command::Hip(hip_target(cur)?),
+        "bolt" | "unbolt" => {
+            let step = if kw == "bolt" { "bolt" } else { "unbolt" };
+            let t = cur.next(step, PAIR)?;
+            let which = if t.text.eq_ignore_ascii_case("all") {
+                Fasteners::All
+            } else {
+                let n = cur.integer(t, PAIR)?;
+                u8::try_from(n)
+                    .ok()
+                    .and_then(BolterPair::from_number)
+                    .map(Fasteners::Pair)
+                    .ok_or_else(|| cur.out_of_range(t, "bolter pair", "1", "4"))?
+            };
+            Command::Bolter(if step == "bolt" {
+                BolterCommand::Bolt(which)
+            } else {
+                BolterCommand::Unbolt(which)
+            })
+        }
+        "bolters" => {
+            let t = cur.next("bolters", "down")?;
+            if !t.text.eq_ignore_ascii_case("down") {
+                return Err(cur.bad(t, "down"));
+            }
+            Command::Bolter(BolterCommand::Down)
+        }
+        "primitive" => {
+            let t = cur.next("primitive", PRIMITIVE)?;
+            let by_name = Primitive::ALL
+                .into_iter()
+                .find(|p| p.name().eq_ignore_ascii_case(t.text));
+            let p = match by_name {
+                Some(p) => p,
+                None => {
+                    let n = cur.integer(t, PRIMITIVE)?;
+                    u8::try_from(n)
+                        .ok()
+                        .and_then(Primitive::from_number)
+                        .ok_or_else(|| cur.out_of_range(t, "primitive", "1", "8"))?
+                }
+            };
+            Command::Primitive(p)
+        }
+        "reconfigure" => {
+            let initial = state(cur)?;
+            let arrow = cur.next("reconfigure", "`->` and a target state")?;
+            if arrow.text != "->" {
+                return Err(cur.bad(arrow, "`->`"));
+            }
+            let target_tok = cur.tokens.get(cur.next).copied();
+            let target = state(cur)?;
+            Command::reconfigure(initial, target).map_err(|e| {
+                let at = target_tok.unwrap_or(arrow);
+                cur.error_at(&at, PlanErrorKind::Reconfiguration(e))
+            })?
+        }
+        "power" => {
+            let t = cur.next("power", "on or off")?;
+            let on = match t.text.to_ascii_lowercase().as_str() {
+                "on" => true,
+                "off" => false,
+                _ => return Err(cur.bad(t, "on or off")),
+            };
+            let t = cur.next("power", POWER_TARGETS)?;
+            let target = if t.text.eq_ignore_ascii_case("all") {
+                PowerTarget::All
+            } else {
+                PowerTarget::Module(
+                    module_from_keyword(t.text).ok_or_else(|| cur.bad(t, POWER_TARGETS))?,
+                )
+            };
+            Command::Power { target, on }
+        }
+        "wait" => return wait(cur),
+        _ => {
+            return Err(cur.error_at(
+                first,
+                PlanErrorKind::UnknownStep {
+                    found: first.text.to_string(),
+                },
+            ))
+        }
+    };
+    Ok(Action::Command(cmd))
+}
+
+fn side(cur: &mut Cursor<'_, '_>, step: &'static str) -> Result<Side, PlanError> {
+    let t = cur.next(step, SIDE)?;
+    match t.text.to_ascii_lowercase().as_str() {
+        "a" => Ok(Side::A),
+        "b" => Ok(Side::B),
+        _ => Err(cur.bad(t, SIDE)),
+    }
+}
+
+fn servo_target(cur: &mut Cursor<'_, '_>, step: &'static str) -> Result<ServoTarget, PlanError> {
+    let t = cur.next(step, SERVO)?;
+    let word = t.text.to_lowercase();
+    match word.as_str() {
+        "contract" => return Ok(ServoTarget::Contract),
+        "extend" => return Ok(ServoTarget::Extend),
+        _ => {}
+    }
+    let number = ["us", "µs", "μs"]
+        .into_iter()
+        .find_map(|u| strip_suffix_ci(&word, u))
+        .unwrap_or(&word);
+    let us = integer(number).ok_or_else(|| cur.bad(t, SERVO))?;
+    u16::try_from(us)
+        .ok()
+        .and_then(|us| PulseWidth::new(us).ok())
+        .map(ServoTarget::Position)
+        .ok_or_else(|| cur.out_of_range(t, "pulse width", "500us", "2500us"))
+}
+
+fn hip_target(cur: &mut Cursor<'_, '_>) -> Result<HipTarget, PlanError> {
+    let t = cur.next("hip", HIP)?;
+    let word = t.text.to_lowercase();
+    match word.as_str() {
+        "home" => return Ok(HipTarget::Home),
+        "straight" => return Ok(HipTarget::Straight),
+        "cw" => return Ok(HipTarget::RightAngleCw),
+        "ccw" => return Ok(HipTarget::RightAngleCcw),
+        _ => {}
+    }
+    let number = ["deg", "°"]
+        .into_iter()
+        .find_map(|u| strip_suffix_ci(&word, u))
+        .unwrap_or(&word);
+    let cdeg = match fixed(number, 2) {
+        None => return Err(cur.bad(t, HIP)),
+        Some(Err(())) => {
+            return Err(cur.bad(t, "an angle with at most 2 decimals (0.01 degree steps)"))
+        }
+        Some(Ok(c)) => c,
+    };
+    u16::try_from(cdeg)
+        .ok()
+        .and_then(|c| HipAngle::new(c).ok())
+        .map(HipTarget::Angle)
+        .ok_or_else(|| cur.out_of_range(t, "hip angle", "0", "359.99 degrees"))
+}
+
+fn state(cur: &mut Cursor<'_, '_>) -> Result<State, PlanError> {
+    let t = cur.next("reconfigure", STATE)?;
+    let mut chars = t.text.chars();
+    match (chars.next(), chars.next()) {
+        (Some(c), None) => State::from_letter(c.to_ascii_lowercase()),
+        _ => None,
+    }
+    .ok_or_else(|| cur.bad(t, STATE))
+}
+
+fn wait(cur: &mut Cursor<'_, '_>) -> Result<Action, PlanError> {
+    let t = cur.next("wait", DURATION)?;
+    let word = t.text.to_ascii_lowercase();
+    let parsed = if let Some(n) = word.strip_suffix("ms") {
+        fixed(n, 0)
+    } else if let Some(n) = word.strip_suffix('s') {
+        fixed(n, 3)
+    } else {
+        None
+    };
+    let ms = match parsed {
+        None => return Err(cur.bad(t, DURATION)),
+        Some(Err(())) => return Err(cur.bad(t, "a duration in whole milliseconds")),
+        Some(Ok(ms)) => ms,
+    };
+    u32::try_from(ms)
+        .ok()
+        .filter(|ms| *ms <= MAX_WAIT_MS)
+        .map(|ms| Action::Wait { ms })
+        .ok_or_else(|| cur.out_of_range(t, "wait", "0ms", "3600s (1 hour)"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn power_error_names_every_module_keyword() {
+        for m in Module::ALL {
+            assert!(POWER_TARGETS.contains(module_keyword(m)), "{m:?}");
+            assert_eq!(module_from_keyword(module_keyword(m)), Some(m));
+        }
+    }
+
+    #[test]
+    fn tokens_carry_character_columns() {
+        let t = tokenize("\tµs  a->m # x");
+        let got: Vec<(&str, usize)> = t.iter().map(|t| (t.text, t.column)).collect();
+        assert_eq!(got, [("µs", 2), ("a", 6), ("->", 7), ("m", 9)]);
+    }
+
+    #[test]
+    fn fixed_point_numbers() {
+        assert_eq!(fixed("45", 2), Some(Ok(4500)));
+        assert_eq!(fixed("45.5", 2), Some(Ok(4550)));
+        assert_eq!(fixed("45.50", 2), Some(Ok(4550)));
+        assert_eq!(fixed("45.555", 2), Some(Err(())));
+        assert_eq!(fixed("-1", 0), Some(Ok(-1)));
+        assert_eq!(fixed("99999999999999999999999", 0), Some(Ok(i64::MAX)));
+        for bad in ["", "-", ".5", "5.", "1e3", "1.2.3", "+1", "x"] {
+            assert_eq!(fixed(bad, 2), None, "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn durations_and_degrees_render_canonically() {
+        assert_eq!(duration(2000, ""), "2s");
+        assert_eq!(duration(1500, ""), "1.5s");
+        assert_eq!(duration(1250, ""), "1250ms");
+        assert_eq!(duration(0, ""), "0ms");
+        assert_eq!(duration(999, " "), "999 ms");
+        for (c, s) in [
+            (0, "0"),
+            (4500, "45"),
+            (4550, "45.5"),
+            (12345, "123.45"),
+            (5, "0.05"),
+        ] {
+            assert_eq!(degrees(HipAngle::wrapping(c)), s);
+        }
     }
 }

@@ -1,253 +1,469 @@
-//! Plan files: every command of Table 1 round-trips through the text form, errors point at the
-//! exact line and column, and the built-in demo parses. Plus the SVG plots' well-formedness.
+//! Plan files: every command class round-trips through the text, and every error names the
+//! line and column of the token to fix.
 
-use mmic::command::{for_each_variant_class, Command};
-use mmic::units::{HipAngle, PulseWidth};
-use mmic_host::plan::{command_text, parse, Action, PlanErrorKind};
-use mmic_host::plot::{bar_chart, line_chart, Series};
+use mmic::command::{
+    for_each_variant_class, BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget,
+    ReconfigurationError, ServoTarget,
+};
+use mmic::mode::Mode;
+use mmic::motion::{Primitive, State};
+use mmic::units::{HipAngle, Module, PulseWidth, Side};
+use mmic_host::plan::{self, Action, Plan, PlanError, PlanErrorKind};
 
-#[test]
-fn every_command_class_round_trips_through_plan_text() {
-    let mut n = 0;
-    for (pw, deg) in [(500, 0), (2500, 35999), (1234, 4550)] {
-        let mut text = String::from("robot 9\n");
-        let mut want = Vec::new();
-        for_each_variant_class(
-            PulseWidth::new(pw).unwrap(),
-            HipAngle::new(deg).unwrap(),
-            |c| {
-                text += &command_text(&c);
-                text += "\n";
-                want.push(c);
-            },
-        );
-        let plan = parse(&text).unwrap();
-        assert_eq!(plan.robot.get(), 9);
-        let got: Vec<Command> = plan
-            .steps
-            .iter()
-            .map(|s| match s.action {
-                Action::Command(c) => c,
-                Action::Wait { .. } => panic!("no waits here"),
-            })
-            .collect();
-        assert_eq!(got, want);
-        // Canonical text parses back to the same steps.
-        let again = parse(&plan.to_text()).unwrap();
-        assert_eq!(
-            again.steps.iter().map(|s| s.action).collect::<Vec<_>>(),
-            plan.steps.iter().map(|s| s.action).collect::<Vec<_>>()
-        );
-        n += want.len();
-    }
-    assert_eq!(n, 3 * 61, "all 61 variant classes of Table 1");
+fn actions(p: &Plan) -> Vec<Action> {
+    p.steps.iter().map(|s| s.action).collect()
 }
 
-#[test]
-fn all_84_reconfigurations_and_the_spellings_users_write() {
-    let mut n = 0;
-    for a in mmic::motion::State::ALL {
-        for b in mmic::motion::State::ALL {
-            if let Ok(c) = Command::reconfigure(a, b) {
-                for text in [
-                    format!("reconfigure {} -> {}", a.letter(), b.letter()),
-                    format!(
-                        "RECONFIGURE {}->{}",
-                        a.letter().to_ascii_uppercase(),
-                        b.letter()
-                    ),
-                    format!(
-                        "  reconfigure\t{}  ->  {}   # comment",
-                        a.letter(),
-                        b.letter()
-                    ),
-                ] {
-                    let p = parse(&text).unwrap();
-                    assert_eq!(p.steps[0].action, Action::Command(c), "{text}");
-                }
-                n += 1;
-            }
-        }
-    }
-    assert_eq!(n, 84);
-    let p =
-        parse("wait 500ms\nwait 2s\nwait 1.25s\nhip 45.5deg\narm b 1500us\npower off gripper-b\n")
-            .unwrap();
-    let actions: Vec<String> = p.steps.iter().map(|s| s.action.describe()).collect();
-    assert_eq!(
-        actions,
-        [
-            "wait 500ms",
-            "wait 2000ms",
-            "wait 1250ms",
-            "hip 45.50",
-            "arm b 1500us",
-            "power off gripper-b"
-        ]
-    );
-    assert_eq!(p.steps[3].line, 4);
-    assert_eq!(p.steps[3].text, "hip 45.5deg");
+fn one(text: &str) -> Action {
+    let p = plan::parse(text).unwrap_or_else(|e| panic!("{text:?}: {e}"));
+    assert_eq!(p.steps.len(), 1, "{text:?}");
+    p.steps[0].action
 }
 
-#[track_caller]
-fn error_at(text: &str, line: usize, column: usize) -> PlanErrorKind {
-    let e = parse(text).unwrap_err();
+fn cmd(text: &str) -> Command {
+    match one(text) {
+        Action::Command(c) => c,
+        other => panic!("{text:?}: {other:?}"),
+    }
+}
+
+fn err(text: &str) -> PlanError {
+    match plan::parse(text) {
+        Ok(p) => panic!("{text:?} parsed: {p:?}"),
+        Err(e) => e,
+    }
+}
+
+/// Asserts the error's line and column and returns its kind.
+fn err_at(text: &str, line: usize, column: usize) -> PlanErrorKind {
+    let e = err(text);
     assert_eq!((e.line, e.column), (line, column), "{text:?}: {e}");
     e.kind
 }
 
+fn variant_classes(pw: u16, cdeg: u16) -> Vec<Command> {
+    let mut v = Vec::new();
+    let pw = PulseWidth::new(pw).expect("pulse width in range");
+    let a = HipAngle::new(cdeg).expect("angle in range");
+    for_each_variant_class(pw, a, |c| v.push(c));
+    v
+}
+
 #[test]
-fn errors_name_line_and_column() {
-    assert!(matches!(
-        error_at("mode operational\nbolt 5\n", 2, 6),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("\n\n   jump 3\n", 3, 4),
-        PlanErrorKind::UnknownStep { .. }
-    ));
-    assert!(matches!(
-        error_at("\tarm c contract", 1, 6),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("arm a", 1, 6),
-        PlanErrorKind::Missing { step: "arm", .. }
-    ));
-    assert!(matches!(
-        error_at("arm a 2501", 1, 7),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("hip 360", 1, 5),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("hip 12.345", 1, 5),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("stop now", 1, 6),
-        PlanErrorKind::Trailing { .. }
-    ));
-    assert!(matches!(
-        error_at("mode standby\nrobot 2", 2, 1),
+fn every_variant_class_round_trips_through_the_text() {
+    for (pw, cdeg) in [
+        (1500, 4550),
+        (500, 0),
+        (2500, 35999),
+        (1234, 12345),
+        (777, 5),
+    ] {
+        let cmds = variant_classes(pw, cdeg);
+        assert_eq!(cmds.len(), 61);
+        let original = Plan {
+            robot: mmic::units::BoardNumber::new(7).expect("robot 7"),
+            steps: cmds
+                .iter()
+                .enumerate()
+                .map(|(i, c)| plan::Step {
+                    line: i + 1,
+                    action: Action::Command(*c),
+                    text: String::new(),
+                })
+                .collect(),
+        };
+        let text = original.to_text();
+        let back = plan::parse(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(back.robot, original.robot);
+        assert_eq!(actions(&back), actions(&original), "{text}");
+        // Each step is its own canonical line, and the text is a fixed point.
+        for (step, line) in back.steps.iter().zip(text.lines().skip(1)) {
+            assert_eq!(step.text, line);
+            assert_eq!(step.action.to_string(), line);
+            assert!(!step.action.describe().is_empty());
+        }
+        assert_eq!(back.to_text(), text);
+    }
+}
+
+#[test]
+fn every_reconfiguration_and_wait_round_trips() {
+    let mut steps = Vec::new();
+    for initial in State::ALL {
+        for target in State::MATCHED {
+            if let Ok(c) = Command::reconfigure(initial, target) {
+                steps.push(Action::Command(c));
+            }
+        }
+    }
+    assert_eq!(steps.len(), 84);
+    for ms in [0, 1, 999, 1000, 1500, 1250, 60_000, plan::MAX_WAIT_MS] {
+        steps.push(Action::Wait { ms });
+    }
+    let text: String = steps.iter().map(|a| format!("{a}\n")).collect();
+    let back = plan::parse(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    assert_eq!(actions(&back), steps);
+}
+
+#[test]
+fn each_step_form_parses_to_its_command() {
+    use Command as C;
+    assert_eq!(cmd("heartbeat"), C::Heartbeat);
+    assert_eq!(cmd("stop"), C::Stop);
+    assert_eq!(cmd("reset"), C::Reset);
+    assert_eq!(cmd("system-fault"), C::SystemFault);
+    assert_eq!(cmd("clear-faults"), C::ClearFaults);
+    assert_eq!(cmd("mode safed"), C::Mode(Mode::Safed));
+    let pw = |us| ServoTarget::Position(PulseWidth::new(us).expect("in range"));
+    for (t, target) in [
+        ("contract", ServoTarget::Contract),
+        ("extend", ServoTarget::Extend),
+        ("1500", pw(1500)),
+        ("1500us", pw(1500)),
+        ("1500µs", pw(1500)),
+        ("500US", pw(500)),
+        ("2500", pw(2500)),
+    ] {
+        assert_eq!(
+            cmd(&format!("arm b {t}")),
+            C::Arm {
+                side: Side::B,
+                target
+            }
+        );
+        assert_eq!(
+            cmd(&format!("gripper a {t}")),
+            C::Gripper {
+                side: Side::A,
+                target
+            }
+        );
+    }
+    let angle = |c| HipTarget::Angle(HipAngle::new(c).expect("in range"));
+    for (t, h) in [
+        ("home", HipTarget::Home),
+        ("straight", HipTarget::Straight),
+        ("cw", HipTarget::RightAngleCw),
+        ("ccw", HipTarget::RightAngleCcw),
+        ("45", angle(4500)),
+        ("45.5", angle(4550)),
+        ("45.50", angle(4550)),
+        ("45deg", angle(4500)),
+        ("45.25°", angle(4525)),
+        ("0", angle(0)),
+        ("359.99", angle(35999)),
+        ("90", angle(9000)), // an angle, not the `cw` preset: a different opcode
+    ] {
+        assert_eq!(cmd(&format!("hip {t}")), C::Hip(h), "{t}");
+    }
+    assert_eq!(
+        cmd("bolt 3"),
+        C::Bolter(BolterCommand::Bolt(Fasteners::Pair(BolterPair::P3)))
+    );
+    assert_eq!(
+        cmd("unbolt all"),
+        C::Bolter(BolterCommand::Unbolt(Fasteners::All))
+    );
+    assert_eq!(cmd("bolters down"), C::Bolter(BolterCommand::Down));
+    assert_eq!(cmd("primitive 4"), C::Primitive(Primitive::BackExtend));
+    assert_eq!(
+        cmd("primitive fwdturnccw"),
+        C::Primitive(Primitive::FwdTurnCcw)
+    );
+    let r = Command::reconfigure(State::A, State::M).expect("valid");
+    assert_eq!(cmd("reconfigure a -> m"), r);
+    assert_eq!(cmd("reconfigure A->M"), r);
+    assert_eq!(cmd("reconfigure a ->m"), r);
+    for m in Module::ALL {
+        let kw = plan::module_keyword(m);
+        assert_eq!(
+            cmd(&format!("power off {kw}")),
+            C::Power {
+                target: PowerTarget::Module(m),
+                on: false
+            }
+        );
+    }
+    assert_eq!(
+        cmd("power on all"),
+        C::Power {
+            target: PowerTarget::All,
+            on: true
+        }
+    );
+    for (t, ms) in [
+        ("2s", 2000),
+        ("500ms", 500),
+        ("1.5s", 1500),
+        ("0.001s", 1),
+        ("3600s", 3_600_000),
+        ("1.500S", 1500),
+    ] {
+        assert_eq!(one(&format!("wait {t}")), Action::Wait { ms }, "{t}");
+    }
+}
+
+#[test]
+fn keywords_are_case_insensitive() {
+    assert_eq!(
+        cmd("ARM A Extend"),
+        Command::Arm {
+            side: Side::A,
+            target: ServoTarget::Extend
+        }
+    );
+    assert_eq!(cmd("Mode OPERATIONAL"), Command::Mode(Mode::Operational));
+    assert_eq!(cmd("System-Fault"), Command::SystemFault);
+    assert_eq!(
+        cmd("POWER ON Gripper-B"),
+        Command::Power {
+            target: PowerTarget::Module(Module::GripperB),
+            on: true
+        }
+    );
+    assert_eq!(plan::parse("ROBOT 3\nstop").map(|p| p.robot.get()), Ok(3));
+}
+
+#[test]
+fn comments_blank_lines_and_indentation_are_ignored() {
+    let text = "# a plan\n\n   \n\tmode operational   # power up\nstop#tight\n  # indented comment\r\nheartbeat\r\n";
+    let p = plan::parse(text).expect("parses");
+    assert_eq!(
+        actions(&p),
+        [
+            Action::Command(Command::Mode(Mode::Operational)),
+            Action::Command(Command::Stop),
+            Action::Command(Command::Heartbeat),
+        ]
+    );
+    let lines: Vec<usize> = p.steps.iter().map(|s| s.line).collect();
+    assert_eq!(lines, [4, 5, 7]);
+    assert_eq!(p.steps[0].text, "mode operational   # power up");
+    assert_eq!(p.steps[2].text, "heartbeat");
+    assert_eq!(p.robot.get(), 1);
+}
+
+#[test]
+fn robot_header() {
+    let p = plan::parse("# header first\nrobot 255 # last client\nstop\n").expect("parses");
+    assert_eq!(p.robot.get(), 255);
+    assert_eq!(p.steps[0].line, 3);
+    assert_eq!(
+        err_at("stop\nrobot 2\n", 2, 1),
         PlanErrorKind::RobotAfterSteps
+    );
+    assert_eq!(
+        err_at("robot 2\n  robot 3\nstop\n", 2, 3),
+        PlanErrorKind::RobotTwice { first: 1 }
+    );
+    for n in ["0", "256", "-1", "99999999999999999999999"] {
+        assert!(
+            matches!(
+                err_at(&format!("robot {n}\nstop"), 1, 7),
+                PlanErrorKind::OutOfRange {
+                    quantity: "robot number",
+                    ..
+                }
+            ),
+            "{n}"
+        );
+    }
+    assert!(matches!(
+        err_at("robot two\nstop", 1, 7),
+        PlanErrorKind::BadArgument { .. }
     ));
     assert!(matches!(
-        error_at("robot 0", 1, 7),
-        PlanErrorKind::Bad { .. }
+        err_at("robot\nstop", 1, 6),
+        PlanErrorKind::MissingArgument { step: "robot", .. }
     ));
-    assert!(matches!(
-        error_at("reconfigure a -> a", 1, 13),
-        PlanErrorKind::Reconfiguration(_)
-    ));
-    assert!(matches!(
-        error_at("reconfigure a m", 1, 15),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("wait 2h", 1, 6),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("wait 3601s", 1, 6),
-        PlanErrorKind::Bad { .. }
-    ));
-    assert!(matches!(
-        error_at("# nothing\n\n", 2, 1),
-        PlanErrorKind::Empty
-    ));
+    assert_eq!(
+        err_at("robot 2 3\nstop", 1, 9),
+        PlanErrorKind::TrailingToken { found: "3".into() }
+    );
+}
+
+#[test]
+fn empty_plans_are_refused() {
+    for text in [
+        "",
+        "\n\n",
+        "# nothing yet\n   # still nothing\n",
+        "robot 4\n",
+        "\u{feff}",
+    ] {
+        assert_eq!(err_at(text, 1, 1), PlanErrorKind::Empty, "{text:?}");
+    }
+}
+
+#[test]
+fn errors_name_line_and_column_of_the_offending_token() {
+    let e = err("mode operational\nbolt 5\n");
+    assert_eq!((e.line, e.column), (2, 6));
+    assert_eq!(
+        e.kind,
+        PlanErrorKind::OutOfRange {
+            quantity: "bolter pair",
+            min: "1",
+            max: "4",
+            found: "5".into()
+        }
+    );
+    assert_eq!(
+        e.to_string(),
+        "line 2, column 6: bolter pair must be 1..=4, found 5"
+    );
+
+    // Unknown keyword: at the keyword, whatever the indentation (a tab is one column).
+    for (text, col) in [
+        ("frobnicate", 1),
+        ("   frobnicate 1", 4),
+        ("\tfrobnicate", 2),
+    ] {
+        assert_eq!(
+            err_at(&format!("stop\n{text}\n"), 2, col),
+            PlanErrorKind::UnknownStep {
+                found: "frobnicate".into()
+            },
+            "{text:?}"
+        );
+    }
     // Columns count characters, not bytes.
     assert!(matches!(
-        error_at("mode °", 1, 6),
-        PlanErrorKind::Bad { .. }
+        err_at("hip 45°° # µ", 1, 5),
+        PlanErrorKind::BadArgument { .. }
     ));
-}
-
-#[test]
-fn the_demo_plan_parses() {
-    let p = parse(mmic_host::sim::report::DEMO_PLAN).unwrap();
-    assert!(p.steps.len() >= 8);
-    assert_eq!(mmic_host::sim::report::demo_steps().len(), p.steps.len());
-}
-
-fn balanced(svg: &str) {
-    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
-    for bad in ["NaN", "inf"] {
-        assert!(!svg.contains(bad), "{bad} in {svg}");
-    }
-    // Every opened element is closed (self-closing or with its end tag), in order.
-    let mut stack = Vec::new();
-    let mut rest = svg;
-    while let Some(i) = rest.find('<') {
-        let j = rest[i..].find('>').unwrap() + i;
-        let tag = &rest[i + 1..j];
-        if let Some(name) = tag.strip_prefix('/') {
-            assert_eq!(stack.pop(), Some(name.to_string()));
-        } else if !tag.ends_with('/') {
-            stack.push(tag.split_whitespace().next().unwrap().to_string());
+    assert_eq!(
+        err_at("arm a 1500µs extra", 1, 14),
+        PlanErrorKind::TrailingToken {
+            found: "extra".into()
         }
-        rest = &rest[j + 1..];
+    );
+    assert!(matches!(
+        err_at("# ünïcödé\n\t  arm c extend", 2, 8),
+        PlanErrorKind::BadArgument {
+            expected: "a side: a or b",
+            ..
+        }
+    ));
+
+    // Missing arguments: just past the last token.
+    assert_eq!(
+        err_at("mode", 1, 5),
+        PlanErrorKind::MissingArgument {
+            step: "mode",
+            expected: "a mode: standby, operational or safed"
+        }
+    );
+    assert!(matches!(
+        err_at("  arm a   # nothing more", 1, 8),
+        PlanErrorKind::MissingArgument { step: "arm", .. }
+    ));
+    assert!(matches!(
+        err_at("reconfigure a ->", 1, 17),
+        PlanErrorKind::MissingArgument {
+            step: "reconfigure",
+            ..
+        }
+    ));
+
+    // Trailing tokens.
+    assert_eq!(
+        err_at("stop now", 1, 6),
+        PlanErrorKind::TrailingToken {
+            found: "now".into()
+        }
+    );
+    assert!(matches!(
+        err_at("arm a extend fast", 1, 14),
+        PlanErrorKind::TrailingToken { .. }
+    ));
+
+    // Out of range: refused, never clamped.
+    for (text, col, quantity) in [
+        ("arm a 2501", 7, "pulse width"),
+        ("gripper b 499us", 11, "pulse width"),
+        ("arm a -5", 7, "pulse width"),
+        ("arm a 70000", 7, "pulse width"),
+        ("hip 360", 5, "hip angle"),
+        ("hip -0.01", 5, "hip angle"),
+        ("bolt 0", 6, "bolter pair"),
+        ("unbolt 5", 8, "bolter pair"),
+        ("primitive 9", 11, "primitive"),
+        ("primitive 0", 11, "primitive"),
+        ("wait 3600.001s", 6, "wait"),
+        ("wait 2h", 6, ""),
+        ("wait -1s", 6, "wait"),
+    ] {
+        let kind = err_at(text, 1, col);
+        if quantity.is_empty() {
+            assert!(matches!(kind, PlanErrorKind::BadArgument { .. }), "{text}");
+        } else {
+            assert!(
+                matches!(kind, PlanErrorKind::OutOfRange { quantity: q, .. } if q == quantity),
+                "{text}: {kind:?}"
+            );
+        }
     }
-    assert!(stack.is_empty(), "{stack:?}");
+    assert_eq!(
+        err("arm a 2501").to_string(),
+        "line 1, column 7: pulse width must be 500us..=2500us, found 2501"
+    );
+
+    // Bad arguments.
+    for (text, col) in [
+        ("mode flying", 6),
+        ("arm a halfway", 7),
+        ("arm a 1500ms", 7),
+        ("hip left", 5),
+        ("hip 45.555", 5),
+        ("bolt some", 6),
+        ("bolters up", 9),
+        ("primitive jump", 11),
+        ("reconfigure p -> a", 13),
+        ("reconfigure a to m", 15),
+        ("reconfigure a -> mm", 18),
+        ("power up all", 7),
+        ("power on arm", 10),
+        ("wait 2", 6),
+        ("wait 1.5ms", 6),
+        ("wait 0.0005s", 6),
+    ] {
+        assert!(
+            matches!(err_at(text, 1, col), PlanErrorKind::BadArgument { .. }),
+            "{text}"
+        );
+    }
 }
 
 #[test]
-fn plots_are_well_formed_for_empty_single_and_many_points() {
-    let many: Vec<(f64, f64)> = (0..50).map(|i| (i as f64, (i % 7) as f64 * 10.0)).collect();
-    for points in [
-        &[][..],
-        &[(3.0, 3.0)][..],
-        &many[..],
-        &[(0.0, f64::NAN), (1.0, 2.0)][..],
-    ] {
-        let svg = line_chart("a <b> & c", "x", "y", None, &[Series { name: "s", points }]);
-        balanced(&svg);
-        assert!(svg.contains("a &lt;b&gt; &amp; c"));
-    }
-    let svg = line_chart(
-        "t",
-        "x",
-        "y",
-        Some((0.0, 100.0)),
-        &[Series {
-            name: "s",
-            points: &many,
-        }],
+fn impossible_reconfigurations_point_at_the_target() {
+    assert_eq!(
+        err_at("stop\nreconfigure  a -> d\n", 2, 19),
+        PlanErrorKind::Reconfiguration(ReconfigurationError::TargetNotMatched { target: State::D })
     );
-    let poly = svg
-        .split("points=\"")
-        .nth(1)
-        .unwrap()
-        .split('"')
-        .next()
-        .unwrap();
-    assert_eq!(poly.split(' ').count(), 50);
-    let two = line_chart(
-        "t",
-        "x",
-        "y",
-        None,
-        &[
-            Series {
-                name: "one",
-                points: &many,
-            },
-            Series {
-                name: "two",
-                points: &many,
-            },
-        ],
+    assert_eq!(
+        err_at("reconfigure m->M", 1, 16),
+        PlanErrorKind::Reconfiguration(ReconfigurationError::SameState { state: State::M })
     );
-    balanced(&two);
-    assert!(two.contains(">one<") && two.contains(">two<"), "legend");
-    let bars = bar_chart(
-        "b",
-        "n",
-        &[("1st", 10.0), ("2nd", 0.0), ("x&y", f64::INFINITY)],
+    assert!(err("reconfigure m->M")
+        .to_string()
+        .starts_with("line 1, column 16: initial and target state are both m"));
+}
+
+#[test]
+fn descriptions_are_short_and_specific() {
+    let d = |t: &str| one(t).describe();
+    assert_eq!(d("arm a 1500"), "arm A to 1500 µs");
+    assert_eq!(d("gripper b extend"), "gripper B: extend");
+    assert_eq!(d("wait 1.5s"), "wait 1.5 s");
+    assert_eq!(d("wait 250ms"), "wait 250 ms");
+    assert_eq!(d("hip 45.5"), "hip to 45.5°");
+    assert_eq!(d("mode safed"), "switch to safed mode");
+    assert_eq!(d("primitive 1"), "primitive 1 (fwdContract)");
+    assert_eq!(d("bolt all"), "bolt all pairs");
+    assert_eq!(d("power off all"), "power off all modules");
+    assert_eq!(
+        d("reconfigure a -> m"),
+        "reconfigure a (Xneg match) -> m (Xpos match)"
     );
-    balanced(&bars);
-    assert!(bars.contains(">10<") && bars.contains("x&amp;y"));
-    balanced(&bar_chart("empty", "n", &[]));
 }

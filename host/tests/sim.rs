@@ -213,6 +213,13 @@ fn low_battery_during_a_motion_enters_standby_only_after_the_motion_completes() 
 }
 
 #[test]
+fn the_demo_plan_parses() {
+    let p = plan::parse(report::DEMO_PLAN).unwrap();
+    assert!(p.steps.len() >= 8);
+    assert_eq!(report::demo_steps().len(), p.steps.len());
+}
+
+#[test]
 fn a_malformed_plan_file_is_refused_with_line_and_column() {
     let dir = out_dir("bad_plan");
     let path = dir.join("bad.plan");
@@ -225,7 +232,7 @@ fn a_malformed_plan_file_is_refused_with_line_and_column() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("line 3, column 18: expected a Table 5 state a..o, found \"q\""),
+        err.contains("line 3, column 18: expected a state letter a..o (Table 5), found \"q\""),
         "{err}"
     );
 }
