@@ -1,10 +1,13 @@
 //! Sensor processing: the moving average equals the naive mean for every window content
 //! (including before the window is full); ADC scaling is monotone, exact at the ends and within
 //! half a unit of the real value; the IMU picks the dominant axis; the encoder maps onto the
-//! hip angle range.
+//! hip angle range; the front end equals scaling the naive mean of each channel and the
+//! gravity of the naive mean of each acceleration (signed, over the ticks that had an IMU
+//! sample).
 
 use mmic::sensors::adc::{electrical, scale, Channel, Scaling, CODE_MAX};
 use mmic::sensors::encoder::hip_angle;
+use mmic::sensors::frontend::{self, Frontend, Raw};
 use mmic::sensors::imu::gravity;
 use mmic::sensors::MovingAverage;
 use mmic::units::Sign;
@@ -19,7 +22,43 @@ fn naive(samples: &[u16], n: usize) -> Option<u16> {
     }
 }
 
+/// Floor of the mean of signed samples, as the front end computes it (offset by 32768).
+fn naive_signed(samples: &[i16], n: usize) -> Option<i16> {
+    let u: Vec<u16> = samples.iter().map(|&a| (a as i32 + 32768) as u16).collect();
+    naive(&u, n).map(|m| (m as i32 - 32768) as i16)
+}
+
 proptest! {
+    #[test]
+    fn frontend_equals_scaling_the_naive_means(
+        ticks in prop::collection::vec((any::<[u16; 8]>(), prop::option::of(any::<[i16; 3]>()), any::<u16>()), 1..120),
+        zero in any::<u16>(),
+    ) {
+        let cfg = frontend::Config { scaling: Scaling::default(), encoder_zero: zero };
+        let mut f = Frontend::<50>::new(cfg);
+        for i in 0..ticks.len() {
+            let (adc, accel, enc) = ticks[i];
+            let out = f.push(&Raw { adc, accel, encoder: enc });
+            let codes: [u16; 8] = core::array::from_fn(|ch| {
+                let col: Vec<u16> = ticks[..=i].iter().map(|t| t.0[ch]).collect();
+                naive(&col, 50).unwrap_or(0)
+            });
+            prop_assert_eq!(out.electrical, electrical(&Scaling::default(), codes));
+            let seen: Vec<[i16; 3]> = ticks[..=i].iter().filter_map(|t| t.1).collect();
+            let want = if seen.is_empty() {
+                None
+            } else {
+                let axis = |k: usize| {
+                    let col: Vec<i16> = seen.iter().map(|a| a[k]).collect();
+                    naive_signed(&col, 50).unwrap_or(0)
+                };
+                gravity([axis(0), axis(1), axis(2)])
+            };
+            prop_assert_eq!(out.gravity, want);
+            prop_assert_eq!(out.hip, hip_angle(enc, zero));
+        }
+    }
+
     #[test]
     fn moving_average_equals_the_naive_mean(samples in prop::collection::vec(any::<u16>(), 0..200)) {
         let mut f = MovingAverage::<50>::new();

@@ -80,7 +80,9 @@ pub struct Config {
     pub estimate: estimate::Config,
     /// A→B command period, ms (sent sooner when its content changes).
     pub b_period_ms: u32,
-    /// The idle overcurrent check starts this long after the last motion ended, ms.
+    /// The idle overcurrent check starts this long after the last motion ended, ms. Default
+    /// 600: the sensor front end's 50-sample window at a 10 ms tick (500 ms) plus two of
+    /// board B's heartbeat periods, so no current of the motion is left in the averages.
     pub idle_settle_ms: u32,
 }
 
@@ -108,7 +110,7 @@ impl Default for Config {
             hip_done_tolerance: 150,
             estimate: estimate::Config::default(),
             b_period_ms: 50,
-            idle_settle_ms: 200,
+            idle_settle_ms: 600,
         }
     }
 }
@@ -464,7 +466,8 @@ impl BoardA {
         let in_motion = self.moving_now(&self.feedback(inp.hip, inp.arm_contracted));
         self.moving = in_motion;
         // The idle check waits until the robot has been still for `idle_settle_ms`: currents
-        // sampled while the last motion ended (B's report is up to a period old) are no fault.
+        // sampled while the last motion ended (still in the moving averages, and B's report
+        // is up to a period old) are no fault.
         if in_motion {
             self.still_since = None;
         } else if self.still_since.is_none() {

@@ -1,6 +1,6 @@
 //! Sensor processing (Section 2): the 50-sample moving average every raw channel goes through,
 //! the ADS7828 channel map and scaling to mV/mA, the IMU's gravity direction, and the hip
-//! encoder's angle. Integer-only (the ESP32-C3 has no FPU).
+//! encoder's angle, and [`frontend`], which joins them for one side of the robot. Integer-only (the ESP32-C3 has no FPU).
 //!
 //! ```
 //! use mmic::sensors::MovingAverage;
@@ -13,6 +13,7 @@
 pub mod adc;
 pub mod encoder;
 mod filter;
+pub mod frontend;
 pub mod imu;
 
 pub use filter::MovingAverage;

@@ -9,6 +9,7 @@ use mmic::node::board_a::{self, BoardA, Event};
 use mmic::node::board_b::{self, BoardB};
 use mmic::node::handoff::{Consumer, Producer};
 use mmic::node::server::{Accepted, Server};
+use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::deframer::{Deframed, Deframer};
@@ -222,6 +223,7 @@ pub fn board_a_control(
     status: Arc<Mutex<Value>>,
 ) {
     let mut next = 0;
+    let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
     while !stop.load(Ordering::Relaxed) {
         sleep_until(&clock, next);
         let now = clock.now_ms();
@@ -231,19 +233,22 @@ pub fn board_a_control(
         next = now - now % TICK_MS + TICK_MS;
         let command = commands.pop();
         let from_b = from_b.try_recv().ok().and_then(|v| v.try_into().ok());
-        let (s, hip) = {
+        let s = {
             let mut p = plant.lock().unwrap_or_else(|e| e.into_inner());
             p.advance(now);
-            (p.sense(0, now), p.hip())
+            let mut s = p.sense(0, now);
+            s.raw.encoder = p.encoder();
+            s
         };
+        let f = sensors.push(&s.raw);
         let out = a.tick(
             now,
             &board_a::Inputs {
                 command,
                 from_b,
-                electrical: s.electrical,
-                hip,
-                gravity: s.gravity,
+                electrical: f.electrical,
+                hip: f.hip,
+                gravity: f.gravity,
                 arm_contracted: s.arm_contracted,
                 bolter: s.bolter,
             },
@@ -309,6 +314,7 @@ pub fn board_b(
 ) {
     let mut next = 0;
     let mut was_lost = false;
+    let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
     while !stop.load(Ordering::Relaxed) {
         sleep_until(&clock, next);
         let now = clock.now_ms();
@@ -321,12 +327,13 @@ pub fn board_b(
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .sense(1, now);
+        let f = sensors.push(&s.raw);
         let out = b.tick(
             now,
             &board_b::Inputs {
                 command,
-                electrical: s.electrical,
-                gravity: s.gravity,
+                electrical: f.electrical,
+                gravity: f.gravity,
                 arm_contracted: s.arm_contracted,
                 bolter: s.bolter,
             },

@@ -1,7 +1,10 @@
 //! The robot's physics, as much as the firmware can notice: servos that move at a limited
 //! speed, a continuous hip servo with lag, currents that rise while something moves, pushes
 //! or hits an obstacle, a battery that sags with current and time, fasteners that lock with a
-//! probability, and gravity readings that follow the state the robot is in.
+//! probability, and gravity readings that follow the state the robot is in. It reads out raw:
+//! ADS7828 codes with a few codes of noise, accelerations with noise, the encoder's count;
+//! each board's shell passes them through the library's sensor front end
+//! (`mmic::sensors::frontend`, Section 2's 50-sample averages) as the firmware would.
 //!
 //! Simplifications, stated: the gravity readings are those the paper's model predicts for the
 //! state the robot last reached (the plant does not integrate the kinematics); both sides'
@@ -12,7 +15,9 @@
 use mmic::bolter::{Drive, MuxLines, Signals};
 use mmic::motion::estimate::{self, predict};
 use mmic::motion::State;
-use mmic::units::{Electrical, Gravity, HipAngle, PulseWidth};
+use mmic::sensors::adc::{Channel, Scaling, CODE_MAX};
+use mmic::sensors::frontend::Raw;
+use mmic::units::{Axis, Gravity, PulseWidth, Sign};
 
 /// Plant parameters and injected faults.
 #[derive(Debug, Clone)]
@@ -72,13 +77,12 @@ pub struct Drives {
     pub mux: MuxLines,
 }
 
-/// What one side's sensors read.
+/// What one side's sensors read: the raw readings the library's front end
+/// ([`mmic::sensors::frontend`]) filters, and the digital inputs.
 #[derive(Debug, Clone, Copy)]
 pub struct Senses {
-    /// Voltages and currents.
-    pub electrical: Electrical,
-    /// Gravity in the side's IMU frame.
-    pub gravity: Option<Gravity>,
+    /// ADS7828 codes and IMU accelerations (the encoder field is left 0: see [`Plant::encoder`]).
+    pub raw: Raw,
     /// Arm contraction switch.
     pub arm_contracted: bool,
     /// Bolter signals.
@@ -89,6 +93,8 @@ pub struct Senses {
 pub struct Plant {
     cfg: PlantConfig,
     rng: fastrand::Rng,
+    /// Sensor noise (a separate stream, so that noise does not change the lock rolls).
+    noise: fastrand::Rng,
     last: u32,
     arm: [f64; 2],
     gripper: [f64; 2],
@@ -110,6 +116,8 @@ pub struct Plant {
 const SERVO_US_PER_S: f64 = 2000.0;
 const BOLTER_TRAVEL_MS: f64 = 800.0;
 const ROTATE_MS: f64 = 1000.0;
+/// ADC noise, codes either side.
+const NOISE: i32 = 5;
 
 impl Plant {
     /// The robot at rest in `state`, arms contracted, grippers closed, hip at 180°.
@@ -117,6 +125,7 @@ impl Plant {
         let a = mmic::node::board_a::Config::default();
         let mut p = Plant {
             rng: fastrand::Rng::with_seed(cfg.seed),
+            noise: fastrand::Rng::with_seed(cfg.seed ^ 0x5eed_5e45),
             last: 0,
             arm: [a.arm.contracted.micros() as f64; 2],
             gripper: [a.gripper.extended.micros() as f64; 2],
@@ -221,14 +230,13 @@ impl Plant {
         self.hip = (self.hip + self.hip_speed * dt / 1000.0).rem_euclid(36000.0);
     }
 
-    /// The hip encoder (4096 counts per turn).
-    pub fn hip(&self) -> HipAngle {
-        let counts = (self.hip / 36000.0 * 4096.0).floor() as u32 % 4096;
-        HipAngle::new(((counts * 36000 + 2048) / 4096 % 36000) as u16).unwrap_or(HipAngle::ZERO)
+    /// The hip encoder's raw reading (12 bits, 4096 counts per turn, 0 at hip 0°).
+    pub fn encoder(&self) -> u16 {
+        ((self.hip / 36000.0 * 4096.0).floor() as u32 % 4096) as u16
     }
 
     /// What side `side` (0 = A, 1 = B) reads at `now`.
-    pub fn sense(&self, side: usize, now: u32) -> Senses {
+    pub fn sense(&mut self, side: usize, now: u32) -> Senses {
         let d = self.drives[side];
         let reg = d.is_some_and(|d| d.regulator);
         let b = self.bolter[side];
@@ -265,21 +273,48 @@ impl Plant {
             _ => self.cfg.battery_mv - self.cfg.drain_mv_per_s * now as f64 / 1000.0,
         };
         let v_bat = rest - i_bat * self.cfg.internal_ohm;
-        let clamp = |x: f64| x.clamp(0.0, 65_535.0) as u16;
+        // The ADS7828's codes, with ±NOISE codes of uniform noise (about ±6 mA on I_loc).
+        let scaling = Scaling::default();
+        let noise = &mut self.noise;
+        let mut code = |ch: Channel, x: f64| {
+            let fs = scaling.full_scale[ch as usize] as f64;
+            let n = noise.i32(-NOISE..=NOISE) as f64;
+            (x / fs * CODE_MAX as f64 + n)
+                .round()
+                .clamp(0.0, CODE_MAX as f64) as u16
+        };
+        let adc = [
+            code(Channel::VBat, v_bat),
+            code(Channel::IBat, i_bat),
+            code(Channel::ILoc, i_loc),
+            code(Channel::IGrip, i_grip),
+            code(Channel::I3v3, i_3v3),
+            code(Channel::VReg, if reg { 7_400.0 } else { 0.0 }),
+            code(Channel::IBo, i_bo),
+            0,
+        ];
+        let g = if side == 0 {
+            self.gravity.0
+        } else {
+            self.gravity.1
+        };
+        let accel = g.map(|g| {
+            let mut a = [0i16; 3].map(|_| self.noise.i16(-400..=400));
+            a[match g.axis {
+                Axis::X => 0,
+                Axis::Y => 1,
+                Axis::Z => 2,
+            }] = match g.sign {
+                Sign::Positive => 16_384,
+                Sign::Negative => -16_384,
+            } + self.noise.i16(-400..=400);
+            a
+        });
         Senses {
-            electrical: Electrical {
-                v_bat: clamp(v_bat),
-                i_bat: clamp(i_bat),
-                i_loc: clamp(i_loc),
-                i_grip: clamp(i_grip),
-                i_3v3: clamp(i_3v3),
-                v_reg: if reg { 7_400 } else { 0 },
-                i_bo: clamp(i_bo),
-            },
-            gravity: if side == 0 {
-                self.gravity.0
-            } else {
-                self.gravity.1
+            raw: Raw {
+                adc,
+                accel,
+                encoder: 0,
             },
             arm_contracted: self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
             bolter: Signals {
