@@ -202,3 +202,68 @@ fn a_and_b_run_together_without_fault_and_link_loss_is_safed_within_the_timeout(
     );
     eprintln!("Safed {latency} ms after the A-B link was cut");
 }
+
+/// Runs A and B linked for 3 s, from Operational, dropping B's heartbeats from 1 s on in one
+/// burst of `silence_ms`; returns when A faulted and when it last heard B (ms), if it faulted.
+fn faulted_after_heartbeat_burst(silence_ms: u32) -> Option<(u32, u32)> {
+    let mut a = BoardA::in_state(board_a::Config::default(), State::A);
+    let mut b = BoardB::with_pose(
+        board_b::Config::default(),
+        board_a::Config::default().arm.contracted,
+        board_a::Config::default().gripper.extended,
+    );
+    send(&mut a, 0, Command::Mode(Mode::Operational), 1);
+    let (mut to_b, mut to_a) = (None, None);
+    let mut heard = 0;
+    for t in (10..3_000).step_by(10) {
+        let dropped = (1_000..1_000 + silence_ms).contains(&t);
+        if to_a.is_some() && !dropped {
+            heard = t;
+        }
+        let out_a = a.tick(
+            t,
+            &Inputs {
+                from_b: if dropped { None } else { to_a },
+                ..Inputs::at_home()
+            },
+        );
+        let out_b = b.tick(
+            t,
+            &board_b::Inputs {
+                command: to_b,
+                ..b_inputs()
+            },
+        );
+        to_b = out_a.to_b;
+        to_a = out_b.heartbeat;
+        if !a.faults().is_empty() {
+            assert_eq!(
+                a.faults(),
+                mmic::faults::Faults::EMPTY.with(Fault::InternalCommLoss)
+            );
+            return Some((t, heard));
+        }
+    }
+    None
+}
+
+#[test]
+fn lost_b_heartbeats_fault_only_past_the_timeout() {
+    // Board A keeps refreshing its A->B command every 50 ms meanwhile: refreshes of an
+    // acknowledged command are not unacknowledged sends (spec/decisions.toml,
+    // comm-loss-unacknowledged).
+    // Dropping heartbeats for up to 450 ms leaves B silent for less than the 500 ms timeout
+    // (its period is 50 ms).
+    for burst in (10..=450).step_by(10) {
+        assert_eq!(faulted_after_heartbeat_burst(burst), None, "{burst} ms");
+    }
+    // Longer: the fault comes at the first tick after 500 ms of silence, not before.
+    for burst in (550..=1_000).step_by(50) {
+        let (t, heard) = faulted_after_heartbeat_burst(burst).expect("faults");
+        assert_eq!(
+            t - heard,
+            510,
+            "burst {burst} ms: faulted at {t}, last heard {heard}"
+        );
+    }
+}

@@ -67,6 +67,9 @@ pub enum PlanEnd {
         step: usize,
         /// Why.
         refusal: Refusal,
+        /// The mode and latched faults in the refusing heartbeat: a refusal for the mode
+        /// often has a fault behind it (a robot safed by a fault refuses the next motion).
+        robot: Option<(Mode, Faults)>,
     },
     /// Step `step`'s command (or a poll during it) went unacknowledged.
     Unacknowledged {
@@ -254,7 +257,11 @@ impl PlanRunner {
             }
             (Phase::Sending, Outcome::Refused(Refusal::Busy)) => self.phase = Phase::Ready,
             (Phase::Sending, Outcome::Refused(refusal)) => {
-                self.phase = Phase::Ended(PlanEnd::Refused { step, refusal })
+                self.phase = Phase::Ended(PlanEnd::Refused {
+                    step,
+                    refusal,
+                    robot: hb.map(|h| (h.mode, h.faults)),
+                })
             }
             (Phase::Sending, Outcome::Accepted) => {
                 if moves(&d.command) {

@@ -42,7 +42,9 @@ pub struct Config {
     /// five periods of B's 100 ms heartbeat.
     pub comm_timeout_ms: u32,
     /// Internal comm loss: the same command sent to B this many times without an
-    /// acknowledgement. Default 3.
+    /// acknowledgement. Default 10: at board A's 50 ms resend period the same 500 ms horizon
+    /// as the silence rule, so a few lost packets never fault the robot (with 3, two lost
+    /// heartbeats in a row did; stateright checks up to four losses).
     pub comm_max_unacked: u8,
     /// Idle check: current at rest above these (robot gripped, not moving) at the start and end
     /// of a reconfiguration. Defaults: locomotion 400 mA, gripper 200 mA, bolter 200 mA.
@@ -65,7 +67,7 @@ impl Default for Config {
             low_battery_mv: 10_000,
             low_battery_ms: 500,
             comm_timeout_ms: 500,
-            comm_max_unacked: 3,
+            comm_max_unacked: 10,
             bolting_max_attempts: 3,
             idle: Limits {
                 locomotion: 400,
@@ -152,6 +154,9 @@ pub struct CommMonitor {
     silent_ms: u32,
     pending: Option<u8>,
     sends: u8,
+    /// The number B last echoed: resending that command refreshes B's snapshot, it is not a
+    /// command "never acknowledged" (a lost refresh is the silence timeout's business).
+    acked: Option<u8>,
 }
 
 impl CommMonitor {
@@ -167,14 +172,21 @@ impl CommMonitor {
     pub fn heartbeat(&mut self, now: u32, ack: u8) {
         self.last_seen = Some(now);
         self.silent_ms = 0;
+        self.acked = Some(ack);
         if self.pending == Some(ack) {
             self.pending = None;
             self.sends = 0;
         }
     }
 
-    /// A command with sequence number `seq` was sent to B (a resend repeats the number).
+    /// A command with sequence number `seq` was sent to B (a resend repeats the number). A
+    /// resend of the command B has already acknowledged is a periodic refresh and is not
+    /// counted: only a command B has not yet acknowledged can be "sent repeatedly without
+    /// acknowledgement" (Table 8).
     pub fn sent(&mut self, seq: u8) {
+        if self.acked == Some(seq) {
+            return;
+        }
         if self.pending == Some(seq) {
             self.sends = self.sends.saturating_add(1);
         } else {
@@ -321,14 +333,30 @@ mod tests {
         assert!(c.lost(&cfg));
         c.heartbeat(600, 0);
         assert!(!c.lost(&cfg));
-        c.sent(7);
-        c.sent(7);
+        let n = cfg.comm_max_unacked;
+        for _ in 1..n - 1 {
+            c.sent(7);
+        }
         assert!(!c.lost(&cfg));
         c.heartbeat(650, 6); // acknowledges an older command: not this one
         c.sent(7);
-        assert!(c.lost(&cfg));
+        assert!(!c.lost(&cfg), "{} sends", n - 1);
+        c.sent(7);
+        assert!(c.lost(&cfg), "{n} sends");
         c.heartbeat(700, 7);
         assert!(!c.lost(&cfg));
+        // Resending the acknowledged command is a refresh: it never counts.
+        for _ in 0..3 * n {
+            c.sent(7);
+        }
+        assert!(!c.lost(&cfg));
+        // A new command counts again from one.
+        for _ in 0..n - 1 {
+            c.sent(8);
+        }
+        assert!(!c.lost(&cfg));
+        c.sent(8);
+        assert!(c.lost(&cfg));
     }
 
     #[test]

@@ -37,7 +37,7 @@ use serde_json::{json, Value};
 use std::io::Write;
 use std::net::TcpListener;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -145,6 +145,10 @@ pub struct Summary {
     pub max_latency_ms: u32,
     /// Board A's final status (mode, faults, state), robot 1.
     pub status: Value,
+    /// The latest any board's control tick started after it was due, simulated ms, all robots.
+    /// The firmware ticks every 10 ms on time; a host that falls behind (too high a `scale`,
+    /// a loaded machine) stretches the time between ticks and can fake timeouts.
+    pub max_tick_lateness_ms: u32,
 }
 
 impl Summary {
@@ -187,6 +191,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     let clock = Clock::start(cfg.scale);
     let statuses: Vec<Arc<Mutex<Value>>> =
         (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
+    let lateness = AtomicU32::new(0);
     let writer_path = cfg.log_path.clone();
     let writer = std::thread::spawn(move || -> std::io::Result<Vec<Value>> {
         match writer_path {
@@ -201,6 +206,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     let result = std::thread::scope(
         |scope| -> std::io::Result<(Vec<Option<PlanEnd>>, GroundStats)> {
             let stop = &stop;
+            let late = &lateness;
             for (i, (robot, (cq, hq))) in robots
                 .into_iter()
                 .zip(cmd_queues.iter_mut().zip(hb_queues.iter_mut()))
@@ -310,10 +316,12 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
                 });
                 scope.spawn(move || {
                     nodes::board_a_control(
-                        a, cmd_c, hb_p, ba_rx, to_b, p1, clock, l1, stop, na2, status,
+                        a, cmd_c, hb_p, ba_rx, to_b, p1, clock, l1, stop, na2, status, late,
                     )
                 });
-                scope.spawn(move || nodes::board_b(b, ab_rx, to_a, p2, clock, l2, stop, name_b));
+                scope.spawn(move || {
+                    nodes::board_b(b, ab_rx, to_a, p2, clock, l2, stop, name_b, late)
+                });
                 let robots = vec![(board, robot.addr)];
                 let visit = cfg.visit_ms;
                 scope.spawn(move || {
@@ -343,6 +351,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         attempts: stats.attempts,
         max_latency_ms: stats.max_latency_ms,
         status,
+        max_tick_lateness_ms: lateness.load(Ordering::Relaxed),
     })
 }
 

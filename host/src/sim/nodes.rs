@@ -18,7 +18,7 @@ use mmic::wire::PacketKind;
 use serde_json::{json, Value};
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -83,6 +83,20 @@ pub fn reader(mut input: impl Read, tx: Sender<Vec<u8>>) {
                     }
                 }
             }
+        }
+    }
+}
+
+/// A tick started this late (simulated ms) is logged as an overrun: a fifth of the 500 ms
+/// communication timeout, beyond which the host's lag starts to matter to the firmware's timers.
+pub const OVERRUN_MS: u32 = 100;
+
+/// Records a tick's lateness in the run's maximum, and logs an overrun.
+fn note_lateness(late: &AtomicU32, by: u32, log: &Option<Log>, now: u32, name: &str) {
+    late.fetch_max(by, Ordering::Relaxed);
+    if by >= OVERRUN_MS {
+        if let Some(l) = log {
+            l.event(now, name, json!({"type": "overrun", "late_ms": by}));
         }
     }
 }
@@ -221,6 +235,7 @@ pub fn board_a_control(
     stop: &AtomicBool,
     name: String,
     status: Arc<Mutex<Value>>,
+    late: &AtomicU32,
 ) {
     let mut next = 0;
     let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
@@ -230,6 +245,7 @@ pub fn board_a_control(
         if now < next {
             continue;
         }
+        note_lateness(late, now - next, &log, now, &name);
         next = now - now % TICK_MS + TICK_MS;
         let command = commands.pop();
         let from_b = from_b.try_recv().ok().and_then(|v| v.try_into().ok());
@@ -311,6 +327,7 @@ pub fn board_b(
     log: Option<Log>,
     stop: &AtomicBool,
     name: String,
+    late: &AtomicU32,
 ) {
     let mut next = 0;
     let mut was_lost = false;
@@ -321,6 +338,7 @@ pub fn board_b(
         if now < next {
             continue;
         }
+        note_lateness(late, now - next, &log, now, &name);
         next = now - now % TICK_MS + TICK_MS;
         let command = from_a.try_recv().ok().and_then(|v| v.try_into().ok());
         let s = plant

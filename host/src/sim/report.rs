@@ -149,8 +149,22 @@ pub fn text(s: &Summary) -> String {
     let mut t = String::new();
     let end = match s.ends.first().copied().flatten() {
         Some(PlanEnd::Completed) => "completed".to_string(),
-        Some(PlanEnd::Refused { step, refusal }) => {
-            format!("stopped: step {} refused ({refusal})", step + 1)
+        Some(PlanEnd::Refused {
+            step,
+            refusal,
+            robot,
+        }) => {
+            let mut t = format!("stopped: step {} refused ({refusal})", step + 1);
+            if let Some((mode, faults)) = robot {
+                let f: Vec<String> = faults.iter().map(|f| f.to_string()).collect();
+                let f = if f.is_empty() {
+                    "none".to_string()
+                } else {
+                    f.join(", ")
+                };
+                let _ = write!(t, ", robot in {mode} (faults: {f})");
+            }
+            t
         }
         Some(PlanEnd::Unacknowledged { step }) => {
             format!("stopped: step {} unacknowledged", step + 1)
@@ -183,6 +197,17 @@ pub fn text(s: &Summary) -> String {
             ok as f64 * 100.0 / n as f64
         },
         s.max_latency_ms
+    );
+    let _ = writeln!(
+        t,
+        "host: board ticks started at most {} ms (simulated) late{}",
+        s.max_tick_lateness_ms,
+        if s.max_tick_lateness_ms >= super::nodes::OVERRUN_MS {
+            " -- the host fell behind the simulated clock, so timeouts and faults in this run \
+             may come from the host, not the robot: rerun with a smaller --scale"
+        } else {
+            ""
+        }
     );
     let executed = s.events("executed").count();
     let dups = s.events("duplicate").count() + s.events("stale").count();
