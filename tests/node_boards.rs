@@ -153,8 +153,15 @@ fn b_inputs() -> board_b::Inputs {
     }
 }
 
-#[test]
-fn a_and_b_run_together_without_fault_and_link_loss_is_safed_within_the_timeout() {
+/// Boards A and B from Operational in state a, ticking every 10 ms from 10 ms to `until`;
+/// at each tick `link(t)` says whether (A->B, B->A) deliver, and `each(t, &a, heard)` looks at
+/// A after the tick (`heard`: a B heartbeat reached A in it) and may stop the run by returning
+/// false.
+fn run_linked(
+    until: u32,
+    link: impl Fn(u32) -> (bool, bool),
+    mut each: impl FnMut(u32, &BoardA, bool) -> bool,
+) {
     let mut a = BoardA::in_state(board_a::Config::default(), State::A);
     let mut b = BoardB::with_pose(
         board_b::Config::default(),
@@ -163,38 +170,53 @@ fn a_and_b_run_together_without_fault_and_link_loss_is_safed_within_the_timeout(
     );
     send(&mut a, 0, Command::Mode(Mode::Operational), 1);
     let (mut to_b, mut to_a) = (None, None);
-    let cut = 5_000;
-    let mut safed_at = None;
-    for t in (10..8_000).step_by(10) {
-        let linked = t < cut;
+    for t in (10..until).step_by(10) {
+        let (ab, ba) = link(t);
+        let heard = ba && to_a.is_some();
         let out_a = a.tick(
             t,
             &Inputs {
-                from_b: if linked { to_a } else { None },
+                from_b: if ba { to_a } else { None },
                 ..Inputs::at_home()
             },
         );
         let out_b = b.tick(
             t,
             &board_b::Inputs {
-                command: if linked { to_b } else { None },
+                command: if ab { to_b } else { None },
                 ..b_inputs()
             },
         );
         to_b = out_a.to_b;
         to_a = out_b.heartbeat;
-        if t < cut {
-            assert!(
-                a.faults().is_empty(),
-                "no fault while linked (t = {t}): {:?}",
-                a.faults()
-            );
-            assert_eq!(a.mode(), Mode::Operational);
-        } else if safed_at.is_none() && a.mode() == Mode::Safed {
-            safed_at = Some(t);
-            assert!(a.faults().contains(Fault::InternalCommLoss));
+        if !each(t, &a, heard) {
+            return;
         }
     }
+}
+
+#[test]
+fn a_and_b_run_together_without_fault_and_link_loss_is_safed_within_the_timeout() {
+    let cut = 5_000;
+    let mut safed_at = None;
+    run_linked(
+        8_000,
+        |t| (t < cut, t < cut),
+        |t, a, _| {
+            if t < cut {
+                assert!(
+                    a.faults().is_empty(),
+                    "no fault while linked (t = {t}): {:?}",
+                    a.faults()
+                );
+                assert_eq!(a.mode(), Mode::Operational);
+            } else if safed_at.is_none() && a.mode() == Mode::Safed {
+                safed_at = Some(t);
+                assert!(a.faults().contains(Fault::InternalCommLoss));
+            }
+            true
+        },
+    );
     let latency = safed_at.expect("Safed") - cut;
     assert!(
         latency <= mmic::safety::detect::Config::default().comm_timeout_ms,
@@ -206,45 +228,27 @@ fn a_and_b_run_together_without_fault_and_link_loss_is_safed_within_the_timeout(
 /// Runs A and B linked for 3 s, from Operational, dropping B's heartbeats from 1 s on in one
 /// burst of `silence_ms`; returns when A faulted and when it last heard B (ms), if it faulted.
 fn faulted_after_heartbeat_burst(silence_ms: u32) -> Option<(u32, u32)> {
-    let mut a = BoardA::in_state(board_a::Config::default(), State::A);
-    let mut b = BoardB::with_pose(
-        board_b::Config::default(),
-        board_a::Config::default().arm.contracted,
-        board_a::Config::default().gripper.extended,
-    );
-    send(&mut a, 0, Command::Mode(Mode::Operational), 1);
-    let (mut to_b, mut to_a) = (None, None);
-    let mut heard = 0;
-    for t in (10..3_000).step_by(10) {
-        let dropped = (1_000..1_000 + silence_ms).contains(&t);
-        if to_a.is_some() && !dropped {
-            heard = t;
-        }
-        let out_a = a.tick(
-            t,
-            &Inputs {
-                from_b: if dropped { None } else { to_a },
-                ..Inputs::at_home()
-            },
-        );
-        let out_b = b.tick(
-            t,
-            &board_b::Inputs {
-                command: to_b,
-                ..b_inputs()
-            },
-        );
-        to_b = out_a.to_b;
-        to_a = out_b.heartbeat;
-        if !a.faults().is_empty() {
+    let dropped = |t: u32| (1_000..1_000 + silence_ms).contains(&t);
+    let (mut fault, mut last_heard) = (None, 0);
+    run_linked(
+        3_000,
+        |t| (true, !dropped(t)),
+        |t, a, heard| {
+            if heard {
+                last_heard = t;
+            }
+            if a.faults().is_empty() {
+                return true;
+            }
             assert_eq!(
                 a.faults(),
                 mmic::faults::Faults::EMPTY.with(Fault::InternalCommLoss)
             );
-            return Some((t, heard));
-        }
-    }
-    None
+            fault = Some((t, last_heard));
+            false
+        },
+    );
+    fault
 }
 
 #[test]
