@@ -157,10 +157,36 @@ fn cutting_board_b_off_gives_internal_comm_loss_and_safed_within_the_timeout() {
         t_fault - cut as u64,
         t_safed - cut as u64
     );
+    // Board B's last heartbeat that crossed before the cut (the log stamps its sending).
+    let last_hb = records
+        .iter()
+        .filter(|r| {
+            r["kind"] == "packet"
+                && r["link"] == "serial_ab"
+                && r["from"] == "board_b1"
+                && r["fate"] == "delivered"
+        })
+        .map(|r| r["t_ms"].as_u64().unwrap())
+        .max()
+        .expect("B heartbeats before the cut");
+    // Safed once B has been silent strictly longer than the timeout: the heartbeat reaches A
+    // at A's next tick, and the detector acts at a tick (two 10 ms ticks), plus however late
+    // the host ran the boards' ticks.
+    let slack = 2 * 10 + s.max_tick_lateness_ms as u64;
+    eprintln!(
+        "last B heartbeat sent at {last_hb} ms; host lateness {} ms",
+        s.max_tick_lateness_ms
+    );
     assert!(
-        t_safed - cut as u64 <= timeout,
-        "Safed {} ms after the cut (timeout {timeout} ms)",
-        t_safed - cut as u64
+        t_safed - last_hb > timeout,
+        "Safed {} ms after B's last heartbeat: before the {timeout} ms timeout",
+        t_safed - last_hb
+    );
+    assert!(
+        t_safed - last_hb <= timeout + slack && t_safed - cut as u64 <= timeout + slack,
+        "Safed {} ms after the cut, {} ms after B's last heartbeat (timeout {timeout} ms + {slack} ms)",
+        t_safed - cut as u64,
+        t_safed - last_hb
     );
     // No A->B packet crossed after the cut.
     assert!(records.iter().all(|r| !(r["kind"] == "packet"

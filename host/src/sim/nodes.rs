@@ -245,7 +245,9 @@ pub fn board_a_control(
         if now < next {
             continue;
         }
-        note_lateness(late, now - next, &log, now, &name);
+        if next > 0 {
+            note_lateness(late, now - next, &log, now, &name);
+        }
         next = now - now % TICK_MS + TICK_MS;
         let command = commands.pop();
         let from_b = from_b.try_recv().ok().and_then(|v| v.try_into().ok());
@@ -338,7 +340,9 @@ pub fn board_b(
         if now < next {
             continue;
         }
-        note_lateness(late, now - next, &log, now, &name);
+        if next > 0 {
+            note_lateness(late, now - next, &log, now, &name);
+        }
         next = now - now % TICK_MS + TICK_MS;
         let command = from_a.try_recv().ok().and_then(|v| v.try_into().ok());
         let s = plant
