@@ -39,7 +39,7 @@ pub struct Config {
     /// Low battery: for strictly longer than this (Section 7: "for more than 0.5 seconds").
     pub low_battery_ms: u32,
     /// Internal comm loss: no board-B heartbeat for strictly longer than this. Default 500 ms,
-    /// five periods of B's 100 ms heartbeat.
+    /// ten periods of B's 50 ms heartbeat.
     pub comm_timeout_ms: u32,
     /// Internal comm loss: the same command sent to B this many times without an
     /// acknowledgement. Default 10: at board A's 50 ms resend period the same 500 ms horizon

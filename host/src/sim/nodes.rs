@@ -254,9 +254,7 @@ pub fn board_a_control(
         let s = {
             let mut p = plant.lock().unwrap_or_else(|e| e.into_inner());
             p.advance(now);
-            let mut s = p.sense(0, now);
-            s.raw.encoder = p.encoder();
-            s
+            p.sense(0, now)
         };
         let f = sensors.push(&s.raw);
         let out = a.tick(

@@ -81,7 +81,7 @@ pub struct Drives {
 /// ([`mmic::sensors::frontend`]) filters, and the digital inputs.
 #[derive(Debug, Clone, Copy)]
 pub struct Senses {
-    /// ADS7828 codes and IMU accelerations (the encoder field is left 0: see [`Plant::encoder`]).
+    /// ADS7828 codes, IMU accelerations and (side A) the hip encoder's count.
     pub raw: Raw,
     /// Arm contraction switch.
     pub arm_contracted: bool,
@@ -314,7 +314,7 @@ impl Plant {
             raw: Raw {
                 adc,
                 accel,
-                encoder: 0,
+                encoder: if side == 0 { self.encoder() } else { 0 },
             },
             arm_contracted: self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
             bolter: Signals {
