@@ -84,7 +84,7 @@ pub const fn preset_angle(t: HipTarget) -> Option<HipAngle> {
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
-    serde(try_from = "u8", into = "u8")
+    serde(try_from = "crate::units::Number", into = "u8")
 )]
 #[repr(u8)]
 pub enum BolterPair {
@@ -131,6 +131,14 @@ impl TryFrom<u8> for BolterPair {
     type Error = BolterPairError;
     fn try_from(n: u8) -> Result<BolterPair, BolterPairError> {
         BolterPair::from_number(n).ok_or(BolterPairError(n))
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<crate::units::Number> for BolterPair {
+    type Error = crate::units::NumberRangeError;
+    fn try_from(n: crate::units::Number) -> Result<Self, Self::Error> {
+        n.narrow("bolter pair", (1, 4), BolterPair::from_number)
     }
 }
 

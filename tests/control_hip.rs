@@ -7,18 +7,39 @@
 //! `load · sin(angle + phase)` (0.01°/s) from the robot's weight; the encoder quantises the
 //! angle to 4096 counts per turn.
 
-use mmic::control::hip::{angle_error, Config, HipController};
+use mmic::control::hip::{Config, HipController};
 use mmic::units::HipAngle;
 use proptest::prelude::*;
 
+mod common;
+
 const TOL: f64 = 50.0; // 0.50°
 const OVERSHOOT_MAX: f64 = 150.0; // 1.50°, documented in spec/control/hip.md
+/// Overshoot counts from the moment the error first comes within 10°: the side the hip
+/// approaches the target from.
+const APPROACH: f64 = 1000.0;
+/// The path may exceed the short way by the overshoot there and back plus this: the
+/// load's push at the start and the settling wobble. A turn the wrong way adds at least
+/// twice the error's distance from 180°, far more for any target not within a few degrees of
+/// the opposite side, and 360° − 2·short-way in general.
+const DETOUR_MAX: f64 = 2.0 * OVERSHOOT_MAX + 100.0;
 
 struct Run {
     settled_at: Option<u32>,
     overshoot: f64,
+    /// Angle travelled in total, 0.01°.
+    travelled: f64,
+    /// How much longer the path was than the short way, 0.01°.
+    detour: f64,
     min_pw: u16,
     max_pw: u16,
+}
+
+/// The angle as the controller reads it: the true angle quantised to the encoder's 4096
+/// counts per turn, each count read as the centre of its 0.088° bin.
+fn encoder(angle: f64) -> HipAngle {
+    let count = (angle.rem_euclid(36000.0) / 36000.0 * 4096.0).floor() as u32 % 4096;
+    HipAngle::new(((count * 36000 + 2048) / 4096 % 36000) as u16).unwrap()
 }
 
 fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run {
@@ -29,18 +50,23 @@ fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run
     let mut run = Run {
         settled_at: None,
         overshoot: 0.0,
+        travelled: 0.0,
+        detour: 0.0,
         min_pw: u16::MAX,
         max_pw: 0,
     };
-    let dir0 = angle_error(
-        HipAngle::new((start.rem_euclid(36000.0)) as u16 % 36000).unwrap(),
-        tgt,
-    )
-    .signum();
+    // Which way is right is judged on the true angle, with the quantisation and the load in
+    // mind: near 180° both ways are equally short, and the encoder's rounding (start 424,
+    // target 18423: 179.99° true, 180.01° measured) or the load's first push decides. So the
+    // oracle does not fix a direction in advance: the path travelled must be a short way
+    // (`detour`), and overshoot is measured against the side the hip approached from
+    // (`approach`: the sign of the error when it first came within APPROACH).
+    let shortest = short_way(start, target);
+    let mut approach: Option<f64> = None;
+    let mut last = start;
     let dt = 0.01;
     for tick in 0..(seconds * 100) {
-        let measured = (angle.rem_euclid(36000.0) / 36000.0 * 4096.0).floor() as u32 % 4096;
-        let m = HipAngle::new(((measured * 36000 + 2048) / 4096 % 36000) as u16).unwrap();
+        let m = encoder(angle);
         let pw = c.step(tgt, m, tick * 10);
         run.min_pw = run.min_pw.min(pw.micros());
         run.max_pw = run.max_pw.max(pw.micros());
@@ -58,9 +84,16 @@ fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run
             }
             d
         };
-        // Overshoot: error of the opposite sign to the initial direction.
-        if dir0 != 0 && (true_err * dir0 as f64) < 0.0 {
-            run.overshoot = run.overshoot.max(true_err.abs());
+        run.travelled += (angle - last).abs();
+        last = angle;
+        if approach.is_none() && true_err.abs() <= APPROACH {
+            approach = Some(true_err.signum());
+        }
+        // Overshoot: error of the opposite sign to the approach.
+        if let Some(dir) = approach {
+            if true_err * dir < 0.0 {
+                run.overshoot = run.overshoot.max(true_err.abs());
+            }
         }
         if true_err.abs() <= TOL {
             run.settled_at.get_or_insert(tick);
@@ -68,18 +101,54 @@ fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run
             run.settled_at = None; // left the band (beyond quantisation): not settled
         }
     }
+    run.detour = run.travelled - shortest;
     run
 }
 
+/// The true angular distance from `start` to `target` the short way, 0.01° (0..=18000).
+fn short_way(start: f64, target: u16) -> f64 {
+    let d = (target as f64 - start).rem_euclid(36000.0);
+    d.min(36000.0 - d)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+    #![proptest_config(common::prop::config(200))]
     #[test]
     fn reaches_any_target_without_large_overshoot(start in 0u16..36000, target in 0u16..36000, load in 0.0f64..300.0, phase in 0.0f64..6.3) {
         // 180° at 10°/s takes 18 s; allow 30 s.
         let r = simulate(start as f64, target, load, phase, 30);
         prop_assert!(r.settled_at.is_some(), "never settled");
         prop_assert!(r.overshoot <= OVERSHOOT_MAX, "overshoot {}", r.overshoot);
+        prop_assert!(r.detour <= DETOUR_MAX, "travelled {} past the short way", r.detour);
         prop_assert!(r.min_pw >= 1200 && r.max_pw <= 1800);
+    }
+}
+
+/// The input that made the property test flaky (about 1 run in 100): a target 179.99° from the
+/// true start reads 180.01° through the encoder, so the controller turns the other way. Kept as
+/// a fixed case over loads and phases, because proptest's random inputs rarely land within one
+/// encoder count of 180°.
+#[test]
+fn half_turn_within_one_encoder_count_takes_either_short_way() {
+    for load in [0.0, 150.0, 300.0] {
+        for quarter in 0..4 {
+            let phase = quarter as f64 * std::f64::consts::FRAC_PI_2;
+            let r = simulate(424.0, 18423, load, phase, 30);
+            assert!(
+                r.settled_at.is_some(),
+                "never settled (load {load}, phase {phase})"
+            );
+            assert!(
+                r.overshoot <= OVERSHOOT_MAX,
+                "overshoot {} (load {load}, phase {phase})",
+                r.overshoot
+            );
+            assert!(
+                r.detour <= DETOUR_MAX,
+                "detour {} (load {load}, phase {phase})",
+                r.detour
+            );
+        }
     }
 }
 
@@ -95,6 +164,7 @@ fn turns_at_about_ten_degrees_per_second() {
 fn sweep_reports_the_worst_case() {
     let mut worst_overshoot: f64 = 0.0;
     let mut worst_settle = 0u32;
+    let mut worst_detour: f64 = 0.0;
     let mut runs = 0;
     for s in (0..36000).step_by(3000) {
         for t in (0..36000u16).step_by(3000) {
@@ -107,15 +177,18 @@ fn sweep_reports_the_worst_case() {
                         .unwrap_or_else(|| panic!("{s} -> {t} load {load} phase {phase}"));
                     worst_settle = worst_settle.max(settled);
                     worst_overshoot = worst_overshoot.max(r.overshoot);
+                    worst_detour = worst_detour.max(r.detour);
                     runs += 1;
                 }
             }
         }
     }
     println!(
-        "hip sweep: {runs} runs, worst settle {:.2} s, worst overshoot {:.1} (0.01 deg)",
+        "hip sweep: {runs} runs, worst settle {:.2} s, worst overshoot {:.1}, worst detour {:.1} (0.01 deg)",
         worst_settle as f64 / 100.0,
-        worst_overshoot
+        worst_overshoot,
+        worst_detour
     );
     assert!(worst_overshoot <= OVERSHOOT_MAX);
+    assert!(worst_detour <= DETOUR_MAX);
 }

@@ -120,7 +120,7 @@ fn any_bytes(kind: PacketKind) -> impl Strategy<Value = Vec<u8>> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(CASES))]
+    #![proptest_config(common::prop::config(CASES))]
 
     #[test]
     fn command_encode_decode_round_trips(c in any::<Command>()) {

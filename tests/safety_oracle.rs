@@ -8,6 +8,8 @@ use mmic::refusal::Refusal;
 use mmic::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use mmic::units::{HipAngle, Module, PulseWidth};
 use proptest::prelude::*;
+
+mod common;
 use std::collections::{BTreeMap, BTreeSet};
 
 #[derive(serde::Deserialize)]
@@ -204,7 +206,7 @@ fn commands() -> Vec<Option<Incoming>> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 2000, ..ProptestConfig::default() })]
+    #![proptest_config(common::prop::config(2000))]
 
     #[test]
     fn supervisor_agrees_with_the_spec_oracle(

@@ -13,6 +13,8 @@ use mmic::sensors::MovingAverage;
 use mmic::units::Sign;
 use proptest::prelude::*;
 
+mod common;
+
 fn naive(samples: &[u16], n: usize) -> Option<u16> {
     let w = &samples[samples.len().saturating_sub(n)..];
     if w.is_empty() {
@@ -29,6 +31,7 @@ fn naive_signed(samples: &[i16], n: usize) -> Option<i16> {
 }
 
 proptest! {
+    #![proptest_config(common::prop::config(256))]
     #[test]
     fn frontend_equals_scaling_the_naive_means(
         ticks in prop::collection::vec((any::<[u16; 8]>(), prop::option::of(any::<[i16; 3]>()), any::<u16>()), 1..120),

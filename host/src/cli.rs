@@ -23,6 +23,8 @@ pub const EXIT_INVALID_PACKET: u8 = 1;
 pub const EXIT_INPUT: u8 = 2;
 /// A file could not be written, or stdout is closed.
 pub const EXIT_IO: u8 = 3;
+/// `mmic sim`: the host fell too far behind the simulated clock for the outcome to count.
+pub const EXIT_HOST: u8 = 4;
 
 const AFTER_HELP: &str = "\
 Units: servo pulse widths in µs (500..=2500), hip angles in 0.01° (0..=35999, 9000 = 90.00°),
@@ -80,7 +82,8 @@ Examples:
     {\"board\":1,\"command\":\"stop\",\"seq\":258}
 
 Exit codes: 0 success; 1 not a valid packet, stderr names the failed check, e.g.
-  mmic: checksum check failed: command packet: checksum carried 0xd54a, computed 0xd44a
+  mmic: checksum check failed: command packet: checksum carried 0xd54a (bytes 4a d5),
+  computed 0xd44a (bytes 4a d4)
 2 bad kind or malformed hex (the message gives the 0-based character position).";
 
 /// `mmic`: encode and decode MMIC-I packets, print the spec tables.
@@ -186,7 +189,10 @@ Examples:
   mmic sim --low-battery-at 40 --overcurrent-at 25 --cut-b-at 60   (seconds)
 
 Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
-2 bad arguments or a malformed plan file (line and column are given); 3 an I/O error.";
+2 bad arguments or a malformed plan file, or a step that does not fit the robot's state
+(line and column are given); 3 an I/O error; 4 the host fell so far behind the simulated
+clock that the outcome may be the host's (the paced clock prevents this: it waits for the
+slowest node, so a busy host slows the run down instead).";
 
 /// Arguments of `mmic sim`.
 #[derive(Debug, clap::Args)]
@@ -227,6 +233,10 @@ pub struct SimArgs {
     /// No live progress.
     #[arg(long)]
     pub quiet: bool,
+    /// Parse the plan and follow the robot's state through it, then exit without running:
+    /// a step that does not fit the state is reported with its line and column.
+    #[arg(long)]
+    pub check_plan: bool,
 }
 
 fn probability(s: &str) -> Result<f64, String> {
@@ -236,6 +246,23 @@ fn probability(s: &str) -> Result<f64, String> {
     } else {
         Err(format!("{v} is not a probability in 0..=1"))
     }
+}
+
+/// The command line, with the help texts computed from the library (the map's legend).
+pub fn command() -> clap::Command {
+    <Cli as clap::CommandFactory>::command().mut_subcommand("map", |c| {
+        c.after_help(format!(
+            "The grid's codes:\n{}\nExample: mmic map --json",
+            motion::map_legend()
+        ))
+    })
+}
+
+/// Parses the process's arguments with [`command`]; prints help or the usage error and exits
+/// as clap does (code 2 for a usage error).
+pub fn parse() -> Cli {
+    let matches = command().get_matches();
+    <Cli as clap::FromArgMatches>::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
 }
 
 /// A packet kind from its name ([`PacketKind::from_name`]).
@@ -295,6 +322,17 @@ pub enum CliError {
     /// The plan did not complete.
     #[error("the plan did not complete: {0}")]
     Incomplete(String),
+    /// The host fell so far behind the simulated clock that the run's timeouts may be the
+    /// host's, not the robot's (an unpaced run on a loaded machine).
+    #[error(
+        "the host fell behind: a board tick started {late_ms} ms (simulated) late, beyond what \
+         the firmware's timers tolerate, so this run's outcome is not the robot's; rerun with a \
+         smaller --scale"
+    )]
+    HostBehind {
+        /// The latest tick, simulated ms.
+        late_ms: u32,
+    },
     /// Standard output or error is closed.
     #[error("cannot write output: {0}")]
     Output(#[source] std::io::Error),
@@ -308,6 +346,7 @@ impl CliError {
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
             CliError::Plan { .. } => EXIT_INPUT,
             CliError::Incomplete(_) => 1,
+            CliError::HostBehind { .. } => EXIT_HOST,
             CliError::Write { .. }
             | CliError::Output(_)
             | CliError::Read { .. }

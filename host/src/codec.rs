@@ -34,13 +34,16 @@ pub enum CodecError {
         /// serde_json's message.
         source: serde_json::Error,
     },
-    /// The bytes are not a valid packet: the failed check and its numbers.
-    #[error("{check} check failed: {source}")]
+    /// The bytes are not a valid packet: the failed check and its numbers, and which kind
+    /// they look like when their header names another one.
+    #[error("{check} check failed: {source}{}", looks_like_text(*looks_like))]
     Packet {
         /// length, header, checksum, field or command.
         check: &'static str,
         /// The wire error.
         source: WireError,
+        /// The kind whose header the bytes start with, when it is not the kind asked for.
+        looks_like: Option<PacketKind>,
     },
 }
 
@@ -57,10 +60,31 @@ impl CodecError {
     }
 }
 
-fn packet_err(source: WireError) -> CodecError {
+fn looks_like_text(kind: Option<PacketKind>) -> String {
+    match kind {
+        Some(k) => format!(
+            "; this looks like a {k} packet ({}): try `mmic decode {} <hex>`",
+            String::from_utf8_lossy(&k.header()),
+            k.name()
+        ),
+        None => String::new(),
+    }
+}
+
+/// The error for `bytes` refused as a `kind` packet, with the kind their header names when a
+/// length or header failure suggests the user picked the wrong kind.
+fn packet_err(kind: PacketKind, bytes: &[u8], source: WireError) -> CodecError {
+    let looks_like = match source {
+        WireError::Length { .. } | WireError::Header { .. } => bytes
+            .get(..mmic::wire::HEADER_LEN)
+            .and_then(PacketKind::from_header)
+            .filter(|&other| other != kind),
+        _ => None,
+    };
     CodecError::Packet {
         check: source.check(),
         source,
+        looks_like,
     }
 }
 
@@ -90,18 +114,18 @@ pub fn encode(kind: PacketKind, json: &str) -> Result<Vec<u8>, CodecError> {
 /// Decodes `bytes` as a `kind` packet to its JSON form (one line, every field).
 pub fn decode(kind: PacketKind, bytes: &[u8]) -> Result<String, CodecError> {
     let json = match kind {
-        PacketKind::Command => {
-            serde_json::to_string(&CommandRepr::parse(bytes).map_err(packet_err)?)
-        }
-        PacketKind::Heartbeat => {
-            serde_json::to_string(&HeartbeatRepr::parse(bytes).map_err(packet_err)?)
-        }
-        PacketKind::InternalHeartbeat => {
-            serde_json::to_string(&InternalHeartbeatRepr::parse(bytes).map_err(packet_err)?)
-        }
-        PacketKind::BCommand => {
-            serde_json::to_string(&BCommandRepr::parse(bytes).map_err(packet_err)?)
-        }
+        PacketKind::Command => serde_json::to_string(
+            &CommandRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
+        ),
+        PacketKind::Heartbeat => serde_json::to_string(
+            &HeartbeatRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
+        ),
+        PacketKind::InternalHeartbeat => serde_json::to_string(
+            &InternalHeartbeatRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
+        ),
+        PacketKind::BCommand => serde_json::to_string(
+            &BCommandRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
+        ),
     };
     json.map_err(|source| CodecError::Print { kind, source })
 }

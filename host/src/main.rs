@@ -1,12 +1,11 @@
 //! `mmic`: encode and decode MMIC-I packets, print the spec tables. The logic lives in
 //! [`mmic_host::cli`]; exit codes are documented there and in `mmic --help`.
 
-use clap::Parser;
-use mmic_host::cli::{run, Cli};
+use mmic_host::cli::{parse, run};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = parse();
     match run(cli, &mut std::io::stdout().lock(), &mut std::io::stderr()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

@@ -69,9 +69,17 @@ pub fn map_json() -> String {
     serde_json::to_string(&MapJson { moves }).unwrap_or_default()
 }
 
-/// The Figure 9 grid as text.
+/// The Figure 9 grid as text, followed by its legend.
 pub fn map_text() -> String {
     let mut s = String::new();
     let _ = map::render(&mut s);
+    s.push('\n');
+    s + &map_legend()
+}
+
+/// What the grid's codes mean ([`map::write_legend`]).
+pub fn map_legend() -> String {
+    let mut s = String::new();
+    let _ = map::write_legend(&mut s);
     s
 }

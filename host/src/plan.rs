@@ -48,6 +48,20 @@
 //! case-insensitive. Columns count characters (a tab is one column).
 //!
 //! An optional header `robot N` (N in 1..=255, default 1) may come before the first step, once.
+//! So may `start S` (a Table 5 state letter): the state the robot is in when the plan starts.
+//! With it, the parser follows the robot's state through the plan ([`Plan::trace`]) and
+//! refuses a reconfiguration that starts from another state than the one the robot will be in,
+//! or a primitive that is no move from there, with the line and column of the step — before
+//! anything is sent. (`mmic sim` traces every plan from its start state, `a` when not given.)
+//!
+//! ```
+//! let e = mmic_host::plan::parse("start a\nreconfigure a -> m\nreconfigure b -> n\n").unwrap_err();
+//! assert_eq!((e.line, e.column), (3, 13));
+//! assert_eq!(
+//!     e.kind.to_string(),
+//!     "this reconfiguration starts from b (Yneg match), but the robot is in m (Xpos match) here (since line 2)"
+//! );
+//! ```
 //!
 //! | Step | Command |
 //! |------|---------|
@@ -98,11 +112,13 @@ pub const STEP_KEYWORDS: [&str; 16] = [
     "wait",
 ];
 
-/// A parsed plan: which robot it addresses and its steps in order.
+/// A parsed plan: which robot it addresses, where it starts and its steps in order.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Plan {
     /// Robot (board A's WiFi client number) the steps are sent to.
     pub robot: BoardNumber,
+    /// The state the robot is in when the plan starts (`start` header), if the plan says.
+    pub start: Option<State>,
     /// The steps, in file order.
     pub steps: Vec<Step>,
 }
@@ -116,6 +132,9 @@ pub struct Step {
     pub action: Action,
     /// The source line, trimmed (comment included), for progress display.
     pub text: String,
+    /// 1-based column of each token of the step, keyword first, for errors found after
+    /// parsing ([`Plan::trace`]).
+    pub columns: Vec<usize>,
 }
 
 /// What a step does: send a command, or pause before the next step.
@@ -199,10 +218,47 @@ pub enum PlanErrorKind {
     /// A reconfiguration the library refuses.
     #[error("{0}")]
     Reconfiguration(ReconfigurationError),
+    /// A `start` header after the first step, or given twice.
+    #[error("`start` must come once, before the first step")]
+    StartMisplaced,
+    /// A reconfiguration that starts from another state than the one the robot is in at that
+    /// point of the plan ([`Plan::trace`]); the robot would refuse it (initial state mismatch).
+    #[error(
+        "this reconfiguration starts from {found}, but the robot is in {tracked} here ({})",
+        since_text(*since)
+    )]
+    StateMismatch {
+        /// The initial state the step names.
+        found: State,
+        /// The state the plan has the robot in.
+        tracked: State,
+        /// The line whose step put the robot there; none for the start state.
+        since: Option<usize>,
+    },
+    /// A primitive that is no move from the state the robot is in at that point of the plan.
+    #[error(
+        "primitive {primitive} is no move from {tracked} (Figure 9), where the robot is here ({})",
+        since_text(*since)
+    )]
+    NoSuchMove {
+        /// The primitive's number.
+        primitive: u8,
+        /// The state the plan has the robot in.
+        tracked: State,
+        /// The line whose step put the robot there; none for the start state.
+        since: Option<usize>,
+    },
     /// No step at all: an empty plan is more likely a wrong file than an intent. Reported at
     /// line 1, column 1.
     #[error("the plan has no steps")]
     Empty,
+}
+
+fn since_text(since: Option<usize>) -> String {
+    match since {
+        Some(line) => format!("since line {line}"),
+        None => "its start state".to_string(),
+    }
 }
 
 /// The keyword of a module in `power` steps: the variant name in kebab case.
@@ -234,6 +290,7 @@ pub fn parse(text: &str) -> Result<Plan, PlanError> {
     // A byte-order mark is not part of the first line as an editor shows it.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut robot: Option<(BoardNumber, usize)> = None;
+    let mut start: Option<State> = None;
     let mut steps = Vec::new();
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
@@ -263,12 +320,21 @@ pub fn parse(text: &str) -> Result<Plan, PlanError> {
             robot = Some((n, line));
             continue;
         }
+        if first.text.eq_ignore_ascii_case("start") {
+            if !steps.is_empty() || start.is_some() {
+                return Err(cur.error_at(first, PlanErrorKind::StartMisplaced));
+            }
+            start = Some(state_token(&mut cur, "start")?);
+            cur.finish()?;
+            continue;
+        }
         let action = step(&mut cur, first)?;
         cur.finish()?;
         steps.push(Step {
             line,
             action,
             text: raw.trim().to_string(),
+            columns: tokens.iter().map(|t| t.column).collect(),
         });
     }
     if steps.is_empty() {
@@ -278,10 +344,17 @@ pub fn parse(text: &str) -> Result<Plan, PlanError> {
             kind: PlanErrorKind::Empty,
         });
     }
-    Ok(Plan {
+    let plan = Plan {
         robot: robot.map_or(BoardNumber::ONE, |(r, _)| r),
+        start,
         steps,
-    })
+    };
+    // With a declared start, a step that does not fit the robot's state is an error of the
+    // file, found before anything is sent.
+    if let Some(start) = start {
+        plan.trace(start)?;
+    }
+    Ok(plan)
 }
 
 impl Plan {
@@ -290,11 +363,75 @@ impl Plan {
     /// rewrite plans and tests can round-trip them.
     pub fn to_text(&self) -> String {
         let mut s = format!("robot {}\n", self.robot.get());
+        if let Some(st) = self.start {
+            s += &format!("start {}\n", st.letter());
+        }
         for step in &self.steps {
             s += &step.action.to_string();
             s.push('\n');
         }
         s
+    }
+}
+
+impl Plan {
+    /// Follows the robot's state through the plan from `start`, as board A tracks it: a
+    /// reconfiguration must start from the state the robot is in and leaves it in its target;
+    /// a primitive must be a move of Figure 9 from that state and leaves it in the move's end
+    /// (unknown where the primitive reaches two states from there, after which reconfigurations
+    /// are taken at their word); every other step leaves the state as it is (the plan runner
+    /// sends a step only after the previous one settled). Returns the state after each step
+    /// (`None` where unknown), or the first step that does not fit, with its line and the
+    /// column of the offending token.
+    pub fn trace(&self, start: State) -> Result<Vec<Option<State>>, PlanError> {
+        let mut at: Option<(State, Option<usize>)> = Some((start, None));
+        let mut out = Vec::with_capacity(self.steps.len());
+        for step in &self.steps {
+            let column = |i: usize| step.columns.get(i).copied().unwrap_or(1);
+            match step.action {
+                Action::Command(Command::Reconfigure(r)) => {
+                    if let Some((tracked, since)) = at {
+                        if tracked != r.initial() {
+                            return Err(PlanError {
+                                line: step.line,
+                                column: column(1),
+                                kind: PlanErrorKind::StateMismatch {
+                                    found: r.initial(),
+                                    tracked,
+                                    since,
+                                },
+                            });
+                        }
+                    }
+                    at = Some((r.target(), Some(step.line)));
+                }
+                Action::Command(Command::Primitive(p)) => {
+                    if let Some((tracked, since)) = at {
+                        let mut ends = State::ALL
+                            .into_iter()
+                            .filter(|&to| mmic::motion::map::primitive(tracked, to) == Some(p));
+                        at = match (ends.next(), ends.next()) {
+                            (Some(to), None) => Some((to, Some(step.line))),
+                            (Some(_), Some(_)) => None,
+                            (None, _) => {
+                                return Err(PlanError {
+                                    line: step.line,
+                                    column: column(1),
+                                    kind: PlanErrorKind::NoSuchMove {
+                                        primitive: p.number(),
+                                        tracked,
+                                        since,
+                                    },
+                                })
+                            }
+                        };
+                    }
+                }
+                _ => {}
+            }
+            out.push(at.map(|(s, _)| s));
+        }
+        Ok(out)
     }
 }
 
@@ -793,7 +930,11 @@ fn hip_target(cur: &mut Cursor<'_, '_>) -> Result<HipTarget, PlanError> {
 }
 
 fn state(cur: &mut Cursor<'_, '_>) -> Result<State, PlanError> {
-    let t = cur.next("reconfigure", STATE)?;
+    state_token(cur, "reconfigure")
+}
+
+fn state_token(cur: &mut Cursor<'_, '_>, step: &'static str) -> Result<State, PlanError> {
+    let t = cur.next(step, STATE)?;
     let mut chars = t.text.chars();
     match (chars.next(), chars.next()) {
         (Some(c), None) => State::from_letter(c.to_ascii_lowercase()),

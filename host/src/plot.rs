@@ -125,6 +125,41 @@ pub fn line_chart(
     y_range: Option<(f64, f64)>,
     series: &[Series],
 ) -> String {
+    line_chart_with(
+        title,
+        x_label,
+        y_label,
+        LineOptions {
+            y_range,
+            ..LineOptions::default()
+        },
+        series,
+    )
+}
+
+/// How [`line_chart_with`] lays out its axes and legend.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LineOptions {
+    /// The y range when both ends are finite (as in [`line_chart`]); otherwise from the data.
+    /// Give headroom above a bound the data can reach (a 100 % line drawn on the top border
+    /// merges with it and is half clipped).
+    pub y_range: Option<(f64, f64)>,
+    /// End the x axis exactly at the data's first and last x (ticks inside) instead of rounding
+    /// outwards to whole ticks: for time series, whose axis should stop where the run did.
+    pub x_at_data: bool,
+    /// Draw the legend even for a single series (it then names what the line is).
+    pub legend: bool,
+}
+
+/// [`line_chart`] with [`LineOptions`].
+pub fn line_chart_with(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    opts: LineOptions,
+    series: &[Series],
+) -> String {
+    let y_range = opts.y_range;
     let finite = || {
         series
             .iter()
@@ -134,7 +169,7 @@ pub fn line_chart(
     };
     let xs = bounds(finite().map(|p| p.0));
     let ys = bounds(finite().map(|p| p.1));
-    let legend_w = if series.len() > 1 {
+    let legend_w = if series.len() > 1 || (opts.legend && !series.is_empty()) {
         let longest = series
             .iter()
             .map(|s| s.name.chars().count().min(SHORT))
@@ -152,7 +187,10 @@ pub fn line_chart(
         },
         ..AREA
     };
-    let xa = Axis::auto(xs.unwrap_or((0.0, 1.0)), area.x0, area.x1);
+    let xa = match (opts.x_at_data, xs) {
+        (true, Some((lo, hi))) => Axis::fixed(lo, hi, area.x0, area.x1),
+        _ => Axis::auto(xs.unwrap_or((0.0, 1.0)), area.x0, area.x1),
+    };
     let ya = match y_range {
         Some((a, b)) if a.is_finite() && b.is_finite() => {
             Axis::fixed(clamp(a.min(b)), clamp(a.max(b)), area.y1, area.y0)

@@ -230,12 +230,19 @@ fn every_error_path_is_reported_with_its_check() {
         1,
         "header check failed",
     );
+    // The right bytes under the wrong kind: the header names the kind they look like.
+    fails(
+        &["decode", "heartbeat", good],
+        1,
+        "length check failed: heartbeat packet: length must be 66 bytes, found 14; this looks like \
+         a command packet (MICM): try `mmic decode command <hex>`",
+    );
     let mut bad_crc = good.to_string();
     bad_crc.replace_range(26..28, "00");
     fails(
         &["decode", "command", &bad_crc],
         1,
-        "checksum check failed: command packet: checksum carried 0x004a, computed 0xd44a",
+        "checksum check failed: command packet: checksum carried 0x004a (bytes 4a 00), computed 0xd44a (bytes 4a d4)",
     );
     // A well-framed packet with an unknown opcode: seal it with the library's CRC.
     let mut b = [0u8; 14];
@@ -323,8 +330,35 @@ fn plan_and_map_commands() {
             assert!(n <= 3 && (n == 0) == (f == t), "{f}->{t}: {p}");
         }
     }
-    let grid = ok(&["map"]);
+    // The grid (a header and 15 rows, every row's cells under their column letters), then
+    // the legend: every code the grid uses is explained, in the output and in --help.
+    let out = ok(&["map"]);
+    let (grid, legend) = out.split_once("\n\n").expect("grid, blank line, legend");
     assert_eq!(grid.lines().count(), 16);
+    let header = grid.lines().next().unwrap();
+    for row in grid.lines().skip(1) {
+        for (i, c) in row.char_indices().skip(7) {
+            if c.is_ascii_digit() || c == '.' {
+                // A primitive number sits one column left of its letter's column, `.` under it.
+                let col = if c == '.' { i } else { i + 1 };
+                assert!(
+                    header
+                        .as_bytes()
+                        .get(col)
+                        .is_some_and(|b| b.is_ascii_lowercase()),
+                    "cell {c:?} at column {i} of {row:?} is not under a state letter"
+                );
+            }
+        }
+    }
+    for code in ["4i", "2F", "*", ".", "--", "primitives: 1 fwdContract"] {
+        assert!(legend.contains(code), "legend lacks {code:?}:\n{legend}");
+    }
+    let help = ok(&["map", "--help"]);
+    assert!(
+        help.contains(legend.trim_end()),
+        "map --help lacks the legend:\n{help}"
+    );
 }
 
 /// CRC-16/CCITT-FALSE bit by bit (poly 0x1021, init 0xffff, no reflection, no xor-out): an
@@ -398,7 +432,33 @@ fn validated_values_are_refused_with_their_numbers() {
     let cmd = |c: Value| json!({"board": 1, "command": c}).to_string();
     let hb = heartbeat();
     let cases: Vec<(&str, String, &str)> = vec![
-        ("command", cmd(json!({"primitive": 9})), "primitive must be 1..=8 (Table 6), found 9"),
+        ("command", cmd(json!({"primitive": 9})), "primitive (Table 6) must be in 1..=8, found 9"),
+        // Out of the wire type's range too (negative, beyond u8/u16): still the field's own
+        // range message, never serde's "expected u8".
+        ("command", cmd(json!({"primitive": 900})), "primitive (Table 6) must be in 1..=8, found 900"),
+        ("command", cmd(json!({"primitive": -1})), "primitive (Table 6) must be in 1..=8, found -1"),
+        (
+            "command",
+            cmd(json!({"arm": {"side": "a", "target": {"position": -5}}})),
+            "servo pulse width (us) must be in 500..=2500, found -5",
+        ),
+        (
+            "command",
+            cmd(json!({"arm": {"side": "a", "target": {"position": 3000}}})),
+            "servo pulse width (us) must be in 500..=2500, found 3000",
+        ),
+        (
+            "command",
+            cmd(json!({"arm": {"side": "a", "target": {"position": 70000}}})),
+            "servo pulse width (us) must be in 500..=2500, found 70000",
+        ),
+        ("command", cmd(json!({"hip": {"angle": -1}})), "hip angle (0.01 deg) must be in 0..=35999, found -1"),
+        ("command", cmd(json!({"hip": {"angle": 1.5}})), "invalid type: floating point `1.5`, expected an integer"),
+        ("command", r#"{"board":300,"command":"stop"}"#.into(), "board number must be in 1..=255, found 300"),
+        ("command", r#"{"board":0,"command":"stop"}"#.into(), "board number must be in 1..=255, found 0"),
+        ("command", r#"{"board":-3,"command":"stop"}"#.into(), "board number must be in 1..=255, found -3"),
+        ("command", r#"{"board":1,"command":"stop","seq":70000}"#.into(), "sequence number must be in 0..=65535, found 70000"),
+        ("command", r#"{"board":1,"command":"stop","seq":-1}"#.into(), "sequence number must be in 0..=65535, found -1"),
         ("command", cmd(json!({"primitive": 0})), "found 0"),
         (
             "command",
@@ -418,7 +478,7 @@ fn validated_values_are_refused_with_their_numbers() {
         (
             "command",
             cmd(json!({"bolter": {"bolt": {"pair": 5}}})),
-            "bolter pair must be 1..=4, found 5",
+            "bolter pair must be in 1..=4, found 5",
         ),
         (
             "command",
@@ -431,7 +491,7 @@ fn validated_values_are_refused_with_their_numbers() {
             cmd(json!({"arm": {"side": "a", "target": "contract", "speed": 2}})),
             "unknown field `speed`",
         ),
-        ("command", r#"{"board":256,"command":"stop"}"#.into(), "integer `256`"),
+        ("command", r#"{"board":256,"command":"stop"}"#.into(), "board number must be in 1..=255, found 256"),
         ("command", r#"{"board":1}"#.into(), "missing field `command`"),
         ("heartbeat", with(hb.clone(), &["bolter_attempt"], json!(4)), "bolter attempt must be in 0..=3, found 4"),
         ("heartbeat", with(hb.clone(), &["active_bolter"], json!(0)), "found 0"),
@@ -444,7 +504,8 @@ fn validated_values_are_refused_with_their_numbers() {
             with(hb.clone(), &["faults"], json!(["low_battery", "low_battery"])),
             "fault `low_battery` (bit 11) listed twice",
         ),
-        ("heartbeat", with(hb.clone(), &["electrical_a", "v_bat"], json!(65536)), "integer `65536`"),
+        ("heartbeat", with(hb.clone(), &["electrical_a", "v_bat"], json!(65536)), "voltage (mV) must be in 0..=65535, found 65536"),
+        ("heartbeat", with(hb.clone(), &["electrical_b", "i_bo"], json!(-20)), "current (mA) must be in 0..=65535, found -20"),
         ("heartbeat", with(hb.clone(), &["electrical_b"], json!({"v_bat": 1})), "missing field `i_bat`"),
         ("heartbeat", with(hb.clone(), &["mode"], json!("off")), "unknown variant `off`"),
         (

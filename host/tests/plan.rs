@@ -62,6 +62,7 @@ fn every_variant_class_round_trips_through_the_text() {
         assert_eq!(cmds.len(), 61);
         let original = Plan {
             robot: mmic::units::BoardNumber::new(7).expect("robot 7"),
+            start: None,
             steps: cmds
                 .iter()
                 .enumerate()
@@ -69,6 +70,7 @@ fn every_variant_class_round_trips_through_the_text() {
                     line: i + 1,
                     action: Action::Command(*c),
                     text: String::new(),
+                    columns: Vec::new(),
                 })
                 .collect(),
         };

@@ -9,6 +9,7 @@
 
 use super::geometry::single_move;
 use super::{Primitive, State};
+use core::fmt::Write as _;
 
 const N: usize = 15;
 
@@ -68,30 +69,59 @@ pub fn used_between_matched(from: State, to: State) -> bool {
 /// Renders the map as a text grid in the manner of Figure 9: rows are initial states, columns
 /// target states; a cell holds the primitive number, `F` when the target is a final (matched)
 /// state or `i` when intermediate, and `*` when no chosen plan between matched states uses the
-/// move; `--` marks the diagonal and `.` pairs with no single-primitive move.
+/// move; `--` marks the diagonal and `.` pairs with no single-primitive move ([`write_legend`]
+/// says so for readers of the grid). Each column is five characters wide, the cell text
+/// right-aligned under its state letter and the `*` after it; lines carry no trailing blanks.
 pub fn render(out: &mut impl core::fmt::Write) -> core::fmt::Result {
-    out.write_str("from\\to")?;
+    let mut line: heapless::String<128> = heapless::String::new();
+    let flush = |line: &mut heapless::String<128>, out: &mut dyn core::fmt::Write| {
+        let r = out
+            .write_str(line.trim_end())
+            .and_then(|_| out.write_char('\n'));
+        line.clear();
+        r
+    };
+    write!(line, "from\\to")?;
     for t in State::ALL {
-        write!(out, " {:>4}", t.letter())?;
+        write!(line, " {:>3} ", t.letter())?;
     }
-    out.write_char('\n')?;
+    flush(&mut line, out)?;
     for f in State::ALL {
-        write!(out, "{:>7}", f.letter())?;
+        write!(line, "{:>7}", f.letter())?;
         for t in State::ALL {
             if f == t {
-                write!(out, " {:>4}", "--")?;
+                write!(line, " {:>3} ", "--")?;
                 continue;
             }
             match primitive(f, t) {
-                None => write!(out, " {:>4}", ".")?,
+                None => write!(line, " {:>3} ", ".")?,
                 Some(p) => {
                     let kind = if t.is_matched() { 'F' } else { 'i' };
                     let star = if used_between_matched(f, t) { ' ' } else { '*' };
-                    write!(out, "  {}{}{}", p.number(), kind, star)?
+                    write!(line, "  {}{}{}", p.number(), kind, star)?
                 }
             }
         }
-        out.write_char('\n')?;
+        flush(&mut line, out)?;
     }
     Ok(())
+}
+
+/// What the codes of [`render`]'s grid mean, with the primitives' Table 6 names.
+pub fn write_legend(out: &mut impl core::fmt::Write) -> core::fmt::Result {
+    out.write_str(
+        "rows: initial state, columns: target state (Table 5 letters)\n\
+         4i   primitive 4 (Table 6) takes the row's state to the column's, an intermediate state\n\
+         \x20    (i: green in Figure 9)\n\
+         2F   primitive 2 takes it to a final (matched) state (F: blue in Figure 9)\n\
+         *    possible, but no chosen plan between matched states uses the move (Figure 9's\n\
+         \x20    asterisk)\n\
+         .    no single primitive does it (grey in Figure 9); a sequence may\n\
+         --   the same state: not a reconfiguration (black in Figure 9)\n\
+         primitives:",
+    )?;
+    for p in Primitive::ALL {
+        write!(out, " {} {}", p.number(), p.name())?;
+    }
+    out.write_char('\n')
 }

@@ -7,7 +7,7 @@ use core::fmt;
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
-    serde(try_from = "u8", into = "u8")
+    serde(try_from = "crate::units::Number", into = "u8")
 )]
 #[repr(u8)]
 pub enum Primitive {
@@ -86,6 +86,14 @@ impl TryFrom<u8> for Primitive {
     type Error = PrimitiveNumberError;
     fn try_from(n: u8) -> Result<Primitive, PrimitiveNumberError> {
         Primitive::from_number(n).ok_or(PrimitiveNumberError(n))
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<crate::units::Number> for Primitive {
+    type Error = crate::units::NumberRangeError;
+    fn try_from(n: crate::units::Number) -> Result<Self, Self::Error> {
+        n.narrow("primitive (Table 6)", (1, 8), Primitive::from_number)
     }
 }
 

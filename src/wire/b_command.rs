@@ -188,6 +188,7 @@ mod json {
     #[derive(serde::Serialize, serde::Deserialize)]
     #[serde(deny_unknown_fields)]
     struct Form {
+        #[serde(deserialize_with = "crate::units::de::seq8")]
         seq: u8,
         flags: Flags,
         arm_target: PulseWidth,

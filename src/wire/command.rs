@@ -145,6 +145,7 @@ pub struct CommandRepr {
     /// [`crate::command::seq_slot`] leaves free; 0 = unsequenced, the paper's
     /// behaviour (board A executes every copy). See spec/protocol/README.md.
     #[cfg_attr(feature = "serde", serde(default))]
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq16"))]
     pub seq: u16,
 }
 

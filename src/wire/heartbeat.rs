@@ -242,7 +242,7 @@ pub const FIELDS: &[FieldSpec] = &[
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
-    serde(try_from = "u8", into = "u8")
+    serde(try_from = "crate::units::Number", into = "u8")
 )]
 pub struct BolterAttempt(u8);
 
@@ -276,6 +276,16 @@ impl TryFrom<u8> for BolterAttempt {
     type Error = crate::units::RangeError;
     fn try_from(n: u8) -> Result<Self, Self::Error> {
         BolterAttempt::new(n)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<crate::units::Number> for BolterAttempt {
+    type Error = crate::units::NumberRangeError;
+    fn try_from(n: crate::units::Number) -> Result<Self, Self::Error> {
+        n.narrow("bolter attempt", (0, Self::MAX as i128), |v: u8| {
+            Self::new(v).ok()
+        })
     }
 }
 
@@ -334,6 +344,7 @@ pub struct HeartbeatRepr {
     /// has taken (executed or refused), 0 before the first; `refusal` then tells its outcome.
     /// The ground's acknowledgement for exactly-once commanding (spec/protocol/README.md).
     #[cfg_attr(feature = "serde", serde(default))]
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq16"))]
     pub last_seq: u16,
 }
 

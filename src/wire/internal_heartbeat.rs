@@ -270,6 +270,7 @@ pub const FIELDS: &[FieldSpec] = &[
 pub struct BolterAux {
     /// Step B is executing; none when idle (wire 0).
     pub step: Option<BolterStep>,
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq8"))]
     /// Sequence number of the A→B command that ordered that step.
     pub seq: u8,
     /// Pair B has selected; none when idle.
@@ -305,6 +306,7 @@ pub struct InternalHeartbeatRepr {
     pub electrical_b: Electrical,
     /// Bolter B progress.
     pub bolter_aux: BolterAux,
+    #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq8"))]
     /// Sequence number of the last A→B command received (the acknowledgement).
     pub command_received: u8,
     /// Gravity in B's IMU frame; none before the first IMU reading (both bytes 0).

@@ -145,7 +145,15 @@ pub enum WireError {
         found: [u8; HEADER_LEN],
     },
     /// The checksum bytes disagree with the CRC of the preceding bytes.
-    #[error("{kind} packet: checksum carried {carried:#06x}, computed {computed:#06x}")]
+    // The values, and the two bytes as they stand at the packet's end in a hex dump (low
+    // byte first), so that either can be found in what the user pasted.
+    #[error(
+        "{kind} packet: checksum carried {carried:#06x} (bytes {:02x} {:02x}), computed {computed:#06x} (bytes {:02x} {:02x})",
+        carried.to_le_bytes()[0],
+        carried.to_le_bytes()[1],
+        computed.to_le_bytes()[0],
+        computed.to_le_bytes()[1]
+    )]
     Checksum {
         /// Packet type being parsed.
         kind: PacketKind,

@@ -3,6 +3,8 @@
 //! framing verdict in the documented check order.
 #![allow(dead_code)] // each test file uses part of this module
 
+pub mod prop;
+
 use mmic::wire::{PacketKind, WireError, CHECKSUM_LEN, HEADER_LEN};
 
 /// CRC-16/CCITT-FALSE: poly 0x1021, init 0xFFFF, MSB first, no final xor; one bit at a time.

@@ -47,6 +47,7 @@ pub fn trial(robots: u8, seconds: u32) -> std::io::Result<Trial> {
     }]);
     cfg.robots = robots;
     cfg.scale = 1.0;
+    cfg.paced = false; // real time: the benchmark measures what the host keeps up with
     cfg.log_packets = false;
     cfg.max_sim_ms = seconds * 1000 + 5000;
     let s = run(&cfg)?;

@@ -87,9 +87,21 @@ pub struct SimConfig {
     pub log_packets: bool,
     /// Print live progress to stderr.
     pub progress: bool,
+    /// Hold simulated time back for the slowest node ([`clock`]), so that a busy host slows
+    /// the run instead of stretching the firmware's timeouts. The scale benchmark, which
+    /// measures what the host can do in real time, runs unpaced.
+    pub paced: bool,
 }
 
+/// How far simulated time may run ahead of the slowest node of a paced run, ms: two of the
+/// boards' 10 ms ticks, a 25th of the 500 ms communication timeout.
+pub const PACE_SLACK_MS: u32 = 20;
+
 impl SimConfig {
+    /// The state a robot starts in when its plan does not say (`start` header): `a`, where
+    /// the demo plan starts.
+    pub const DEFAULT_START: State = State::A;
+
     /// The built-in demo plan at the default settings.
     pub fn demo() -> SimConfig {
         SimConfig::with_steps(crate::sim::report::demo_steps())
@@ -107,7 +119,7 @@ impl SimConfig {
             ab_loss: 0.0,
             cut_b_at: None,
             plant: PlantConfig::default(),
-            start_state: State::A,
+            start_state: SimConfig::DEFAULT_START,
             // The paper resends until acknowledged; 20 attempts make an unacknowledged command
             // unlikely even at 30 % loss each way (0.51^20 < 2e-6) while still ending a run
             // whose link is gone.
@@ -120,6 +132,7 @@ impl SimConfig {
             log_path: None,
             log_packets: true,
             progress: false,
+            paced: true,
         }
     }
 }
@@ -131,6 +144,14 @@ pub struct Summary {
     pub ends: Vec<Option<PlanEnd>>,
     /// Steps.
     pub steps: usize,
+    /// The plan's steps, for reports that quote the step that stopped the plan.
+    pub plan: Vec<SimStep>,
+    /// The state the robot started in.
+    pub start_state: State,
+    /// WiFi loss each way, 0..1, as configured.
+    pub wifi_loss: f64,
+    /// How long the server waits for a heartbeat, ms, as configured.
+    pub visit_ms: u32,
     /// Simulated time, ms.
     pub sim_ms: u32,
     /// Wall time.
@@ -149,6 +170,22 @@ pub struct Summary {
     /// The firmware ticks every 10 ms on time; a host that falls behind (too high a `scale`,
     /// a loaded machine) stretches the time between ticks and can fake timeouts.
     pub max_tick_lateness_ms: u32,
+    /// Simulated ms the paced clock was held back for slow nodes (0 unpaced).
+    pub held_ms: u64,
+    /// The pace's slack when paced: the bound on tick lateness by construction.
+    pub pace_slack_ms: Option<u32>,
+    /// Robot 1's last heartbeat as the ground received it.
+    pub last_heartbeat: Option<HeartbeatRepr>,
+}
+
+impl Summary {
+    /// Whether the host fell behind far enough to change what the firmware saw: a tick later
+    /// than [`nodes::OVERRUN_MS`]. A paced run cannot get there (its ticks are at most
+    /// [`PACE_SLACK_MS`] late); an unpaced run on a loaded host can, and then its timeouts
+    /// and faults may come from the host.
+    pub fn host_fell_behind(&self) -> bool {
+        self.max_tick_lateness_ms >= nodes::OVERRUN_MS
+    }
 }
 
 impl Summary {
@@ -188,7 +225,14 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     }
     let mut cmd_queues: Vec<PacketQueue<14, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
     let mut hb_queues: Vec<PacketQueue<66, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
-    let clock = Clock::start(cfg.scale);
+    // Four paced nodes per robot (board A's two tasks, board B, the server board) and the
+    // ground; an unpaced run hands out no slots.
+    let pace = clock::Pace::new(if cfg.paced { 4 * n + 1 } else { 0 }, PACE_SLACK_MS);
+    let clock = if cfg.paced {
+        Clock::paced(cfg.scale, &pace)
+    } else {
+        Clock::start(cfg.scale)
+    };
     let statuses: Vec<Arc<Mutex<Value>>> =
         (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
     let lateness = AtomicU32::new(0);
@@ -301,6 +345,8 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
                 let wifi_loss = cfg.wifi_loss;
                 let status = statuses[i].clone();
                 let (na, na2) = (name_a.clone(), name_a);
+                let (c_wifi, c_control, c_b, c_server) =
+                    (clock.node(), clock.node(), clock.node(), clock.node());
                 scope.spawn(move || {
                     nodes::board_a_wifi(
                         robot.listener,
@@ -308,7 +354,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
                         hb_c,
                         wifi_loss,
                         seed ^ 0x5eed,
-                        clock,
+                        c_wifi,
                         l3,
                         stop,
                         na,
@@ -316,19 +362,18 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
                 });
                 scope.spawn(move || {
                     nodes::board_a_control(
-                        a, cmd_c, hb_p, ba_rx, to_b, p1, clock, l1, stop, na2, status, late,
+                        a, cmd_c, hb_p, ba_rx, to_b, p1, c_control, l1, stop, na2, status, late,
                     )
                 });
-                scope.spawn(move || {
-                    nodes::board_b(b, ab_rx, to_a, p2, clock, l2, stop, name_b, late)
-                });
+                scope
+                    .spawn(move || nodes::board_b(b, ab_rx, to_a, p2, c_b, l2, stop, name_b, late));
                 let robots = vec![(board, robot.addr)];
                 let visit = cfg.visit_ms;
                 scope.spawn(move || {
-                    nodes::server(gs_rx, to_ground, robots, visit, clock, l4, stop, name_s)
+                    nodes::server(gs_rx, to_ground, robots, visit, c_server, l4, stop, name_s)
                 });
             }
-            let out = ground_loop(cfg, &steps, ground_links, clock, log.clone(), &statuses);
+            let out = ground_loop(cfg, &steps, ground_links, clock.node(), log.clone());
             stop.store(true, Ordering::Relaxed);
             Ok(out)
         },
@@ -344,6 +389,10 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     Ok(Summary {
         ends,
         steps: cfg.steps.len(),
+        plan: cfg.steps.clone(),
+        start_state: cfg.start_state,
+        wifi_loss: cfg.wifi_loss,
+        visit_ms: cfg.visit_ms,
         sim_ms: stats.sim_ms,
         wall: clock.wall_elapsed(),
         records,
@@ -352,6 +401,9 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         max_latency_ms: stats.max_latency_ms,
         status,
         max_tick_lateness_ms: lateness.load(Ordering::Relaxed),
+        held_ms: clock.held_ms(),
+        pace_slack_ms: clock.slack_ms(),
+        last_heartbeat: stats.last_heartbeat,
     })
 }
 
@@ -360,6 +412,7 @@ struct GroundStats {
     efficiency: Vec<(f64, f64)>,
     attempts: (u64, u64),
     max_latency_ms: u32,
+    last_heartbeat: Option<HeartbeatRepr>,
 }
 
 type GroundLink = (
@@ -373,9 +426,8 @@ fn ground_loop(
     cfg: &SimConfig,
     steps: &[PlanStep],
     mut links: Vec<GroundLink>,
-    clock: Clock,
+    clock: clock::NodeClock<'_>,
     log: Option<log::Log>,
-    statuses: &[Arc<Mutex<Value>>],
 ) -> (Vec<Option<PlanEnd>>, GroundStats) {
     let mut runners: Vec<PlanRunner> = links
         .iter()
@@ -389,10 +441,12 @@ fn ground_loop(
         efficiency: Vec::new(),
         attempts: (0, 0),
         max_latency_ms: 0,
+        last_heartbeat: None,
     };
-    let mut progress = report::Progress::new(cfg.progress, cfg.steps.clone());
+    let mut progress = report::Progress::new(cfg.progress, cfg.steps.clone(), cfg.start_state);
     loop {
         let now = clock.now_ms();
+        clock.ready(now);
         stats.sim_ms = now;
         if now > cfg.max_sim_ms || ends.iter().all(|e| e.is_some()) {
             break;
@@ -471,11 +525,12 @@ fn ground_loop(
         }
         if let Some(hb) = &last_hb[0] {
             let eff = runners[0].uplink().efficiency();
-            progress.status(now, runners[0].step(), hb, eff, &statuses[0]);
+            progress.status(now, hb, eff);
         }
         std::thread::sleep(Duration::from_micros(500));
     }
     progress.finish();
     let _ = std::io::stderr().flush();
+    stats.last_heartbeat = last_hb.first().copied().flatten();
     (ends, stats)
 }

@@ -2,7 +2,7 @@
 //! node, and does nothing else. Board A runs two threads, as on the ESP32's two cores: the
 //! WiFi task (TCP) and the control loop, joined by the library's SPSC hand-off queues.
 
-use super::clock::Clock;
+use super::clock::{Clock, NodeClock};
 use super::log::Log;
 use super::plant::{Drives, Plant};
 use mmic::node::board_a::{self, BoardA, Event};
@@ -142,7 +142,7 @@ pub fn board_a_wifi(
     mut heartbeats: Consumer<'_, HEARTBEAT_LEN, 8>,
     loss: f64,
     seed: u64,
-    clock: Clock,
+    clock: NodeClock<'_>,
     log: Option<Log>,
     stop: &AtomicBool,
     name: String,
@@ -151,6 +151,7 @@ pub fn board_a_wifi(
     let lost = |rng: &mut fastrand::Rng| loss > 0.0 && rng.f64() < loss;
     let _ = listener.set_nonblocking(true);
     while !stop.load(Ordering::Relaxed) {
+        clock.ready(clock.now_ms());
         let sock = match listener.accept() {
             Ok((s, _)) => s,
             Err(_) => {
@@ -169,6 +170,7 @@ pub fn board_a_wifi(
         let mut d = Deframer::<256>::new();
         let mut buf = [0u8; 256];
         'conn: while !stop.load(Ordering::Relaxed) {
+            clock.ready(clock.now_ms());
             match sock.read(&mut buf) {
                 Ok(0) => break 'conn,
                 Ok(n) => {
@@ -230,7 +232,7 @@ pub fn board_a_control(
     from_b: Receiver<Vec<u8>>,
     mut to_b: Lossy<std::io::PipeWriter>,
     plant: Arc<Mutex<Plant>>,
-    clock: Clock,
+    clock: NodeClock<'_>,
     log: Option<Log>,
     stop: &AtomicBool,
     name: String,
@@ -249,6 +251,8 @@ pub fn board_a_control(
             note_lateness(late, now - next, &log, now, &name);
         }
         next = now - now % TICK_MS + TICK_MS;
+        // Everything due before this tick is done: time may run on to the pace's slack.
+        clock.ready(now);
         let command = commands.pop();
         let from_b = from_b.try_recv().ok().and_then(|v| v.try_into().ok());
         let s = {
@@ -323,7 +327,7 @@ pub fn board_b(
     from_a: Receiver<Vec<u8>>,
     mut to_a: Lossy<std::io::PipeWriter>,
     plant: Arc<Mutex<Plant>>,
-    clock: Clock,
+    clock: NodeClock<'_>,
     log: Option<Log>,
     stop: &AtomicBool,
     name: String,
@@ -342,6 +346,8 @@ pub fn board_b(
             note_lateness(late, now - next, &log, now, &name);
         }
         next = now - now % TICK_MS + TICK_MS;
+        // Everything due before this tick is done: time may run on to the pace's slack.
+        clock.ready(now);
         let command = from_a.try_recv().ok().and_then(|v| v.try_into().ok());
         let s = plant
             .lock()
@@ -392,13 +398,14 @@ pub fn server(
     mut to_ground: Lossy<std::io::PipeWriter>,
     robots: Vec<(BoardNumber, SocketAddr)>,
     visit_ms: u32,
-    clock: Clock,
+    clock: NodeClock<'_>,
     log: Option<Log>,
     stop: &AtomicBool,
     name: String,
 ) {
     let mut srv: Server<4> = Server::new();
     while !stop.load(Ordering::Relaxed) {
+        clock.ready(clock.now_ms());
         while let Ok(bytes) = from_ground.try_recv() {
             let now = clock.now_ms();
             let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(bytes.as_slice()) else {
@@ -432,13 +439,16 @@ pub fn server(
             continue;
         }
         srv.delivered(robot, &packet);
-        // Wait for the heartbeat, then disconnect (one robot per loop).
-        let _ = sock.set_read_timeout(Some(Duration::from_millis(2)));
+        // Wait for the heartbeat, then disconnect (one robot per loop). Polled without blocking:
+        // a socket read timeout is rounded up to the kernel's tick (4–8 ms here), and a blocked
+        // server would hold the paced clock back.
+        let _ = sock.set_nonblocking(true);
         let until = clock.now_ms().saturating_add(visit_ms);
         let mut d = Deframer::<256>::new();
         let mut buf = [0u8; 256];
         let mut got = false;
         while !got && clock.now_ms() < until && !stop.load(Ordering::Relaxed) {
+            clock.ready(clock.now_ms());
             match sock.read(&mut buf) {
                 Ok(0) => break,
                 Ok(n) => {
@@ -455,7 +465,9 @@ pub fn server(
                         }
                     }
                 }
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+                    std::thread::sleep(Duration::from_micros(200));
+                }
                 Err(_) => break,
             }
         }

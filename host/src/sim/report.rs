@@ -1,14 +1,14 @@
 //! Live progress, the end-of-run summary and the plots (Figure 10 and 11 analogues).
 
 use super::{SimStep, Summary};
-use crate::plot::{bar_chart, line_chart, Series};
+use crate::plot::{bar_chart, line_chart_with, LineOptions, Series};
+use mmic::motion::State;
 use mmic::node::ground::Efficiency;
 use mmic::node::plan::PlanEnd;
+use mmic::refusal::Refusal;
 use mmic::wire::heartbeat::HeartbeatRepr;
-use serde_json::Value;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::sync::{Arc, Mutex};
 
 /// The built-in demo plan's text (host/plans/demo.plan).
 pub const DEMO_PLAN: &str = include_str!("../../plans/demo.plan");
@@ -39,19 +39,27 @@ pub fn steps_of(p: &crate::plan::Plan) -> Vec<SimStep> {
 
 /// Live progress on stderr: a line when a step starts or the robot's mode, state or faults
 /// change (as the ground sees them, from heartbeats), and every 10 simulated seconds.
+///
+/// Status lines name the step that last *started*, so a status line never runs ahead of its
+/// step's header; before any reconfiguration the state shown is the plan's start state (the
+/// heartbeat's state byte is the last commanded target, none at power-up).
 pub struct Progress {
     on: bool,
     steps: Vec<SimStep>,
+    start: State,
+    current: Option<usize>,
     last_key: String,
     last_print: u32,
 }
 
 impl Progress {
-    /// Printing or not.
-    pub fn new(on: bool, steps: Vec<SimStep>) -> Progress {
+    /// Printing or not; the plan's steps and the state the robot starts in.
+    pub fn new(on: bool, steps: Vec<SimStep>, start: State) -> Progress {
         Progress {
             on,
             steps,
+            start,
+            current: None,
             last_key: String::new(),
             last_print: 0,
         }
@@ -59,6 +67,7 @@ impl Progress {
 
     /// Step `k` (0-based) started.
     pub fn step(&mut self, now: u32, k: usize) {
+        self.current = Some(k);
         if self.on {
             if let Some(s) = self.steps.get(k) {
                 eprintln!(
@@ -74,14 +83,7 @@ impl Progress {
     }
 
     /// The latest heartbeat.
-    pub fn status(
-        &mut self,
-        now: u32,
-        step: usize,
-        hb: &HeartbeatRepr,
-        eff: Efficiency,
-        _board: &Arc<Mutex<Value>>,
-    ) {
+    pub fn status(&mut self, now: u32, hb: &HeartbeatRepr, eff: Efficiency) {
         if !self.on {
             return;
         }
@@ -89,16 +91,18 @@ impl Progress {
         let state = match (hb.target_state, hb.command_complete) {
             (Some(s), true) => format!("{s}"),
             (Some(s), false) => format!("-> {s}"),
-            (None, _) => "start".to_string(),
+            (None, _) => format!("{} (start)", self.start),
         };
         let key = format!("{} {state} {faults:?}", hb.mode);
         if key != self.last_key || now.saturating_sub(self.last_print) >= 10_000 {
             let (ok, n) = eff.counts();
+            let step = match self.current {
+                Some(k) => format!("step {}/{}", k + 1, self.steps.len()),
+                None => format!("step -/{}", self.steps.len()),
+            };
             eprintln!(
-                "[{:>6.1} s]   step {}/{} | {} | state {state} | faults: {} | wifi {}% ({ok}/{n})",
+                "[{:>6.1} s]   {step} | {} | state {state} | faults: {} | wifi {}% ({ok}/{n})",
                 now as f64 / 1000.0,
-                (step + 1).min(self.steps.len()),
-                self.steps.len(),
                 hb.mode,
                 if faults.is_empty() {
                     "none".to_string()
@@ -144,42 +148,144 @@ pub fn executed_twice(s: &Summary) -> Vec<u64> {
         .collect()
 }
 
-/// The summary as text.
-pub fn text(s: &Summary) -> String {
-    let mut t = String::new();
-    let end = match s.ends.first().copied().flatten() {
-        Some(PlanEnd::Completed) => "completed".to_string(),
+/// Which WiFi packets of a run crossed and which were lost (from the packet log; none when
+/// packets were not logged).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct WifiCrossings {
+    /// Command packets the server boards sent to boards A.
+    pub commands: u64,
+    /// ... of which the link lost.
+    pub commands_lost: u64,
+    /// Heartbeats boards A sent back while the server was connected.
+    pub heartbeats: u64,
+    /// ... of which the link lost.
+    pub heartbeats_lost: u64,
+}
+
+/// Counts the WiFi link's packets in the log.
+pub fn wifi_crossings(s: &Summary) -> Option<WifiCrossings> {
+    let mut w = WifiCrossings::default();
+    let mut any = false;
+    for r in s
+        .records
+        .iter()
+        .filter(|r| r["kind"] == "packet" && r["link"] == "wifi")
+    {
+        any = true;
+        let lost = r["fate"] == "lost";
+        let from_server = r["from"].as_str().is_some_and(|f| f.starts_with("server"));
+        let counted = r["fate"] == "delivered" || lost;
+        match (from_server, counted) {
+            (true, true) => {
+                w.commands += 1;
+                w.commands_lost += lost as u64;
+            }
+            (false, true) => {
+                w.heartbeats += 1;
+                w.heartbeats_lost += lost as u64;
+            }
+            _ => {}
+        }
+    }
+    any.then_some(w)
+}
+
+/// The share of attempts answered that independent losses of `loss` each way predict, and its
+/// standard deviation over `n` attempts: an attempt is answered only when its command and the
+/// heartbeat both cross, (1 − loss)².
+pub fn expected_efficiency(loss: f64, n: u64) -> (f64, f64) {
+    let p = (1.0 - loss.clamp(0.0, 1.0)).powi(2);
+    (p, (p * (1.0 - p) / n.max(1) as f64).sqrt())
+}
+
+fn step_ref(s: &Summary, k: usize) -> String {
+    match s.plan.get(k) {
+        Some(st) => format!(
+            "step {} of {} (line {}: {})",
+            k + 1,
+            s.steps,
+            st.line,
+            st.text.split('#').next().unwrap_or("").trim()
+        ),
+        None => format!("step {} of {}", k + 1, s.steps),
+    }
+}
+
+fn fault_list(faults: &mmic::faults::Faults) -> String {
+    let f: Vec<String> = faults.iter().map(|f| f.to_string()).collect();
+    if f.is_empty() {
+        "none".to_string()
+    } else {
+        f.join(", ")
+    }
+}
+
+/// The plan's end as one line (and, for a state mismatch, what the plan expected and what
+/// the robot reported).
+pub fn plan_line(s: &Summary) -> String {
+    match s.ends.first().copied().flatten() {
+        Some(PlanEnd::Completed) => format!("plan: completed, all {} steps", s.steps),
         Some(PlanEnd::Refused {
             step,
             refusal,
             robot,
         }) => {
-            let mut t = format!("stopped: step {} refused ({refusal})", step + 1);
+            let mut t = format!(
+                "plan: stopped at {}: refused ({refusal})",
+                step_ref(s, step)
+            );
             if let Some((mode, faults)) = robot {
-                let f: Vec<String> = faults.iter().map(|f| f.to_string()).collect();
-                let f = if f.is_empty() {
-                    "none".to_string()
-                } else {
-                    f.join(", ")
-                };
-                let _ = write!(t, ", robot in {mode} (faults: {f})");
+                let _ = write!(t, ", robot in {mode} (faults: {})", fault_list(&faults));
+            }
+            if refusal == Refusal::InitialStateMismatch {
+                let _ = write!(t, "\n  {}", mismatch(s, step));
             }
             t
         }
         Some(PlanEnd::Unacknowledged { step }) => {
-            format!("stopped: step {} unacknowledged", step + 1)
+            format!("plan: stopped at {}: unacknowledged", step_ref(s, step))
         }
-        Some(PlanEnd::Interrupted { step, mode, faults }) => {
-            let f: Vec<String> = faults.iter().map(|f| f.to_string()).collect();
+        Some(PlanEnd::Interrupted { step, mode, faults }) => format!(
+            "plan: stopped at {}: interrupted, robot in {mode} (faults: {})",
+            step_ref(s, step),
+            fault_list(&faults)
+        ),
+        None => "plan: time limit reached".to_string(),
+    }
+}
+
+/// What the refused step expected and what the robot last reported.
+fn mismatch(s: &Summary, step: usize) -> String {
+    let expected = match s.plan.get(step).map(|st| st.step) {
+        Some(mmic::node::plan::PlanStep::Command(mmic::command::Command::Reconfigure(r))) => {
+            format!("the plan expected the robot in {}", r.initial())
+        }
+        Some(mmic::node::plan::PlanStep::Command(mmic::command::Command::Primitive(p))) => {
             format!(
-                "stopped: step {} interrupted, robot in {mode} (faults: {})",
-                step + 1,
-                f.join(", ")
+                "primitive {} is no move from the state the robot is in",
+                p.number()
             )
         }
-        None => "time limit reached".to_string(),
+        _ => "the step does not fit the robot's state".to_string(),
     };
-    let _ = writeln!(t, "plan: {end} ({} steps)", s.steps);
+    let reported = match s.last_heartbeat {
+        Some(hb) => match (hb.target_state, hb.command_complete) {
+            (Some(st), true) => format!("the robot last reported {st}"),
+            (Some(st), false) => format!("the robot last reported moving to {st}"),
+            (None, _) => format!(
+                "the robot has not been reconfigured since it started in {}",
+                s.start_state
+            ),
+        },
+        None => "no heartbeat was received".to_string(),
+    };
+    format!("{expected}; {reported}")
+}
+
+/// The summary as text.
+pub fn text(s: &Summary) -> String {
+    let mut t = String::new();
+    let _ = writeln!(t, "{}", plan_line(s));
     let _ = writeln!(
         t,
         "time: {:.1} s simulated in {:.1} s wall ({:.1}x)",
@@ -198,15 +304,51 @@ pub fn text(s: &Summary) -> String {
         },
         s.max_latency_ms
     );
+    if s.wifi_loss > 0.0 {
+        let (p, sd) = expected_efficiency(s.wifi_loss, n);
+        let _ = writeln!(
+            t,
+            "  expected at {:.0}% loss each way: (1 - {:.2})^2 = {:.1}% +/- {:.1}% (1 sigma, {n} attempts)",
+            s.wifi_loss * 100.0,
+            s.wifi_loss,
+            p * 100.0,
+            sd * 100.0
+        );
+        if let Some(w) = wifi_crossings(s) {
+            let pct = |a: u64, b: u64| a as f64 * 100.0 / b.max(1) as f64;
+            let _ = writeln!(
+                t,
+                "  this run lost {}/{} commands ({:.1}%) and {}/{} heartbeats ({:.1}%)",
+                w.commands_lost,
+                w.commands,
+                pct(w.commands_lost, w.commands),
+                w.heartbeats_lost,
+                w.heartbeats,
+                pct(w.heartbeats_lost, w.heartbeats)
+            );
+        }
+        let _ = writeln!(
+            t,
+            "  (an attempt is answered only if its command and the heartbeat both cross the WiFi\n  \
+             link: the server forwards each attempt once and waits {} ms, the ground resends after 1.2 s)",
+            s.visit_ms
+        );
+    }
+    let held = if s.held_ms > 0 {
+        format!("; the clock waited {} ms for slow nodes", s.held_ms)
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         t,
-        "host: board ticks started at most {} ms (simulated) late{}",
+        "host: board ticks started at most {} ms (simulated) late{}{held}",
         s.max_tick_lateness_ms,
-        if s.max_tick_lateness_ms >= super::nodes::OVERRUN_MS {
-            " -- the host fell behind the simulated clock, so timeouts and faults in this run \
-             may come from the host, not the robot: rerun with a smaller --scale"
-        } else {
-            ""
+        match (s.host_fell_behind(), s.pace_slack_ms) {
+            (true, _) => " -- the host fell behind the simulated clock, so timeouts and faults \
+                          in this run may come from the host, not the robot"
+                .to_string(),
+            (false, Some(slack)) => format!(" (paced, bound {slack} ms)"),
+            (false, None) => String::new(),
         }
     );
     let executed = s.events("executed").count();
@@ -235,19 +377,45 @@ pub fn text(s: &Summary) -> String {
     t
 }
 
-/// Writes wifi-efficiency.svg and bolting-attempts.svg into `dir`; returns their paths.
-pub fn plots(s: &Summary, dir: &Path) -> std::io::Result<Vec<std::path::PathBuf>> {
-    std::fs::create_dir_all(dir)?;
-    let eff = line_chart(
+/// The Figure 11 analogue: robot 1's efficiency over its last 100 attempts against simulated
+/// time, the axis ending where the run did, headroom above 100 %, and — with WiFi loss — the
+/// share that independent losses predict, (1 − loss)², as a reference line.
+pub fn efficiency_chart(s: &Summary) -> String {
+    let expected: Vec<(f64, f64)> = match (s.efficiency.first(), s.efficiency.last()) {
+        (Some(first), Some(last)) if s.wifi_loss > 0.0 => {
+            let p = expected_efficiency(s.wifi_loss, 1).0 * 100.0;
+            vec![(first.0, p), (last.0, p)]
+        }
+        _ => Vec::new(),
+    };
+    let expected_name = format!("expected (1-{:.2})^2", s.wifi_loss);
+    let mut series = vec![Series {
+        name: "robot 1",
+        points: &s.efficiency,
+    }];
+    if !expected.is_empty() {
+        series.push(Series {
+            name: &expected_name,
+            points: &expected,
+        });
+    }
+    line_chart_with(
         "WiFi efficiency over the last 100 attempts (Figure 11 analogue)",
         "simulated time (s)",
         "efficiency (%)",
-        Some((0.0, 100.0)),
-        &[Series {
-            name: "robot 1",
-            points: &s.efficiency,
-        }],
-    );
+        LineOptions {
+            y_range: Some((0.0, 110.0)),
+            x_at_data: true,
+            legend: true,
+        },
+        &series,
+    )
+}
+
+/// Writes wifi-efficiency.svg and bolting-attempts.svg into `dir`; returns their paths.
+pub fn plots(s: &Summary, dir: &Path) -> std::io::Result<Vec<std::path::PathBuf>> {
+    std::fs::create_dir_all(dir)?;
+    let eff = efficiency_chart(s);
     let b = bolting(s);
     let bars = bar_chart(
         "Bolting attempts per fastener pair (Figure 10 analogue)",
