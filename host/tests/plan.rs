@@ -469,3 +469,88 @@ fn descriptions_are_short_and_specific() {
         "reconfigure a (Xneg match) -> m (Xpos match)"
     );
 }
+
+#[test]
+fn a_start_header_round_trips_and_the_state_is_traced_through_the_plan() {
+    let p = plan::parse(
+        "robot 2\nstart a\nmode operational\nreconfigure a -> m\nbolt 1\nreconfigure m -> b\n",
+    )
+    .unwrap();
+    assert_eq!(p.start, Some(State::A));
+    assert_eq!(plan::parse(&p.to_text()).unwrap().start, Some(State::A));
+    let states = p.trace(State::A).unwrap();
+    assert_eq!(
+        states,
+        [
+            Some(State::A),
+            Some(State::M),
+            Some(State::M),
+            Some(State::B)
+        ]
+    );
+    // The demo plan says where it starts, and traces through three voxels.
+    let demo = plan::parse(mmic_host::sim::report::DEMO_PLAN).unwrap();
+    assert_eq!(demo.start, Some(State::A));
+    let ends: Vec<State> = demo
+        .trace(State::A)
+        .unwrap()
+        .into_iter()
+        .flatten()
+        .collect();
+    assert_eq!(ends.last(), Some(&State::N));
+}
+
+#[test]
+fn a_step_that_does_not_fit_the_state_is_refused_with_line_and_column() {
+    // With a start header, the parser itself refuses it.
+    let e = plan::parse("start a\nmode operational\nreconfigure a -> m\n  reconfigure b -> n\n")
+        .unwrap_err();
+    assert_eq!((e.line, e.column), (4, 15));
+    assert_eq!(
+        e.kind,
+        PlanErrorKind::StateMismatch {
+            found: State::B,
+            tracked: State::M,
+            since: Some(3)
+        }
+    );
+    assert!(e
+        .to_string()
+        .contains("but the robot is in m (Xpos match) here (since line 3)"));
+    // From the start state.
+    let e = plan::parse("start m\nreconfigure a -> b\n").unwrap_err();
+    assert_eq!(e.to_string(), "line 2, column 13: this reconfiguration starts from a (Xneg match), but the robot is in m (Xpos match) here (its start state)");
+    // Without one, parsing succeeds and the caller's start decides (mmic sim uses `a`).
+    let p = plan::parse("reconfigure b -> n\n").unwrap();
+    assert_eq!(p.start, None);
+    assert!(p.trace(State::B).is_ok());
+    assert_eq!(p.trace(State::A).unwrap_err().column, 13);
+    // A primitive that is no move from the tracked state (Figure 9): a -> ? by primitive 1.
+    let none = mmic::motion::Primitive::ALL
+        .into_iter()
+        .find(|&pr| {
+            State::ALL
+                .into_iter()
+                .all(|to| mmic::motion::map::primitive(State::A, to) != Some(pr))
+        })
+        .unwrap();
+    let e = plan::parse(&format!("start a\nprimitive {}\n", none.number())).unwrap_err();
+    assert_eq!((e.line, e.column), (2, 11));
+    assert!(matches!(
+        e.kind,
+        PlanErrorKind::NoSuchMove {
+            tracked: State::A,
+            since: None,
+            ..
+        }
+    ));
+    // The header goes once, before the first step.
+    assert_eq!(
+        plan::parse("stop\nstart a\n").unwrap_err().kind,
+        PlanErrorKind::StartMisplaced
+    );
+    assert_eq!(
+        plan::parse("start a\nstart b\nstop\n").unwrap_err().kind,
+        PlanErrorKind::StartMisplaced
+    );
+}

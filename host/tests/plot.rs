@@ -1,7 +1,7 @@
 //! SVG charts: well-formed XML, escaped text, finite numbers, and lines that carry exactly
 //! their input points, whatever the input.
 
-use mmic_host::plot::{bar_chart, line_chart, Series, PALETTE};
+use mmic_host::plot::{bar_chart, line_chart, line_chart_with, LineOptions, Series, PALETTE};
 
 /// A tiny XML well-formedness check, enough for what the charts write: one root element, tags
 /// balanced and properly nested, attributes `name="value"` without duplicates, no raw `<` in
@@ -472,4 +472,68 @@ fn bar_charts_handle_empty_odd_and_crowded_input() {
     check_chart(&svg);
     assert_eq!(svg.matches("rotate(-35").count(), 20);
     assert_eq!(svg.matches("<title>a rather long category").count(), 20);
+}
+
+#[test]
+fn a_time_series_ends_at_its_data_with_headroom_and_a_legend() {
+    // The WiFi efficiency at 0 % loss: 100 % from 1.2 s to 127.6 s.
+    let pts: Vec<(f64, f64)> = (0..=105).map(|i| (1.2 + i as f64 * 1.2, 100.0)).collect();
+    let last_x = pts.last().unwrap().0;
+    let svg = line_chart_with(
+        "WiFi",
+        "simulated time (s)",
+        "efficiency (%)",
+        LineOptions {
+            y_range: Some((0.0, 110.0)),
+            x_at_data: true,
+            legend: true,
+        },
+        &[Series {
+            name: "robot 1",
+            points: &pts,
+        }],
+    );
+    check_chart(&svg);
+    let lines = polylines(&svg);
+    let right = lines[0].iter().map(|p| p.0).fold(f64::MIN, f64::max);
+    let left = lines[0].iter().map(|p| p.0).fold(f64::MAX, f64::min);
+    // The legend takes the right margin; the axis spans exactly the data's x range: the first
+    // and last points sit on the plot area's left and right edges (its clip rectangle).
+    let clip = svg
+        .split("<clipPath id=\"plot-area\"><rect ")
+        .nth(1)
+        .unwrap();
+    let attr = |name: &str| -> f64 {
+        clip.split(&format!("{name}=\""))
+            .nth(1)
+            .unwrap()
+            .split('"')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let (x0, x1) = (attr("x"), attr("x") + attr("width"));
+    assert!(
+        (left - x0).abs() < 0.01,
+        "first point at the axis start: {left} vs {x0}"
+    );
+    assert!(
+        (right - x1).abs() < 0.01,
+        "last point at the axis end: {right} vs {x1}"
+    );
+    // No tick label past the data (the axis used to run on to the next round tick).
+    let ticks: Vec<f64> = texts(&svg).iter().filter_map(|t| t.parse().ok()).collect();
+    assert!(ticks.iter().all(|&t| t <= last_x), "{ticks:?}");
+    // 100 % is drawn below the top border (y = 44), not on it.
+    assert!(
+        lines[0].iter().all(|p| p.1 > 44.0 + 10.0),
+        "{:?}",
+        &lines[0][..2]
+    );
+    assert!(
+        svg.contains("class=\"legend\""),
+        "a legend names the single series"
+    );
+    assert!(texts(&svg).contains(&"robot 1"));
 }

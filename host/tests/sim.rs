@@ -72,6 +72,15 @@ fn the_demo_plan_completes_with_no_fault() {
     let pairs = events(&records, "pair").count();
     assert_eq!(pairs, 4 + 2 + 4 + 1, "every pair of every bolt/unbolt step");
     assert!(executions(&records).values().all(|&n| n == 1));
+    // The paced clock keeps every tick within its slack, however busy the host (cargo runs
+    // tests in parallel), so the verdict is the robot's.
+    assert!(
+        s.max_tick_lateness_ms <= mmic_host::sim::PACE_SLACK_MS,
+        "ticks {} ms late",
+        s.max_tick_lateness_ms
+    );
+    assert!(!s.host_fell_behind());
+    assert!(report::plan_line(&s).starts_with("plan: completed, all 11 steps"));
     // The plots exist and have content.
     let svg = std::fs::read_to_string(out_dir("demo").join("wifi-efficiency.svg")).unwrap();
     assert!(svg.contains("<polyline"));
@@ -107,6 +116,42 @@ fn thirty_percent_wifi_loss_still_completes_and_runs_nothing_twice() {
         .filter(|&(seq, n)| seq != 0 && n > 1)
         .collect();
     assert_eq!(twice, vec![], "no command executed twice");
+    // The efficiency is what independent losses predict: an attempt is answered only when its
+    // command and the heartbeat both cross, (1 - 0.3)^2 = 49 %. Tolerance: 4 standard
+    // deviations of the binomial share over this run's attempts (for seed 7, about 170
+    // attempts: +/- 15 points); each direction's loss rate likewise around 30 %.
+    let (ok, n) = s.attempts;
+    let (p, sd) = report::expected_efficiency(0.3, n);
+    let share = ok as f64 / n as f64;
+    assert!(
+        (share - p).abs() <= 4.0 * sd,
+        "efficiency {share:.3} over {n} attempts, expected {p:.3} +/- 4 x {sd:.3}"
+    );
+    let w = report::wifi_crossings(&s).expect("packets logged");
+    assert_eq!(w.commands, n, "the server forwards each attempt once");
+    assert_eq!(
+        w.heartbeats,
+        w.commands - w.commands_lost,
+        "one heartbeat per delivered command"
+    );
+    for (lost, of) in [
+        (w.commands_lost, w.commands),
+        (w.heartbeats_lost, w.heartbeats),
+    ] {
+        let sd = (0.3 * 0.7 / of as f64).sqrt();
+        let rate = lost as f64 / of as f64;
+        assert!((rate - 0.3).abs() <= 4.0 * sd, "lost {lost}/{of}");
+    }
+    // The summary explains the figure.
+    let text = report::text(&s);
+    assert!(
+        text.contains("expected at 30% loss each way: (1 - 0.30)^2 = 49.0%"),
+        "{text}"
+    );
+    assert!(
+        text.contains("commands (") && text.contains("heartbeats ("),
+        "{text}"
+    );
     // Every command the ground reports accepted ran exactly once.
     let runs = executions(&records);
     for d in events(&records, "done") {
@@ -260,5 +305,131 @@ fn a_malformed_plan_file_is_refused_with_line_and_column() {
     assert!(
         err.contains("line 3, column 18: expected a state letter a..o (Table 5), found \"q\""),
         "{err}"
+    );
+}
+
+#[test]
+fn a_state_mismatch_on_the_robot_says_what_the_plan_expected_and_what_it_reported() {
+    // The library-level run does not trace the plan (`mmic sim` would refuse this file before
+    // sending anything): the robot starts in a, the plan claims b.
+    let cfg = SimConfig {
+        scale: 20.0,
+        ..SimConfig::with_steps(steps("mode operational\nreconfigure b -> n\n"))
+    };
+    let (s, _) = simulate("mismatch", cfg);
+    assert!(
+        matches!(
+            s.ends[0],
+            Some(PlanEnd::Refused {
+                step: 1,
+                refusal: mmic::refusal::Refusal::InitialStateMismatch,
+                ..
+            })
+        ),
+        "{:?}",
+        s.ends
+    );
+    let line = report::plan_line(&s);
+    assert!(
+        line.starts_with("plan: stopped at step 2 of 2 (line 2: reconfigure b -> n): refused (initial_state_mismatch)"),
+        "{line}"
+    );
+    assert!(
+        line.contains(
+            "the plan expected the robot in b (Yneg match); the robot has not been reconfigured \
+             since it started in a (Xneg match)"
+        ),
+        "{line}"
+    );
+    assert!(!line.contains("steps)"), "no stray step count: {line}");
+}
+
+/// Runs the `mmic` binary; returns (exit code, stdout, stderr).
+fn mmic(args: &[&str]) -> (i32, String, String) {
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_mmic"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn progress_names_the_start_state_and_never_runs_ahead_of_its_step() {
+    let dir = out_dir("progress");
+    let plan = dir.join("short.plan");
+    std::fs::write(
+        &plan,
+        "start a\nmode operational\nbolt 1\nreconfigure a -> m\nbolt 2\nmode standby\n",
+    )
+    .unwrap();
+    let out = dir.to_string_lossy().into_owned();
+    let (code, stdout, stderr) = mmic(&[
+        "sim",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--scale",
+        "20",
+        "--out",
+        &out,
+    ]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let mut started = 0;
+    let mut saw_start_state = false;
+    for line in stderr.lines() {
+        if let Some(rest) = line.split("] step ").nth(1) {
+            // A step header: "step k/N (line L): ...".
+            let k: usize = rest.split('/').next().unwrap().parse().unwrap();
+            assert_eq!(k, started + 1, "headers in order: {line}");
+            started = k;
+        } else if let Some(rest) = line.split("]   step ").nth(1) {
+            // A status line names the step that last started, never the next one.
+            let k: usize = rest.split('/').next().unwrap().parse().unwrap();
+            assert_eq!(k, started, "status ahead of its step: {line}\n{stderr}");
+            assert!(!line.contains("state start"), "{line}");
+            saw_start_state |= line.contains("state a (Xneg match) (start)");
+        }
+    }
+    assert_eq!(started, 5, "{stderr}");
+    assert!(
+        saw_start_state,
+        "the start state is shown before the first reconfiguration:\n{stderr}"
+    );
+}
+
+#[test]
+fn check_plan_refuses_a_step_that_does_not_fit_before_anything_runs() {
+    let dir = out_dir("check_plan");
+    let bad = dir.join("bad.plan");
+    std::fs::write(
+        &bad,
+        "mode operational\nreconfigure a -> m\nreconfigure b -> n\n",
+    )
+    .unwrap();
+    for extra in [&["--check-plan"][..], &[][..]] {
+        let mut args = vec![
+            "sim",
+            "--plan",
+            bad.to_str().unwrap(),
+            "--out",
+            dir.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let (code, stdout, stderr) = mmic(&args);
+        assert_eq!(code, 2, "{stdout}{stderr}");
+        assert!(
+            stderr.contains("line 3, column 13: this reconfiguration starts from b (Yneg match), but the robot is in m (Xpos match) here (since line 2)"),
+            "{stderr}"
+        );
+        assert!(stdout.is_empty(), "nothing ran: {stdout}");
+    }
+    let (code, stdout, _) = mmic(&["sim", "--check-plan"]);
+    assert_eq!(code, 0);
+    assert_eq!(
+        stdout.trim(),
+        "plan OK: 11 steps for robot 1, states a -> m -> b -> n"
     );
 }
