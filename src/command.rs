@@ -702,6 +702,24 @@ impl CommandKind {
         CommandKind::ClearFaults,
     ];
 
+    /// Whether commands of this kind move an actuator (an arm, a gripper, the hip, a bolter,
+    /// or several through a primitive or a reconfiguration): the commands a Stop blocks until
+    /// Reset (Table 1), that Table 7 refuses outside Operational (arm and hip excepted in Safed),
+    /// and that board A runs one at a time. A mode change is not one: it powers modules, and
+    /// entering Operational homes the servos as part of the mode. spec/modes.toml lists them
+    /// (`moving`), and a test holds this to it.
+    pub const fn moves(self) -> bool {
+        matches!(
+            self,
+            CommandKind::Arm
+                | CommandKind::Gripper
+                | CommandKind::Hip
+                | CommandKind::Bolter
+                | CommandKind::Primitive
+                | CommandKind::Reconfiguration
+        )
+    }
+
     /// snake_case name, as in spec/ and JSON.
     pub const fn name(self) -> &'static str {
         match self {

@@ -323,6 +323,8 @@ impl HipAngle {
     pub const TURN: u16 = 36000;
     /// 0.00°.
     pub const ZERO: HipAngle = HipAngle(0);
+    /// 180.00°: the hip straight, both sides in line (the robot's home and matched pose).
+    pub const STRAIGHT: HipAngle = HipAngle(18000);
 
     /// `cdeg` hundredths of a degree, refused at or above 360.00°.
     pub const fn new(cdeg: u16) -> Result<Self, RangeError> {

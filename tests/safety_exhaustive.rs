@@ -73,18 +73,6 @@ fn incoming() -> Vec<Option<Incoming>> {
     v
 }
 
-const fn moves(k: CommandKind) -> bool {
-    matches!(
-        k,
-        CommandKind::Arm
-            | CommandKind::Gripper
-            | CommandKind::Hip
-            | CommandKind::Bolter
-            | CommandKind::Primitive
-            | CommandKind::Reconfiguration
-    )
-}
-
 /// The mode Table 8 sends an Operational robot to for this set of faults, with no command.
 fn table8_mode(faults: Faults, in_motion: bool) -> (Mode, bool) {
     let safed = faults.iter().any(|f| fault_action(f).mode == Mode::Safed);
@@ -191,7 +179,7 @@ fn supervisor_properties_hold_on_the_whole_domain() {
                                 (Incoming::Command(cm), Answer::Accepted(a)) => {
                                     assert_eq!(*cm, a);
                                     let k = cm.kind();
-                                    if moves(k) {
+                                    if k.moves() {
                                         // Faults are handled first, so `out.mode` is the mode the command met
                                         // (a reconfiguration is accepted only with agreeing states, so it
                                         // never changes the mode itself).
@@ -237,7 +225,7 @@ fn supervisor_properties_hold_on_the_whole_domain() {
                                                 .contains(Fault::InitialStateMismatch));
                                         }
                                         Refusal::Stopped => {
-                                            assert!(s0.stopped() && moves(k), "{}", ctx())
+                                            assert!(s0.stopped() && k.moves(), "{}", ctx())
                                         }
                                         other => panic!("unexpected refusal {other:?}: {}", ctx()),
                                     }

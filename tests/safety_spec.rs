@@ -14,6 +14,7 @@ use std::collections::BTreeMap;
 
 #[derive(Deserialize)]
 struct Spec {
+    moving: Vec<String>,
     table7: BTreeMap<String, Vec<String>>,
     accepts: BTreeMap<String, Vec<String>>,
     power: Power,
@@ -75,6 +76,16 @@ fn module_name(m: Module) -> &'static str {
         Module::BolterA => "bolter_a",
         Module::BolterB => "bolter_b",
     }
+}
+
+#[test]
+fn the_moving_command_kinds_equal_spec() {
+    let got: Vec<&str> = CommandKind::ALL
+        .iter()
+        .filter(|k| k.moves())
+        .map(|k| k.name())
+        .collect();
+    assert_eq!(got, spec().moving, "spec/modes.toml `moving`");
 }
 
 #[test]

@@ -145,11 +145,20 @@ pub fn valid_packets() -> Vec<(PacketKind, &'static str, Vec<u8>)> {
 /// A byte of each packet whose value is out of its field's domain when set to `value`: the
 /// field near misses (the checksum is rewritten, so only the field check fails).
 fn field_miss(kind: PacketKind) -> (usize, u8) {
+    use core::mem::offset_of;
+    use mmic::wire::{
+        b_command::BCommandPacket, command::CommandPacket, heartbeat::HeartbeatPacket,
+        internal_heartbeat::InternalHeartbeatPacket,
+    };
     match kind {
-        PacketKind::Command => (5, 0x00),         // opcode 0: unassigned
-        PacketKind::Heartbeat => (63, 0x00),      // mode 0: no mode
-        PacketKind::InternalHeartbeat => (44, 2), // arm contracted: not a boolean
-        PacketKind::BCommand => (5, 0x20),        // flags: undefined bit 5
+        // Opcode 0: unassigned.
+        PacketKind::Command => (offset_of!(CommandPacket, command), 0x00),
+        // Mode 0: no mode.
+        PacketKind::Heartbeat => (offset_of!(HeartbeatPacket, mode), 0x00),
+        // Arm contracted 2: not a boolean.
+        PacketKind::InternalHeartbeat => (offset_of!(InternalHeartbeatPacket, arm_contracted), 2),
+        // Flags: undefined bit 5.
+        PacketKind::BCommand => (offset_of!(BCommandPacket, flags), 0x20),
     }
 }
 

@@ -5,7 +5,7 @@ use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
 use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
-use mmic::wire::{PacketKind, WireError};
+use mmic::wire::{PacketKind, Repr, WireError};
 
 /// Why a codec call failed.
 #[derive(Debug, thiserror::Error)]
@@ -88,46 +88,43 @@ fn packet_err(kind: PacketKind, bytes: &[u8], source: WireError) -> CodecError {
     }
 }
 
+/// Runs the generic function `$f::<R>(args)` with `R` the `Repr` of `$kind`: the one place
+/// the four kinds are listed.
+macro_rules! by_kind {
+    ($kind:expr, $f:ident($($arg:expr),*)) => {
+        match $kind {
+            PacketKind::Command => $f::<CommandRepr>($($arg),*),
+            PacketKind::Heartbeat => $f::<HeartbeatRepr>($($arg),*),
+            PacketKind::InternalHeartbeat => $f::<InternalHeartbeatRepr>($($arg),*),
+            PacketKind::BCommand => $f::<BCommandRepr>($($arg),*),
+        }
+    };
+}
+
 /// Encodes the JSON form of a `kind` packet to its bytes.
 pub fn encode(kind: PacketKind, json: &str) -> Result<Vec<u8>, CodecError> {
-    let err = |source| CodecError::Json { kind, source };
-    Ok(match kind {
-        PacketKind::Command => serde_json::from_str::<CommandRepr>(json)
-            .map_err(err)?
-            .to_bytes()
-            .to_vec(),
-        PacketKind::Heartbeat => serde_json::from_str::<HeartbeatRepr>(json)
-            .map_err(err)?
-            .to_bytes()
-            .to_vec(),
-        PacketKind::InternalHeartbeat => serde_json::from_str::<InternalHeartbeatRepr>(json)
-            .map_err(err)?
-            .to_bytes()
-            .to_vec(),
-        PacketKind::BCommand => serde_json::from_str::<BCommandRepr>(json)
-            .map_err(err)?
-            .to_bytes()
-            .to_vec(),
-    })
+    by_kind!(kind, encode_as(json))
+}
+
+fn encode_as<R: Repr + serde::de::DeserializeOwned>(json: &str) -> Result<Vec<u8>, CodecError> {
+    let repr: R = serde_json::from_str(json).map_err(|source| CodecError::Json {
+        kind: R::KIND,
+        source,
+    })?;
+    Ok(repr.to_bytes().as_ref().to_vec())
 }
 
 /// Decodes `bytes` as a `kind` packet to its JSON form (one line, every field).
 pub fn decode(kind: PacketKind, bytes: &[u8]) -> Result<String, CodecError> {
-    let json = match kind {
-        PacketKind::Command => serde_json::to_string(
-            &CommandRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
-        ),
-        PacketKind::Heartbeat => serde_json::to_string(
-            &HeartbeatRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
-        ),
-        PacketKind::InternalHeartbeat => serde_json::to_string(
-            &InternalHeartbeatRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
-        ),
-        PacketKind::BCommand => serde_json::to_string(
-            &BCommandRepr::parse(bytes).map_err(|e| packet_err(kind, bytes, e))?,
-        ),
-    };
-    json.map_err(|source| CodecError::Print { kind, source })
+    by_kind!(kind, decode_as(bytes))
+}
+
+fn decode_as<R: Repr + serde::Serialize>(bytes: &[u8]) -> Result<String, CodecError> {
+    let repr = R::parse(bytes).map_err(|e| packet_err(R::KIND, bytes, e))?;
+    serde_json::to_string(&repr).map_err(|source| CodecError::Print {
+        kind: R::KIND,
+        source,
+    })
 }
 
 /// Decodes a packet of whichever kind its header names; none if it is no valid packet.

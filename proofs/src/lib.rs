@@ -11,7 +11,8 @@
 //!
 //! ```
 //! use mmic::wire::command::CommandRepr;
-//! use mmic_proofs::{check_parse, crc16_bitwise, Repr};
+//! use mmic::wire::Repr;
+//! use mmic_proofs::{check_parse, crc16_bitwise};
 //!
 //! assert_eq!(crc16_bitwise(b"123456789"), 0x29b1); // the CRC-16/CCITT-FALSE check value
 //!
@@ -37,13 +38,14 @@ use mmic::mode::Mode;
 use mmic::motion::State;
 use mmic::refusal::Refusal;
 use mmic::units::{Axis, BoardNumber, Electrical, Gravity, HipAngle, PulseWidth, Sign};
-use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder, B_COMMAND_LEN};
-use mmic::wire::command::{CommandRepr, COMMAND_LEN};
+use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder};
+use mmic::wire::command::CommandRepr;
 use mmic::wire::deframer::{Deframed, Deframer, Frame};
 use mmic::wire::heartbeat::BolterAttempt;
-use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
+use mmic::wire::heartbeat::HeartbeatRepr;
 use mmic::wire::internal_heartbeat::BolterAux;
-use mmic::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
+use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
+pub use mmic::wire::Repr;
 use mmic::wire::{PacketKind, WireError, CHECKSUM_LEN, HEADER_LEN, MAX_PACKET_LEN};
 
 /// CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, no final xor), one bit at a
@@ -117,50 +119,29 @@ pub fn framing(kind: PacketKind, bytes: &[u8]) -> Framing {
     Framing::Sound
 }
 
-/// The four packet `Repr`s behind one interface, so that each property is written once.
-pub trait Repr: Sized + Copy + PartialEq + Debug {
-    /// Packet type.
-    const KIND: PacketKind;
-    /// Its length (`KIND.len()`).
-    const LEN: usize;
-    /// The packet as bytes.
-    type Bytes: AsRef<[u8]> + Debug;
-    /// `Repr::parse`.
-    fn parse(bytes: &[u8]) -> Result<Self, WireError>;
-    /// `Repr::to_bytes` (which calls `emit`).
-    fn to_bytes(&self) -> Self::Bytes;
-    /// A valid value built from arbitrary bytes (see [`Seed`]).
+/// A valid value of any packet, built from arbitrary bytes (see [`Seed`]): the one thing the
+/// harnesses need beyond the library's [`Repr`], so that each property is written once.
+pub trait Sample: Repr {
+    /// A valid value built from arbitrary bytes.
     fn sample(seed: &mut Seed<'_>) -> Self;
 }
 
-macro_rules! repr {
-    ($t:ty, $kind:ident, $len:ident, $sample:ident) => {
-        impl Repr for $t {
-            const KIND: PacketKind = PacketKind::$kind;
-            const LEN: usize = $len;
-            type Bytes = [u8; $len];
-            fn parse(bytes: &[u8]) -> Result<Self, WireError> {
-                <$t>::parse(bytes)
-            }
-            fn to_bytes(&self) -> [u8; $len] {
-                <$t>::to_bytes(self)
-            }
+macro_rules! sample {
+    ($($t:ty => $sample:ident;)*) => {$(
+        impl Sample for $t {
             fn sample(seed: &mut Seed<'_>) -> Self {
                 $sample(seed)
             }
         }
-    };
+    )*};
 }
 
-repr!(CommandRepr, Command, COMMAND_LEN, sample_command);
-repr!(HeartbeatRepr, Heartbeat, HEARTBEAT_LEN, sample_heartbeat);
-repr!(
-    InternalHeartbeatRepr,
-    InternalHeartbeat,
-    INTERNAL_HEARTBEAT_LEN,
-    sample_internal_heartbeat
-);
-repr!(BCommandRepr, BCommand, B_COMMAND_LEN, sample_b_command);
+sample! {
+    CommandRepr => sample_command;
+    HeartbeatRepr => sample_heartbeat;
+    InternalHeartbeatRepr => sample_internal_heartbeat;
+    BCommandRepr => sample_b_command;
+}
 
 /// Arbitrary bytes read as the choices that build a valid value: every byte is folded into
 /// its field's domain (a pulse width is `500 + raw % 2001`, an optional pair is none for
@@ -431,7 +412,7 @@ pub fn check_round_trip<R: Repr>(body: &[u8]) -> bool {
 /// the checksum is rewritten, and the near miss must pass [`check_parse`]: accepted
 /// canonically, or refused by a field or command check. Returns whether the edited packet was
 /// accepted.
-pub fn check_round_trip_near_valid<R: Repr>(seed: &[u8], edits: &[[u8; 2]]) -> bool {
+pub fn check_round_trip_near_valid<R: Sample>(seed: &[u8], edits: &[[u8; 2]]) -> bool {
     let repr = R::sample(&mut Seed::new(seed));
     let bytes = repr.to_bytes();
     assert_eq!(R::parse(bytes.as_ref()), Ok(repr), "parse(emit(x)) != x");

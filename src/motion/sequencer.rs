@@ -73,10 +73,7 @@ impl Targets {
         Targets {
             arm: [ServoTarget::Contract; 2],
             gripper: [ServoTarget::Extend; 2],
-            hip: match HipAngle::new(18000) {
-                Ok(a) => a,
-                Err(_) => HipAngle::ZERO,
-            },
+            hip: HipAngle::STRAIGHT,
         }
     }
 

@@ -33,9 +33,7 @@ use super::exactly_once::{Admission, CommandLog};
 use crate::bolter::{
     self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals,
 };
-use crate::command::{
-    preset_angle, seq_slot, BolterCommand, Command, CommandKind, HipTarget, ServoTarget,
-};
+use crate::command::{preset_angle, seq_slot, BolterCommand, Command, HipTarget, ServoTarget};
 use crate::control::hip::{self, HipController};
 use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::faults::{Fault, Faults};
@@ -150,10 +148,7 @@ impl Inputs {
                 v_reg: 7_400,
                 i_bo: 0,
             },
-            hip: match HipAngle::new(18000) {
-                Ok(a) => a,
-                Err(_) => HipAngle::ZERO,
-            },
+            hip: HipAngle::STRAIGHT,
             gravity: None,
             arm_contracted: true,
             bolter: Signals {
@@ -282,19 +277,6 @@ pub struct BoardA {
     moving: bool,
     pair: Option<(crate::command::BolterPair, u8)>,
     still_since: Option<u32>,
-}
-
-/// Commands that move something.
-const fn moves(kind: CommandKind) -> bool {
-    matches!(
-        kind,
-        CommandKind::Arm
-            | CommandKind::Gripper
-            | CommandKind::Hip
-            | CommandKind::Bolter
-            | CommandKind::Primitive
-            | CommandKind::Reconfiguration
-    )
 }
 
 impl BoardA {
@@ -628,7 +610,7 @@ impl BoardA {
         let kind = c.kind();
         // Board-level checks the supervisor does not make: one motion at a time, and a
         // primitive must be a move from the state the robot is in.
-        if moves(kind) && in_motion && self.sup.mode() == Mode::Operational {
+        if kind.moves() && in_motion && self.sup.mode() == Mode::Operational {
             return Received::Refuse(repr.seq, c, Refusal::Busy);
         }
         if let Command::Primitive(pr) = c {

@@ -132,18 +132,11 @@ pub struct PlanRunner {
     polling: bool,
 }
 
-/// Does this command start a motion that must finish before the next step?
-pub const fn moves(c: &Command) -> bool {
-    matches!(
-        c.kind(),
-        CommandKind::Arm
-            | CommandKind::Gripper
-            | CommandKind::Hip
-            | CommandKind::Bolter
-            | CommandKind::Primitive
-            | CommandKind::Reconfiguration
-            | CommandKind::Mode
-    )
+/// Does this command start something that must settle before the next step? Every command
+/// that moves an actuator ([`CommandKind::moves`]), and a mode change too: entering
+/// Operational drives the servos home, leaving it powers them down.
+pub const fn settles_after(c: &Command) -> bool {
+    c.kind().moves() || matches!(c.kind(), CommandKind::Mode)
 }
 
 /// The heartbeat shows no motion: the last reconfiguration complete (if any), no bolter
@@ -264,7 +257,7 @@ impl PlanRunner {
                 })
             }
             (Phase::Sending, Outcome::Accepted) => {
-                if moves(&d.command) {
+                if settles_after(&d.command) {
                     let need = matches!(d.command.kind(), CommandKind::Bolter) as u16;
                     let mode_step = matches!(d.command.kind(), CommandKind::Mode);
                     self.phase = Phase::Settling {

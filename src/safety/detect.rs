@@ -79,10 +79,7 @@ impl Default for Config {
                 gripper: 1500,
                 bolter: 2000,
             },
-            hip_home: match HipAngle::new(18000) {
-                Ok(a) => a,
-                Err(_) => HipAngle::ZERO,
-            },
+            hip_home: HipAngle::STRAIGHT,
             hip_tolerance: 1000,
         }
     }

@@ -35,7 +35,7 @@
 
 use super::module_set::ModuleSet;
 use super::policy::{accepts, fault_action, is_condition, powered, regulator_on};
-use crate::command::{Command, CommandKind, PowerTarget};
+use crate::command::{Command, PowerTarget};
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
 use crate::refusal::Refusal;
@@ -133,19 +133,6 @@ impl Default for Supervisor {
     fn default() -> Self {
         Self::new()
     }
-}
-
-/// Is this a command that moves something (refused while stopped)?
-const fn moves(kind: CommandKind) -> bool {
-    matches!(
-        kind,
-        CommandKind::Arm
-            | CommandKind::Gripper
-            | CommandKind::Hip
-            | CommandKind::Bolter
-            | CommandKind::Primitive
-            | CommandKind::Reconfiguration
-    )
 }
 
 impl Supervisor {
@@ -257,7 +244,7 @@ impl Supervisor {
         if !accepts(self.mode, kind) {
             return Answer::Refused(Refusal::NotAllowedInMode);
         }
-        if self.stopped && moves(kind) {
+        if self.stopped && kind.moves() {
             return Answer::Refused(Refusal::Stopped);
         }
         match cmd {

@@ -351,10 +351,7 @@ pub struct HeartbeatRepr {
 impl Default for HeartbeatRepr {
     /// Robot 1 at startup: Standby, no fault, servos centred, hip at 180°.
     fn default() -> Self {
-        let straight = match HipAngle::new(18000) {
-            Ok(a) => a,
-            Err(_) => HipAngle::ZERO,
-        };
+        let straight = HipAngle::STRAIGHT;
         HeartbeatRepr {
             board: BoardNumber::ONE,
             hip_target: straight,

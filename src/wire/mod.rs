@@ -194,6 +194,66 @@ impl WireError {
     }
 }
 
+/// What every packet's typed form offers, so that code written once serves all four (and any
+/// later) packets: tools that encode or decode by kind, fuzz targets, and the property
+/// harnesses in `proofs/`. The kind gives the name, header and length
+/// ([`PacketKind::name`], [`PacketKind::header`], [`PacketKind::len`]).
+///
+/// ```
+/// use mmic::wire::{command::CommandRepr, Repr};
+/// use mmic::command::Command;
+/// use mmic::units::BoardNumber;
+///
+/// fn round_trip<R: Repr>(r: R) -> bool {
+///     R::parse(r.to_bytes().as_ref()) == Ok(r)
+/// }
+/// let stop = CommandRepr { board: BoardNumber::ONE, command: Command::Stop, seq: 0 };
+/// assert!(round_trip(stop));
+/// assert_eq!(<CommandRepr as Repr>::KIND.name(), "command");
+/// ```
+pub trait Repr: Sized + Copy + PartialEq + fmt::Debug {
+    /// Which packet this is.
+    const KIND: PacketKind;
+    /// Its fixed length in bytes (`KIND.len()`).
+    const LEN: usize;
+    /// The packet's bytes: `[u8; LEN]`.
+    type Bytes: AsRef<[u8]> + AsMut<[u8]> + Copy + fmt::Debug;
+    /// Checks length, header, checksum and every field, in that order; the first failure is
+    /// the error.
+    fn parse(bytes: &[u8]) -> Result<Self, WireError>;
+    /// Writes the whole packet into `out`: header, fields, checksum.
+    fn emit(&self, out: &mut Self::Bytes);
+    /// The packet as new bytes.
+    fn to_bytes(&self) -> Self::Bytes;
+}
+
+macro_rules! impl_repr {
+    ($($t:ty => $kind:ident, $len:expr;)*) => {$(
+        impl Repr for $t {
+            const KIND: PacketKind = PacketKind::$kind;
+            const LEN: usize = $len;
+            type Bytes = [u8; $len];
+            fn parse(bytes: &[u8]) -> Result<Self, WireError> {
+                <$t>::parse(bytes)
+            }
+            fn emit(&self, out: &mut [u8; $len]) {
+                <$t>::emit(self, out)
+            }
+            fn to_bytes(&self) -> [u8; $len] {
+                <$t>::to_bytes(self)
+            }
+        }
+        const _: () = assert!(<$t as Repr>::LEN == PacketKind::$kind.len());
+    )*};
+}
+
+impl_repr! {
+    command::CommandRepr => Command, command::COMMAND_LEN;
+    heartbeat::HeartbeatRepr => Heartbeat, heartbeat::HEARTBEAT_LEN;
+    internal_heartbeat::InternalHeartbeatRepr => InternalHeartbeat, internal_heartbeat::INTERNAL_HEARTBEAT_LEN;
+    b_command::BCommandRepr => BCommand, b_command::B_COMMAND_LEN;
+}
+
 /// A packet layout: fixed size, no padding, byte-aligned, readable from any bytes.
 pub trait Packet: FromBytes + KnownLayout + Immutable + Unaligned + Sized {
     /// Which packet this is.
