@@ -7,7 +7,7 @@
 //! for bad input (unknown kind or state, invalid JSON, malformed hex) and usage errors (clap's
 //! own code); [`EXIT_IO`] 3 when a page cannot be written or stdout is closed.
 
-use crate::codec::{self, CodecError};
+use crate::codec;
 use crate::{motion, pages};
 use clap::{Parser, Subcommand};
 use mmic::motion::State;
@@ -15,16 +15,8 @@ use mmic::wire::PacketKind;
 use std::io::Write;
 use std::path::PathBuf;
 
-/// Success.
-pub const EXIT_OK: u8 = 0;
-/// The bytes are not a valid packet.
-pub const EXIT_INVALID_PACKET: u8 = 1;
-/// Bad input: unknown kind or state, invalid JSON, malformed hex, usage error.
-pub const EXIT_INPUT: u8 = 2;
-/// A file could not be written, or stdout is closed.
-pub const EXIT_IO: u8 = 3;
-/// `mmic sim`: the host fell too far behind the simulated clock for the outcome to count.
-pub const EXIT_HOST: u8 = 4;
+pub use crate::error::CliError;
+pub use crate::exit::{EXIT_HOST, EXIT_INPUT, EXIT_INVALID_PACKET, EXIT_IO, EXIT_OK};
 
 const AFTER_HELP: &str = "\
 Units: servo pulse widths in µs (500..=2500), hip angles in 0.01° (0..=35999, 9000 = 90.00°),
@@ -144,8 +136,8 @@ pub enum Cmd {
     },
     /// Run the host simulator: opsUI, server board, boards A and B and a plant model over
     /// real transports, driving a plan (the built-in demo without --plan).
-    #[command(long_about = SIM_HELP, after_help = SIM_AFTER)]
-    Sim(SimArgs),
+    #[command(long_about = crate::simcli::SIM_HELP, after_help = crate::simcli::SIM_AFTER)]
+    Sim(crate::simcli::SimArgs),
     /// Scale benchmark: N simulated robots, each with its own server link, against one ground
     /// process; reports the largest N for which every heartbeat arrives within the timeout.
     #[command(after_help = "Example: mmic bench --max 64 --seconds 30")]
@@ -170,84 +162,6 @@ pub enum Cmd {
     },
 }
 
-const SIM_HELP: &str = "\
-Run the host simulator. The four nodes of the paper's Figure 3 run the real mmic library:
-the opsUI plan runner and the server board talk over an OS pipe (the RS232 line), the server
-board connects to board A over TCP on loopback for each command (the WiFi link), boards A and
-B talk over OS pipes (the wired serial line), and a plant model moves the servos, draws
-currents, drains the battery and locks fasteners with the paper's Figure 10 probabilities.
-
-Live progress goes to stderr; at the end a summary is printed, the JSON-lines log of every
-packet and event is written (OUT/sim.jsonl), and two SVG plots: OUT/wifi-efficiency.svg
-(Figure 11 analogue) and OUT/bolting-attempts.svg (Figure 10 analogue).";
-
-const SIM_AFTER: &str = "\
-Examples:
-  mmic sim                                   the built-in demo plan (host/plans/demo.plan)
-  mmic sim --plan my.plan --scale 20
-  mmic sim --wifi-loss 0.3                   30 % of WiFi packets lost, each way
-  mmic sim --low-battery-at 40 --overcurrent-at 25 --cut-b-at 60   (seconds)
-
-Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
-2 bad arguments or a malformed plan file, or a step that does not fit the robot's state
-(line and column are given); 3 an I/O error; 4 the host fell so far behind the simulated
-clock that the outcome may be the host's (the paced clock prevents this: it waits for the
-slowest node, so a busy host slows the run down instead).";
-
-/// Arguments of `mmic sim`.
-#[derive(Debug, clap::Args)]
-pub struct SimArgs {
-    /// Plan file (format: see host/plans/demo.plan); the built-in demo without it.
-    #[arg(long, value_name = "FILE")]
-    pub plan: Option<PathBuf>,
-    /// Simulated seconds per wall second.
-    #[arg(long, default_value_t = 10.0)]
-    pub scale: f64,
-    /// Seed for losses and fastener locks.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// WiFi packet loss, each direction, 0..1.
-    #[arg(long, default_value_t = 0.0, value_parser = probability)]
-    pub wifi_loss: f64,
-    /// opsUI <-> server serial packet loss, 0..1.
-    #[arg(long, default_value_t = 0.0, value_parser = probability)]
-    pub serial_loss: f64,
-    /// Board A <-> board B serial packet loss, 0..1.
-    #[arg(long, default_value_t = 0.0, value_parser = probability)]
-    pub ab_loss: f64,
-    /// The battery sags below 10 V from this simulated second on.
-    #[arg(long, value_name = "S")]
-    pub low_battery_at: Option<f64>,
-    /// Arm A hits an obstacle (3.5 A for 0.5 s) at this simulated second.
-    #[arg(long, value_name = "S")]
-    pub overcurrent_at: Option<f64>,
-    /// Board B is cut off from board A at this simulated second.
-    #[arg(long, value_name = "S")]
-    pub cut_b_at: Option<f64>,
-    /// Give up after this many simulated seconds.
-    #[arg(long, default_value_t = 900.0)]
-    pub max_seconds: f64,
-    /// Directory for the log and the plots.
-    #[arg(long, value_name = "DIR", default_value = "target/sim")]
-    pub out: PathBuf,
-    /// No live progress.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Parse the plan and follow the robot's state through it, then exit without running:
-    /// a step that does not fit the state is reported with its line and column.
-    #[arg(long)]
-    pub check_plan: bool,
-}
-
-fn probability(s: &str) -> Result<f64, String> {
-    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
-    if (0.0..=1.0).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!("{v} is not a probability in 0..=1"))
-    }
-}
-
 /// The command line, with the help texts computed from the library (the map's legend).
 pub fn command() -> clap::Command {
     <Cli as clap::CommandFactory>::command().mut_subcommand("map", |c| {
@@ -270,89 +184,6 @@ pub fn parse_kind(name: &str) -> Result<PacketKind, CliError> {
     PacketKind::from_name(name).ok_or_else(|| CliError::UnknownKind {
         name: name.to_string(),
     })
-}
-
-/// Why `mmic` failed.
-#[derive(Debug, thiserror::Error)]
-pub enum CliError {
-    /// The packet kind is not one of the four names.
-    #[error(
-        "unknown packet kind {name:?}; expected one of: command, heartbeat, internal-heartbeat, b-command"
-    )]
-    UnknownKind {
-        /// What was given.
-        name: String,
-    },
-    /// The state is not a Table 5 letter.
-    #[error("unknown state {text:?}: expected a Table 5 letter a..o")]
-    UnknownState {
-        /// What was given.
-        text: String,
-    },
-    /// Encoding or decoding failed.
-    #[error(transparent)]
-    Codec(#[from] CodecError),
-    /// A page could not be written.
-    #[error("cannot write {}: {source}", path.display())]
-    Write {
-        /// The file or directory.
-        path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
-    },
-    /// The plan file could not be read.
-    #[error("cannot read {}: {source}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
-    },
-    /// The plan file is malformed.
-    #[error("{}: {error}", path.display())]
-    Plan {
-        /// The file.
-        path: PathBuf,
-        /// Where and why.
-        error: crate::plan::PlanError,
-    },
-    /// The simulation failed (transport set-up).
-    #[error("simulation failed: {0}")]
-    Sim(#[source] std::io::Error),
-    /// The plan did not complete.
-    #[error("the plan did not complete: {0}")]
-    Incomplete(String),
-    /// The host fell so far behind the simulated clock that the run's timeouts may be the
-    /// host's, not the robot's (an unpaced run on a loaded machine).
-    #[error(
-        "the host fell behind: a board tick started {late_ms} ms (simulated) late, beyond what \
-         the firmware's timers tolerate, so this run's outcome is not the robot's; rerun with a \
-         smaller --scale"
-    )]
-    HostBehind {
-        /// The latest tick, simulated ms.
-        late_ms: u32,
-    },
-    /// Standard output or error is closed.
-    #[error("cannot write output: {0}")]
-    Output(#[source] std::io::Error),
-}
-
-impl CliError {
-    /// The process exit code (see the module docs).
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            CliError::Codec(e) => e.exit_code(),
-            CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
-            CliError::Plan { .. } => EXIT_INPUT,
-            CliError::Incomplete(_) => 1,
-            CliError::HostBehind { .. } => EXIT_HOST,
-            CliError::Write { .. }
-            | CliError::Output(_)
-            | CliError::Read { .. }
-            | CliError::Sim(_) => EXIT_IO,
-        }
-    }
 }
 
 /// Runs one command: results on `out`, progress notes (`spec --write`) on `log`.

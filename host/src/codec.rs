@@ -1,6 +1,6 @@
 //! JSON ⇄ packet bytes for the four packet kinds, and hex parsing with positioned errors.
 
-use crate::cli::{EXIT_INPUT, EXIT_INVALID_PACKET};
+use crate::exit::{EXIT_INPUT, EXIT_INVALID_PACKET};
 use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;

@@ -4,6 +4,8 @@
 
 pub mod cli;
 pub mod codec;
+pub mod error;
+pub mod exit;
 pub mod motion;
 pub mod pages;
 pub mod plan;

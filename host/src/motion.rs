@@ -1,6 +1,6 @@
 //! `mmic plan` and `mmic map`: the motion library's plans and map, as text and JSON.
 
-use crate::cli::CliError;
+use crate::error::CliError;
 use mmic::motion::{map, plan, State};
 use serde::Serialize;
 

@@ -1,6 +1,6 @@
 //! `mmic sim` and `mmic bench`: argument handling around [`crate::sim`].
 
-use crate::cli::{CliError, SimArgs};
+use crate::error::CliError;
 use crate::sim::{self, report, SimConfig};
 use std::io::Write;
 use std::path::PathBuf;
@@ -9,12 +9,92 @@ fn ms(s: Option<f64>) -> Option<u32> {
     s.map(|s| (s.max(0.0) * 1000.0) as u32)
 }
 
+/// `mmic sim --help`'s description.
+pub const SIM_HELP: &str = "\
+Run the host simulator. The four nodes of the paper's Figure 3 run the real mmic library:
+the opsUI plan runner and the server board talk over an OS pipe (the RS232 line), the server
+board connects to board A over TCP on loopback for each command (the WiFi link), boards A and
+B talk over OS pipes (the wired serial line), and a plant model moves the servos, draws
+currents, drains the battery and locks fasteners with the paper's Figure 10 probabilities.
+
+Live progress goes to stderr; at the end a summary is printed, the JSON-lines log of every
+packet and event is written (OUT/sim.jsonl), and two SVG plots: OUT/wifi-efficiency.svg
+(Figure 11 analogue) and OUT/bolting-attempts.svg (Figure 10 analogue).";
+
+/// `mmic sim --help`'s examples and exit codes.
+pub const SIM_AFTER: &str = "\
+Examples:
+  mmic sim                                   the built-in demo plan (host/plans/demo.plan)
+  mmic sim --plan my.plan --scale 20
+  mmic sim --wifi-loss 0.3                   30 % of WiFi packets lost, each way
+  mmic sim --low-battery-at 40 --overcurrent-at 25 --cut-b-at 60   (seconds)
+
+Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
+2 bad arguments or a malformed plan file, or a step that does not fit the robot's state
+(line and column are given); 3 an I/O error; 4 the host fell so far behind the simulated
+clock that the outcome may be the host's (the paced clock prevents this: it waits for the
+slowest node, so a busy host slows the run down instead).";
+
+/// Arguments of `mmic sim`.
+#[derive(Debug, clap::Args)]
+pub struct SimArgs {
+    /// Plan file (format: see host/plans/demo.plan); the built-in demo without it.
+    #[arg(long, value_name = "FILE")]
+    pub plan: Option<PathBuf>,
+    /// Simulated seconds per wall second.
+    #[arg(long, default_value_t = 10.0)]
+    pub scale: f64,
+    /// Seed for losses and fastener locks.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// WiFi packet loss, each direction, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub wifi_loss: f64,
+    /// opsUI <-> server serial packet loss, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub serial_loss: f64,
+    /// Board A <-> board B serial packet loss, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub ab_loss: f64,
+    /// The battery sags below 10 V from this simulated second on.
+    #[arg(long, value_name = "S")]
+    pub low_battery_at: Option<f64>,
+    /// Arm A hits an obstacle (3.5 A for 0.5 s) at this simulated second.
+    #[arg(long, value_name = "S")]
+    pub overcurrent_at: Option<f64>,
+    /// Board B is cut off from board A at this simulated second.
+    #[arg(long, value_name = "S")]
+    pub cut_b_at: Option<f64>,
+    /// Give up after this many simulated seconds.
+    #[arg(long, default_value_t = 900.0)]
+    pub max_seconds: f64,
+    /// Directory for the log and the plots.
+    #[arg(long, value_name = "DIR", default_value = "target/sim")]
+    pub out: PathBuf,
+    /// No live progress.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Parse the plan and follow the robot's state through it, then exit without running:
+    /// a step that does not fit the state is reported with its line and column.
+    #[arg(long)]
+    pub check_plan: bool,
+}
+
+fn probability(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not a probability in 0..=1"))
+    }
+}
+
 /// The plan `mmic sim` runs (the built-in demo without `--plan`), with its name for errors.
 fn load_plan(a: &SimArgs) -> Result<(PathBuf, crate::plan::Plan), CliError> {
     let (path, text) = match &a.plan {
         None => (
             PathBuf::from("host/plans/demo.plan (built in)"),
-            report::DEMO_PLAN.to_string(),
+            sim::DEMO_PLAN.to_string(),
         ),
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|source| CliError::Read {
@@ -57,7 +137,7 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
         .map_err(CliError::Output)?;
         return Ok(());
     }
-    let steps = report::steps_of(&plan);
+    let steps = sim::steps_of(&plan);
     std::fs::create_dir_all(&a.out).map_err(|source| CliError::Write {
         path: a.out.clone(),
         source,

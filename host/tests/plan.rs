@@ -489,7 +489,7 @@ fn a_start_header_round_trips_and_the_state_is_traced_through_the_plan() {
         ]
     );
     // The demo plan says where it starts, and traces through three voxels.
-    let demo = plan::parse(mmic_host::sim::report::DEMO_PLAN).unwrap();
+    let demo = plan::parse(mmic_host::sim::DEMO_PLAN).unwrap();
     assert_eq!(demo.start, Some(State::A));
     let ends: Vec<State> = demo
         .trace(State::A)

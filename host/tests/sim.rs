@@ -53,7 +53,7 @@ fn executions(records: &[Value]) -> BTreeMap<u64, u32> {
 }
 
 fn steps(text: &str) -> Vec<mmic_host::sim::SimStep> {
-    report::steps_of(&plan::parse(text).unwrap())
+    mmic_host::sim::steps_of(&plan::parse(text).unwrap())
 }
 
 #[test]
@@ -285,9 +285,9 @@ fn low_battery_during_a_motion_enters_standby_only_after_the_motion_completes() 
 
 #[test]
 fn the_demo_plan_parses() {
-    let p = plan::parse(report::DEMO_PLAN).unwrap();
+    let p = plan::parse(mmic_host::sim::DEMO_PLAN).unwrap();
     assert!(p.steps.len() >= 8);
-    assert_eq!(report::demo_steps().len(), p.steps.len());
+    assert_eq!(mmic_host::sim::demo_steps().len(), p.steps.len());
 }
 
 #[test]

@@ -243,6 +243,22 @@ pub struct Outputs {
 }
 
 impl Outputs {
+    /// Nothing driven, nothing to send, no event.
+    fn empty() -> Outputs {
+        Outputs {
+            hip: None,
+            arm: None,
+            gripper: None,
+            regulator: false,
+            bolter: Drive::Idle,
+            mux: MuxLines::default(),
+            to_b: None,
+            heartbeat: None,
+            events: heapless::Vec::new(),
+            events_lost: 0,
+        }
+    }
+
     fn push(&mut self, e: Event) {
         if self.events.push(e).is_err() {
             self.events_lost = self.events_lost.saturating_add(1);
@@ -382,23 +398,45 @@ impl BoardA {
         }
     }
 
-    /// One tick at `now` (ms, wrapping).
+    /// One tick at `now` (ms, wrapping), in phases that read in order: take board B's report,
+    /// advance the motion and the bolting, detect the fault conditions, take the command
+    /// through the exactly-once log, let the supervisor judge it against the faults, answer,
+    /// drive the outputs.
     pub fn tick(&mut self, now: u32, inp: &Inputs) -> Outputs {
-        let mut out = Outputs {
-            hip: None,
-            arm: None,
-            gripper: None,
-            regulator: false,
-            bolter: Drive::Idle,
-            mux: MuxLines::default(),
-            to_b: None,
-            heartbeat: None,
-            events: heapless::Vec::new(),
-            events_lost: 0,
-        };
-        // Board B's report.
+        let mut out = Outputs::empty();
+        self.ingest_b(now, inp.from_b, &mut out);
+        // Motion and bolting advance first, so the supervisor sees whether they still run.
+        let fb = self.feedback(inp.hip, inp.arm_contracted);
+        let events = self.advance(now, &fb, inp.arm_contracted, &mut out);
+        // Whether anything moves, judged on the targets the motion just set.
+        let in_motion = self.moving_now(&self.feedback(inp.hip, inp.arm_contracted));
+        self.moving = in_motion;
+        let conditions = self.detect(now, inp, in_motion);
+        let taken = self.take_command(inp.command, in_motion, &mut out);
+        let s = self.supervise(
+            now,
+            inp,
+            conditions.union(events),
+            taken,
+            in_motion,
+            &mut out,
+        );
+        self.drive(now, inp, &s, &mut out);
+        if taken.answer.is_some() {
+            out.heartbeat = Some(self.heartbeat(inp, &s.faults).to_bytes());
+        }
+        out
+    }
+
+    /// Board B's report: refreshes the communication monitor and what A knows of side B.
+    fn ingest_b(
+        &mut self,
+        now: u32,
+        from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
+        out: &mut Outputs,
+    ) {
         self.comm.tick(now);
-        if let Some(bytes) = inp.from_b {
+        if let Some(bytes) = from_b {
             match InternalHeartbeatRepr::parse(&bytes) {
                 Ok(hb) => {
                     self.comm.heartbeat(now, hb.command_received);
@@ -408,12 +446,20 @@ impl BoardA {
                 Err(e) => out.push(Event::Rejected(e)),
             }
         }
-        let fb = self.feedback(inp.hip, inp.arm_contracted);
+    }
 
-        // Motion and bolting advance first, so the supervisor sees whether they still run.
-        let mut events_faults = Faults::EMPTY;
+    /// Advances the reconfiguration, the bolting and the arm contraction check; returns the
+    /// faults they raised this tick (events, not conditions).
+    fn advance(
+        &mut self,
+        now: u32,
+        fb: &Feedback,
+        arm_contracted: bool,
+        out: &mut Outputs,
+    ) -> Faults {
+        let mut faults = Faults::EMPTY;
         if let Some(mut r) = self.runner {
-            match r.step(now, &fb) {
+            match r.step(now, fb) {
                 RunStatus::Running => {
                     self.targets = r.targets();
                     self.runner = Some(r);
@@ -428,25 +474,27 @@ impl BoardA {
                 RunStatus::Failed(f) => {
                     self.tracked = None;
                     self.runner = None;
-                    events_faults = events_faults.with(f);
+                    faults = faults.with(f);
                 }
             }
         }
-        self.bolting(now, &mut out, &mut events_faults);
+        self.bolting(now, out, &mut faults);
         // Arm contraction check (Table 8): when a commanded contraction of arm A ends.
         if self.contracting && self.arm.done() {
             self.contracting = false;
-            if detect::arm_contraction_fault(true, inp.arm_contracted) {
-                events_faults = events_faults.with(Fault::ArmNotContracted);
+            if detect::arm_contraction_fault(true, arm_contracted) {
+                faults = faults.with(Fault::ArmNotContracted);
             }
         }
+        faults
+    }
 
-        // Conditions holding now.
+    /// The fault conditions holding now: overcurrent (the idle check once the robot has been
+    /// still for `idle_settle_ms`), low battery, lost communication with board B.
+    fn detect(&mut self, now: u32, inp: &Inputs, in_motion: bool) -> Faults {
         let e_b = self.b.electrical_b;
         let mut conditions =
             detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, &e_b);
-        let in_motion = self.moving_now(&self.feedback(inp.hip, inp.arm_contracted));
-        self.moving = in_motion;
         // The idle check waits until the robot has been still for `idle_settle_ms`: currents
         // sampled while the last motion ended (still in the moving averages, and B's report
         // is up to a period old) are no fault.
@@ -474,37 +522,66 @@ impl BoardA {
         if self.comm.lost(&self.cfg.safety) {
             conditions = conditions.with(Fault::InternalCommLoss);
         }
+        conditions
+    }
 
-        // The command, through the exactly-once log.
-        let mut incoming = None;
-        let mut answer_seq = None;
-        if let Some(bytes) = inp.command {
-            match self.receive(&bytes, in_motion) {
-                Received::Ignore(e) => out.push(e),
-                Received::Answer(ev) => {
-                    // A copy: byte 62 reports the outcome of the command bytes 57-58 name.
-                    out.push(ev);
-                    self.refusal = self.log.last().1;
-                    answer_seq = Some(0);
-                }
-                Received::Run(seq, inc) => {
-                    incoming = Some(inc);
-                    answer_seq = Some(seq);
-                }
-                Received::Refuse(seq, command, r) => {
-                    self.log.record(seq, Some(r));
-                    self.refusal = Some(r);
-                    out.push(Event::Executed {
-                        seq,
-                        command,
-                        refusal: Some(r),
-                    });
-                    answer_seq = Some(seq);
-                }
+    /// The command packet of this tick, through the exactly-once log: what goes to the
+    /// supervisor, and which number the heartbeat answers.
+    fn take_command(
+        &mut self,
+        command: Option<[u8; COMMAND_LEN]>,
+        in_motion: bool,
+        out: &mut Outputs,
+    ) -> Taken {
+        let mut taken = Taken::default();
+        let Some(bytes) = command else {
+            return taken;
+        };
+        match self.receive(&bytes, in_motion) {
+            Received::Ignore(e) => out.push(e),
+            Received::Answer(ev) => {
+                // A copy: byte 62 reports the outcome of the command bytes 57-58 name.
+                out.push(ev);
+                self.refusal = self.log.last().1;
+                taken.answer = Some(0);
+            }
+            Received::Run(seq, inc) => {
+                taken.incoming = Some(inc);
+                taken.answer = Some(seq);
+            }
+            Received::Refuse(seq, command, r) => {
+                self.settle(seq, command, Some(r), out);
+                taken.answer = Some(seq);
             }
         }
+        taken
+    }
+
+    /// Writes a command's outcome: into the exactly-once log, the heartbeat's refusal byte and
+    /// the events. The one place a command number is settled.
+    fn settle(&mut self, seq: u16, command: Command, refusal: Option<Refusal>, out: &mut Outputs) {
+        self.log.record(seq, refusal);
+        self.refusal = refusal;
+        out.push(Event::Executed {
+            seq,
+            command,
+            refusal,
+        });
+    }
+
+    /// The supervisor's step over this tick's faults and command; applies its stop and home
+    /// orders, settles and dispatches the command, reports mode and fault changes.
+    fn supervise(
+        &mut self,
+        now: u32,
+        inp: &Inputs,
+        faults: Faults,
+        taken: Taken,
+        in_motion: bool,
+        out: &mut Outputs,
+    ) -> crate::safety::supervisor::Output {
         let before = (self.sup.mode(), self.sup.faults());
-        let initial_state_ok = match incoming {
+        let initial_state_ok = match taken.incoming {
             Some(Incoming::Command(Command::Reconfigure(r))) => {
                 let sensed = estimate::consistent(&self.cfg.estimate, &self.readings(inp));
                 initial_state_consistent(r.initial(), self.tracked, sensed)
@@ -512,8 +589,8 @@ impl BoardA {
             _ => true,
         };
         let s = self.sup.step(&Input {
-            faults: conditions.union(events_faults),
-            command: incoming,
+            faults,
+            command: taken.incoming,
             in_motion,
             hip_at_home: detect::hip_at_home(&self.cfg.safety, inp.hip),
             initial_state_ok,
@@ -524,27 +601,20 @@ impl BoardA {
         if s.go_home {
             self.go_home(now);
         }
-        if let (Some(seq), Some(a)) = (answer_seq, s.answer) {
-            let (command, refusal) = match a {
-                Answer::Accepted(c) => (c, None),
-                Answer::Refused(r) => (
-                    match incoming {
+        if let (Some(seq), Some(a)) = (taken.answer, s.answer) {
+            match a {
+                Answer::Accepted(c) => {
+                    self.settle(seq, c, None, out);
+                    self.dispatch(c, now);
+                }
+                Answer::Refused(r) => {
+                    let c = match taken.incoming {
                         Some(Incoming::Command(c)) => c,
                         _ => Command::Heartbeat,
-                    },
-                    Some(r),
-                ),
-            };
-            self.log.record(seq, refusal);
-            self.refusal = refusal;
-            if let Answer::Accepted(c) = a {
-                self.dispatch(c, now);
+                    };
+                    self.settle(seq, c, Some(r), out);
+                }
             }
-            out.push(Event::Executed {
-                seq,
-                command,
-                refusal,
-            });
         }
         if s.mode != before.0 {
             out.push(Event::Mode {
@@ -556,8 +626,17 @@ impl BoardA {
         if !new_faults.is_empty() {
             out.push(Event::Faults(new_faults));
         }
+        s
+    }
 
-        // Outputs.
+    /// Drives side A's actuators and board B's command from the supervisor's power decision.
+    fn drive(
+        &mut self,
+        now: u32,
+        inp: &Inputs,
+        s: &crate::safety::supervisor::Output,
+        out: &mut Outputs,
+    ) {
         let live = s.mode != Mode::Standby;
         let p = s.powered;
         self.arm_targets(now);
@@ -574,10 +653,6 @@ impl BoardA {
         }
         out.mux = self.side_a.mux();
         out.to_b = self.b_command(now, p, s.regulator);
-        if answer_seq.is_some() {
-            out.heartbeat = Some(self.heartbeat(inp, &s.faults).to_bytes());
-        }
-        out
     }
 
     fn receive(&mut self, bytes: &[u8], in_motion: bool) -> Received {
@@ -589,8 +664,9 @@ impl BoardA {
                 let at = 6 + seq_slot(bytes[5]).offset();
                 let seq = u16::from_le_bytes([bytes[at], bytes[at + 1]]);
                 return match self.log.admit(seq) {
+                    // The supervisor refuses it like any other command it cannot take.
                     Admission::Execute => {
-                        Received::Refuse(seq, Command::Heartbeat, Refusal::for_command_error(&ce))
+                        Received::Run(seq, Incoming::Malformed(Refusal::for_command_error(&ce)))
                     }
                     Admission::Duplicate => Received::Answer(Event::Duplicate { seq }),
                     Admission::Stale => Received::Answer(Event::Stale { seq }),
@@ -844,6 +920,14 @@ impl BoardA {
             last_seq,
         }
     }
+}
+
+/// This tick's command after the exactly-once log: what the supervisor judges, and the number
+/// the heartbeat answers (0 for a copy, whose outcome the log already holds).
+#[derive(Debug, Clone, Copy, Default)]
+struct Taken {
+    incoming: Option<Incoming>,
+    answer: Option<u16>,
 }
 
 enum Received {

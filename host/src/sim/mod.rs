@@ -20,7 +20,9 @@ pub mod clock;
 pub mod log;
 pub mod nodes;
 pub mod plant;
+pub mod progress;
 pub mod report;
+pub mod steps;
 
 use clock::Clock;
 use mmic::motion::State;
@@ -40,17 +42,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
-
-/// A step of the plan with where it came from.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SimStep {
-    /// Line in the plan file (1-based).
-    pub line: usize,
-    /// The line's text.
-    pub text: String,
-    /// The step.
-    pub step: PlanStep,
-}
+pub use steps::{demo_steps, steps_of, SimStep, DEMO_PLAN};
 
 /// What to simulate.
 #[derive(Debug, Clone)]
@@ -104,7 +96,7 @@ impl SimConfig {
 
     /// The built-in demo plan at the default settings.
     pub fn demo() -> SimConfig {
-        SimConfig::with_steps(crate::sim::report::demo_steps())
+        SimConfig::with_steps(demo_steps())
     }
 
     /// Default settings for these steps.
@@ -202,9 +194,185 @@ impl Summary {
     }
 }
 
+/// A robot's board A listening for the server board's connections (the WiFi link).
 struct Robot {
     addr: std::net::SocketAddr,
     listener: TcpListener,
+}
+
+/// A serial line: its two ends as OS pipes, with a reader thread deframing packets into a
+/// channel at the receiving end.
+struct Serial {
+    write: std::io::PipeWriter,
+    read: std::sync::mpsc::Receiver<Vec<u8>>,
+}
+
+/// What every robot's threads share within one run.
+struct RunEnv<'a> {
+    cfg: &'a SimConfig,
+    clock: Clock<'a>,
+    stop: &'a AtomicBool,
+    late: &'a AtomicU32,
+    /// Events (always), packets (when logged).
+    log: Option<log::Log>,
+    packet_log: Option<log::Log>,
+}
+
+impl<'a> RunEnv<'a> {
+    /// The context of one node loop, holding a slot of the paced clock.
+    fn node(&self, name: &str, log: &Option<log::Log>) -> nodes::Node<'a> {
+        nodes::Node {
+            name: name.to_string(),
+            clock: self.clock.node(),
+            log: log.clone(),
+            stop: self.stop,
+            late: self.late,
+        }
+    }
+
+    /// A lossy writer for one direction of a link; its loss draws are seeded from the robot's
+    /// seed and `k`, so each direction draws its own sequence.
+    #[allow(clippy::too_many_arguments)]
+    fn lossy(
+        &self,
+        out: std::io::PipeWriter,
+        link: &'static str,
+        (from, to): (&str, &str),
+        loss: f64,
+        cut_at: Option<u32>,
+        seed: u64,
+        k: u64,
+    ) -> Lossy<std::io::PipeWriter> {
+        Lossy {
+            out,
+            link,
+            from: from.to_string(),
+            to: to.to_string(),
+            loss,
+            cut_at,
+            rng: fastrand::Rng::with_seed(seed.wrapping_add(k * 7919)),
+            log: self.packet_log.clone(),
+        }
+    }
+}
+
+/// Opens a serial line and starts its reader.
+fn serial<'scope>(scope: &'scope std::thread::Scope<'scope, '_>) -> std::io::Result<Serial> {
+    let (r, write) = std::io::pipe()?;
+    let (tx, read) = std::sync::mpsc::channel();
+    scope.spawn(move || nodes::reader(r, tx));
+    Ok(Serial { write, read })
+}
+
+/// Starts robot `i`'s four nodes (board A's WiFi and control tasks joined by `queues`, board
+/// B, the server board) and returns the ground's end of its serial line.
+fn spawn_robot<'scope, 'env>(
+    scope: &'scope std::thread::Scope<'scope, 'env>,
+    env: &RunEnv<'env>,
+    i: usize,
+    robot: Robot,
+    queues: &'env mut (PacketQueue<14, 8>, PacketQueue<66, 8>),
+    status: Arc<Mutex<Value>>,
+) -> std::io::Result<GroundLink> {
+    let cfg = env.cfg;
+    let board = BoardNumber::new(i as u8 + 1).unwrap_or(BoardNumber::ONE);
+    let (name_a, name_b, name_s) = (
+        format!("board_a{}", i + 1),
+        format!("board_b{}", i + 1),
+        format!("server{}", i + 1),
+    );
+    let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
+    let plant = Arc::new(Mutex::new(plant::Plant::new(
+        PlantConfig {
+            seed,
+            ..cfg.plant.clone()
+        },
+        cfg.start_state,
+    )));
+    let (a_to_b, b_to_a) = (serial(scope)?, serial(scope)?);
+    let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
+    let (cmd_queue, hb_queue) = (&mut queues.0, &mut queues.1);
+    let (cmd_p, cmd_c) = cmd_queue.split();
+    let (hb_p, hb_c) = hb_queue.split();
+    let wifi = nodes::WifiTask {
+        listener: robot.listener,
+        commands: cmd_p,
+        heartbeats: hb_c,
+        loss: cfg.wifi_loss,
+        seed: seed ^ 0x5eed,
+    };
+    let control = nodes::ControlTask {
+        a: BoardA::in_state(
+            board_a::Config {
+                board,
+                ..board_a::Config::default()
+            },
+            cfg.start_state,
+        ),
+        commands: cmd_c,
+        heartbeats: hb_p,
+        from_b: b_to_a.read,
+        to_b: env.lossy(
+            a_to_b.write,
+            "serial_ab",
+            (&name_a, &name_b),
+            cfg.ab_loss,
+            cfg.cut_b_at,
+            seed,
+            1,
+        ),
+        plant: plant.clone(),
+        status,
+    };
+    let b = nodes::BoardBTask {
+        b: BoardB::new(board_b::Config::default()),
+        from_a: a_to_b.read,
+        to_a: env.lossy(
+            b_to_a.write,
+            "serial_ab",
+            (&name_b, &name_a),
+            cfg.ab_loss,
+            cfg.cut_b_at,
+            seed,
+            2,
+        ),
+        plant,
+    };
+    let server = nodes::ServerTask {
+        from_ground: ground_to_server.read,
+        to_ground: env.lossy(
+            server_to_ground.write,
+            "serial_ground",
+            (&name_s, "ground"),
+            cfg.serial_loss,
+            None,
+            seed,
+            3,
+        ),
+        robots: vec![(board, robot.addr)],
+        visit_ms: cfg.visit_ms,
+    };
+    // The WiFi task logs its packets (the packet log) and the hand-off events with them.
+    let nodes = (
+        env.node(&name_a, &env.packet_log),
+        env.node(&name_a, &env.log),
+        env.node(&name_b, &env.log),
+        env.node(&name_s, &env.log),
+    );
+    scope.spawn(move || wifi.run(nodes.0));
+    scope.spawn(move || control.run(nodes.1));
+    scope.spawn(move || b.run(nodes.2));
+    scope.spawn(move || server.run(nodes.3));
+    let to_server = env.lossy(
+        ground_to_server.write,
+        "serial_ground",
+        ("ground", &name_s),
+        cfg.serial_loss,
+        None,
+        seed,
+        4,
+    );
+    Ok((to_server, server_to_ground.read, board))
 }
 
 /// Runs the simulation to the end of every robot's plan (or the time limit).
@@ -212,19 +380,18 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     let n = cfg.robots.max(1) as usize;
     let steps: Vec<PlanStep> = cfg.steps.iter().map(|s| s.step).collect();
     let (logger, log_rx) = log::Log::new();
-    let log = Some(logger.clone());
-    let plog = if cfg.log_packets { log.clone() } else { None };
-    let stop = AtomicBool::new(false);
-    let mut robots = Vec::new();
-    for _ in 0..n {
-        let listener = TcpListener::bind("127.0.0.1:0")?;
-        robots.push(Robot {
-            addr: listener.local_addr()?,
-            listener,
-        });
-    }
-    let mut cmd_queues: Vec<PacketQueue<14, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
-    let mut hb_queues: Vec<PacketQueue<66, 8>> = (0..n).map(|_| PacketQueue::new()).collect();
+    let robots = (0..n)
+        .map(|_| {
+            let listener = TcpListener::bind("127.0.0.1:0")?;
+            Ok(Robot {
+                addr: listener.local_addr()?,
+                listener,
+            })
+        })
+        .collect::<std::io::Result<Vec<Robot>>>()?;
+    let mut queues: Vec<(PacketQueue<14, 8>, PacketQueue<66, 8>)> = (0..n)
+        .map(|_| (PacketQueue::new(), PacketQueue::new()))
+        .collect();
     // Four paced nodes per robot (board A's two tasks, board B, the server board) and the
     // ground; an unpaced run hands out no slots.
     let pace = clock::Pace::new(if cfg.paced { 4 * n + 1 } else { 0 }, PACE_SLACK_MS);
@@ -235,152 +402,27 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     };
     let statuses: Vec<Arc<Mutex<Value>>> =
         (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
-    let lateness = AtomicU32::new(0);
-    let writer_path = cfg.log_path.clone();
-    let writer = std::thread::spawn(move || -> std::io::Result<Vec<Value>> {
-        match writer_path {
-            Some(p) => {
-                let f = std::fs::File::create(p)?;
-                log::write_all(log_rx, &mut std::io::BufWriter::new(f))
-            }
-            None => log::write_all(log_rx, &mut std::io::sink()),
-        }
-    });
-    let mut ground_links = Vec::new();
-    let result = std::thread::scope(
-        |scope| -> std::io::Result<(Vec<Option<PlanEnd>>, GroundStats)> {
-            let stop = &stop;
-            let late = &lateness;
-            for (i, (robot, (cq, hq))) in robots
-                .into_iter()
-                .zip(cmd_queues.iter_mut().zip(hb_queues.iter_mut()))
-                .enumerate()
-            {
-                let board = BoardNumber::new(i as u8 + 1).unwrap_or(BoardNumber::ONE);
-                let name_a = format!("board_a{}", i + 1);
-                let name_b = format!("board_b{}", i + 1);
-                let name_s = format!("server{}", i + 1);
-                let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
-                let plant = Arc::new(Mutex::new(plant::Plant::new(
-                    PlantConfig {
-                        seed,
-                        ..cfg.plant.clone()
-                    },
-                    cfg.start_state,
-                )));
-                let (cmd_p, cmd_c) = cq.split();
-                let (hb_p, hb_c) = hq.split();
-                // Serial A <-> B.
-                let (ab_r, ab_w) = std::io::pipe()?;
-                let (ba_r, ba_w) = std::io::pipe()?;
-                let (ab_tx, ab_rx) = std::sync::mpsc::channel();
-                let (ba_tx, ba_rx) = std::sync::mpsc::channel();
-                scope.spawn(move || nodes::reader(ab_r, ab_tx));
-                scope.spawn(move || nodes::reader(ba_r, ba_tx));
-                // Serial ground <-> server.
-                let (gs_r, gs_w) = std::io::pipe()?;
-                let (sg_r, sg_w) = std::io::pipe()?;
-                let (gs_tx, gs_rx) = std::sync::mpsc::channel();
-                let (sg_tx, sg_rx) = std::sync::mpsc::channel();
-                scope.spawn(move || nodes::reader(gs_r, gs_tx));
-                scope.spawn(move || nodes::reader(sg_r, sg_tx));
-                let a_cfg = board_a::Config {
-                    board,
-                    ..board_a::Config::default()
-                };
-                let a = BoardA::in_state(a_cfg, cfg.start_state);
-                let b = BoardB::new(board_b::Config::default());
-                let lossy = |out, link, from: &str, to: &str, loss, cut_at, k: u64| Lossy {
-                    out,
-                    link,
-                    from: from.to_string(),
-                    to: to.to_string(),
-                    loss,
-                    cut_at,
-                    rng: fastrand::Rng::with_seed(seed.wrapping_add(k * 7919)),
-                    log: plog.clone(),
-                };
-                let to_b = lossy(
-                    ab_w,
-                    "serial_ab",
-                    &name_a,
-                    &name_b,
-                    cfg.ab_loss,
-                    cfg.cut_b_at,
-                    1,
-                );
-                let to_a = lossy(
-                    ba_w,
-                    "serial_ab",
-                    &name_b,
-                    &name_a,
-                    cfg.ab_loss,
-                    cfg.cut_b_at,
-                    2,
-                );
-                let to_ground = lossy(
-                    sg_w,
-                    "serial_ground",
-                    &name_s,
-                    "ground",
-                    cfg.serial_loss,
-                    None,
-                    3,
-                );
-                ground_links.push((
-                    lossy(
-                        gs_w,
-                        "serial_ground",
-                        "ground",
-                        &name_s,
-                        cfg.serial_loss,
-                        None,
-                        4,
-                    ),
-                    sg_rx,
-                    board,
-                ));
-                let (l1, l2, l3, l4) = (log.clone(), log.clone(), plog.clone(), log.clone());
-                let (p1, p2) = (plant.clone(), plant);
-                let wifi_loss = cfg.wifi_loss;
-                let status = statuses[i].clone();
-                let (na, na2) = (name_a.clone(), name_a);
-                let (c_wifi, c_control, c_b, c_server) =
-                    (clock.node(), clock.node(), clock.node(), clock.node());
-                scope.spawn(move || {
-                    nodes::board_a_wifi(
-                        robot.listener,
-                        cmd_p,
-                        hb_c,
-                        wifi_loss,
-                        seed ^ 0x5eed,
-                        c_wifi,
-                        l3,
-                        stop,
-                        na,
-                    )
-                });
-                scope.spawn(move || {
-                    nodes::board_a_control(
-                        a, cmd_c, hb_p, ba_rx, to_b, p1, c_control, l1, stop, na2, status, late,
-                    )
-                });
-                scope
-                    .spawn(move || nodes::board_b(b, ab_rx, to_a, p2, c_b, l2, stop, name_b, late));
-                let robots = vec![(board, robot.addr)];
-                let visit = cfg.visit_ms;
-                scope.spawn(move || {
-                    nodes::server(gs_rx, to_ground, robots, visit, c_server, l4, stop, name_s)
-                });
-            }
-            let out = ground_loop(cfg, &steps, ground_links, clock.node(), log.clone());
-            stop.store(true, Ordering::Relaxed);
-            Ok(out)
-        },
-    );
-    drop(log);
-    drop(plog);
+    let (stop, lateness) = (AtomicBool::new(false), AtomicU32::new(0));
+    let writer = spawn_log_writer(cfg.log_path.clone(), log_rx);
+    let env = RunEnv {
+        cfg,
+        clock,
+        stop: &stop,
+        late: &lateness,
+        log: Some(logger.clone()),
+        packet_log: cfg.log_packets.then(|| logger.clone()),
+    };
     drop(logger);
+    let result = std::thread::scope(|scope| -> std::io::Result<_> {
+        let mut ground_links = Vec::new();
+        for (i, (robot, q)) in robots.into_iter().zip(queues.iter_mut()).enumerate() {
+            ground_links.push(spawn_robot(scope, &env, i, robot, q, statuses[i].clone())?);
+        }
+        let out = ground_loop(cfg, &steps, ground_links, clock.node(), env.log.clone());
+        stop.store(true, Ordering::Relaxed);
+        Ok(out)
+    });
+    drop(env);
     let (ends, stats) = result?;
     let records = writer
         .join()
@@ -404,6 +446,21 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         held_ms: clock.held_ms(),
         pace_slack_ms: clock.slack_ms(),
         last_heartbeat: stats.last_heartbeat,
+    })
+}
+
+/// The thread that writes the log (to a file, or nowhere) and returns its records when every
+/// sender has gone.
+fn spawn_log_writer(
+    path: Option<PathBuf>,
+    rx: std::sync::mpsc::Receiver<log::Record>,
+) -> std::thread::JoinHandle<std::io::Result<Vec<Value>>> {
+    std::thread::spawn(move || match path {
+        Some(p) => {
+            let f = std::fs::File::create(p)?;
+            log::write_all(rx, &mut std::io::BufWriter::new(f))
+        }
+        None => log::write_all(rx, &mut std::io::sink()),
     })
 }
 
@@ -443,7 +500,7 @@ fn ground_loop(
         max_latency_ms: 0,
         last_heartbeat: None,
     };
-    let mut progress = report::Progress::new(cfg.progress, cfg.steps.clone(), cfg.start_state);
+    let mut progress = progress::Progress::new(cfg.progress, cfg.steps.clone(), cfg.start_state);
     loop {
         let now = clock.now_ms();
         clock.ready(now);

@@ -91,16 +91,6 @@ pub fn reader(mut input: impl Read, tx: Sender<Vec<u8>>) {
 /// communication timeout, beyond which the host's lag starts to matter to the firmware's timers.
 pub const OVERRUN_MS: u32 = 100;
 
-/// Records a tick's lateness in the run's maximum, and logs an overrun.
-fn note_lateness(late: &AtomicU32, by: u32, log: &Option<Log>, now: u32, name: &str) {
-    late.fetch_max(by, Ordering::Relaxed);
-    if by >= OVERRUN_MS {
-        if let Some(l) = log {
-            l.event(now, name, json!({"type": "overrun", "late_ms": by}));
-        }
-    }
-}
-
 /// Sleeps until simulated time `t`.
 pub fn sleep_until(clock: &Clock, t: u32) {
     let now = clock.now_ms();
@@ -108,6 +98,64 @@ pub fn sleep_until(clock: &Clock, t: u32) {
         std::thread::sleep(clock.wall((t - now) as f64).min(Duration::from_millis(5)));
     } else {
         std::thread::yield_now();
+    }
+}
+
+/// What every node loop shares: its name in the log, its copy of the (paced) clock, the log,
+/// the run's stop flag and the run's worst tick lateness.
+pub struct Node<'a> {
+    /// Name in the log, e.g. `board_a1`.
+    pub name: String,
+    /// This node's copy of the clock (it holds the node's pace slot).
+    pub clock: NodeClock<'a>,
+    /// Where events go (none: not logged).
+    pub log: Option<Log>,
+    /// Set when the run ends.
+    pub stop: &'a AtomicBool,
+    /// The latest any tick started after it was due, simulated ms.
+    pub late: &'a AtomicU32,
+}
+
+impl Node<'_> {
+    fn running(&self) -> bool {
+        !self.stop.load(Ordering::Relaxed)
+    }
+
+    fn event(&self, now: u32, what: Value) {
+        if let Some(l) = &self.log {
+            l.event(now, &self.name, what);
+        }
+    }
+
+    /// Tells the paced clock this node has done everything due up to now; returns now.
+    fn poll(&self) -> u32 {
+        let now = self.clock.now_ms();
+        self.clock.ready(now);
+        now
+    }
+
+    /// Runs `tick(now)` every [`TICK_MS`] until the run stops: records how late each tick
+    /// started (an overrun past [`OVERRUN_MS`] is logged) and tells the paced clock when the
+    /// node is ready, at the start of each tick, so time may run on to the pace's slack.
+    fn every_tick(&self, mut tick: impl FnMut(u32)) {
+        let mut next = 0;
+        while self.running() {
+            sleep_until(&self.clock, next);
+            let now = self.clock.now_ms();
+            if now < next {
+                continue;
+            }
+            if next > 0 {
+                let by = now - next;
+                self.late.fetch_max(by, Ordering::Relaxed);
+                if by >= OVERRUN_MS {
+                    self.event(now, json!({"type": "overrun", "late_ms": by}));
+                }
+            }
+            next = now - now % TICK_MS + TICK_MS;
+            self.clock.ready(now);
+            tick(now);
+        }
     }
 }
 
@@ -135,133 +183,150 @@ pub fn event_json(e: &Event) -> Value {
 
 /// Board A's WiFi task (core 0): accepts the server's connections, deframes command packets
 /// into the hand-off queue, writes heartbeats from the other queue back.
-#[allow(clippy::too_many_arguments)]
-pub fn board_a_wifi(
-    listener: TcpListener,
-    mut commands: Producer<'_, COMMAND_LEN, 8>,
-    mut heartbeats: Consumer<'_, HEARTBEAT_LEN, 8>,
-    loss: f64,
-    seed: u64,
-    clock: NodeClock<'_>,
-    log: Option<Log>,
-    stop: &AtomicBool,
-    name: String,
-) {
-    let mut rng = fastrand::Rng::with_seed(seed);
-    let lost = |rng: &mut fastrand::Rng| loss > 0.0 && rng.f64() < loss;
-    let _ = listener.set_nonblocking(true);
-    while !stop.load(Ordering::Relaxed) {
-        clock.ready(clock.now_ms());
-        let sock = match listener.accept() {
-            Ok((s, _)) => s,
-            Err(_) => {
-                while let Some(hb) = heartbeats.pop() {
-                    if let Some(l) = &log {
-                        l.packet(clock.now_ms(), "wifi", &name, "server", "unconnected", &hb);
+pub struct WifiTask<'q> {
+    /// Where the server board connects.
+    pub listener: TcpListener,
+    /// Commands to the control task (the rx queue).
+    pub commands: Producer<'q, COMMAND_LEN, 8>,
+    /// Heartbeats from the control task (the tx queue).
+    pub heartbeats: Consumer<'q, HEARTBEAT_LEN, 8>,
+    /// Injected loss, each direction.
+    pub loss: f64,
+    /// Seed of the loss draws.
+    pub seed: u64,
+}
+
+impl WifiTask<'_> {
+    /// Runs until the run stops.
+    pub fn run(mut self, node: Node<'_>) {
+        let mut rng = fastrand::Rng::with_seed(self.seed);
+        let _ = self.listener.set_nonblocking(true);
+        while node.running() {
+            node.poll();
+            match self.listener.accept() {
+                Ok((sock, _)) => self.serve(&node, sock, &mut rng),
+                Err(_) => {
+                    while let Some(hb) = self.heartbeats.pop() {
+                        if let Some(l) = &node.log {
+                            let now = node.clock.now_ms();
+                            l.packet(now, "wifi", &node.name, "server", "unconnected", &hb);
+                        }
                     }
+                    std::thread::sleep(Duration::from_micros(300));
                 }
-                std::thread::sleep(Duration::from_micros(300));
-                continue;
             }
-        };
-        let mut sock = sock;
+        }
+    }
+
+    fn lost(&self, rng: &mut fastrand::Rng) -> bool {
+        self.loss > 0.0 && rng.f64() < self.loss
+    }
+
+    /// One connection of the server board, until it disconnects.
+    fn serve(&mut self, node: &Node<'_>, mut sock: TcpStream, rng: &mut fastrand::Rng) {
         let _ = sock.set_nonblocking(true);
         let _ = sock.set_nodelay(true);
         let mut d = Deframer::<256>::new();
         let mut buf = [0u8; 256];
-        'conn: while !stop.load(Ordering::Relaxed) {
-            clock.ready(clock.now_ms());
+        while node.running() {
+            node.poll();
             match sock.read(&mut buf) {
-                Ok(0) => break 'conn,
+                Ok(0) => return,
                 Ok(n) => {
-                    let mut frames = Vec::new();
-                    d.feed(&buf[..n], |e| {
-                        if let Deframed::Frame(f) = e {
-                            frames.push(f);
-                        }
-                    });
-                    for f in frames {
-                        if f.kind() != PacketKind::Command {
-                            continue;
-                        }
-                        let now = clock.now_ms();
-                        let bytes = f.as_bytes();
-                        let fate = if lost(&mut rng) { "lost" } else { "delivered" };
-                        if let Some(l) = &log {
-                            l.packet(now, "wifi", "server", &name, fate, bytes);
-                        }
-                        if fate == "delivered" {
-                            let mut p = [0u8; COMMAND_LEN];
-                            p.copy_from_slice(bytes);
-                            if let Err(full) = commands.push(p) {
-                                if let Some(l) = &log {
-                                    l.event(now, &name, json!({"type": "handoff_full", "hex": super::log::hex(&full.0)}));
-                                }
-                                commands.give_up(full);
-                            }
+                    for f in frames(&mut d, &buf[..n]) {
+                        if f.kind() == PacketKind::Command {
+                            self.take_command(node, f.as_bytes(), rng);
                         }
                     }
                 }
                 Err(e) if e.kind() == ErrorKind::WouldBlock => {}
-                Err(_) => break 'conn,
+                Err(_) => return,
             }
-            while let Some(hb) = heartbeats.pop() {
-                let now = clock.now_ms();
-                let fate = if lost(&mut rng) {
+            while let Some(hb) = self.heartbeats.pop() {
+                let fate = if self.lost(rng) {
                     "lost"
                 } else if sock.write_all(&hb).is_ok() {
                     "delivered"
                 } else {
                     "closed"
                 };
-                if let Some(l) = &log {
-                    l.packet(now, "wifi", &name, "server", fate, &hb);
+                if let Some(l) = &node.log {
+                    l.packet(node.clock.now_ms(), "wifi", &node.name, "server", fate, &hb);
                 }
             }
             std::thread::sleep(Duration::from_micros(200));
         }
     }
+
+    /// A command packet off the link: lost, or handed to the control task (a full queue hands
+    /// it back, and that is logged).
+    fn take_command(&mut self, node: &Node<'_>, bytes: &[u8], rng: &mut fastrand::Rng) {
+        let now = node.clock.now_ms();
+        let fate = if self.lost(rng) { "lost" } else { "delivered" };
+        if let Some(l) = &node.log {
+            l.packet(now, "wifi", "server", &node.name, fate, bytes);
+        }
+        let Ok(p) = <[u8; COMMAND_LEN]>::try_from(bytes) else {
+            return;
+        };
+        if fate == "delivered" {
+            if let Err(full) = self.commands.push(p) {
+                node.event(
+                    now,
+                    json!({"type": "handoff_full", "hex": super::log::hex(&full.0)}),
+                );
+                self.commands.give_up(full);
+            }
+        }
+    }
+}
+
+/// The packets the deframer finds in `bytes`.
+fn frames(d: &mut Deframer<256>, bytes: &[u8]) -> Vec<mmic::wire::deframer::Frame> {
+    let mut out = Vec::new();
+    d.feed(bytes, |e| {
+        if let Deframed::Frame(f) = e {
+            out.push(f);
+        }
+    });
+    out
 }
 
 /// Board A's control loop (core 1): one library tick every 10 ms.
-#[allow(clippy::too_many_arguments)]
-pub fn board_a_control(
-    mut a: BoardA,
-    mut commands: Consumer<'_, COMMAND_LEN, 8>,
-    mut heartbeats: Producer<'_, HEARTBEAT_LEN, 8>,
-    from_b: Receiver<Vec<u8>>,
-    mut to_b: Lossy<std::io::PipeWriter>,
-    plant: Arc<Mutex<Plant>>,
-    clock: NodeClock<'_>,
-    log: Option<Log>,
-    stop: &AtomicBool,
-    name: String,
-    status: Arc<Mutex<Value>>,
-    late: &AtomicU32,
-) {
-    let mut next = 0;
-    let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
-    while !stop.load(Ordering::Relaxed) {
-        sleep_until(&clock, next);
-        let now = clock.now_ms();
-        if now < next {
-            continue;
-        }
-        if next > 0 {
-            note_lateness(late, now - next, &log, now, &name);
-        }
-        next = now - now % TICK_MS + TICK_MS;
-        // Everything due before this tick is done: time may run on to the pace's slack.
-        clock.ready(now);
-        let command = commands.pop();
-        let from_b = from_b.try_recv().ok().and_then(|v| v.try_into().ok());
+pub struct ControlTask<'q> {
+    /// The library's board A.
+    pub a: BoardA,
+    /// Commands from the WiFi task (the rx queue).
+    pub commands: Consumer<'q, COMMAND_LEN, 8>,
+    /// Heartbeats to the WiFi task (the tx queue).
+    pub heartbeats: Producer<'q, HEARTBEAT_LEN, 8>,
+    /// Packets from board B's serial line.
+    pub from_b: Receiver<Vec<u8>>,
+    /// Board B's serial line.
+    pub to_b: Lossy<std::io::PipeWriter>,
+    /// The robot's body.
+    pub plant: Arc<Mutex<Plant>>,
+    /// Board A's mode, faults and state for the run's summary.
+    pub status: Arc<Mutex<Value>>,
+}
+
+impl ControlTask<'_> {
+    /// Runs until the run stops.
+    pub fn run(mut self, node: Node<'_>) {
+        let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
+        node.every_tick(|now| self.tick(&node, &mut sensors, now));
+    }
+
+    fn tick(&mut self, node: &Node<'_>, sensors: &mut Frontend<WINDOW>, now: u32) {
+        let command = self.commands.pop();
+        let from_b = self.from_b.try_recv().ok().and_then(|v| v.try_into().ok());
         let s = {
-            let mut p = plant.lock().unwrap_or_else(|e| e.into_inner());
+            let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
             p.advance(now);
             p.sense(0, now)
         };
         let f = sensors.push(&s.raw);
-        let out = a.tick(
+        let out = self.a.tick(
             now,
             &board_a::Inputs {
                 command,
@@ -274,7 +339,7 @@ pub fn board_a_control(
             },
         );
         {
-            let mut p = plant.lock().unwrap_or_else(|e| e.into_inner());
+            let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
             p.drive_a(
                 Drives {
                     arm: out.arm,
@@ -292,122 +357,133 @@ pub fn board_a_control(
             }
         }
         for e in &out.events {
-            if let Some(l) = &log {
-                l.event(now, &name, event_json(e));
-            }
+            node.event(now, event_json(e));
         }
         if let Some(b) = out.to_b {
-            to_b.send(now, &b);
+            self.to_b.send(now, &b);
         }
         if let Some(hb) = out.heartbeat {
-            if let Err(full) = heartbeats.push(hb) {
-                if let Some(l) = &log {
-                    l.event(
-                        now,
-                        &name,
-                        json!({"type": "handoff_full", "hex": super::log::hex(&full.0)}),
-                    );
-                }
-                heartbeats.give_up(full);
+            if let Err(full) = self.heartbeats.push(hb) {
+                node.event(
+                    now,
+                    json!({"type": "handoff_full", "hex": super::log::hex(&full.0)}),
+                );
+                self.heartbeats.give_up(full);
             }
         }
-        if let Ok(mut st) = status.lock() {
+        if let Ok(mut st) = self.status.lock() {
             *st = json!({
-                "mode": a.mode(), "faults": a.faults(), "state": a.state(),
-                "in_motion": a.in_motion(), "t_ms": now,
+                "mode": self.a.mode(), "faults": self.a.faults(), "state": self.a.state(),
+                "in_motion": self.a.in_motion(), "t_ms": now,
             });
         }
     }
 }
 
 /// Board B: one library tick every 10 ms.
-#[allow(clippy::too_many_arguments)]
-pub fn board_b(
-    mut b: BoardB,
-    from_a: Receiver<Vec<u8>>,
-    mut to_a: Lossy<std::io::PipeWriter>,
-    plant: Arc<Mutex<Plant>>,
-    clock: NodeClock<'_>,
-    log: Option<Log>,
-    stop: &AtomicBool,
-    name: String,
-    late: &AtomicU32,
-) {
-    let mut next = 0;
-    let mut was_lost = false;
-    let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
-    while !stop.load(Ordering::Relaxed) {
-        sleep_until(&clock, next);
-        let now = clock.now_ms();
-        if now < next {
-            continue;
-        }
-        if next > 0 {
-            note_lateness(late, now - next, &log, now, &name);
-        }
-        next = now - now % TICK_MS + TICK_MS;
-        // Everything due before this tick is done: time may run on to the pace's slack.
-        clock.ready(now);
-        let command = from_a.try_recv().ok().and_then(|v| v.try_into().ok());
-        let s = plant
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .sense(1, now);
-        let f = sensors.push(&s.raw);
-        let out = b.tick(
-            now,
-            &board_b::Inputs {
-                command,
-                electrical: f.electrical,
-                gravity: f.gravity,
-                arm_contracted: s.arm_contracted,
-                bolter: s.bolter,
-            },
-        );
-        plant
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .drive_b(Drives {
-                arm: out.arm,
-                gripper: out.gripper,
-                regulator: out.regulator,
-                bolter: out.bolter,
-                mux: out.mux,
-            });
-        if out.link_lost != was_lost {
-            was_lost = out.link_lost;
-            if let Some(l) = &log {
-                l.event(
-                    now,
-                    &name,
-                    json!({"type": "link_lost", "holding": was_lost}),
-                );
+pub struct BoardBTask {
+    /// The library's board B.
+    pub b: BoardB,
+    /// Packets from board A's serial line.
+    pub from_a: Receiver<Vec<u8>>,
+    /// Board A's serial line.
+    pub to_a: Lossy<std::io::PipeWriter>,
+    /// The robot's body.
+    pub plant: Arc<Mutex<Plant>>,
+}
+
+impl BoardBTask {
+    /// Runs until the run stops.
+    pub fn run(mut self, node: Node<'_>) {
+        let mut was_lost = false;
+        let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
+        node.every_tick(|now| {
+            let command = self.from_a.try_recv().ok().and_then(|v| v.try_into().ok());
+            let s = self
+                .plant
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .sense(1, now);
+            let f = sensors.push(&s.raw);
+            let out = self.b.tick(
+                now,
+                &board_b::Inputs {
+                    command,
+                    electrical: f.electrical,
+                    gravity: f.gravity,
+                    arm_contracted: s.arm_contracted,
+                    bolter: s.bolter,
+                },
+            );
+            self.plant
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .drive_b(Drives {
+                    arm: out.arm,
+                    gripper: out.gripper,
+                    regulator: out.regulator,
+                    bolter: out.bolter,
+                    mux: out.mux,
+                });
+            if out.link_lost != was_lost {
+                was_lost = out.link_lost;
+                node.event(now, json!({"type": "link_lost", "holding": was_lost}));
             }
-        }
-        if let Some(hb) = out.heartbeat {
-            to_a.send(now, &hb);
-        }
+            if let Some(hb) = out.heartbeat {
+                self.to_a.send(now, &hb);
+            }
+        });
     }
 }
 
 /// The server board: takes commands from the ground's serial line, visits robots with a
 /// pending command (connect, send, wait for the heartbeat, forward it, disconnect).
-#[allow(clippy::too_many_arguments)]
-pub fn server(
-    from_ground: Receiver<Vec<u8>>,
-    mut to_ground: Lossy<std::io::PipeWriter>,
-    robots: Vec<(BoardNumber, SocketAddr)>,
-    visit_ms: u32,
-    clock: NodeClock<'_>,
-    log: Option<Log>,
-    stop: &AtomicBool,
-    name: String,
-) {
-    let mut srv: Server<4> = Server::new();
-    while !stop.load(Ordering::Relaxed) {
-        clock.ready(clock.now_ms());
-        while let Ok(bytes) = from_ground.try_recv() {
-            let now = clock.now_ms();
+pub struct ServerTask {
+    /// Packets from the ground's serial line.
+    pub from_ground: Receiver<Vec<u8>>,
+    /// The ground's serial line.
+    pub to_ground: Lossy<std::io::PipeWriter>,
+    /// Each robot's board A and where it listens.
+    pub robots: Vec<(BoardNumber, SocketAddr)>,
+    /// How long to wait for a heartbeat, simulated ms.
+    pub visit_ms: u32,
+}
+
+impl ServerTask {
+    /// Runs until the run stops.
+    pub fn run(mut self, node: Node<'_>) {
+        let mut srv: Server<4> = Server::new();
+        while node.running() {
+            node.poll();
+            self.take_from_ground(&node, &mut srv);
+            let Some((robot, packet)) = srv.next_visit() else {
+                std::thread::sleep(Duration::from_micros(300));
+                continue;
+            };
+            let Some(addr) = self
+                .robots
+                .iter()
+                .find(|(b, _)| *b == robot)
+                .map(|(_, a)| *a)
+            else {
+                continue;
+            };
+            let Ok(mut sock) = TcpStream::connect_timeout(&addr, Duration::from_millis(200)) else {
+                std::thread::sleep(Duration::from_millis(1));
+                continue;
+            };
+            let _ = sock.set_nodelay(true);
+            if sock.write_all(&packet).is_err() {
+                continue;
+            }
+            srv.delivered(robot, &packet);
+            self.await_heartbeat(&node, sock);
+        }
+    }
+
+    fn take_from_ground(&mut self, node: &Node<'_>, srv: &mut Server<4>) {
+        while let Ok(bytes) = self.from_ground.try_recv() {
+            let now = node.clock.now_ms();
             let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(bytes.as_slice()) else {
                 continue;
             };
@@ -419,56 +495,33 @@ pub fn server(
                 }
                 Err(e) => json!({"type": "refused", "error": e.to_string()}),
             };
-            if let Some(l) = &log {
-                l.event(now, &name, what);
-            }
+            node.event(now, what);
         }
-        let Some((robot, packet)) = srv.next_visit() else {
-            std::thread::sleep(Duration::from_micros(300));
-            continue;
-        };
-        let Some(addr) = robots.iter().find(|(b, _)| *b == robot).map(|(_, a)| *a) else {
-            continue;
-        };
-        let Ok(mut sock) = TcpStream::connect_timeout(&addr, Duration::from_millis(200)) else {
-            std::thread::sleep(Duration::from_millis(1));
-            continue;
-        };
-        let _ = sock.set_nodelay(true);
-        if sock.write_all(&packet).is_err() {
-            continue;
-        }
-        srv.delivered(robot, &packet);
-        // Wait for the heartbeat, then disconnect (one robot per loop). Polled without blocking:
-        // a socket read timeout is rounded up to the kernel's tick (4–8 ms here), and a blocked
-        // server would hold the paced clock back.
+    }
+
+    /// Waits up to `visit_ms` for the robot's heartbeat and forwards it; then disconnects (one
+    /// robot per loop). Polled without blocking: a socket read timeout is rounded up to the
+    /// kernel's tick (4–8 ms here), and a blocked server would hold the paced clock back.
+    fn await_heartbeat(&mut self, node: &Node<'_>, mut sock: TcpStream) {
         let _ = sock.set_nonblocking(true);
-        let until = clock.now_ms().saturating_add(visit_ms);
+        let until = node.clock.now_ms().saturating_add(self.visit_ms);
         let mut d = Deframer::<256>::new();
         let mut buf = [0u8; 256];
-        let mut got = false;
-        while !got && clock.now_ms() < until && !stop.load(Ordering::Relaxed) {
-            clock.ready(clock.now_ms());
+        while node.running() && node.poll() < until {
             match sock.read(&mut buf) {
-                Ok(0) => break,
+                Ok(0) => return,
                 Ok(n) => {
-                    let mut frames = Vec::new();
-                    d.feed(&buf[..n], |e| {
-                        if let Deframed::Frame(f) = e {
-                            frames.push(f);
-                        }
-                    });
-                    for f in frames {
+                    for f in frames(&mut d, &buf[..n]) {
                         if f.kind() == PacketKind::Heartbeat {
-                            to_ground.send(clock.now_ms(), f.as_bytes());
-                            got = true;
+                            self.to_ground.send(node.clock.now_ms(), f.as_bytes());
+                            return;
                         }
                     }
                 }
                 Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
                     std::thread::sleep(Duration::from_micros(200));
                 }
-                Err(_) => break,
+                Err(_) => return,
             }
         }
     }

@@ -1,0 +1,88 @@
+//! Why a `mmic` command failed, and the exit code each failure maps to.
+
+use crate::codec::CodecError;
+use crate::exit::{EXIT_HOST, EXIT_INPUT, EXIT_IO};
+use std::path::PathBuf;
+
+/// Why `mmic` failed.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// The packet kind is not one of the four names.
+    #[error(
+        "unknown packet kind {name:?}; expected one of: command, heartbeat, internal-heartbeat, b-command"
+    )]
+    UnknownKind {
+        /// What was given.
+        name: String,
+    },
+    /// The state is not a Table 5 letter.
+    #[error("unknown state {text:?}: expected a Table 5 letter a..o")]
+    UnknownState {
+        /// What was given.
+        text: String,
+    },
+    /// Encoding or decoding failed.
+    #[error(transparent)]
+    Codec(#[from] CodecError),
+    /// A page could not be written.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file or directory.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The plan file could not be read.
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The plan file is malformed.
+    #[error("{}: {error}", path.display())]
+    Plan {
+        /// The file.
+        path: PathBuf,
+        /// Where and why.
+        error: crate::plan::PlanError,
+    },
+    /// The simulation failed (transport set-up).
+    #[error("simulation failed: {0}")]
+    Sim(#[source] std::io::Error),
+    /// The plan did not complete.
+    #[error("the plan did not complete: {0}")]
+    Incomplete(String),
+    /// The host fell so far behind the simulated clock that the run's timeouts may be the
+    /// host's, not the robot's (an unpaced run on a loaded machine).
+    #[error(
+        "the host fell behind: a board tick started {late_ms} ms (simulated) late, beyond what \
+         the firmware's timers tolerate, so this run's outcome is not the robot's; rerun with a \
+         smaller --scale"
+    )]
+    HostBehind {
+        /// The latest tick, simulated ms.
+        late_ms: u32,
+    },
+    /// Standard output or error is closed.
+    #[error("cannot write output: {0}")]
+    Output(#[source] std::io::Error),
+}
+
+impl CliError {
+    /// The process exit code (see the module docs).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Codec(e) => e.exit_code(),
+            CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
+            CliError::Plan { .. } => EXIT_INPUT,
+            CliError::Incomplete(_) => 1,
+            CliError::HostBehind { .. } => EXIT_HOST,
+            CliError::Write { .. }
+            | CliError::Output(_)
+            | CliError::Read { .. }
+            | CliError::Sim(_) => EXIT_IO,
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! The `mmic` tool's process exit codes: a leaf module, so that every command module can name
+//! them without depending on the command line ([`crate::cli`]).
+
+/// Success.
+pub const EXIT_OK: u8 = 0;
+/// The bytes are not a valid packet.
+pub const EXIT_INVALID_PACKET: u8 = 1;
+/// Bad input: unknown kind or state, invalid JSON, malformed hex, usage error.
+pub const EXIT_INPUT: u8 = 2;
+/// A file could not be written, or stdout is closed.
+pub const EXIT_IO: u8 = 3;
+/// `mmic sim`: the host fell too far behind the simulated clock for the outcome to count.
+pub const EXIT_HOST: u8 = 4;
