@@ -22,7 +22,7 @@
 //!
 //! The strategies are a feature of the library crate rather than a test helper so that they
 //! stay next to the types they must cover. A variant added without a strategy arm is caught by
-//! `tests/round_trip.rs` in the repository, which draws a fixed-seed sample and requires every
+//! `tests/wire/round_trip.rs` in the repository, which draws a fixed-seed sample and requires every
 //! one of the 61 command opcodes (and every optional field, both ways) to appear in it.
 
 use crate::bolter::{BolterDirection, BolterStep, MuxLines};

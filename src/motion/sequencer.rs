@@ -15,7 +15,7 @@
 //! 4. **Grip** S's gripper (gripper S → extend); wait until done.
 //!
 //! Only S's gripper is ever opened, and only after O's is closed, so the robot always holds the
-//! structure with at least one closed gripper (checked exhaustively in `tests/motion_sequencer.rs`).
+//! structure with at least one closed gripper (checked exhaustively in `tests/motion/motion_sequencer.rs`).
 //!
 //! ```
 //! use mmic::motion::sequencer::{Config, Feedback, Sequencer, Status, Targets};

@@ -19,9 +19,9 @@
 //! publishes the new head; each index has one writer. A full queue hands the packet back
 //! ([`Full`]) instead of overwriting, and the producer counts any packet its caller gives up on
 //! ([`Producer::give_up`]), so a loss is always visible. Checked in
-//! tests/node_handoff.rs by two OS threads exchanging 2,000,000 numbered, checksummed packets
+//! tests/node/node_handoff.rs by two OS threads exchanging 2,000,000 numbered, checksummed packets
 //! through an 8-slot queue (every packet arrives once, in order, intact) and by a bolero
-//! harness against a `VecDeque` model (proofs/tests/node_handoff.rs).
+//! harness against a `VecDeque` model (proofs/tests/harnesses/node.rs).
 //!
 //! Needs atomic loads and stores: available on targets with atomics (ESP32, ESP32-C6, hosts);
 //! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`.

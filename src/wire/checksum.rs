@@ -2,7 +2,7 @@
 //! poly 0x1021, init 0xFFFF, no reflection, no final xor), the CCSDS packet error control.
 //!
 //! It catches every 1-, 2- and 3-bit error in packets this short (the Hamming distance of this
-//! polynomial is 4 up to 32751 data bits), which `tests/corruption.rs` checks exhaustively.
+//! polynomial is 4 up to 32751 data bits), which `tests/wire/corruption.rs` checks exhaustively.
 //!
 //! **Table size.** By default the `crc` crate's slice-by-16 tables (16 × 256 × 2 = 8 KiB of
 //! flash), because they make the 47- and 66-byte heartbeats several times faster to check than

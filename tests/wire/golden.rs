@@ -9,7 +9,7 @@
 //! Neighbouring fields hold different values wherever their domains allow, so swapped or
 //! shifted fields show.
 
-mod common;
+use crate::common;
 
 use common::crc16_bitwise;
 use mmic::bolter::{BolterDirection, BolterStep, MuxLines};

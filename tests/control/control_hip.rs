@@ -11,7 +11,7 @@ use mmic::control::hip::{Config, HipController};
 use mmic::units::HipAngle;
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 
 const TOL: f64 = 50.0; // 0.50°
 const OVERSHOOT_MAX: f64 = 150.0; // 1.50°, documented in spec/control/hip.md

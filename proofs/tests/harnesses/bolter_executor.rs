@@ -11,7 +11,7 @@
 //!   in Done, BoltingFailure or InternalCommLoss only, and stays ended.
 //!
 //! The sequence-level protocol (lossy links, every interleaving) is model-checked exhaustively
-//! in `tests/bolter_handshake.rs`.
+//! in `tests/control/bolter_handshake.rs`.
 
 use mmic::bolter::{
     BolterDirection, BolterSide, BolterStep, Config, Coordinator, Drive, Job, MuxLines, Signals,

@@ -4,13 +4,13 @@
 
 use proptest::test_runner::{FailurePersistence, PersistedSeed, TestCaseError, TestRunner};
 
-mod common;
-use common::prop::{config, scaled, CommittedRegressions};
+use crate::common::prop::{config, scaled, CommittedRegressions};
 
 #[test]
 fn committed_seeds_are_replayed() {
-    let seeds = CommittedRegressions.load_persisted_failures2(Some("tests/control_hip.rs"));
-    let committed = std::fs::read_to_string("tests/control_hip.proptest-regressions").unwrap();
+    let seeds = CommittedRegressions.load_persisted_failures2(Some("tests/control/control_hip.rs"));
+    let committed =
+        std::fs::read_to_string("tests/control/control_hip.proptest-regressions").unwrap();
     let lines = committed.lines().filter(|l| l.starts_with("cc ")).count();
     assert!(lines >= 2);
     assert_eq!(seeds.len(), lines, "every committed seed is loaded");
@@ -18,7 +18,7 @@ fn committed_seeds_are_replayed() {
 
 #[test]
 fn a_new_failure_is_not_written_into_the_tree() {
-    let beside = "tests/proptest_config.proptest-regressions";
+    let beside = "tests/wire/proptest_config.proptest-regressions";
     assert!(!std::path::Path::new(beside).exists());
     // Directly: saving prints, writes nothing.
     let seed: PersistedSeed = "cc 611db20704156869ee0852447abcf5a5c7587fbe761e3b4a5486aa2e67eeb212"

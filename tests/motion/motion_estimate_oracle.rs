@@ -1,7 +1,7 @@
 //! State estimation against an independent sensor simulation over all 24 orientations of the
 //! structure.
 //!
-//! `tests/motion_estimate.rs` feeds the estimator the readings of its own `predict`, which shares
+//! `tests/motion/motion_estimate.rs` feeds the estimator the readings of its own `predict`, which shares
 //! the estimator's code. Here the readings come from separate code: each of the 24 proper
 //! rotations of the cube (signed permutation matrices with determinant +1) places the structure
 //! in a world where gravity is −Z; each IMU frame is built from the arm and hip-axis vectors

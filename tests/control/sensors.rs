@@ -13,7 +13,7 @@ use mmic::sensors::MovingAverage;
 use mmic::units::Sign;
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 
 fn naive(samples: &[u16], n: usize) -> Option<u16> {
     let w = &samples[samples.len().saturating_sub(n)..];

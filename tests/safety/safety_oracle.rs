@@ -9,7 +9,7 @@ use mmic::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use mmic::units::{HipAngle, Module, PulseWidth};
 use proptest::prelude::*;
 
-mod common;
+use crate::common;
 use std::collections::{BTreeMap, BTreeSet};
 
 #[derive(serde::Deserialize)]

@@ -12,7 +12,7 @@
 //!   (fixed-seed sample, so the check is deterministic);
 //! * serde: every `Repr` survives JSON (feature `serde`).
 
-mod common;
+use crate::common;
 
 use common::{framing_error, seal};
 use mmic::arbitrary::sealed_bytes;

@@ -1,0 +1,6 @@
+//! Sections 3 and 4: boards A and B as nodes, and the two-core hand-off.
+//!
+//! One test binary per area, each file a module: fewer binaries to link than one per file.
+
+mod node_boards;
+mod node_handoff;
