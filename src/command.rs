@@ -26,7 +26,7 @@
 use crate::mode::Mode;
 use crate::motion::{Primitive, State};
 use crate::units::{HipAngle, Module, PulseWidth, Side};
-use core::fmt;
+use crate::wire_enum::wire_enum;
 
 /// Index in the command packet of the first parameter byte (Table 2 byte 6).
 pub const PARAM_OFFSET: usize = 6;
@@ -79,73 +79,36 @@ pub const fn preset_angle(t: HipTarget) -> Option<HipAngle> {
     }
 }
 
-/// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(try_from = "crate::units::Number", into = "u8")
-)]
-#[repr(u8)]
-pub enum BolterPair {
-    /// Pair 1.
-    P1 = 1,
-    /// Pair 2.
-    P2 = 2,
-    /// Pair 3.
-    P3 = 3,
-    /// Pair 4.
-    P4 = 4,
-}
+wire_enum! {
+    /// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(
+        feature = "serde",
+        derive(serde::Serialize, serde::Deserialize),
+        serde(try_from = "crate::units::Number", into = "u8")
+    )]
+    pub enum BolterPair: u8 {
+        /// Pair 1.
+        P1 = 1,
+        /// Pair 2.
+        P2 = 2,
+        /// Pair 3.
+        P3 = 3,
+        /// Pair 4.
+        P4 = 4,
+    }
 
-impl BolterPair {
     /// Pairs 1..=4 in the order "all four" runs them.
-    pub const ALL: [BolterPair; 4] = [
-        BolterPair::P1,
-        BolterPair::P2,
-        BolterPair::P3,
-        BolterPair::P4,
-    ];
-
+    const ALL;
     /// Pair number 1..=4.
-    pub const fn number(self) -> u8 {
-        self as u8
-    }
-
+    pub const fn number(self) -> u8;
     /// Pair with number `n`.
-    pub const fn from_number(n: u8) -> Option<BolterPair> {
-        if n >= 1 && n <= 4 {
-            Some(Self::ALL[(n - 1) as usize])
-        } else {
-            None
-        }
-    }
-}
+    pub const fn from_number(n: u8) -> Option<Self>;
 
-/// A pair number outside 1..=4.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
-#[error("bolter pair must be 1..=4, found {0}")]
-pub struct BolterPairError(pub u8);
-
-impl TryFrom<u8> for BolterPair {
-    type Error = BolterPairError;
-    fn try_from(n: u8) -> Result<BolterPair, BolterPairError> {
-        BolterPair::from_number(n).ok_or(BolterPairError(n))
-    }
-}
-
-#[cfg(feature = "serde")]
-impl TryFrom<crate::units::Number> for BolterPair {
-    type Error = crate::units::NumberRangeError;
-    fn try_from(n: crate::units::Number) -> Result<Self, Self::Error> {
-        n.narrow("bolter pair", (1, 4), BolterPair::from_number)
-    }
-}
-
-impl From<BolterPair> for u8 {
-    fn from(p: BolterPair) -> u8 {
-        p.number()
-    }
+    /// A pair number outside 1..=4.
+    #[error("bolter pair must be 1..=4, found {0}")]
+    pub struct BolterPairError(pub u8);
+    impl TryFrom<Number>("bolter pair");
 }
 
 /// Which fasteners a bolt or unbolt command works on.
@@ -651,57 +614,48 @@ impl Command {
     }
 }
 
-/// The rows of Table 1 (plus the `ClearFaults` extension): what mode rules and spec/ talk about.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-pub enum CommandKind {
-    /// Single module: arm.
-    Arm,
-    /// Single module: gripper.
-    Gripper,
-    /// Single module: hip.
-    Hip,
-    /// Single module: bolter.
-    Bolter,
-    /// Primitive motion.
-    Primitive,
-    /// Stop.
-    Stop,
-    /// Reset.
-    Reset,
-    /// Power control.
-    PowerControl,
-    /// Reconfiguration.
-    Reconfiguration,
-    /// Mode.
-    Mode,
-    /// System fault.
-    SystemFault,
-    /// Heartbeat.
-    Heartbeat,
-    /// Clear latched faults (extension, not in Table 1).
-    ClearFaults,
+wire_enum! {
+    /// The rows of Table 1 (plus the `ClearFaults` extension): what mode rules and spec/ talk about.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+    pub enum CommandKind {
+        /// Single module: arm.
+        Arm => "arm",
+        /// Single module: gripper.
+        Gripper => "gripper",
+        /// Single module: hip.
+        Hip => "hip",
+        /// Single module: bolter.
+        Bolter => "bolter",
+        /// Primitive motion.
+        Primitive => "primitive",
+        /// Stop.
+        Stop => "stop",
+        /// Reset.
+        Reset => "reset",
+        /// Power control.
+        PowerControl => "power_control",
+        /// Reconfiguration.
+        Reconfiguration => "reconfiguration",
+        /// Mode.
+        Mode => "mode",
+        /// System fault.
+        SystemFault => "system_fault",
+        /// Heartbeat.
+        Heartbeat => "heartbeat",
+        /// Clear latched faults (extension, not in Table 1).
+        ClearFaults => "clear_faults",
+    }
+
+    /// Table 1 order, then the extension.
+    const ALL;
+    /// snake_case name, as in spec/ and JSON.
+    pub const fn name(self) -> &'static str;
+    impl Display("{}", name);
 }
 
 impl CommandKind {
-    /// Table 1 order, then the extension.
-    pub const ALL: [CommandKind; 13] = [
-        CommandKind::Arm,
-        CommandKind::Gripper,
-        CommandKind::Hip,
-        CommandKind::Bolter,
-        CommandKind::Primitive,
-        CommandKind::Stop,
-        CommandKind::Reset,
-        CommandKind::PowerControl,
-        CommandKind::Reconfiguration,
-        CommandKind::Mode,
-        CommandKind::SystemFault,
-        CommandKind::Heartbeat,
-        CommandKind::ClearFaults,
-    ];
-
     /// Whether commands of this kind move an actuator (an arm, a gripper, the hip, a bolter,
     /// or several through a primitive or a reconfiguration): the commands a Stop blocks until
     /// Reset (Table 1), that Table 7 refuses outside Operational (arm and hip excepted in Safed),
@@ -718,31 +672,6 @@ impl CommandKind {
                 | CommandKind::Primitive
                 | CommandKind::Reconfiguration
         )
-    }
-
-    /// snake_case name, as in spec/ and JSON.
-    pub const fn name(self) -> &'static str {
-        match self {
-            CommandKind::Arm => "arm",
-            CommandKind::Gripper => "gripper",
-            CommandKind::Hip => "hip",
-            CommandKind::Bolter => "bolter",
-            CommandKind::Primitive => "primitive",
-            CommandKind::Stop => "stop",
-            CommandKind::Reset => "reset",
-            CommandKind::PowerControl => "power_control",
-            CommandKind::Reconfiguration => "reconfiguration",
-            CommandKind::Mode => "mode",
-            CommandKind::SystemFault => "system_fault",
-            CommandKind::Heartbeat => "heartbeat",
-            CommandKind::ClearFaults => "clear_faults",
-        }
-    }
-}
-
-impl fmt::Display for CommandKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
     }
 }
 

@@ -14,89 +14,49 @@
 //! assert_eq!(f.iter().count(), 2);
 //! ```
 
-use core::fmt;
+use crate::wire_enum::wire_enum;
 
-/// One autonomously detectable fault (Table 8), with its bit number in the fault bytes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-#[repr(u8)]
-pub enum Fault {
-    /// Three consecutive failed (un)bolting attempts.
-    BoltingFailure = 0,
-    /// Arm contraction not sensed by the switch.
-    ArmNotContracted = 1,
-    /// Bolter current above its idle limit at the start or end of a reconfiguration.
-    BolterOvercurrentIdle = 2,
-    /// Bolter current above its absolute limit.
-    BolterOvercurrent = 3,
-    /// Gripper current above its idle limit at the start or end of a reconfiguration.
-    GripperOvercurrentIdle = 4,
-    /// Gripper current above its absolute limit.
-    GripperOvercurrent = 5,
-    /// Locomotion (arm and hip) current above its idle limit at the start or end of a reconfiguration.
-    LocomotionOvercurrentIdle = 6,
-    /// Locomotion current above its absolute limit.
-    LocomotionOvercurrent = 7,
-    /// Hip angle far from its contracted-gripped value when entering Operational.
-    HipMismatch = 8,
-    /// Reconfiguration command's initial state differs from the detected state.
-    InitialStateMismatch = 9,
-    /// Board B heartbeat missing, or a command to B never acknowledged.
-    InternalCommLoss = 10,
-    /// V_batA or V_batB below threshold for longer than the debounce time.
-    LowBattery = 11,
-    /// Assembly system operation fault, injected by command.
-    AssemblySystem = 12,
-}
+wire_enum! {
+    /// One autonomously detectable fault (Table 8), with its bit number in the fault bytes.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+    pub enum Fault: u8 {
+        /// Three consecutive failed (un)bolting attempts.
+        BoltingFailure = 0 => "bolting_failure",
+        /// Arm contraction not sensed by the switch.
+        ArmNotContracted = 1 => "arm_not_contracted",
+        /// Bolter current above its idle limit at the start or end of a reconfiguration.
+        BolterOvercurrentIdle = 2 => "bolter_overcurrent_idle",
+        /// Bolter current above its absolute limit.
+        BolterOvercurrent = 3 => "bolter_overcurrent",
+        /// Gripper current above its idle limit at the start or end of a reconfiguration.
+        GripperOvercurrentIdle = 4 => "gripper_overcurrent_idle",
+        /// Gripper current above its absolute limit.
+        GripperOvercurrent = 5 => "gripper_overcurrent",
+        /// Locomotion (arm and hip) current above its idle limit at the start or end of a reconfiguration.
+        LocomotionOvercurrentIdle = 6 => "locomotion_overcurrent_idle",
+        /// Locomotion current above its absolute limit.
+        LocomotionOvercurrent = 7 => "locomotion_overcurrent",
+        /// Hip angle far from its contracted-gripped value when entering Operational.
+        HipMismatch = 8 => "hip_mismatch",
+        /// Reconfiguration command's initial state differs from the detected state.
+        InitialStateMismatch = 9 => "initial_state_mismatch",
+        /// Board B heartbeat missing, or a command to B never acknowledged.
+        InternalCommLoss = 10 => "internal_comm_loss",
+        /// V_batA or V_batB below threshold for longer than the debounce time.
+        LowBattery = 11 => "low_battery",
+        /// Assembly system operation fault, injected by command.
+        AssemblySystem = 12 => "assembly_system",
+    }
 
-impl Fault {
     /// Every fault, in bit order.
-    pub const ALL: [Fault; 13] = [
-        Fault::BoltingFailure,
-        Fault::ArmNotContracted,
-        Fault::BolterOvercurrentIdle,
-        Fault::BolterOvercurrent,
-        Fault::GripperOvercurrentIdle,
-        Fault::GripperOvercurrent,
-        Fault::LocomotionOvercurrentIdle,
-        Fault::LocomotionOvercurrent,
-        Fault::HipMismatch,
-        Fault::InitialStateMismatch,
-        Fault::InternalCommLoss,
-        Fault::LowBattery,
-        Fault::AssemblySystem,
-    ];
-
+    const ALL;
     /// Bit number in the 24-bit fault map.
-    pub const fn bit(self) -> u8 {
-        self as u8
-    }
-
+    pub const fn bit(self) -> u8;
     /// Stable snake_case name (spec/ and JSON).
-    pub const fn name(self) -> &'static str {
-        match self {
-            Fault::BoltingFailure => "bolting_failure",
-            Fault::ArmNotContracted => "arm_not_contracted",
-            Fault::BolterOvercurrentIdle => "bolter_overcurrent_idle",
-            Fault::BolterOvercurrent => "bolter_overcurrent",
-            Fault::GripperOvercurrentIdle => "gripper_overcurrent_idle",
-            Fault::GripperOvercurrent => "gripper_overcurrent",
-            Fault::LocomotionOvercurrentIdle => "locomotion_overcurrent_idle",
-            Fault::LocomotionOvercurrent => "locomotion_overcurrent",
-            Fault::HipMismatch => "hip_mismatch",
-            Fault::InitialStateMismatch => "initial_state_mismatch",
-            Fault::InternalCommLoss => "internal_comm_loss",
-            Fault::LowBattery => "low_battery",
-            Fault::AssemblySystem => "assembly_system",
-        }
-    }
-}
-
-impl fmt::Display for Fault {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
-    }
+    pub const fn name(self) -> &'static str;
+    impl Display("{}", name);
 }
 
 /// A set of faults: the latched fault map, or the conditions holding now.
@@ -198,7 +158,7 @@ impl<'de> serde::Deserialize<'de> for Faults {
         struct V;
         impl<'de> serde::de::Visitor<'de> for V {
             type Value = Faults;
-            fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            fn expecting(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
                 f.write_str("a list of fault names")
             }
             fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut a: A) -> Result<Faults, A::Error> {

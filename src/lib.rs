@@ -32,6 +32,9 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+// First: the modules below declare their C-like enums with it.
+mod wire_enum;
+
 #[cfg(feature = "proptest")]
 pub mod arbitrary;
 pub mod bolter;

@@ -7,79 +7,47 @@
 //! assert_eq!(Refusal::from_wire(0), None); // 0 = the command was accepted
 //! ```
 
-use core::fmt;
+use crate::wire_enum::wire_enum;
 
-/// A refused command's reason. Wire value 1..=7; 0 means accepted.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-pub enum Refusal {
-    /// Table 7: the current mode does not accept this kind of command.
-    NotAllowedInMode,
-    /// Operational refused: a fault condition still holds (see the fault bytes).
-    FaultConditionHolds,
-    /// Reconfiguration refused: its initial state is not the detected state (Table 8).
-    InitialStateMismatch,
-    /// Opcode unknown (includes an unknown mode value).
-    UnknownCommand,
-    /// Opcode known, parameters invalid (range, unused byte not zero, impossible state pair).
-    InvalidParameter,
-    /// A motion is running; a new motion command must wait for command complete.
-    Busy,
-    /// Motion is stopped; send Reset first.
-    Stopped,
+wire_enum! {
+    /// A refused command's reason. Wire value 1..=7; 0 means accepted.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+    pub enum Refusal {
+        /// Table 7: the current mode does not accept this kind of command.
+        NotAllowedInMode = 1 => "not_allowed_in_mode",
+        /// Operational refused: a fault condition still holds (see the fault bytes).
+        FaultConditionHolds = 2 => "fault_condition_holds",
+        /// Reconfiguration refused: its initial state is not the detected state (Table 8).
+        InitialStateMismatch = 3 => "initial_state_mismatch",
+        /// Opcode unknown (includes an unknown mode value).
+        UnknownCommand = 4 => "unknown_command",
+        /// Opcode known, parameters invalid (range, unused byte not zero, impossible state pair).
+        InvalidParameter = 5 => "invalid_parameter",
+        /// A motion is running; a new motion command must wait for command complete.
+        Busy = 6 => "busy",
+        /// Motion is stopped; send Reset first.
+        Stopped = 7 => "stopped",
+    }
+
+    /// All reasons, in wire order.
+    const ALL;
+    /// Wire value 1..=7.
+    pub const fn to_wire(self) -> u8;
+    /// Reason from its wire value; `None` for 0 (accepted) and unknown values.
+    pub const fn from_wire(b: u8) -> Option<Self>;
+    /// snake_case name (spec/ and JSON).
+    pub const fn name(self) -> &'static str;
+    impl Display("{}", name);
 }
 
 impl Refusal {
-    /// All reasons, in wire order.
-    pub const ALL: [Refusal; 7] = [
-        Refusal::NotAllowedInMode,
-        Refusal::FaultConditionHolds,
-        Refusal::InitialStateMismatch,
-        Refusal::UnknownCommand,
-        Refusal::InvalidParameter,
-        Refusal::Busy,
-        Refusal::Stopped,
-    ];
-
-    /// Wire value 1..=7.
-    pub const fn to_wire(self) -> u8 {
-        self as u8 + 1
-    }
-
-    /// Reason from its wire value; `None` for 0 (accepted) and unknown values.
-    pub const fn from_wire(b: u8) -> Option<Refusal> {
-        if b >= 1 && b <= 7 {
-            Some(Self::ALL[(b - 1) as usize])
-        } else {
-            None
-        }
-    }
-
-    /// snake_case name (spec/ and JSON).
-    pub const fn name(self) -> &'static str {
-        match self {
-            Refusal::NotAllowedInMode => "not_allowed_in_mode",
-            Refusal::FaultConditionHolds => "fault_condition_holds",
-            Refusal::InitialStateMismatch => "initial_state_mismatch",
-            Refusal::UnknownCommand => "unknown_command",
-            Refusal::InvalidParameter => "invalid_parameter",
-            Refusal::Busy => "busy",
-            Refusal::Stopped => "stopped",
-        }
-    }
-
     /// The refusal a malformed command packet earns.
     pub const fn for_command_error(e: &crate::command::CommandError) -> Refusal {
         match e {
             crate::command::CommandError::UnknownId { .. } => Refusal::UnknownCommand,
             _ => Refusal::InvalidParameter,
         }
-    }
-}
-
-impl fmt::Display for Refusal {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
     }
 }

@@ -14,6 +14,7 @@
 //! ```
 
 pub use crate::command::BolterPair;
+use crate::wire_enum::wire_enum;
 
 mod coordinator;
 mod side;
@@ -21,86 +22,55 @@ mod side;
 pub use coordinator::{Config, Coordinator, Job, Output, Status};
 pub use side::{BolterSide, Drive, SideConfig, Signals};
 
-/// Bolting or unbolting.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-pub enum BolterDirection {
-    /// Engage and lock the fasteners (wire 1).
-    Bolt,
-    /// Unlock and release them (wire 2).
-    Unbolt,
-}
+wire_enum! {
+    /// Bolting or unbolting.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+    pub enum BolterDirection {
+        /// Engage and lock the fasteners (wire 1).
+        Bolt = 1,
+        /// Unlock and release them (wire 2).
+        Unbolt = 2,
+    }
 
-impl BolterDirection {
     /// Wire value.
-    pub const fn to_wire(self) -> u8 {
-        match self {
-            BolterDirection::Bolt => 1,
-            BolterDirection::Unbolt => 2,
-        }
-    }
-
+    pub const fn to_wire(self) -> u8;
     /// Direction from its wire value.
-    pub const fn from_wire(b: u8) -> Option<BolterDirection> {
-        match b {
-            1 => Some(BolterDirection::Bolt),
-            2 => Some(BolterDirection::Unbolt),
-            _ => None,
-        }
+    pub const fn from_wire(b: u8) -> Option<Self>;
+}
+
+wire_enum! {
+    /// A step of the bolter state machine (Figure 8) that a side is executing. Steps marked * end
+    /// on a current threshold and have a timeout.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+    pub enum BolterStep {
+        /// 1*: translate towards the fastener and push until the current threshold.
+        Descend = 1,
+        /// 2: go back to the initial configuration.
+        Retract = 2,
+        /// 3*: descend again until the threshold, to engage.
+        DescendEngage = 3,
+        /// 4*: rotate the head until the current says locked (unlocked when unbolting).
+        Rotate = 4,
+        /// 5: counter-rotate to free the head and go back to the initial configuration; ends at home.
+        CounterRotate = 5,
+        /// 6: after a timed-out attempt, go back to the initial configuration; ends at home.
+        ReturnHome = 6,
+        /// 7: run finished, pair (un)bolted.
+        Done = 7,
+        /// 8: run failed (timeout).
+        Failed = 8,
     }
-}
 
-/// A step of the bolter state machine (Figure 8) that a side is executing. Steps marked * end
-/// on a current threshold and have a timeout.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-pub enum BolterStep {
-    /// 1*: translate towards the fastener and push until the current threshold.
-    Descend,
-    /// 2: go back to the initial configuration.
-    Retract,
-    /// 3*: descend again until the threshold, to engage.
-    DescendEngage,
-    /// 4*: rotate the head until the current says locked (unlocked when unbolting).
-    Rotate,
-    /// 5: counter-rotate to free the head and go back to the initial configuration; ends at home.
-    CounterRotate,
-    /// 6: after a timed-out attempt, go back to the initial configuration; ends at home.
-    ReturnHome,
-    /// 7: run finished, pair (un)bolted.
-    Done,
-    /// 8: run failed (timeout).
-    Failed,
-}
-
-impl BolterStep {
     /// All steps in order.
-    pub const ALL: [BolterStep; 8] = [
-        BolterStep::Descend,
-        BolterStep::Retract,
-        BolterStep::DescendEngage,
-        BolterStep::Rotate,
-        BolterStep::CounterRotate,
-        BolterStep::ReturnHome,
-        BolterStep::Done,
-        BolterStep::Failed,
-    ];
-
+    const ALL;
     /// Wire value 1..=8 (0 on the wire means idle).
-    pub const fn to_wire(self) -> u8 {
-        self as u8 + 1
-    }
-
+    pub const fn to_wire(self) -> u8;
     /// Step from its wire value.
-    pub const fn from_wire(b: u8) -> Option<BolterStep> {
-        if b >= 1 && b <= 8 {
-            Some(Self::ALL[(b - 1) as usize])
-        } else {
-            None
-        }
-    }
+    pub const fn from_wire(b: u8) -> Option<Self>;
 }
 
 /// The ADG1604 select lines A0 and A1.

@@ -1,6 +1,6 @@
 //! The 15 allowed configurations of Table 5.
 
-use core::fmt;
+use crate::wire_enum::wire_enum;
 
 /// Shape of a configuration (Section 6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -15,74 +15,48 @@ pub enum StateKind {
     Turn,
 }
 
-/// One of the 15 configuration states of Table 5, lettered `a`..`o`.
-///
-/// On the wire a state is its lowercase ASCII letter (`0x61`..`0x6f`), so it reads plainly in a
-/// hex dump and a zero byte is never a state.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(try_from = "char", into = "char")
-)]
-#[allow(missing_docs)] // the letters are documented by `name()` and Table 5
-pub enum State {
-    A,
-    B,
-    C,
-    D,
-    E,
-    F,
-    G,
-    H,
-    I,
-    J,
-    K,
-    L,
-    M,
-    N,
-    O,
+wire_enum! {
+    /// One of the 15 configuration states of Table 5, lettered `a`..`o`.
+    ///
+    /// On the wire a state is its lowercase ASCII letter (`0x61`..`0x6f`), so it reads plainly in a
+    /// hex dump and a zero byte is never a state.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(
+        feature = "serde",
+        derive(serde::Serialize, serde::Deserialize),
+        serde(try_from = "char", into = "char")
+    )]
+    #[allow(missing_docs)] // the letters are documented by `name()` and Table 5
+    pub enum State {
+        A = b'a' => "Xneg match",
+        B = b'b' => "Yneg match",
+        C = b'c' => "Zneg match",
+        D = b'd' => "Xneg Xpos stretch",
+        E = b'e' => "Xneg Ypos turn",
+        F = b'f' => "Xneg Zpos turn",
+        G = b'g' => "Yneg Xpos turn",
+        H = b'h' => "Yneg Ypos stretch",
+        I = b'i' => "Yneg Zpos turn",
+        J = b'j' => "Zneg Xpos turn",
+        K = b'k' => "Zneg Ypos turn",
+        L = b'l' => "Zneg Zpos stretch",
+        M = b'm' => "Xpos match",
+        N = b'n' => "Ypos match",
+        O = b'o' => "Zpos match",
+    }
+
+    /// All states in Table 5 order.
+    const ALL;
+    /// Byte on the wire: the ASCII letter.
+    pub const fn to_wire(self) -> u8;
+    /// State from its wire byte.
+    pub const fn from_wire(b: u8) -> Option<Self>;
+    /// Table 5 descriptive name.
+    pub const fn name(self) -> &'static str;
+    impl Display("{} ({})", letter, name);
 }
 
-/// Table 5, in order: letter, name.
-const TABLE5: [(char, &str); 15] = [
-    ('a', "Xneg match"),
-    ('b', "Yneg match"),
-    ('c', "Zneg match"),
-    ('d', "Xneg Xpos stretch"),
-    ('e', "Xneg Ypos turn"),
-    ('f', "Xneg Zpos turn"),
-    ('g', "Yneg Xpos turn"),
-    ('h', "Yneg Ypos stretch"),
-    ('i', "Yneg Zpos turn"),
-    ('j', "Zneg Xpos turn"),
-    ('k', "Zneg Ypos turn"),
-    ('l', "Zneg Zpos stretch"),
-    ('m', "Xpos match"),
-    ('n', "Ypos match"),
-    ('o', "Zpos match"),
-];
-
 impl State {
-    /// All states in Table 5 order.
-    pub const ALL: [State; 15] = [
-        State::A,
-        State::B,
-        State::C,
-        State::D,
-        State::E,
-        State::F,
-        State::G,
-        State::H,
-        State::I,
-        State::J,
-        State::K,
-        State::L,
-        State::M,
-        State::N,
-        State::O,
-    ];
-
     /// The six matched (final) states.
     pub const MATCHED: [State; 6] = [State::A, State::B, State::C, State::M, State::N, State::O];
 
@@ -93,7 +67,7 @@ impl State {
 
     /// State at Table 5 index `i`.
     pub const fn from_index(i: usize) -> Option<State> {
-        if i < 15 {
+        if i < Self::ALL.len() {
             Some(Self::ALL[i])
         } else {
             None
@@ -102,32 +76,13 @@ impl State {
 
     /// Table 5 letter.
     pub const fn letter(self) -> char {
-        TABLE5[self as usize].0
-    }
-
-    /// Table 5 descriptive name.
-    pub const fn name(self) -> &'static str {
-        TABLE5[self as usize].1
+        self.to_wire() as char
     }
 
     /// State with Table 5 letter `c` (lowercase).
     pub const fn from_letter(c: char) -> Option<State> {
-        if c >= 'a' && c <= 'o' {
-            State::from_index(c as usize - 'a' as usize)
-        } else {
-            None
-        }
-    }
-
-    /// Byte on the wire: the ASCII letter.
-    pub const fn to_wire(self) -> u8 {
-        b'a' + self as u8
-    }
-
-    /// State from its wire byte.
-    pub const fn from_wire(b: u8) -> Option<State> {
-        if b >= b'a' && b <= b'o' {
-            State::from_index((b - b'a') as usize)
+        if c.is_ascii() {
+            State::from_wire(c as u8)
         } else {
             None
         }
@@ -145,12 +100,6 @@ impl State {
     /// True for the matched states, the only final states of a reconfiguration.
     pub const fn is_matched(self) -> bool {
         matches!(self.kind(), StateKind::Matched)
-    }
-}
-
-impl fmt::Display for State {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{} ({})", self.letter(), self.name())
     }
 }
 
@@ -184,6 +133,11 @@ mod tests {
             assert_eq!(State::from_wire(s.to_wire()), Some(*s));
             assert_eq!(s.to_wire(), s.letter() as u8);
         }
+        // Table 5 letters in order: a..=o.
+        assert!(State::ALL
+            .iter()
+            .zip('a'..='o')
+            .all(|(s, c)| s.letter() == c));
         assert_eq!(State::from_wire(0), None);
         assert_eq!(State::from_wire(b'p'), None);
         assert_eq!(State::from_letter('p'), None);

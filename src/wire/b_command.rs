@@ -23,7 +23,7 @@
 //! ```
 
 use super::heartbeat::pulse;
-use super::layout::{span, FieldSpec, Unit};
+use super::layout::{field_table, FieldSpec};
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
 use crate::bolter::{BolterDirection, BolterPair, BolterStep};
 use crate::units::PulseWidth;
@@ -58,18 +58,6 @@ impl Packet for BCommandPacket {
 
 const _: () = assert!(core::mem::size_of::<BCommandPacket>() == B_COMMAND_LEN);
 
-macro_rules! f {
-    ($name:literal, $field:ident, $ty:ty, $unit:ident, $paper:literal) => {
-        FieldSpec {
-            name: $name,
-            range: span!(BCommandPacket, $field, $ty),
-            unit: Unit::$unit,
-            paper: $paper,
-            cells: &[],
-        }
-    };
-}
-
 macro_rules! at {
     ($f:ident) => {
         core::mem::offset_of!(BCommandPacket, $f)
@@ -78,28 +66,17 @@ macro_rules! at {
 
 /// Field table, from the layout (spec/packets/b-command.toml is checked against it). The
 /// "paper" labels are this project's, written in the paper's style.
-pub const FIELDS: &[FieldSpec] = &[
-    f!("header", header, [u8; 4], Header, "header"),
-    f!("seq", seq, u8, Sequence, "sequence number"),
-    f!("flags", flags, u8, Bits, "power/stop flags"),
-    f!("arm_target", arm_target, U16, Micros, "arm B-target"),
-    f!(
-        "gripper_target",
-        gripper_target,
-        U16,
-        Micros,
-        "gripper B-target"
-    ),
-    f!("bolter.pair", bolter_pair, u8, Enum, "bolter pair"),
-    f!(
-        "bolter.direction",
-        bolter_direction,
-        u8,
-        Enum,
-        "bolter direction"
-    ),
-    f!("bolter.step", bolter_step, u8, Enum, "bolter step"),
-    f!("checksum", checksum, U16, Crc16, "checksum"),
+pub const FIELDS: &[FieldSpec] = field_table![BCommandPacket;
+    // (name, field, type, unit, the paper's label)
+    ("header", header, [u8; 4], Header, "header"),
+    ("seq", seq, u8, Sequence, "sequence number"),
+    ("flags", flags, u8, Bits, "power/stop flags"),
+    ("arm_target", arm_target, U16, Micros, "arm B-target"),
+    ("gripper_target", gripper_target, U16, Micros, "gripper B-target"),
+    ("bolter.pair", bolter_pair, u8, Enum, "bolter pair"),
+    ("bolter.direction", bolter_direction, u8, Enum, "bolter direction"),
+    ("bolter.step", bolter_step, u8, Enum, "bolter step"),
+    ("checksum", checksum, U16, Crc16, "checksum"),
 ];
 
 /// Flag bits of byte 5.

@@ -11,7 +11,7 @@
 //! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
 
-use super::layout::{span, ElectricalLayout, FieldSpec, Unit};
+use super::layout::{field_table, span, ElectricalLayout, FieldSpec, Unit};
 use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
 use crate::command::BolterPair;
 use crate::faults::Faults;
@@ -65,158 +65,27 @@ impl Packet for HeartbeatPacket {
 
 const _: () = assert!(core::mem::size_of::<HeartbeatPacket>() == HEARTBEAT_LEN);
 
-macro_rules! f {
-    ($name:literal, $($field:ident).+, $ty:ty, $unit:ident, $paper:literal) => {
-        FieldSpec {
-            name: $name,
-            range: span!(HeartbeatPacket, $($field).+, $ty),
-            unit: Unit::$unit,
-            paper: $paper,
-            cells: &[],
-        }
-    };
-}
-
 /// Field table, from the layout (spec/packets/heartbeat.toml is checked against it).
-pub const FIELDS: &[FieldSpec] = &[
-    f!("header", header, [u8; 4], Header, "header"),
-    f!("board", board, u8, Board, "board number"),
-    f!("hip_target", hip_target, U16, Centidegrees, "hip-target"),
-    f!("hip_now", hip_now, U16, Centidegrees, "hip-now"),
-    f!("arm_a_target", arm_a_target, U16, Micros, "arm A-target"),
-    f!("arm_a_now", arm_a_now, U16, Micros, "arm A-now"),
-    f!("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
-    f!("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
-    f!(
-        "gripper_a_target",
-        gripper_a_target,
-        U16,
-        Micros,
-        "gripper A-target"
-    ),
-    f!("gripper_a_now", gripper_a_now, U16, Micros, "gripper A-now"),
-    f!(
-        "gripper_b_target",
-        gripper_b_target,
-        U16,
-        Micros,
-        "gripper B-target"
-    ),
-    f!("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
-    f!(
-        "electrical_a.v_bat",
-        electrical_a.v_bat,
-        U16,
-        Millivolts,
-        "V_{batA}"
-    ),
-    f!(
-        "electrical_a.i_bat",
-        electrical_a.i_bat,
-        U16,
-        Milliamps,
-        "I_{batA}"
-    ),
-    f!(
-        "electrical_a.i_loc",
-        electrical_a.i_loc,
-        U16,
-        Milliamps,
-        "I_{locA}"
-    ),
-    f!(
-        "electrical_a.i_grip",
-        electrical_a.i_grip,
-        U16,
-        Milliamps,
-        "I_{gripA}"
-    ),
-    f!(
-        "electrical_a.i_3v3",
-        electrical_a.i_3v3,
-        U16,
-        Milliamps,
-        "I_{3v3A}"
-    ),
-    f!(
-        "electrical_a.v_reg",
-        electrical_a.v_reg,
-        U16,
-        Millivolts,
-        "V_{regA}"
-    ),
-    f!(
-        "electrical_a.i_bo",
-        electrical_a.i_bo,
-        U16,
-        Milliamps,
-        "I_{boA}"
-    ),
-    f!(
-        "electrical_b.v_bat",
-        electrical_b.v_bat,
-        U16,
-        Millivolts,
-        "V_{batB}"
-    ),
-    f!(
-        "electrical_b.i_bat",
-        electrical_b.i_bat,
-        U16,
-        Milliamps,
-        "I_{batB}"
-    ),
-    f!(
-        "electrical_b.i_loc",
-        electrical_b.i_loc,
-        U16,
-        Milliamps,
-        "I_{locB}"
-    ),
-    f!(
-        "electrical_b.i_grip",
-        electrical_b.i_grip,
-        U16,
-        Milliamps,
-        "I_{gripB}"
-    ),
-    f!(
-        "electrical_b.i_3v3",
-        electrical_b.i_3v3,
-        U16,
-        Milliamps,
-        "I_{3v3B}"
-    ),
-    f!(
-        "electrical_b.v_reg",
-        electrical_b.v_reg,
-        U16,
-        Millivolts,
-        "V_{regB}"
-    ),
-    f!(
-        "electrical_b.i_bo",
-        electrical_b.i_bo,
-        U16,
-        Milliamps,
-        "I_{boB}"
-    ),
-    f!(
-        "target_state",
-        target_state,
-        u8,
-        StateLetter,
-        "target state"
-    ),
-    f!(
-        "command_complete",
-        command_complete,
-        u8,
-        Bool,
-        "command complete"
-    ),
-    f!("active_bolter", active_bolter, u8, Enum, "active bolter"),
-    f!("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
+pub const FIELDS: &[FieldSpec] = field_table![HeartbeatPacket;
+    // (name, field, type, unit, the paper's label)
+    ("header", header, [u8; 4], Header, "header"),
+    ("board", board, u8, Board, "board number"),
+    ("hip_target", hip_target, U16, Centidegrees, "hip-target"),
+    ("hip_now", hip_now, U16, Centidegrees, "hip-now"),
+    ("arm_a_target", arm_a_target, U16, Micros, "arm A-target"),
+    ("arm_a_now", arm_a_now, U16, Micros, "arm A-now"),
+    ("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
+    ("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
+    ("gripper_a_target", gripper_a_target, U16, Micros, "gripper A-target"),
+    ("gripper_a_now", gripper_a_now, U16, Micros, "gripper A-now"),
+    ("gripper_b_target", gripper_b_target, U16, Micros, "gripper B-target"),
+    ("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
+    ..electrical(electrical_a, "A"),
+    ..electrical(electrical_b, "B"),
+    ("target_state", target_state, u8, StateLetter, "target state"),
+    ("command_complete", command_complete, u8, Bool, "command complete"),
+    ("active_bolter", active_bolter, u8, Enum, "active bolter"),
+    ("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
     FieldSpec {
         name: "last_seq",
         range: span!(HeartbeatPacket, last_seq, U16),
@@ -224,7 +93,7 @@ pub const FIELDS: &[FieldSpec] = &[
         paper: "empty",
         cells: &["empty", "empty"],
     },
-    f!("empty", empty, u8, Reserved, "empty"),
+    ("empty", empty, u8, Reserved, "empty"),
     FieldSpec {
         name: "faults",
         range: span!(HeartbeatPacket, faults, [u8; 2]),
@@ -232,9 +101,9 @@ pub const FIELDS: &[FieldSpec] = &[
         paper: "fault byte0-1",
         cells: &["fault byte0", "fault byte1"],
     },
-    f!("refusal", refusal, u8, Enum, "fault byte2"),
-    f!("mode", mode, u8, Enum, "operating mode"),
-    f!("checksum", checksum, U16, Crc16, "checksum"),
+    ("refusal", refusal, u8, Enum, "fault byte2"),
+    ("mode", mode, u8, Enum, "operating mode"),
+    ("checksum", checksum, U16, Crc16, "checksum"),
 ];
 
 /// Which attempt of the bolter state machine is running: 0 (none), 1, 2 or 3.

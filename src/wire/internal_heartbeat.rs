@@ -10,7 +10,7 @@
 //! ```
 
 use super::heartbeat::pulse;
-use super::layout::{span, ElectricalLayout, FieldSpec, Unit};
+use super::layout::{field_table, ElectricalLayout, FieldSpec};
 use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
 use crate::bolter::{BolterDirection, BolterPair, BolterStep, MuxLines};
 use crate::units::{Axis, Electrical, Gravity, PulseWidth, Sign};
@@ -63,18 +63,6 @@ impl Packet for InternalHeartbeatPacket {
 
 const _: () = assert!(core::mem::size_of::<InternalHeartbeatPacket>() == INTERNAL_HEARTBEAT_LEN);
 
-macro_rules! f {
-    ($name:literal, $($field:ident).+, $ty:ty, $unit:ident, $paper:literal) => {
-        FieldSpec {
-            name: $name,
-            range: span!(InternalHeartbeatPacket, $($field).+, $ty),
-            unit: Unit::$unit,
-            paper: $paper,
-            cells: &[],
-        }
-    };
-}
-
 macro_rules! at {
     ($f:ident) => {
         core::mem::offset_of!(InternalHeartbeatPacket, $f)
@@ -84,183 +72,34 @@ macro_rules! at {
 const AUX: &str = "bolter B operation auxiliary variables";
 
 /// Field table, from the layout (spec/packets/internal-heartbeat.toml is checked against it).
-pub const FIELDS: &[FieldSpec] = &[
-    f!("header", header, [u8; 4], Header, "header"),
-    f!("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
-    f!("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
-    f!(
-        "gripper_b_target",
-        gripper_b_target,
-        U16,
-        Micros,
-        "gripper B-target"
-    ),
-    f!("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
-    f!(
-        "electrical_b.v_bat",
-        electrical_b.v_bat,
-        U16,
-        Millivolts,
-        "V_{batB}"
-    ),
-    f!(
-        "electrical_b.i_bat",
-        electrical_b.i_bat,
-        U16,
-        Milliamps,
-        "I_{batB}"
-    ),
-    f!(
-        "electrical_b.i_loc",
-        electrical_b.i_loc,
-        U16,
-        Milliamps,
-        "I_{locB}"
-    ),
-    f!(
-        "electrical_b.i_grip",
-        electrical_b.i_grip,
-        U16,
-        Milliamps,
-        "I_{gripB}"
-    ),
-    f!(
-        "electrical_b.i_3v3",
-        electrical_b.i_3v3,
-        U16,
-        Milliamps,
-        "I_{3v3B}"
-    ),
-    f!(
-        "electrical_b.v_reg",
-        electrical_b.v_reg,
-        U16,
-        Millivolts,
-        "V_{regB}"
-    ),
-    f!(
-        "electrical_b.i_bo",
-        electrical_b.i_bo,
-        U16,
-        Milliamps,
-        "I_{boB}"
-    ),
-    FieldSpec {
-        name: "bolter_aux.step",
-        range: span!(InternalHeartbeatPacket, bolter_step, u8),
-        unit: Unit::Enum,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.seq",
-        range: span!(InternalHeartbeatPacket, bolter_seq, u8),
-        unit: Unit::Sequence,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.pair",
-        range: span!(InternalHeartbeatPacket, bolter_pair, u8),
-        unit: Unit::Enum,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.direction",
-        range: span!(InternalHeartbeatPacket, bolter_direction, u8),
-        unit: Unit::Enum,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.threshold_reached",
-        range: span!(InternalHeartbeatPacket, bolter_threshold, u8),
-        unit: Unit::Bool,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.locked",
-        range: span!(InternalHeartbeatPacket, bolter_locked, u8),
-        unit: Unit::Bool,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.timed_out",
-        range: span!(InternalHeartbeatPacket, bolter_timed_out, u8),
-        unit: Unit::Bool,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.at_home",
-        range: span!(InternalHeartbeatPacket, bolter_at_home, u8),
-        unit: Unit::Bool,
-        paper: AUX,
-        cells: &[],
-    },
-    FieldSpec {
-        name: "bolter_aux.mux",
-        range: span!(InternalHeartbeatPacket, bolter_mux, u8),
-        unit: Unit::Bits,
-        paper: AUX,
-        cells: &[],
-    },
-    f!(
-        "command_received",
-        command_received,
-        u8,
-        Sequence,
-        "command received"
-    ),
-    f!("gravity.sign", g_sign, u8, Enum, "g direction sign"),
-    f!("gravity.axis", g_axis, u8, Enum, "g direction axis"),
-    f!("arm_over_idle", arm_over_idle, u8, Bool, "arm B over-idle"),
-    f!(
-        "gripper_over_idle",
-        gripper_over_idle,
-        u8,
-        Bool,
-        "gripper B over-idle"
-    ),
-    f!(
-        "bolter_over_idle",
-        bolter_over_idle,
-        u8,
-        Bool,
-        "bolter B over-idle"
-    ),
-    f!(
-        "arm_overcurrent",
-        arm_overcurrent,
-        u8,
-        Bool,
-        "arm B overcurrent"
-    ),
-    f!(
-        "gripper_overcurrent",
-        gripper_overcurrent,
-        u8,
-        Bool,
-        "gripper B overcurrent"
-    ),
-    f!(
-        "bolter_overcurrent",
-        bolter_overcurrent,
-        u8,
-        Bool,
-        "bolter B overcurrent"
-    ),
-    f!(
-        "arm_contracted",
-        arm_contracted,
-        u8,
-        Bool,
-        "arm B contracted"
-    ),
-    f!("checksum", checksum, U16, Crc16, "checksum"),
+pub const FIELDS: &[FieldSpec] = field_table![InternalHeartbeatPacket;
+    // (name, field, type, unit, the paper's label)
+    ("header", header, [u8; 4], Header, "header"),
+    ("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
+    ("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
+    ("gripper_b_target", gripper_b_target, U16, Micros, "gripper B-target"),
+    ("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
+    ..electrical(electrical_b, "B"),
+    ("bolter_aux.step", bolter_step, u8, Enum, AUX),
+    ("bolter_aux.seq", bolter_seq, u8, Sequence, AUX),
+    ("bolter_aux.pair", bolter_pair, u8, Enum, AUX),
+    ("bolter_aux.direction", bolter_direction, u8, Enum, AUX),
+    ("bolter_aux.threshold_reached", bolter_threshold, u8, Bool, AUX),
+    ("bolter_aux.locked", bolter_locked, u8, Bool, AUX),
+    ("bolter_aux.timed_out", bolter_timed_out, u8, Bool, AUX),
+    ("bolter_aux.at_home", bolter_at_home, u8, Bool, AUX),
+    ("bolter_aux.mux", bolter_mux, u8, Bits, AUX),
+    ("command_received", command_received, u8, Sequence, "command received"),
+    ("gravity.sign", g_sign, u8, Enum, "g direction sign"),
+    ("gravity.axis", g_axis, u8, Enum, "g direction axis"),
+    ("arm_over_idle", arm_over_idle, u8, Bool, "arm B over-idle"),
+    ("gripper_over_idle", gripper_over_idle, u8, Bool, "gripper B over-idle"),
+    ("bolter_over_idle", bolter_over_idle, u8, Bool, "bolter B over-idle"),
+    ("arm_overcurrent", arm_overcurrent, u8, Bool, "arm B overcurrent"),
+    ("gripper_overcurrent", gripper_overcurrent, u8, Bool, "gripper B overcurrent"),
+    ("bolter_overcurrent", bolter_overcurrent, u8, Bool, "bolter B overcurrent"),
+    ("arm_contracted", arm_contracted, u8, Bool, "arm B contracted"),
+    ("checksum", checksum, U16, Crc16, "checksum"),
 ];
 
 /// Bolter B's progress, the nine "auxiliary variables" A needs to keep both bolters in step.

@@ -60,6 +60,70 @@ macro_rules! span {
 }
 pub(crate) use span;
 
+/// A packet's field table, `&[FieldSpec]`, from layout `$t` and its entries in byte order, each
+/// one of:
+/// - a row `(name, field, type, unit, paper)`: field `field` (of type `type`) of `$t`, named
+///   `name`, its unit `Unit::unit` and the paper's label `paper`;
+/// - `..electrical(field, "X")`: the seven readings of the [`ElectricalLayout`] `field`, named
+///   `field.v_bat` … `field.i_bo` and labelled as the paper does, `V_{batX}` … `I_{boX}` (`X` the
+///   side): both heartbeats carry such blocks;
+/// - any `FieldSpec` expression (explicit `cells`).
+macro_rules! field_table {
+    (@munch $t:ty; [$($done:expr,)*];) => {
+        &[$($done,)*]
+    };
+    (
+        @munch $t:ty; [$($done:expr,)*];
+        ($name:literal, $($field:ident).+, $ft:ty, $unit:ident, $paper:expr) $(, $($rest:tt)*)?
+    ) => {
+        $crate::wire::layout::field_table!(@munch $t; [
+            $($done,)*
+            $crate::wire::layout::field_table!(@field $t, $name, $($field).+, $ft, $unit, $paper),
+        ]; $($($rest)*)?)
+    };
+    (
+        @munch $t:ty; [$($done:expr,)*];
+        ..electrical($side:ident, $x:literal) $(, $($rest:tt)*)?
+    ) => {
+        $crate::wire::layout::field_table!(@munch $t; [
+            $($done,)*
+            $crate::wire::layout::field_table!(@reading $t, $side, v_bat, Millivolts, "V_{bat", $x),
+            $crate::wire::layout::field_table!(@reading $t, $side, i_bat, Milliamps, "I_{bat", $x),
+            $crate::wire::layout::field_table!(@reading $t, $side, i_loc, Milliamps, "I_{loc", $x),
+            $crate::wire::layout::field_table!(@reading $t, $side, i_grip, Milliamps, "I_{grip", $x),
+            $crate::wire::layout::field_table!(@reading $t, $side, i_3v3, Milliamps, "I_{3v3", $x),
+            $crate::wire::layout::field_table!(@reading $t, $side, v_reg, Millivolts, "V_{reg", $x),
+            $crate::wire::layout::field_table!(@reading $t, $side, i_bo, Milliamps, "I_{bo", $x),
+        ]; $($($rest)*)?)
+    };
+    (@munch $t:ty; [$($done:expr,)*]; $entry:expr $(, $($rest:tt)*)?) => {
+        $crate::wire::layout::field_table!(@munch $t; [$($done,)* $entry,]; $($($rest)*)?)
+    };
+    (@reading $t:ty, $side:ident, $reading:ident, $unit:ident, $label:literal, $x:literal) => {
+        $crate::wire::layout::field_table!(
+            @field $t,
+            concat!(stringify!($side), ".", stringify!($reading)),
+            $side.$reading,
+            zerocopy::byteorder::little_endian::U16,
+            $unit,
+            concat!($label, $x, "}")
+        )
+    };
+    (@field $t:ty, $name:expr, $($field:ident).+, $ft:ty, $unit:ident, $paper:expr) => {
+        $crate::wire::layout::FieldSpec {
+            name: $name,
+            range: $crate::wire::layout::span!($t, $($field).+, $ft),
+            unit: $crate::wire::layout::Unit::$unit,
+            paper: $paper,
+            cells: &[],
+        }
+    };
+    ($t:ty; $($entries:tt)*) => {
+        $crate::wire::layout::field_table!(@munch $t; []; $($entries)*)
+    };
+}
+pub(crate) use field_table;
+
 /// Unit or encoding of a field, as spec/ names it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Unit {
