@@ -2,7 +2,7 @@
 //! Run: `cargo bench --bench motion`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mmic::motion::{plan, State};
+use mmic::motion::{route, State};
 use std::hint::black_box;
 use std::time::Duration;
 
@@ -16,7 +16,7 @@ fn plans(c: &mut Criterion) {
         b.iter(|| {
             pairs
                 .iter()
-                .map(|(f, t)| plan::lookup(black_box(*f), black_box(*t)).len())
+                .map(|(f, t)| route::lookup(black_box(*f), black_box(*t)).len())
                 .sum::<usize>()
         })
     });
@@ -24,7 +24,7 @@ fn plans(c: &mut Criterion) {
         b.iter(|| {
             pairs
                 .iter()
-                .map(|(f, t)| plan::search(black_box(*f), black_box(*t)).len())
+                .map(|(f, t)| route::search(black_box(*f), black_box(*t)).len())
                 .sum::<usize>()
         })
     });

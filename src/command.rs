@@ -79,37 +79,8 @@ pub const fn preset_angle(t: HipTarget) -> Option<HipAngle> {
     }
 }
 
-wire_enum! {
-    /// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.
-    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-    #[cfg_attr(
-        feature = "serde",
-        derive(serde::Serialize, serde::Deserialize),
-        serde(try_from = "crate::units::Number", into = "u8")
-    )]
-    pub enum BolterPair: u8 {
-        /// Pair 1.
-        P1 = 1,
-        /// Pair 2.
-        P2 = 2,
-        /// Pair 3.
-        P3 = 3,
-        /// Pair 4.
-        P4 = 4,
-    }
-
-    /// Pairs 1..=4 in the order "all four" runs them.
-    const ALL;
-    /// Pair number 1..=4.
-    pub const fn number(self) -> u8;
-    /// Pair with number `n`.
-    pub const fn from_number(n: u8) -> Option<Self>;
-
-    /// A pair number outside 1..=4.
-    #[error("bolter pair must be 1..=4, found {0}")]
-    pub struct BolterPairError(pub u8);
-    impl TryFrom<Number>("bolter pair");
-}
+/// The bolter pairs are the bolter's concept ([`crate::bolter`]); commands name them.
+pub use crate::bolter::{BolterPair, BolterPairError};
 
 /// Which fasteners a bolt or unbolt command works on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -399,6 +370,112 @@ fn put_u16(p: &mut [u8; PARAM_LEN], slot: Slot, v: u16) {
     p[o + 1] = b[1];
 }
 
+/// `id` is one of the `n` opcodes from `first` on.
+const fn in_block(id: u8, first: u8, n: u8) -> bool {
+    id >= first && id - first < n
+}
+
+/// Arm and gripper opcodes: per module two blocks of four (side A, side B), each contract,
+/// extend, position and one unassigned.
+const fn is_servo(id: u8) -> bool {
+    (in_block(id, opcode::ARM, 8) || in_block(id, opcode::GRIPPER, 8))
+        && (id - opcode::ARM) % 4 != 3
+}
+
+/// An arm or gripper command; a position uses its side's parameter slot.
+fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+    let base = if id < opcode::GRIPPER {
+        opcode::ARM
+    } else {
+        opcode::GRIPPER
+    };
+    let side = side_of(id, base);
+    let slot = Slot::for_side(side);
+    let (target, used) = match (id - base) % 4 {
+        0 => (ServoTarget::Contract, 0),
+        1 => (ServoTarget::Extend, 0),
+        _ => {
+            let raw = get_u16(p, slot);
+            let pw = PulseWidth::new(raw).map_err(|_| CommandError::PulseWidth {
+                index: PARAM_OFFSET + slot.offset(),
+                found: raw,
+            })?;
+            (ServoTarget::Position(pw), 0b11 << slot.offset())
+        }
+    };
+    let cmd = if base == opcode::ARM {
+        Command::Arm { side, target }
+    } else {
+        Command::Gripper { side, target }
+    };
+    Ok((cmd, used))
+}
+
+/// A hip command: the four presets, or an angle in the hip slot.
+fn decode_hip(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+    Ok(match id - opcode::HIP {
+        0 => (Command::Hip(HipTarget::Home), 0),
+        1 => (Command::Hip(HipTarget::Straight), 0),
+        2 => (Command::Hip(HipTarget::RightAngleCw), 0),
+        3 => (Command::Hip(HipTarget::RightAngleCcw), 0),
+        _ => {
+            let raw = get_u16(p, Slot::Hip);
+            let a = HipAngle::new(raw).map_err(|_| CommandError::HipAngle {
+                index: PARAM_OFFSET,
+                found: raw,
+            })?;
+            (Command::Hip(HipTarget::Angle(a)), 0b11)
+        }
+    })
+}
+
+/// A bolt or unbolt command: pairs 1..=4, then all four.
+fn decode_bolter(id: u8) -> BolterCommand {
+    let base = if id < opcode::UNBOLT {
+        opcode::BOLT
+    } else {
+        opcode::UNBOLT
+    };
+    let which = match BolterPair::from_number(id - base + 1) {
+        Some(n) => Fasteners::Pair(n),
+        None => Fasteners::All,
+    };
+    if base == opcode::BOLT {
+        BolterCommand::Bolt(which)
+    } else {
+        BolterCommand::Unbolt(which)
+    }
+}
+
+/// A reconfiguration: target state in the first parameter byte, initial state in the second
+/// (Table 2's "final state / init state").
+fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+    let at = Slot::ArmA.offset();
+    let state = |i: usize| {
+        State::from_wire(p[i]).ok_or(CommandError::State {
+            index: PARAM_OFFSET + i,
+            found: p[i],
+        })
+    };
+    let target = state(at)?;
+    let initial = state(at + 1)?;
+    Ok((
+        Command::Reconfigure(Reconfiguration::new(initial, target)?),
+        0b11 << at,
+    ))
+}
+
+/// A power command: on or off, one of the seven modules or all.
+fn decode_power(id: u8) -> Command {
+    let on = id < opcode::POWER_OFF;
+    let i = (id - opcode::POWER_ON) % 8;
+    let target = match Module::from_index(i) {
+        Some(m) => PowerTarget::Module(m),
+        None => PowerTarget::All,
+    };
+    Command::Power { target, on }
+}
+
 fn side_of(id: u8, base: u8) -> Side {
     if id - base >= 4 {
         Side::B
@@ -480,106 +557,35 @@ impl Command {
         (id, p)
     }
 
-    /// The command for opcode `id` and parameter bytes `p` (packet bytes 6..=11).
+    /// The command for opcode `id` and parameter bytes `p` (packet bytes 6..=11). Each block
+    /// of opcodes is recognised from its [`opcode`] constant; parameter bytes the command does
+    /// not use must be zero.
     pub fn decode(id: u8, p: [u8; PARAM_LEN]) -> Result<Command, CommandError> {
-        // Which parameter bytes this opcode uses, as a bit mask over p[0..6].
+        // The command, and which parameter bytes it uses as a bit mask over p[0..6].
         let (cmd, used): (Command, u8) = match id {
             opcode::HEARTBEAT => (Command::Heartbeat, 0),
             opcode::STOP => (Command::Stop, 0),
             opcode::RESET => (Command::Reset, 0),
             opcode::SYSTEM_FAULT => (Command::SystemFault, 0),
             opcode::CLEAR_FAULTS => (Command::ClearFaults, 0),
-            0x10..=0x12 => match Mode::from_wire(id - opcode::MODE + 1) {
+            opcode::BOLTERS_DOWN => (Command::Bolter(BolterCommand::Down), 0),
+            opcode::RECONFIGURE => decode_reconfigure(&p)?,
+            _ if in_block(id, opcode::MODE, 3) => match Mode::from_wire(id - opcode::MODE + 1) {
                 Some(m) => (Command::Mode(m), 0),
                 None => return Err(CommandError::UnknownId { id }),
             },
-            0x20..=0x22 | 0x24..=0x26 | 0x28..=0x2a | 0x2c..=0x2e => {
-                let base = if id < opcode::GRIPPER {
-                    opcode::ARM
-                } else {
-                    opcode::GRIPPER
-                };
-                let side = side_of(id, base);
-                let slot = Slot::for_side(side);
-                let (target, used) = match (id - base) % 4 {
-                    0 => (ServoTarget::Contract, 0),
-                    1 => (ServoTarget::Extend, 0),
-                    _ => {
-                        let raw = get_u16(&p, slot);
-                        let pw = PulseWidth::new(raw).map_err(|_| CommandError::PulseWidth {
-                            index: PARAM_OFFSET + slot.offset(),
-                            found: raw,
-                        })?;
-                        (ServoTarget::Position(pw), 0b11 << slot.offset())
-                    }
-                };
-                let cmd = if base == opcode::ARM {
-                    Command::Arm { side, target }
-                } else {
-                    Command::Gripper { side, target }
-                };
-                (cmd, used)
+            _ if is_servo(id) => decode_servo(id, &p)?,
+            _ if in_block(id, opcode::HIP, 5) => decode_hip(id, &p)?,
+            _ if in_block(id, opcode::BOLT, 5) || in_block(id, opcode::UNBOLT, 5) => {
+                (Command::Bolter(decode_bolter(id)), 0)
             }
-            0x30..=0x34 => match id - opcode::HIP {
-                0 => (Command::Hip(HipTarget::Home), 0),
-                1 => (Command::Hip(HipTarget::Straight), 0),
-                2 => (Command::Hip(HipTarget::RightAngleCw), 0),
-                3 => (Command::Hip(HipTarget::RightAngleCcw), 0),
-                _ => {
-                    let raw = get_u16(&p, Slot::Hip);
-                    let a = HipAngle::new(raw).map_err(|_| CommandError::HipAngle {
-                        index: PARAM_OFFSET,
-                        found: raw,
-                    })?;
-                    (Command::Hip(HipTarget::Angle(a)), 0b11)
+            _ if in_block(id, opcode::PRIMITIVE + 1, 8) => {
+                match Primitive::from_number(id - opcode::PRIMITIVE) {
+                    Some(pr) => (Command::Primitive(pr), 0),
+                    None => return Err(CommandError::UnknownId { id }),
                 }
-            },
-            0x40..=0x44 | 0x48..=0x4c => {
-                let base = if id < opcode::UNBOLT {
-                    opcode::BOLT
-                } else {
-                    opcode::UNBOLT
-                };
-                let which = match BolterPair::from_number(id - base + 1) {
-                    Some(n) => Fasteners::Pair(n),
-                    None => Fasteners::All,
-                };
-                let b = if base == opcode::BOLT {
-                    BolterCommand::Bolt(which)
-                } else {
-                    BolterCommand::Unbolt(which)
-                };
-                (Command::Bolter(b), 0)
             }
-            opcode::BOLTERS_DOWN => (Command::Bolter(BolterCommand::Down), 0),
-            0x51..=0x58 => match Primitive::from_number(id - opcode::PRIMITIVE) {
-                Some(pr) => (Command::Primitive(pr), 0),
-                None => return Err(CommandError::UnknownId { id }),
-            },
-            opcode::RECONFIGURE => {
-                let at = Slot::ArmA.offset();
-                let state = |i: usize| {
-                    State::from_wire(p[i]).ok_or(CommandError::State {
-                        index: PARAM_OFFSET + i,
-                        found: p[i],
-                    })
-                };
-                let target = state(at)?;
-                let initial = state(at + 1)?;
-                (
-                    Command::Reconfigure(Reconfiguration::new(initial, target)?),
-                    0b11 << at,
-                )
-            }
-            0x70..=0x7f => {
-                let on = id < opcode::POWER_OFF;
-                let i = (id - opcode::POWER_ON) % 8;
-                let target = match Module::from_index(i) {
-                    Some(m) => PowerTarget::Module(m),
-                    None => PowerTarget::All,
-                };
-                (Command::Power { target, on }, 0)
-            }
+            _ if in_block(id, opcode::POWER_ON, 16) => (decode_power(id), 0),
             _ => return Err(CommandError::UnknownId { id }),
         };
         for (i, &b) in p.iter().enumerate() {

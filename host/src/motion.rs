@@ -1,7 +1,7 @@
 //! `mmic plan` and `mmic map`: the motion library's plans and map, as text and JSON.
 
 use crate::error::CliError;
-use mmic::motion::{map, plan, State};
+use mmic::motion::{map, route, State};
 use serde::Serialize;
 
 #[derive(Serialize)]
@@ -37,7 +37,7 @@ pub fn state(s: &str) -> Result<State, CliError> {
 
 /// `{"from":"a","to":"m","primitives":[4,1]}`.
 pub fn plan_json(from: State, to: State) -> String {
-    let p = plan::lookup(from, to);
+    let p = route::lookup(from, to);
     let prims: Vec<u8> = p.primitives().iter().map(|p| p.number()).collect();
     let v = PlanJson {
         from: from.letter().to_string(),
@@ -49,7 +49,7 @@ pub fn plan_json(from: State, to: State) -> String {
 
 /// One line per primitive: number, name, and the state it reaches.
 pub fn plan_text(from: State, to: State) -> String {
-    let p = plan::lookup(from, to);
+    let p = route::lookup(from, to);
     let mut s = format!("{from} -> {to}: {} primitive(s)", p.len());
     for (prim, st) in p.primitives().iter().zip(p.states()) {
         s += &format!("\n  {} {:<12} -> {st}", prim.number(), prim.name());

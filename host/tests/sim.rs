@@ -2,7 +2,7 @@
 //! scaled time. Each test reads the JSON-lines log the run wrote, as a user would.
 
 use mmic::mode::Mode;
-use mmic::node::plan::PlanEnd;
+use mmic::node::plan_runner::PlanEnd;
 use mmic_host::plan;
 use mmic_host::sim::{report, run, SimConfig, Summary};
 use serde_json::Value;

@@ -8,12 +8,11 @@
 //!
 //! ```
 //! use mmic::bolter::{BolterStep, MuxLines};
-//! use mmic::command::BolterPair;
+//! use mmic::bolter::BolterPair;
 //! assert_eq!(BolterStep::from_wire(BolterStep::Rotate.to_wire()), Some(BolterStep::Rotate));
 //! assert_eq!(MuxLines::for_pair(BolterPair::P3), MuxLines { a0: true, a1: false });
 //! ```
 
-pub use crate::command::BolterPair;
 use crate::wire_enum::wire_enum;
 
 mod coordinator;
@@ -21,6 +20,38 @@ mod side;
 
 pub use coordinator::{Config, Coordinator, Job, Output, Status};
 pub use side::{BolterSide, Drive, SideConfig, Signals};
+
+wire_enum! {
+    /// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(
+        feature = "serde",
+        derive(serde::Serialize, serde::Deserialize),
+        serde(try_from = "crate::units::Number", into = "u8")
+    )]
+    pub enum BolterPair: u8 {
+        /// Pair 1.
+        P1 = 1,
+        /// Pair 2.
+        P2 = 2,
+        /// Pair 3.
+        P3 = 3,
+        /// Pair 4.
+        P4 = 4,
+    }
+
+    /// Pairs 1..=4 in the order "all four" runs them.
+    const ALL;
+    /// Pair number 1..=4.
+    pub const fn number(self) -> u8;
+    /// Pair with number `n`.
+    pub const fn from_number(n: u8) -> Option<Self>;
+
+    /// A pair number outside 1..=4.
+    #[error("bolter pair must be 1..=4, found {0}")]
+    pub struct BolterPairError(pub u8);
+    impl TryFrom<Number>("bolter pair");
+}
 
 wire_enum! {
     /// Bolting or unbolting.
@@ -110,5 +141,62 @@ impl MuxLines {
                 a1: b & 2 != 0,
             })
         }
+    }
+}
+/// Which attempt of the bolter state machine is running: 0 (none), 1, 2 or 3.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(try_from = "crate::units::Number", into = "u8")
+)]
+pub struct BolterAttempt(u8);
+
+impl BolterAttempt {
+    /// Three attempts at most (Table 8).
+    pub const MAX: u8 = 3;
+    /// No attempt running.
+    pub const NONE: BolterAttempt = BolterAttempt(0);
+
+    /// Attempt `n`, refused above 3.
+    pub const fn new(n: u8) -> Result<Self, crate::units::RangeError> {
+        if n <= Self::MAX {
+            Ok(BolterAttempt(n))
+        } else {
+            Err(crate::units::RangeError {
+                quantity: "bolter attempt",
+                min: 0,
+                max: 3,
+                found: n as u32,
+            })
+        }
+    }
+
+    /// The attempt number.
+    pub const fn get(self) -> u8 {
+        self.0
+    }
+}
+
+impl TryFrom<u8> for BolterAttempt {
+    type Error = crate::units::RangeError;
+    fn try_from(n: u8) -> Result<Self, Self::Error> {
+        BolterAttempt::new(n)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<crate::units::Number> for BolterAttempt {
+    type Error = crate::units::NumberRangeError;
+    fn try_from(n: crate::units::Number) -> Result<Self, Self::Error> {
+        n.narrow("bolter attempt", (0, Self::MAX as i128), |v: u8| {
+            Self::new(v).ok()
+        })
+    }
+}
+
+impl From<BolterAttempt> for u8 {
+    fn from(a: BolterAttempt) -> u8 {
+        a.get()
     }
 }

@@ -51,11 +51,11 @@ pub fn moves() -> impl Iterator<Item = (State, State, Primitive)> {
 /// Whether the move `from → to` appears in a chosen plan between two matched states (the final
 /// states of reconfiguration commands). Moves that do not are the paper's asterisked cells:
 /// possible, but never used. Which moves these are depends on the plan tie-break
-/// ([`plan`](super::plan)).
+/// ([`route`](super::route)).
 pub fn used_between_matched(from: State, to: State) -> bool {
     State::MATCHED.into_iter().any(|f| {
         State::MATCHED.into_iter().any(|t| {
-            let p = super::plan::lookup(f, t);
+            let p = super::route::lookup(f, t);
             let mut at = f;
             p.states().iter().any(|&next| {
                 let hit = at == from && next == to;

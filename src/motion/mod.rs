@@ -1,6 +1,6 @@
 //! Motion generation (Section 6): the 15 configuration states of Table 5, the 8 motion
 //! primitives of Table 6, the reconfiguration map of Figure 9 computed from a geometric model
-//! ([`geometry`], [`map`]), and shortest plans between states ([`plan`]).
+//! ([`geometry`], [`map`]), and shortest routes of primitives between states ([`route`]).
 //!
 //! ```
 //! use mmic::motion::{State, StateKind, Primitive};
@@ -13,8 +13,8 @@
 pub mod estimate;
 pub mod geometry;
 pub mod map;
-pub mod plan;
 mod primitive;
+pub mod route;
 pub mod runner;
 pub mod sequencer;
 mod state;

@@ -14,7 +14,7 @@
 //! assert!(r.command_complete());
 //! ```
 
-use super::plan::{lookup, Plan};
+use super::route::{lookup, Route};
 use super::sequencer::{Config, Feedback, Sequencer, Status, Targets};
 use super::State;
 use crate::faults::Fault;
@@ -35,7 +35,7 @@ pub enum RunStatus {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Runner {
     cfg: Config,
-    plan: Plan,
+    plan: Route,
     next: u8,
     current: State,
     target: State,
@@ -126,7 +126,7 @@ impl Runner {
     }
 
     /// The plan being run.
-    pub const fn plan(&self) -> &Plan {
+    pub const fn plan(&self) -> &Route {
         &self.plan
     }
 

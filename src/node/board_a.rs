@@ -167,8 +167,9 @@ pub enum Event {
     Executed {
         /// Its sequence number (0 = unsequenced).
         seq: u16,
-        /// The command.
-        command: Command,
+        /// The command; none when the packet held no command (an unknown opcode or invalid
+        /// parameters, which are refused).
+        command: Option<Command>,
         /// Refused, and why; none = accepted.
         refusal: Option<Refusal>,
     },
@@ -550,7 +551,7 @@ impl BoardA {
                 taken.answer = Some(seq);
             }
             Received::Refuse(seq, command, r) => {
-                self.settle(seq, command, Some(r), out);
+                self.settle(seq, Some(command), Some(r), out);
                 taken.answer = Some(seq);
             }
         }
@@ -559,7 +560,13 @@ impl BoardA {
 
     /// Writes a command's outcome: into the exactly-once log, the heartbeat's refusal byte and
     /// the events. The one place a command number is settled.
-    fn settle(&mut self, seq: u16, command: Command, refusal: Option<Refusal>, out: &mut Outputs) {
+    fn settle(
+        &mut self,
+        seq: u16,
+        command: Option<Command>,
+        refusal: Option<Refusal>,
+        out: &mut Outputs,
+    ) {
         self.log.record(seq, refusal);
         self.refusal = refusal;
         out.push(Event::Executed {
@@ -604,13 +611,13 @@ impl BoardA {
         if let (Some(seq), Some(a)) = (taken.answer, s.answer) {
             match a {
                 Answer::Accepted(c) => {
-                    self.settle(seq, c, None, out);
+                    self.settle(seq, Some(c), None, out);
                     self.dispatch(c, now);
                 }
                 Answer::Refused(r) => {
                     let c = match taken.incoming {
-                        Some(Incoming::Command(c)) => c,
-                        _ => Command::Heartbeat,
+                        Some(Incoming::Command(c)) => Some(c),
+                        _ => None,
                     };
                     self.settle(seq, c, Some(r), out);
                 }

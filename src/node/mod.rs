@@ -36,5 +36,5 @@ pub mod ground;
     feature = "portable-atomic-critical-section"
 ))]
 pub mod handoff;
-pub mod plan;
+pub mod plan_runner;
 pub mod server;

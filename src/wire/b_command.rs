@@ -22,8 +22,8 @@
 //! assert_eq!(BCommandRepr::parse(&bytes), Ok(cmd));
 //! ```
 
-use super::heartbeat::pulse;
 use super::layout::{field_table, FieldSpec};
+use super::pulse;
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
 use crate::bolter::{BolterDirection, BolterPair, BolterStep};
 use crate::units::PulseWidth;

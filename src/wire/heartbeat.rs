@@ -12,7 +12,7 @@
 //! ```
 
 use super::layout::{field_table, span, ElectricalLayout, FieldSpec, Unit};
-use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
+use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKind, WireError};
 use crate::command::BolterPair;
 use crate::faults::Faults;
 use crate::mode::Mode;
@@ -106,63 +106,8 @@ pub const FIELDS: &[FieldSpec] = field_table![HeartbeatPacket;
     ("checksum", checksum, U16, Crc16, "checksum"),
 ];
 
-/// Which attempt of the bolter state machine is running: 0 (none), 1, 2 or 3.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(try_from = "crate::units::Number", into = "u8")
-)]
-pub struct BolterAttempt(u8);
-
-impl BolterAttempt {
-    /// Three attempts at most (Table 8).
-    pub const MAX: u8 = 3;
-    /// No attempt running.
-    pub const NONE: BolterAttempt = BolterAttempt(0);
-
-    /// Attempt `n`, refused above 3.
-    pub const fn new(n: u8) -> Result<Self, crate::units::RangeError> {
-        if n <= Self::MAX {
-            Ok(BolterAttempt(n))
-        } else {
-            Err(crate::units::RangeError {
-                quantity: "bolter attempt",
-                min: 0,
-                max: 3,
-                found: n as u32,
-            })
-        }
-    }
-
-    /// The attempt number.
-    pub const fn get(self) -> u8 {
-        self.0
-    }
-}
-
-impl TryFrom<u8> for BolterAttempt {
-    type Error = crate::units::RangeError;
-    fn try_from(n: u8) -> Result<Self, Self::Error> {
-        BolterAttempt::new(n)
-    }
-}
-
-#[cfg(feature = "serde")]
-impl TryFrom<crate::units::Number> for BolterAttempt {
-    type Error = crate::units::NumberRangeError;
-    fn try_from(n: crate::units::Number) -> Result<Self, Self::Error> {
-        n.narrow("bolter attempt", (0, Self::MAX as i128), |v: u8| {
-            Self::new(v).ok()
-        })
-    }
-}
-
-impl From<BolterAttempt> for u8 {
-    fn from(a: BolterAttempt) -> u8 {
-        a.get()
-    }
-}
+/// The attempt counter is the bolter's ([`crate::bolter`]); the heartbeat reports it.
+pub use crate::bolter::BolterAttempt;
 
 /// The WiFi heartbeat: the robot's whole status.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -247,15 +192,6 @@ impl Default for HeartbeatRepr {
     }
 }
 
-pub(crate) fn pulse(
-    kind: PacketKind,
-    name: &'static str,
-    at: usize,
-    v: U16,
-) -> Result<PulseWidth, WireError> {
-    PulseWidth::new(v.get()).map_err(|_| field_err(kind, at, name, "500..=2500 us", v.get() as u32))
-}
-
 fn angle(name: &'static str, at: usize, v: U16) -> Result<HipAngle, WireError> {
     HipAngle::new(v.get())
         .map_err(|_| field_err(KIND, at, name, "0..=35999 (0.01 deg)", v.get() as u32))
@@ -274,24 +210,22 @@ impl HeartbeatRepr {
         let p: &HeartbeatPacket = check(bytes)?;
         let board =
             BoardNumber::new(p.board).map_err(|_| field_err(KIND, 4, "board", "1..=255", 0))?;
-        let target_state = match p.target_state {
-            0 => None,
-            b => Some(State::from_wire(b).ok_or_else(|| {
-                field_err(
-                    KIND,
-                    at!(target_state),
-                    "target_state",
-                    "0 or 'a'..='o'",
-                    b as u32,
-                )
-            })?),
-        };
-        let active_bolter = match p.active_bolter {
-            0 => None,
-            b => Some(BolterPair::from_number(b).ok_or_else(|| {
-                field_err(KIND, at!(active_bolter), "active_bolter", "0..=4", b as u32)
-            })?),
-        };
+        let target_state = optional(
+            KIND,
+            at!(target_state),
+            "target_state",
+            "0 or 'a'..='o'",
+            p.target_state,
+            State::from_wire,
+        )?;
+        let active_bolter = optional(
+            KIND,
+            at!(active_bolter),
+            "active_bolter",
+            "0..=4",
+            p.active_bolter,
+            BolterPair::from_number,
+        )?;
         let bolter_attempt = BolterAttempt::new(p.bolter_attempt).map_err(|_| {
             field_err(
                 KIND,
@@ -306,18 +240,14 @@ impl HeartbeatRepr {
         }
         let faults = Faults::from_wire(p.faults)
             .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=12 only", e.reserved))?;
-        let refusal = match p.refusal {
-            0 => None,
-            v => Some(Refusal::from_wire(v).ok_or_else(|| {
-                field_err(
-                    KIND,
-                    at!(refusal),
-                    "refusal",
-                    "0 (accepted) or 1..=7",
-                    v as u32,
-                )
-            })?),
-        };
+        let refusal = optional(
+            KIND,
+            at!(refusal),
+            "refusal",
+            "0 (accepted) or 1..=7",
+            p.refusal,
+            Refusal::from_wire,
+        )?;
         let mode = Mode::from_wire(p.mode).ok_or_else(|| {
             field_err(
                 KIND,

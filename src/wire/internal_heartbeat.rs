@@ -9,9 +9,8 @@
 //! assert_eq!(InternalHeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
 
-use super::heartbeat::pulse;
 use super::layout::{field_table, ElectricalLayout, FieldSpec};
-use super::{check, field_err, get_bool, seal, Packet, PacketKind, WireError};
+use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKind, WireError};
 use crate::bolter::{BolterDirection, BolterPair, BolterStep, MuxLines};
 use crate::units::{Axis, Electrical, Gravity, PulseWidth, Sign};
 use zerocopy::byteorder::little_endian::U16;
@@ -194,69 +193,8 @@ impl InternalHeartbeatRepr {
     pub fn parse(bytes: &[u8]) -> Result<InternalHeartbeatRepr, WireError> {
         let p: &InternalHeartbeatPacket = check(bytes)?;
         let b = |i: usize, name: &'static str, v: u8| get_bool(KIND, i, name, v);
-        let step = match p.bolter_step {
-            0 => None,
-            v => Some(BolterStep::from_wire(v).ok_or_else(|| {
-                field_err(
-                    KIND,
-                    at!(bolter_step),
-                    "bolter_aux.step",
-                    "0 (idle) or 1..=8",
-                    v as u32,
-                )
-            })?),
-        };
-        let pair = match p.bolter_pair {
-            0 => None,
-            v => Some(BolterPair::from_number(v).ok_or_else(|| {
-                field_err(KIND, at!(bolter_pair), "bolter_aux.pair", "0..=4", v as u32)
-            })?),
-        };
-        let direction = match p.bolter_direction {
-            0 => None,
-            v => Some(BolterDirection::from_wire(v).ok_or_else(|| {
-                field_err(
-                    KIND,
-                    at!(bolter_direction),
-                    "bolter_aux.direction",
-                    "0, 1 (bolt) or 2 (unbolt)",
-                    v as u32,
-                )
-            })?),
-        };
-        let mux = MuxLines::from_wire(p.bolter_mux).ok_or_else(|| {
-            field_err(
-                KIND,
-                at!(bolter_mux),
-                "bolter_aux.mux",
-                "bits 0 (A0) and 1 (A1) only",
-                p.bolter_mux as u32,
-            )
-        })?;
-        let gravity = match (p.g_sign, p.g_axis) {
-            (0, 0) => None,
-            (s, a) => {
-                let sign = Sign::from_wire(s).ok_or_else(|| {
-                    field_err(
-                        KIND,
-                        at!(g_sign),
-                        "gravity.sign",
-                        "'+' or '-' (or 0 with axis 0)",
-                        s as u32,
-                    )
-                })?;
-                let axis = Axis::from_wire(a).ok_or_else(|| {
-                    field_err(
-                        KIND,
-                        at!(g_axis),
-                        "gravity.axis",
-                        "'X', 'Y' or 'Z' (or 0 with sign 0)",
-                        a as u32,
-                    )
-                })?;
-                Some(Gravity { axis, sign })
-            }
-        };
+        let bolter_aux = bolter_aux(p)?;
+        let gravity = gravity(p)?;
         Ok(InternalHeartbeatRepr {
             arm_b_target: pulse(KIND, "arm_b_target", at!(arm_b_target), p.arm_b_target)?,
             arm_b_now: pulse(KIND, "arm_b_now", at!(arm_b_now), p.arm_b_now)?,
@@ -268,25 +206,7 @@ impl InternalHeartbeatRepr {
             )?,
             gripper_b_now: pulse(KIND, "gripper_b_now", at!(gripper_b_now), p.gripper_b_now)?,
             electrical_b: Electrical::from(&p.electrical_b),
-            bolter_aux: BolterAux {
-                step,
-                seq: p.bolter_seq,
-                pair,
-                direction,
-                threshold_reached: b(
-                    at!(bolter_threshold),
-                    "bolter_aux.threshold_reached",
-                    p.bolter_threshold,
-                )?,
-                locked: b(at!(bolter_locked), "bolter_aux.locked", p.bolter_locked)?,
-                timed_out: b(
-                    at!(bolter_timed_out),
-                    "bolter_aux.timed_out",
-                    p.bolter_timed_out,
-                )?,
-                at_home: b(at!(bolter_at_home), "bolter_aux.at_home", p.bolter_at_home)?,
-                mux,
-            },
+            bolter_aux,
             command_received: p.command_received,
             gravity,
             arm_over_idle: b(at!(arm_over_idle), "arm_over_idle", p.arm_over_idle)?,
@@ -357,4 +277,89 @@ impl InternalHeartbeatRepr {
         self.emit(&mut out);
         out
     }
+}
+
+/// Bytes 25–33: board B's bolter progress (Table 4's "bolter aux").
+fn bolter_aux(p: &InternalHeartbeatPacket) -> Result<BolterAux, WireError> {
+    let b = |i: usize, name: &'static str, v: u8| get_bool(KIND, i, name, v);
+    let step = optional(
+        KIND,
+        at!(bolter_step),
+        "bolter_aux.step",
+        "0 (idle) or 1..=8",
+        p.bolter_step,
+        BolterStep::from_wire,
+    )?;
+    let pair = optional(
+        KIND,
+        at!(bolter_pair),
+        "bolter_aux.pair",
+        "0..=4",
+        p.bolter_pair,
+        BolterPair::from_number,
+    )?;
+    let direction = optional(
+        KIND,
+        at!(bolter_direction),
+        "bolter_aux.direction",
+        "0, 1 (bolt) or 2 (unbolt)",
+        p.bolter_direction,
+        BolterDirection::from_wire,
+    )?;
+    let mux = MuxLines::from_wire(p.bolter_mux).ok_or_else(|| {
+        field_err(
+            KIND,
+            at!(bolter_mux),
+            "bolter_aux.mux",
+            "bits 0 (A0) and 1 (A1) only",
+            p.bolter_mux as u32,
+        )
+    })?;
+    Ok(BolterAux {
+        step,
+        seq: p.bolter_seq,
+        pair,
+        direction,
+        threshold_reached: b(
+            at!(bolter_threshold),
+            "bolter_aux.threshold_reached",
+            p.bolter_threshold,
+        )?,
+        locked: b(at!(bolter_locked), "bolter_aux.locked", p.bolter_locked)?,
+        timed_out: b(
+            at!(bolter_timed_out),
+            "bolter_aux.timed_out",
+            p.bolter_timed_out,
+        )?,
+        at_home: b(at!(bolter_at_home), "bolter_aux.at_home", p.bolter_at_home)?,
+        mux,
+    })
+}
+
+/// Bytes 35–36: the gravity direction in B's IMU frame; none before the first reading.
+fn gravity(p: &InternalHeartbeatPacket) -> Result<Option<Gravity>, WireError> {
+    Ok(match (p.g_sign, p.g_axis) {
+        (0, 0) => None,
+        (s, a) => {
+            let sign = Sign::from_wire(s).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(g_sign),
+                    "gravity.sign",
+                    "'+' or '-' (or 0 with axis 0)",
+                    s as u32,
+                )
+            })?;
+            let axis = Axis::from_wire(a).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(g_axis),
+                    "gravity.axis",
+                    "'X', 'Y' or 'Z' (or 0 with sign 0)",
+                    a as u32,
+                )
+            })?;
+            Some(Gravity { axis, sign })
+        }
+    })
 }

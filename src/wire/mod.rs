@@ -322,6 +322,35 @@ pub(crate) const fn field_err(
 }
 
 /// Reads a boolean byte: exactly 0 or 1.
+/// A servo pulse field (µs, little-endian u16), refused outside 500..=2500 µs.
+pub(crate) fn pulse(
+    kind: PacketKind,
+    name: &'static str,
+    at: usize,
+    v: zerocopy::little_endian::U16,
+) -> Result<crate::units::PulseWidth, WireError> {
+    crate::units::PulseWidth::new(v.get())
+        .map_err(|_| field_err(kind, at, name, "500..=2500 us", v.get() as u32))
+}
+
+/// An optional byte field: `None` for 0 (the field is empty), else the value `from_wire`
+/// gives, or the field error naming what is `expected`.
+pub(crate) fn optional<T>(
+    kind: PacketKind,
+    index: usize,
+    field: &'static str,
+    expected: &'static str,
+    b: u8,
+    from_wire: impl FnOnce(u8) -> Option<T>,
+) -> Result<Option<T>, WireError> {
+    match b {
+        0 => Ok(None),
+        v => from_wire(v)
+            .map(Some)
+            .ok_or_else(|| field_err(kind, index, field, expected, v as u32)),
+    }
+}
+
 pub(crate) fn get_bool(
     kind: PacketKind,
     index: usize,

@@ -3,7 +3,7 @@
 #![allow(clippy::needless_range_loop)] // Floyd–Warshall reads best with indices
 
 use mmic::motion::geometry::single_move;
-use mmic::motion::{map, plan, Primitive, State, StateKind};
+use mmic::motion::{map, route, Primitive, State, StateKind};
 use mmic::units::Side;
 
 fn inverse(p: Primitive) -> Primitive {
@@ -95,9 +95,9 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
     let mut matched = [0u32; 4];
     for f in State::ALL {
         for t in State::ALL {
-            let p = plan::lookup(f, t);
+            let p = route::lookup(f, t);
             assert_eq!(
-                plan::search(f, t),
+                route::search(f, t),
                 p,
                 "{f} -> {t}: table and search disagree"
             );
@@ -140,7 +140,7 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
         [0, 0, 18, 12],
         "plan lengths between the 30 ordered pairs of matched states"
     );
-    assert_eq!(plan::TABLE_BYTES, 450);
+    assert_eq!(route::TABLE_BYTES, 450);
 }
 
 #[test]

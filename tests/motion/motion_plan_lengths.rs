@@ -3,7 +3,7 @@
 //! regenerate with `MMIC_REGENERATE=1 cargo test --test motion_plan_lengths`), and its
 //! histogram, which must be the numbers.
 
-use mmic::motion::{map, plan, State};
+use mmic::motion::{map, route, State};
 use std::fmt::Write;
 
 /// Length of the shortest path by breadth-first search over `map::MAP`, written here again so
@@ -43,9 +43,9 @@ fn plan_length_table() {
     for f in State::ALL {
         write!(grid, "{:>7}", f.letter()).unwrap();
         for t in State::ALL {
-            let n = plan::lookup(f, t).len();
+            let n = route::lookup(f, t).len();
             assert_eq!(n, bfs_len(f, t), "{f}->{t}");
-            assert_eq!(plan::search(f, t).len(), n);
+            assert_eq!(route::search(f, t).len(), n);
             if f == t {
                 grid.push_str(" -");
                 assert_eq!(n, 0);
@@ -71,7 +71,7 @@ fn plan_length_table() {
         matched_hist[2], matched_hist[3]
     )
     .unwrap();
-    writeln!(grid, "plan table: {} bytes of flash", plan::TABLE_BYTES).unwrap();
+    writeln!(grid, "plan table: {} bytes of flash", route::TABLE_BYTES).unwrap();
     assert_eq!(hist, [0, 72, 126, 12]);
     assert_eq!(matched_hist, [0, 0, 18, 12]);
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/motion/plan-lengths.txt");

@@ -9,7 +9,7 @@ use mmic::command::ServoTarget;
 use mmic::faults::Fault;
 use mmic::motion::runner::{RunStatus, Runner};
 use mmic::motion::sequencer::{Config, Feedback, Sequencer, Status, Step, Targets};
-use mmic::motion::{map, plan, State};
+use mmic::motion::{map, route, State};
 use mmic::units::Side;
 
 #[derive(Clone, Copy, Debug)]
@@ -179,7 +179,7 @@ fn every_reconfiguration_reaches_its_target() {
             }
             assert_eq!(r.status(), RunStatus::Complete, "{from}->{to}");
             assert_eq!(r.current_state(), to);
-            assert_eq!(visited, plan::lookup(from, to).states(), "{from}->{to}");
+            assert_eq!(visited, route::lookup(from, to).states(), "{from}->{to}");
             // A matched target ends contracted and gripped, with the hip straight again.
             if from.is_matched() && to.is_matched() {
                 assert_eq!(r.targets().arm, [ServoTarget::Contract; 2]);

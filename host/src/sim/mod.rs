@@ -30,7 +30,7 @@ use mmic::node::board_a::{self, BoardA};
 use mmic::node::board_b::{self, BoardB};
 use mmic::node::ground;
 use mmic::node::handoff::PacketQueue;
-use mmic::node::plan::{PlanEnd, PlanRunner, PlanStep};
+use mmic::node::plan_runner::{PlanEnd, PlanRunner, PlanStep};
 use mmic::units::BoardNumber;
 use mmic::wire::heartbeat::HeartbeatRepr;
 use nodes::Lossy;

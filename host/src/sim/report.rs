@@ -2,7 +2,7 @@
 
 use super::Summary;
 use crate::plot::{bar_chart, line_chart_with, LineOptions, Series};
-use mmic::node::plan::PlanEnd;
+use mmic::node::plan_runner::PlanEnd;
 use mmic::refusal::Refusal;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -144,10 +144,12 @@ pub fn plan_line(s: &Summary) -> String {
 /// What the refused step expected and what the robot last reported.
 fn mismatch(s: &Summary, step: usize) -> String {
     let expected = match s.plan.get(step).map(|st| st.step) {
-        Some(mmic::node::plan::PlanStep::Command(mmic::command::Command::Reconfigure(r))) => {
+        Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Reconfigure(
+            r,
+        ))) => {
             format!("the plan expected the robot in {}", r.initial())
         }
-        Some(mmic::node::plan::PlanStep::Command(mmic::command::Command::Primitive(p))) => {
+        Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Primitive(p))) => {
             format!(
                 "primitive {} is no move from the state the robot is in",
                 p.number()

@@ -1,4 +1,4 @@
-//! Shortest primitive sequences between states: the paper's iterative search over the map, and
+//! Routes: the shortest primitive sequences between states (what a reconfiguration runs): the paper's iterative search over the map, and
 //! the same answers precomputed into a 450-byte table for O(1) lookup.
 //!
 //! **Tie-break.** Among the shortest plans, the one whose sequence of visited states is first in
@@ -6,11 +6,11 @@
 //! order finds exactly that plan, and the table is built by the same search.
 //!
 //! ```
-//! use mmic::motion::{plan, Primitive, State};
-//! let p = plan::lookup(State::A, State::M);
+//! use mmic::motion::{route, Primitive, State};
+//! let p = route::lookup(State::A, State::M);
 //! assert_eq!(p.primitives(), &[Primitive::BackExtend, Primitive::FwdContract]);
-//! assert_eq!(plan::search(State::A, State::M), p);
-//! assert_eq!(plan::lookup(State::A, State::B).len(), 3);
+//! assert_eq!(route::search(State::A, State::M), p);
+//! assert_eq!(route::lookup(State::A, State::B).len(), 3);
 //! ```
 
 use super::map::MAP;
@@ -19,16 +19,16 @@ use super::{Primitive, State};
 /// Longest shortest plan between any two states.
 pub const MAX_LEN: usize = 3;
 
-/// A plan: up to three primitives, and the states they pass through.
+/// A route: up to three primitives, and the states they pass through.
 #[derive(Debug, Clone, Copy)]
-pub struct Plan {
+pub struct Route {
     len: u8,
     prims: [Primitive; MAX_LEN],
     states: [State; MAX_LEN],
 }
 
-impl Plan {
-    const EMPTY: Plan = Plan {
+impl Route {
+    const EMPTY: Route = Route {
         len: 0,
         prims: [Primitive::FwdContract; MAX_LEN],
         states: [State::A; MAX_LEN],
@@ -56,15 +56,15 @@ impl Plan {
     }
 }
 
-impl PartialEq for Plan {
-    fn eq(&self, other: &Plan) -> bool {
+impl PartialEq for Route {
+    fn eq(&self, other: &Route) -> bool {
         self.primitives() == other.primitives() && self.states() == other.states()
     }
 }
 
-impl Eq for Plan {}
+impl Eq for Route {}
 
-impl core::hash::Hash for Plan {
+impl core::hash::Hash for Route {
     // Consistent with `PartialEq`: only the used prefix counts.
     fn hash<H: core::hash::Hasher>(&self, h: &mut H) {
         self.primitives().hash(h);
@@ -73,7 +73,7 @@ impl core::hash::Hash for Plan {
 }
 
 /// Depth-limited search in Table 5 order: the first plan of exactly `depth` primitives.
-const fn dfs(at: State, to: State, depth: usize, mut acc: Plan) -> Option<Plan> {
+const fn dfs(at: State, to: State, depth: usize, mut acc: Route) -> Option<Route> {
     if depth == 0 {
         return if at.index() == to.index() {
             Some(acc)
@@ -102,15 +102,15 @@ const fn dfs(at: State, to: State, depth: usize, mut acc: Plan) -> Option<Plan> 
 
 /// The paper's iterative search: try plans of 0, 1, 2, 3 primitives. Every pair of states is
 /// connected within three (checked exhaustively in the tests), so this always finds one.
-pub const fn search(from: State, to: State) -> Plan {
+pub const fn search(from: State, to: State) -> Route {
     let mut depth = 0;
     while depth <= MAX_LEN {
-        if let Some(p) = dfs(from, to, depth, Plan::EMPTY) {
+        if let Some(p) = dfs(from, to, depth, Route::EMPTY) {
             return p;
         }
         depth += 1;
     }
-    Plan::EMPTY
+    Route::EMPTY
 }
 
 const fn build() -> [[u16; 15]; 15] {
@@ -146,9 +146,9 @@ pub const TABLE: [[u16; 15]; 15] = build();
 pub const TABLE_BYTES: usize = core::mem::size_of::<[[u16; 15]; 15]>();
 
 /// The plan from `from` to `to`, from the precomputed table: O(1).
-pub fn lookup(from: State, to: State) -> Plan {
+pub fn lookup(from: State, to: State) -> Route {
     let v = TABLE[from.index()][to.index()];
-    let mut plan = Plan::EMPTY;
+    let mut plan = Route::EMPTY;
     let mut at = from;
     for k in 0..(v & 0b11) as usize {
         let next = match State::from_index(((v >> (2 + 4 * k)) & 0xf) as usize) {

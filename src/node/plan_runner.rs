@@ -11,7 +11,7 @@
 //! use mmic::command::Command;
 //! use mmic::mode::Mode;
 //! use mmic::node::ground::{self, Outcome};
-//! use mmic::node::plan::{PlanEnd, PlanRunner, PlanStep};
+//! use mmic::node::plan_runner::{PlanEnd, PlanRunner, PlanStep};
 //! use mmic::units::BoardNumber;
 //! use mmic::wire::heartbeat::HeartbeatRepr;
 //!
