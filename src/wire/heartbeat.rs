@@ -210,22 +210,14 @@ impl HeartbeatRepr {
         let p: &HeartbeatPacket = check(bytes)?;
         let board =
             BoardNumber::new(p.board).map_err(|_| field_err(KIND, 4, "board", "1..=255", 0))?;
-        let target_state = optional(
-            KIND,
-            at!(target_state),
-            "target_state",
-            "0 or 'a'..='o'",
-            p.target_state,
-            State::from_wire,
-        )?;
-        let active_bolter = optional(
-            KIND,
-            at!(active_bolter),
-            "active_bolter",
-            "0..=4",
-            p.active_bolter,
-            BolterPair::from_number,
-        )?;
+        // An optional byte field whose JSON name is the layout field's name.
+        macro_rules! opt {
+            ($f:ident, $expected:literal, $from:path) => {
+                optional(KIND, at!($f), stringify!($f), $expected, p.$f, $from)?
+            };
+        }
+        let target_state = opt!(target_state, "0 or 'a'..='o'", State::from_wire);
+        let active_bolter = opt!(active_bolter, "0..=4", BolterPair::from_number);
         let bolter_attempt = BolterAttempt::new(p.bolter_attempt).map_err(|_| {
             field_err(
                 KIND,
@@ -240,14 +232,7 @@ impl HeartbeatRepr {
         }
         let faults = Faults::from_wire(p.faults)
             .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=12 only", e.reserved))?;
-        let refusal = optional(
-            KIND,
-            at!(refusal),
-            "refusal",
-            "0 (accepted) or 1..=7",
-            p.refusal,
-            Refusal::from_wire,
-        )?;
+        let refusal = opt!(refusal, "0 (accepted) or 1..=7", Refusal::from_wire);
         let mode = Mode::from_wire(p.mode).ok_or_else(|| {
             field_err(
                 KIND,
