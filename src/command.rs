@@ -35,6 +35,7 @@ pub const PARAM_LEN: usize = 6;
 
 /// Where an arm or gripper goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum ServoTarget {
@@ -48,6 +49,7 @@ pub enum ServoTarget {
 
 /// Where the hip goes: one of the common positions, or any angle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum HipTarget {
@@ -84,6 +86,7 @@ pub use crate::bolter::{BolterPair, BolterPairError};
 
 /// Which fasteners a bolt or unbolt command works on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Fasteners {
@@ -95,6 +98,7 @@ pub enum Fasteners {
 
 /// A bolter command (Table 1, "Bolter").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum BolterCommand {
@@ -108,6 +112,7 @@ pub enum BolterCommand {
 
 /// What a power command switches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum PowerTarget {
@@ -119,6 +124,7 @@ pub enum PowerTarget {
 
 /// A validated reconfiguration: the initial state and a different, matched target state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Reconfiguration {
     initial: State,
@@ -164,6 +170,7 @@ impl<'de> serde::Deserialize<'de> for Reconfiguration {
 
 /// A reconfiguration that cannot be executed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ReconfigurationError {
     /// Only matched states are final states (Section 6).
     #[error("target state {target} is not a matched (final) state")]
@@ -182,6 +189,7 @@ pub enum ReconfigurationError {
 /// A command to the robot (Table 1, plus `ClearFaults`, which the fault latching of Section 7
 /// needs and the paper does not list).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(
     feature = "serde",
@@ -269,6 +277,7 @@ pub mod opcode {
 
 /// A parameter slot of Table 2, as a range of the 6 parameter bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Slot {
     /// Bytes 6–7: hip target.
     Hip,
@@ -312,6 +321,7 @@ pub const fn seq_slot(id: u8) -> Slot {
 
 /// A parameter block that does not decode to a command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum CommandError {
     /// Byte 5 holds no assigned opcode.
     #[error("byte 5: unknown command id {id:#04x}")]
@@ -623,6 +633,7 @@ impl Command {
 wire_enum! {
     /// The rows of Table 1 (plus the `ClearFaults` extension): what mode rules and spec/ talk about.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
     #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
     pub enum CommandKind {

@@ -19,6 +19,7 @@ use crate::wire_enum::wire_enum;
 wire_enum! {
     /// One autonomously detectable fault (Table 8), with its bit number in the fault bytes.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
     #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
     pub enum Fault: u8 {
@@ -61,10 +62,12 @@ wire_enum! {
 
 /// A set of faults: the latched fault map, or the conditions holding now.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Faults(u32);
 
 /// Bits set in the fault bytes that name no fault.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[error("fault bytes set reserved bits {reserved:#06x} (only bits 0..=12 name faults)")]
 pub struct ReservedFaultBits {
     /// The reserved bits that were set.

@@ -49,3 +49,26 @@ pub mod safety;
 pub mod sensors;
 pub mod units;
 pub mod wire;
+
+/// With the `defmt` feature, the types a firmware logs are `defmt::Format` (checked here at
+/// compile time, so a type that loses its derive fails the build for the RISC-V target in CI).
+#[cfg(feature = "defmt")]
+const _: () = {
+    const fn format<T: defmt::Format>() {}
+    format::<wire::command::CommandRepr>();
+    format::<wire::heartbeat::HeartbeatRepr>();
+    format::<wire::internal_heartbeat::InternalHeartbeatRepr>();
+    format::<wire::b_command::BCommandRepr>();
+    format::<wire::WireError>();
+    format::<command::Command>();
+    format::<mode::Mode>();
+    format::<faults::Faults>();
+    format::<faults::Fault>();
+    format::<refusal::Refusal>();
+    format::<motion::State>();
+    format::<motion::Primitive>();
+    format::<bolter::BolterPair>();
+    format::<node::board_a::Event>();
+    format::<units::PulseWidth>();
+    format::<units::HipAngle>();
+};

@@ -11,6 +11,7 @@ use crate::wire_enum::wire_enum;
 wire_enum! {
     /// Operating mode (Table 7). On the wire: Standby 1, Operational 2, Safed 3; 0 is never a mode.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
     #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
     pub enum Mode {

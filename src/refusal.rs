@@ -12,6 +12,7 @@ use crate::wire_enum::wire_enum;
 wire_enum! {
     /// A refused command's reason. Wire value 1..=7; 0 means accepted.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
     #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
     pub enum Refusal {

@@ -13,6 +13,7 @@ use core::fmt;
 
 /// Out-of-range value handed to a unit constructor; carries the offending value and the range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[error("{quantity} must be in {min}..={max}, found {found}")]
 pub struct RangeError {
     /// Which quantity was being built.
@@ -43,11 +44,13 @@ pub struct RangeError {
 /// ```
 #[cfg(feature = "serde")]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Number(pub i128);
 
 /// A number outside the range of the field it was read for (see [`Number`]).
 #[cfg(feature = "serde")]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[error("{quantity} must be in {min}..={max}, found {found}")]
 pub struct NumberRangeError {
     /// Which quantity was being read.
@@ -148,6 +151,7 @@ pub(crate) mod de {
 
 /// Side of the robot. The robot is symmetric about the hip; board A is on side A.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Side {
     /// Side A: board A (primary, WiFi client, hip), "fwd" in Table 6.
@@ -176,6 +180,7 @@ impl fmt::Display for Side {
 ///
 /// 1..=255; 0 is refused so that a zeroed buffer can never address a robot.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
@@ -231,6 +236,7 @@ impl From<BoardNumber> for u8 {
 ///
 /// Range 500..=2500 µs, the standard hobby-servo pulse range the MMIC-I servos accept.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
@@ -311,6 +317,7 @@ impl From<PulseWidth> for u16 {
 /// around an absolute magnetic encoder, so the commanded quantity is an angle. Centidegrees
 /// keep the 3° and 10°/s of Section 5 exact in integers and fit a u16.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
@@ -382,6 +389,7 @@ pub type Milliamps = u16;
 
 /// A powered module (Table 1 "Power Control": individual modules).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Module {
@@ -438,6 +446,7 @@ impl Module {
 
 /// A lattice axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Axis {
     /// X.
@@ -477,6 +486,7 @@ impl Axis {
 
 /// Sign along an axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub enum Sign {
     /// Positive direction.
@@ -509,6 +519,7 @@ impl Sign {
 /// Direction of gravity in an IMU's frame: the axis with the largest acceleration and its sign
 /// (Table 4 bytes 36–37).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Gravity {
@@ -520,6 +531,7 @@ pub struct Gravity {
 
 /// Voltage and current readings of one side's ADS7828 (Table 3 bytes 25–52, Table 4 bytes 12–25).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Electrical {

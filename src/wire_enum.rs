@@ -131,6 +131,7 @@ macro_rules! wire_enum {
     (@error $Name:ident [$($V:ident $(= $val:literal)? $(=> $vname:literal)?;)+]
         [$(#[$m:meta])*] $Err:ident) => {
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+        #[cfg_attr(feature = "defmt", derive(defmt::Format))]
         $(#[$m])*
         pub struct $Err(pub u8);
 
@@ -213,6 +214,7 @@ mod tests {
     wire_enum! {
         /// Values with gaps, as discriminants.
         #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        #[cfg_attr(feature = "defmt", derive(defmt::Format))]
         enum Sparse: u8 {
             /// Two.
             Two = 2 => "two",
@@ -240,6 +242,7 @@ mod tests {
     wire_enum! {
         /// Values apart from the (default) discriminants.
         #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        #[cfg_attr(feature = "defmt", derive(defmt::Format))]
         enum Letters {
             /// x.
             X = b'x',

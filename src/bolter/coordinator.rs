@@ -12,6 +12,7 @@ use crate::wire::internal_heartbeat::BolterAux;
 
 /// Coordinator settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// The sides' step timeouts.
     pub side: SideConfig,
@@ -34,6 +35,7 @@ impl Default for Config {
 
 /// A bolting job.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Job {
     /// Bolt or unbolt.
     pub direction: BolterDirection,
@@ -43,6 +45,7 @@ pub struct Job {
 
 /// Where the coordinator is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Status {
     /// No job.
     Idle,
@@ -57,6 +60,7 @@ pub enum Status {
 
 /// What the coordinator asks for this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Output {
     /// The order for both sides and the sequence number it was first issued with (send to B
     /// in every A→B command until it changes; apply to side A's executor).
@@ -71,6 +75,7 @@ pub struct Output {
 
 /// The coordinator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Coordinator {
     job: Option<Job>,
     pair: BolterPair,

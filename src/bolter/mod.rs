@@ -24,6 +24,7 @@ pub use side::{BolterSide, Drive, SideConfig, Signals};
 wire_enum! {
     /// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(
         feature = "serde",
         derive(serde::Serialize, serde::Deserialize),
@@ -56,6 +57,7 @@ wire_enum! {
 wire_enum! {
     /// Bolting or unbolting.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
     #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
     pub enum BolterDirection {
@@ -75,6 +77,7 @@ wire_enum! {
     /// A step of the bolter state machine (Figure 8) that a side is executing. Steps marked * end
     /// on a current threshold and have a timeout.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
     #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
     pub enum BolterStep {
@@ -106,6 +109,7 @@ wire_enum! {
 
 /// The ADG1604 select lines A0 and A1.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct MuxLines {
@@ -145,6 +149,7 @@ impl MuxLines {
 }
 /// Which attempt of the bolter state machine is running: 0 (none), 1, 2 or 3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),

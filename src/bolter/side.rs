@@ -8,6 +8,7 @@ use crate::wire::internal_heartbeat::BolterAux;
 
 /// What the side's bolter hardware reports this tick (from the filtered I_bo and the position).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Signals {
     /// The bolter current passed its push threshold.
     pub threshold: bool,
@@ -19,6 +20,7 @@ pub struct Signals {
 
 /// What the side's bolter motor must do now.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Drive {
     /// Nothing: idle, or the current step is finished or timed out.
     Idle,
@@ -34,6 +36,7 @@ pub enum Drive {
 
 /// Step timeouts, ms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SideConfig {
     /// Current-sensed steps (the paper's asterisks): Descend, DescendEngage, Rotate.
     pub sensed_ms: u32,
@@ -52,6 +55,7 @@ impl Default for SideConfig {
 
 /// A side's bolter executor.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BolterSide {
     order: Option<(u8, BolterOrder)>,
     last: u32,

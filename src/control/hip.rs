@@ -22,6 +22,7 @@ use crate::units::{HipAngle, PulseWidth};
 
 /// Controller settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// Switch to position mode within this error, 0.01°. Paper: 3°.
     pub position_band: i32,
@@ -61,6 +62,7 @@ impl Default for Config {
 
 /// Which law is active.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Mode {
     /// |error| > band: track ±speed.
     Velocity,
@@ -70,6 +72,7 @@ pub enum Mode {
 
 /// The controller's state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct HipController {
     cfg: Config,
     last: Option<(u32, HipAngle)>,

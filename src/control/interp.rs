@@ -8,6 +8,7 @@ use crate::units::PulseWidth;
 
 /// Interpolation rate: `step_us` every `period_ms`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rate {
     /// Pulse change per period, µs (≥ 1). Default 10 µs.
     pub step_us: u16,
@@ -36,6 +37,7 @@ impl Default for Rate {
 /// assert_eq!(arm.resolve(ServoTarget::Position(PulseWidth::new(1300).unwrap())).micros(), 1300);
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Travel {
     /// Fully contracted (arm retracted / gripper open).
     pub contracted: PulseWidth,
@@ -56,6 +58,7 @@ impl Travel {
 
 /// One servo's interpolator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Interpolator {
     now: PulseWidth,
     target: PulseWidth,

@@ -27,6 +27,7 @@ use crate::units::{Axis, Gravity, HipAngle, Side, Sign};
 
 /// A set of states (bit i = Table 5 index i).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct StateSet(u16);
 
 impl StateSet {
@@ -66,6 +67,7 @@ impl StateSet {
 
 /// Estimation settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// The structure axis pointing up (gravity points the other way). Default: +Z.
     pub up: (Axis, Sign),
@@ -84,6 +86,7 @@ impl Default for Config {
 
 /// What the sensors say, already filtered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Readings {
     /// Gravity in board A's IMU frame; none = no reading (not used).
     pub gravity_a: Option<Gravity>,

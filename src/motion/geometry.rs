@@ -7,6 +7,7 @@ use crate::units::{Axis, Side, Sign};
 
 /// A face of the reference voxel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Face {
     /// The axis the face is normal to.
     pub axis: Axis,

@@ -5,6 +5,7 @@ use crate::wire_enum::wire_enum;
 wire_enum! {
     /// A motion primitive, numbered 1..=8 as in Table 6. "fwd" moves side A, "back" side B.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(
         feature = "serde",
         derive(serde::Serialize, serde::Deserialize),

@@ -21,6 +21,7 @@ pub const MAX_LEN: usize = 3;
 
 /// A route: up to three primitives, and the states they pass through.
 #[derive(Debug, Clone, Copy)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Route {
     len: u8,
     prims: [Primitive; MAX_LEN],

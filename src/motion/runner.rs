@@ -21,6 +21,7 @@ use crate::faults::Fault;
 
 /// Where a reconfiguration is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum RunStatus {
     /// A primitive is running.
     Running,
@@ -33,6 +34,7 @@ pub enum RunStatus {
 
 /// Runs a reconfiguration plan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Runner {
     cfg: Config,
     plan: Route,

@@ -37,6 +37,7 @@ use crate::units::{HipAngle, Side};
 
 /// Per-step timeouts, ms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// Release or grip: the gripper's interpolation. Default 3000 ms.
     pub gripper_ms: u32,
@@ -58,6 +59,7 @@ impl Default for Config {
 
 /// Targets for every module; index 0 = side A, 1 = side B.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Targets {
     /// Arm targets.
     pub arm: [ServoTarget; 2],
@@ -86,6 +88,7 @@ impl Targets {
 
 /// Completion signals, as of this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Feedback {
     /// Arm interpolation finished (A: local; B: reported in the internal heartbeat).
     pub arm_done: [bool; 2],
@@ -99,6 +102,7 @@ pub struct Feedback {
 
 /// A step of a primitive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Step {
     /// Open the moving side's gripper.
     Release,
@@ -112,6 +116,7 @@ pub enum Step {
 
 /// Where a sequencer is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Status {
     /// Waiting for the current step.
     Running,
@@ -123,6 +128,7 @@ pub enum Status {
 
 /// `from → to` is not a single-primitive move.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[error("no single primitive takes {from} to {to}")]
 pub struct NotAMove {
     /// Initial state.
@@ -166,6 +172,7 @@ pub fn hip_goal(from: State, to: State, primitive: Primitive) -> Option<HipAngle
 
 /// Runs one primitive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Sequencer {
     cfg: Config,
     primitive: Primitive,

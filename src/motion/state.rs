@@ -4,6 +4,7 @@ use crate::wire_enum::wire_enum;
 
 /// Shape of a configuration (Section 6).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum StateKind {
@@ -21,6 +22,7 @@ wire_enum! {
     /// On the wire a state is its lowercase ASCII letter (`0x61`..`0x6f`), so it reads plainly in a
     /// hex dump and a zero byte is never a state.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(
         feature = "serde",
         derive(serde::Serialize, serde::Deserialize),
@@ -105,6 +107,7 @@ impl State {
 
 /// A character that is not a Table 5 letter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[error("state must be a letter 'a'..='o' (Table 5), found {0:?}")]
 pub struct StateLetterError(pub char);
 

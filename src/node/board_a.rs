@@ -55,6 +55,7 @@ use crate::wire::WireError;
 
 /// Board A's settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// This robot's number.
     pub board: BoardNumber,
@@ -115,6 +116,7 @@ impl Default for Config {
 
 /// One tick's inputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Inputs {
     /// A command packet from the WiFi hand-off queue.
     pub command: Option<[u8; COMMAND_LEN]>,
@@ -162,6 +164,7 @@ impl Inputs {
 
 /// Something that happened in a tick, for logs and tests.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Event {
     /// A command was taken and run (or refused) — once per sequence number.
     Executed {
@@ -220,6 +223,7 @@ pub const EVENTS: usize = 6;
 
 /// One tick's outputs.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Outputs {
     /// Hip servo pulse; none = unpowered.
     pub hip: Option<PulseWidth>,
@@ -269,6 +273,7 @@ impl Outputs {
 
 /// Board A's state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BoardA {
     cfg: Config,
     sup: Supervisor,
@@ -932,6 +937,7 @@ impl BoardA {
 /// This tick's command after the exactly-once log: what the supervisor judges, and the number
 /// the heartbeat answers (0 for a copy, whose outcome the log already holds).
 #[derive(Debug, Clone, Copy, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct Taken {
     incoming: Option<Incoming>,
     answer: Option<u16>,

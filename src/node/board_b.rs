@@ -39,6 +39,7 @@ use crate::wire::WireError;
 
 /// Board B's settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// Internal heartbeat period, ms. Default 50.
     pub heartbeat_period_ms: u32,
@@ -66,6 +67,7 @@ impl Default for Config {
 
 /// One tick's inputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Inputs {
     /// An A→B command packet received since the last tick.
     pub command: Option<[u8; B_COMMAND_LEN]>,
@@ -81,6 +83,7 @@ pub struct Inputs {
 
 /// One tick's outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Outputs {
     /// Arm B pulse; none = unpowered.
     pub arm: Option<PulseWidth>,
@@ -102,6 +105,7 @@ pub struct Outputs {
 
 /// Board B's state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BoardB {
     cfg: Config,
     arm: Interpolator,

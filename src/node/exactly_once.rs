@@ -30,6 +30,7 @@ use crate::refusal::Refusal;
 
 /// What to do with a received command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Admission {
     /// Run it (then [`CommandLog::record`] its outcome if it was sequenced).
     Execute,
@@ -41,6 +42,7 @@ pub enum Admission {
 
 /// The last sequenced command taken and its outcome.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct CommandLog {
     last: Option<(u16, Option<Refusal>)>,
 }

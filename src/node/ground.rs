@@ -38,6 +38,7 @@ use crate::wire::heartbeat::HeartbeatRepr;
 
 /// Timing of the uplink.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// Time between transmissions (first attempts and resends), ms. Paper: 1200.
     pub period_ms: u32,
@@ -59,6 +60,7 @@ impl Default for Config {
 
 /// How a command ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Outcome {
@@ -72,6 +74,7 @@ pub enum Outcome {
 
 /// A finished command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Done {
     /// Its sequence number.
     pub seq: u16,
@@ -85,6 +88,7 @@ pub struct Done {
 
 /// What one call asks the ground to do or report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Tick {
     /// Transmit this packet now.
     pub send: Option<CommandRepr>,
@@ -96,6 +100,7 @@ pub struct Tick {
 
 /// The last 100 attempts, for the efficiency of Figure 11.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Efficiency {
     bits: u128,
     len: u8,
@@ -129,6 +134,7 @@ impl Efficiency {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 struct Outstanding {
     command: Command,
     seq: u16,
@@ -139,6 +145,7 @@ struct Outstanding {
 
 /// The uplink's state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Uplink {
     cfg: Config,
     board: BoardNumber,
@@ -150,6 +157,7 @@ pub struct Uplink {
 
 /// [`Uplink::submit`] while a command is outstanding: the command is handed back.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[error("command {outstanding} is still outstanding; {command:?} not taken")]
 pub struct Busy {
     /// The outstanding command's number.

@@ -30,6 +30,7 @@ use heapless::spsc;
 
 /// A packet the queue had no room for, handed back.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[error("hand-off queue full: packet handed back")]
 pub struct Full<const L: usize>(pub [u8; L]);
 

@@ -46,6 +46,7 @@ use crate::wire::heartbeat::HeartbeatRepr;
 
 /// A step of a plan.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum PlanStep {
     /// Send this command (and, if it moves something, wait for the motion to finish).
     Command(Command),
@@ -58,6 +59,7 @@ pub enum PlanStep {
 
 /// How a plan ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum PlanEnd {
     /// Every step done.
     Completed,
@@ -90,6 +92,7 @@ pub enum PlanEnd {
 
 /// What one call asks for or reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PlanTick {
     /// Transmit this packet now.
     pub send: Option<CommandRepr>,
@@ -104,6 +107,7 @@ pub struct PlanTick {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 enum Phase {
     /// Ready for step `next`.
     Ready,
@@ -124,6 +128,7 @@ enum Phase {
 
 /// The runner.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PlanRunner {
     up: Uplink,
     next: usize,

@@ -40,6 +40,7 @@ pub type Packet = [u8; COMMAND_LEN];
 
 /// What became of an accepted packet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Accepted {
     /// Now pending for its robot.
     Queued,
@@ -51,6 +52,7 @@ pub enum Accepted {
 
 /// Why the server refused a packet from the ground.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ServerError {
     /// Not a valid command packet.
     #[error("not a command packet: {0}")]
@@ -69,6 +71,7 @@ pub enum ServerError {
 
 /// Pending commands for up to `N` robots.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Server<const N: usize> {
     slots: [Option<(BoardNumber, Option<Packet>)>; N],
     cursor: usize,

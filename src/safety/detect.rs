@@ -21,6 +21,7 @@ use crate::units::{Electrical, HipAngle, Milliamps, Millivolts};
 
 /// Current limits of the three module classes of Table 8.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Limits {
     /// Locomotion: arm and hip current I_loc.
     pub locomotion: Milliamps,
@@ -32,6 +33,7 @@ pub struct Limits {
 
 /// Every fault threshold, with documented defaults (spec/modes.toml lists them).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// Low battery: V_batA or V_batB strictly below this (Section 2: "Below 10 V, the battery is
     /// considered out of charge").
@@ -97,6 +99,7 @@ pub const fn elapsed(last: u32, now: u32) -> u32 {
 
 /// A condition that must hold continuously for longer than a duration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Debounce {
     /// Time of the previous sample while the condition held.
     last: Option<u32>,
@@ -127,6 +130,7 @@ impl Debounce {
 
 /// Low battery (Table 8): V_batA or V_batB below the threshold for longer than the duration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct LowBattery(Debounce);
 
 impl LowBattery {
@@ -146,6 +150,7 @@ impl LowBattery {
 /// Internal communication loss (Table 8): no heartbeat from board B for too long, or the same
 /// command sent to B repeatedly without acknowledgement.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct CommMonitor {
     last_seen: Option<u32>,
     silent_ms: u32,

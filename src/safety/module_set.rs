@@ -4,6 +4,7 @@ use crate::units::Module;
 
 /// A set of [`Module`]s (bit i = `Module::ALL[i]`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ModuleSet(u8);
 
 impl ModuleSet {

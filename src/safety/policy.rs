@@ -45,6 +45,7 @@ pub const fn regulator_on(mode: Mode) -> bool {
 
 /// What a fault does when it is detected in Operational (Table 8).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FaultAction {
     /// Mode the robot enters.
     pub mode: Mode,

@@ -42,6 +42,7 @@ use crate::refusal::Refusal;
 
 /// What reached the supervisor from the command link in this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Incoming {
     /// A well-formed command.
     Command(Command),
@@ -51,6 +52,7 @@ pub enum Incoming {
 
 /// One tick's inputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Input {
     /// Faults detected in this tick: conditions holding now and events raised now.
     pub faults: Faults,
@@ -81,6 +83,7 @@ impl Input {
 
 /// The answer to a command, reported in the heartbeat that follows it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Answer {
     /// Accepted: the motion and module layers execute it.
     Accepted(Command),
@@ -100,6 +103,7 @@ impl Answer {
 
 /// One tick's outputs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Output {
     /// Mode after this tick.
     pub mode: Mode,
@@ -121,6 +125,7 @@ pub struct Output {
 
 /// The supervisor's state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Supervisor {
     mode: Mode,
     enabled: ModuleSet,

@@ -15,6 +15,7 @@ use crate::units::Electrical;
 
 /// ADS7828 input channels, in channel order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Channel {
     /// CH0: battery voltage V_bat (mV).
     VBat,
@@ -50,6 +51,7 @@ impl Channel {
 
 /// Full-scale value of each channel (the quantity at code 4095), in mV or mA.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Scaling {
     /// Per channel, CH0..CH7.
     pub full_scale: [u16; 8],

@@ -5,6 +5,7 @@
 /// The running sum is a `u32`: `N` samples of at most 65535 fit while `N` ≤ 65537, which a
 /// compile-time check enforces.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct MovingAverage<const N: usize> {
     window: [u16; N],
     next: usize,

@@ -28,6 +28,7 @@ pub const WINDOW: usize = 50;
 
 /// Front-end configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// ADS7828 channel scaling.
     pub scaling: Scaling,
@@ -37,6 +38,7 @@ pub struct Config {
 
 /// One tick's raw readings of a side.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Raw {
     /// ADS7828 codes, CH0..CH7 (12-bit; larger values are clamped by the scaling).
     pub adc: [u16; 8],
@@ -48,6 +50,7 @@ pub struct Raw {
 
 /// The filtered readings a board node takes as input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Filtered {
     /// Voltages and currents from the averaged codes.
     pub electrical: Electrical,
@@ -60,6 +63,7 @@ pub struct Filtered {
 
 /// A side's `N`-sample moving averages (the paper's `N` is 50).
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Frontend<const N: usize> {
     cfg: Config,
     adc: [MovingAverage<N>; 8],

@@ -97,6 +97,7 @@ pub mod flags {
 
 /// Side B's power switches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct BPower {
@@ -112,6 +113,7 @@ pub struct BPower {
 
 /// A bolter step ordered on side B: which pair, which way, which step of Figure 8.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct BolterOrder {
@@ -130,6 +132,7 @@ pub struct BolterOrder {
 /// `{"seq":7,"flags":{"regulator":true,"arm":true,"gripper":true,"bolter":false,"stop":false},
 /// "arm_target":1000,"gripper_target":2000,"bolter":null}`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BCommandRepr {
     /// Wrapping sequence number, echoed by B as the acknowledgement.
     pub seq: u8,

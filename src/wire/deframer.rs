@@ -36,6 +36,7 @@ use super::{checksum, PacketKind, CHECKSUM_LEN, HEADER_LEN, MAX_PACKET_LEN};
 
 /// A packet whose header and checksum hold (its fields are checked by the `Repr` parsers).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Frame {
     kind: PacketKind,
     bytes: [u8; MAX_PACKET_LEN],
@@ -55,6 +56,7 @@ impl Frame {
 
 /// What the deframer found next in the stream.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Deframed {
     /// This many bytes were dropped: no header, or a header whose checksum failed.
     Discarded(usize),
@@ -64,6 +66,7 @@ pub enum Deframed {
 
 /// Stream deframer with an `N`-byte buffer (`N` ≥ 66, the longest packet).
 #[derive(Debug, Clone)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Deframer<const N: usize> {
     buf: [u8; N],
     len: usize,

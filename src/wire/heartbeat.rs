@@ -111,6 +111,7 @@ pub use crate::bolter::BolterAttempt;
 
 /// The WiFi heartbeat: the robot's whole status.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct HeartbeatRepr {

@@ -103,6 +103,7 @@ pub const FIELDS: &[FieldSpec] = field_table![InternalHeartbeatPacket;
 
 /// Bolter B's progress, the nine "auxiliary variables" A needs to keep both bolters in step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct BolterAux {
@@ -129,6 +130,7 @@ pub struct BolterAux {
 
 /// Board B's status, sent to A periodically.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct InternalHeartbeatRepr {

@@ -126,6 +126,7 @@ pub(crate) use field_table;
 
 /// Unit or encoding of a field, as spec/ names it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Unit {
     /// Fixed ASCII bytes.
     Header,
@@ -187,6 +188,7 @@ impl Unit {
 
 /// One field of a packet.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct FieldSpec {
     /// Field name (spec/ and JSON).
     pub name: &'static str,

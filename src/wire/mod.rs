@@ -39,6 +39,7 @@ pub const MAX_PACKET_LEN: usize = 66;
 
 /// The four packet types.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
 pub enum PacketKind {
@@ -123,6 +124,7 @@ impl fmt::Display for PacketKind {
 /// Why bytes are not a valid packet. Checks run in this order: length, header, checksum,
 /// fields; the first failure is reported with the numbers that explain it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum WireError {
     /// Wrong number of bytes.
     #[error("{kind} packet: length must be {expected} bytes, found {found}")]
