@@ -33,7 +33,7 @@ use super::exactly_once::{Admission, CommandLog};
 use crate::bolter::{
     self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals,
 };
-use crate::command::{preset_angle, seq_slot, BolterCommand, Command, HipTarget, ServoTarget};
+use crate::command::{preset_angle, BolterCommand, Command, HipTarget, ServoTarget};
 use crate::control::hip::{self, HipController};
 use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::faults::{Fault, Faults};
@@ -48,7 +48,7 @@ use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use crate::safety::ModuleSet;
 use crate::units::{BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth};
 use crate::wire::b_command::{BCommandRepr, BPower, B_COMMAND_LEN};
-use crate::wire::command::{CommandRepr, COMMAND_LEN};
+use crate::wire::command::{CommandPacket, CommandRepr, COMMAND_LEN};
 use crate::wire::heartbeat::{BolterAttempt, HeartbeatRepr, HEARTBEAT_LEN};
 use crate::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
 use crate::wire::WireError;
@@ -672,9 +672,15 @@ impl BoardA {
             Ok(r) => r,
             // Header and checksum held but the opcode or parameters are no command: ours to
             // answer (with its sequence number, so the ground stops resending it).
-            Err(WireError::Command(ce)) if bytes.get(4) == Some(&self.cfg.board.get()) => {
-                let at = 6 + seq_slot(bytes[5]).offset();
-                let seq = u16::from_le_bytes([bytes[at], bytes[at + 1]]);
+            Err(WireError::Command(ce)) => {
+                // Length, header and checksum held (the command check comes after them).
+                let Ok(p) = crate::wire::check::<CommandPacket>(bytes) else {
+                    return Received::Ignore(Event::Rejected(WireError::Command(ce)));
+                };
+                if p.board_number() != self.cfg.board.get() {
+                    return Received::Ignore(Event::Rejected(WireError::Command(ce)));
+                }
+                let seq = p.seq();
                 return match self.log.admit(seq) {
                     // The supervisor refuses it like any other command it cannot take.
                     Admission::Execute => {

@@ -17,7 +17,7 @@
 
 use super::layout::{span, FieldSpec, Unit};
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
-use crate::command::{seq_slot, Command, PARAM_LEN, PARAM_OFFSET};
+use crate::command::{seq_slot, Command, Slot, PARAM_LEN, PARAM_OFFSET};
 use crate::units::BoardNumber;
 use zerocopy::byteorder::little_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -52,6 +52,40 @@ impl Packet for CommandPacket {
 }
 
 const _: () = assert!(core::mem::size_of::<CommandPacket>() == COMMAND_LEN);
+
+/// Read-only accessors, for a packet whose length, header and checksum [`check`](super::check)
+/// has passed but whose opcode or parameters may not decode: board A still answers such a
+/// packet, with its sequence number, so the ground stops resending it.
+///
+/// ```
+/// use mmic::wire::{check, command::{CommandPacket, CommandRepr}};
+/// use mmic::command::Command;
+/// use mmic::units::BoardNumber;
+/// let bytes = CommandRepr { board: BoardNumber::ONE, command: Command::Stop, seq: 258 }.to_bytes();
+/// let p: &CommandPacket = check(&bytes).unwrap();
+/// assert_eq!((p.board_number(), p.opcode(), p.seq()), (1, 0x02, 258));
+/// ```
+impl CommandPacket {
+    /// Byte 4: the robot the packet addresses (0 refused by [`CommandRepr::parse`]).
+    pub fn board_number(&self) -> u8 {
+        self.board
+    }
+
+    /// Byte 5: the opcode.
+    pub fn opcode(&self) -> u8 {
+        self.command
+    }
+
+    /// The exactly-once sequence number, in the parameter slot the opcode leaves free
+    /// ([`seq_slot`]).
+    pub fn seq(&self) -> u16 {
+        match seq_slot(self.command) {
+            Slot::Hip => self.hip.get(),
+            Slot::ArmA => self.arm_a.get(),
+            Slot::ArmB => self.arm_b.get(),
+        }
+    }
+}
 
 /// Byte ranges, from the layout.
 pub mod field {
