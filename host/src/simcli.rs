@@ -19,13 +19,18 @@ currents, drains the battery and locks fasteners with the paper's Figure 10 prob
 
 Live progress goes to stderr; at the end a summary is printed, the JSON-lines log of every
 packet and event is written (OUT/sim.jsonl), and two SVG plots: OUT/wifi-efficiency.svg
-(Figure 11 analogue) and OUT/bolting-attempts.svg (Figure 10 analogue).";
+(Figure 11 analogue) and OUT/bolting-attempts.svg (Figure 10 analogue).
+
+The clock is paced: simulated time never runs more than 20 ms ahead of the slowest node, so a
+busy host slows the run down instead of making the firmware's timeouts fire. Before anything
+is sent, the plan is checked against the robot's state, from its `start` line (`a` if none).";
 
 /// `mmic sim --help`'s examples and exit codes.
 pub const SIM_AFTER: &str = "\
 Examples:
   mmic sim                                   the built-in demo plan (host/plans/demo.plan)
   mmic sim --plan my.plan --scale 20
+  mmic sim --plan my.plan --check-plan       parse it and trace the robot's state, run nothing
   mmic sim --wifi-loss 0.3                   30 % of WiFi packets lost, each way
   mmic sim --low-battery-at 40 --overcurrent-at 25 --cut-b-at 60   (seconds)
 
