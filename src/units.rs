@@ -176,6 +176,78 @@ impl fmt::Display for Side {
     }
 }
 
+/// One value per side of the robot, indexed by [`Side`] (never by 0 and 1): the arms,
+/// grippers, switches and their targets come in pairs, and an index that names the side cannot
+/// pick the wrong one.
+///
+/// ```
+/// use mmic::units::{PerSide, Side};
+/// let mut done = PerSide::both(false);
+/// done[Side::B] = true;
+/// assert_eq!((done.a, done.b), (false, true));
+/// assert!(!done.all());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct PerSide<T> {
+    /// Side A's value.
+    pub a: T,
+    /// Side B's value.
+    pub b: T,
+}
+
+impl<T: Copy> PerSide<T> {
+    /// Side A's and side B's values.
+    pub const fn new(a: T, b: T) -> Self {
+        PerSide { a, b }
+    }
+
+    /// The same value on both sides.
+    pub const fn both(v: T) -> Self {
+        PerSide { a: v, b: v }
+    }
+
+    /// The value of side `s`.
+    pub const fn get(&self, s: Side) -> T {
+        match s {
+            Side::A => self.a,
+            Side::B => self.b,
+        }
+    }
+}
+
+impl PerSide<bool> {
+    /// Both sides hold.
+    pub const fn all(&self) -> bool {
+        self.a && self.b
+    }
+
+    /// Either side holds.
+    pub const fn any(&self) -> bool {
+        self.a || self.b
+    }
+}
+
+impl<T> core::ops::Index<Side> for PerSide<T> {
+    type Output = T;
+    fn index(&self, s: Side) -> &T {
+        match s {
+            Side::A => &self.a,
+            Side::B => &self.b,
+        }
+    }
+}
+
+impl<T> core::ops::IndexMut<Side> for PerSide<T> {
+    fn index_mut(&mut self, s: Side) -> &mut T {
+        match s {
+            Side::A => &mut self.a,
+            Side::B => &mut self.b,
+        }
+    }
+}
+
 /// Number of a robot's WiFi client (board A) on a server, Table 2 byte 4 and Table 3 byte 4.
 ///
 /// 1..=255; 0 is refused so that a zeroed buffer can never address a robot.

@@ -4,9 +4,10 @@
 //! use mmic::motion::runner::{Runner, RunStatus};
 //! use mmic::motion::sequencer::{Config, Feedback, Targets};
 //! use mmic::motion::State;
+//! use mmic::units::PerSide;
 //! let mut r = Runner::start(Config::default(), State::A, State::B, Targets::home(), 0);
 //! assert_eq!(r.target_state(), State::B);
-//! let all = Feedback { arm_done: [true; 2], gripper_done: [true; 2], hip_done: true, arm_switch: [true; 2] };
+//! let all = Feedback { arm_done: PerSide::both(true), gripper_done: PerSide::both(true), hip_done: true, arm_switch: PerSide::both(true) };
 //! let mut t = 0;
 //! while r.status() == RunStatus::Running { t += 10; r.step(t, &all); }
 //! assert_eq!(r.status(), RunStatus::Complete);

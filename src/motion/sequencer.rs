@@ -20,9 +20,10 @@
 //! ```
 //! use mmic::motion::sequencer::{Config, Feedback, Sequencer, Status, Targets};
 //! use mmic::motion::State;
+//! use mmic::units::PerSide;
 //! let mut s = Sequencer::start(Config::default(), State::A, State::D, Targets::home(), 0).unwrap();
 //! assert_eq!(s.step(10, &Feedback::default()), Status::Running); // waits for the release
-//! let all = Feedback { arm_done: [true; 2], gripper_done: [true; 2], hip_done: true, arm_switch: [false; 2] };
+//! let all = Feedback { arm_done: PerSide::both(true), gripper_done: PerSide::both(true), hip_done: true, arm_switch: PerSide::both(false) };
 //! let mut t = 10;
 //! while s.status() == Status::Running { t += 10; s.step(t, &all); }
 //! assert_eq!(s.status(), Status::Done);
@@ -33,7 +34,7 @@ use super::{Primitive, State};
 use crate::command::{preset_angle, HipTarget, ServoTarget};
 use crate::faults::Fault;
 use crate::safety::detect::elapsed;
-use crate::units::{HipAngle, Side};
+use crate::units::{HipAngle, PerSide, Side};
 
 /// Per-step timeouts, ms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -62,9 +63,9 @@ impl Default for Config {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Targets {
     /// Arm targets.
-    pub arm: [ServoTarget; 2],
+    pub arm: PerSide<ServoTarget>,
     /// Gripper targets: `Extend` = closed on a face, `Contract` = released.
-    pub gripper: [ServoTarget; 2],
+    pub gripper: PerSide<ServoTarget>,
     /// Hip target.
     pub hip: HipAngle,
 }
@@ -73,16 +74,16 @@ impl Targets {
     /// Contracted and gripped, hip straight: the home position of a matched state.
     pub const fn home() -> Targets {
         Targets {
-            arm: [ServoTarget::Contract; 2],
-            gripper: [ServoTarget::Extend; 2],
+            arm: PerSide::both(ServoTarget::Contract),
+            gripper: PerSide::both(ServoTarget::Extend),
             hip: HipAngle::STRAIGHT,
         }
     }
 
     /// Whether at least one gripper is commanded closed.
     pub const fn holds(&self) -> bool {
-        matches!(self.gripper[0], ServoTarget::Extend)
-            || matches!(self.gripper[1], ServoTarget::Extend)
+        matches!(self.gripper.a, ServoTarget::Extend)
+            || matches!(self.gripper.b, ServoTarget::Extend)
     }
 }
 
@@ -91,13 +92,13 @@ impl Targets {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Feedback {
     /// Arm interpolation finished (A: local; B: reported in the internal heartbeat).
-    pub arm_done: [bool; 2],
+    pub arm_done: PerSide<bool>,
     /// Gripper interpolation finished.
-    pub gripper_done: [bool; 2],
+    pub gripper_done: PerSide<bool>,
     /// Hip within tolerance of its target.
     pub hip_done: bool,
     /// Arm-contracted switch pressed.
-    pub arm_switch: [bool; 2],
+    pub arm_switch: PerSide<bool>,
 }
 
 /// A step of a primitive.
@@ -188,13 +189,6 @@ pub struct Sequencer {
     status: Status,
 }
 
-const fn idx(s: Side) -> usize {
-    match s {
-        Side::A => 0,
-        Side::B => 1,
-    }
-}
-
 impl Sequencer {
     /// Starts the primitive taking `from` to `to` at time `now` (ms), from the current module
     /// targets. The first step is issued at once.
@@ -265,12 +259,12 @@ impl Sequencer {
 
     /// Sets the targets of the current step.
     fn issue(&mut self) {
-        let s = idx(self.side);
+        let s = self.side;
         match self.steps.get(self.at as usize) {
             Some(Step::Release) => self.targets.gripper[s] = ServoTarget::Contract,
             Some(Step::Move) => {
                 if self.to.is_matched() {
-                    self.targets.arm = [ServoTarget::Contract; 2];
+                    self.targets.arm = PerSide::both(ServoTarget::Contract);
                 } else {
                     self.targets.arm[s] = ServoTarget::Extend;
                 }
@@ -294,7 +288,7 @@ impl Sequencer {
         }
         self.waited_ms = self.waited_ms.saturating_add(elapsed(self.last, now));
         self.last = now;
-        let s = idx(self.side);
+        let s = self.side;
         let step = match self.steps.get(self.at as usize) {
             Some(st) => *st,
             None => {
@@ -306,13 +300,13 @@ impl Sequencer {
             Step::Release | Step::Grip => (fb.gripper_done[s], self.cfg.gripper_ms),
             Step::Move => {
                 let arms = if self.to.is_matched() {
-                    fb.arm_done[0] && fb.arm_done[1]
+                    fb.arm_done.all()
                 } else {
                     fb.arm_done[s]
                 };
                 (arms && (!self.is_turn() || fb.hip_done), self.cfg.move_ms)
             }
-            Step::Confirm => (fb.arm_switch[0] && fb.arm_switch[1], self.cfg.confirm_ms),
+            Step::Confirm => (fb.arm_switch.all(), self.cfg.confirm_ms),
         };
         if done {
             self.at += 1;
@@ -335,7 +329,7 @@ impl Sequencer {
             Step::Confirm => Fault::ArmNotContracted,
             Step::Move if self.is_turn() && !fb.hip_done => Fault::HipMismatch,
             // Side B's completion comes from B's heartbeat: silence there is a link problem.
-            Step::Move if (b_moves || self.to.is_matched()) && !fb.arm_done[1] => {
+            Step::Move if (b_moves || self.to.is_matched()) && !fb.arm_done.b => {
                 Fault::InternalCommLoss
             }
             Step::Move => Fault::LocomotionOvercurrent,

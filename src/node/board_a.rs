@@ -46,7 +46,7 @@ use crate::refusal::Refusal;
 use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
 use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use crate::safety::ModuleSet;
-use crate::units::{BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth};
+use crate::units::{BoardNumber, Electrical, Gravity, HipAngle, Module, PerSide, PulseWidth};
 use crate::wire::b_command::{BCommandRepr, BPower, B_COMMAND_LEN};
 use crate::wire::command::{CommandPacket, CommandRepr, COMMAND_LEN};
 use crate::wire::heartbeat::{BolterAttempt, HeartbeatRepr, HEARTBEAT_LEN};
@@ -374,8 +374,8 @@ impl BoardA {
             .is_some_and(|r| r.status() == RunStatus::Running)
             || self.coord.status() == coordinator::Status::Running
             || self.waiting_job.is_some()
-            || !(fb.arm_done[0] && fb.arm_done[1])
-            || !(fb.gripper_done[0] && fb.gripper_done[1])
+            || !fb.arm_done.all()
+            || !fb.gripper_done.all()
             || !fb.hip_done
     }
 
@@ -383,24 +383,24 @@ impl BoardA {
         let b_ok =
             |now: PulseWidth, target: PulseWidth, want: PulseWidth| now == target && target == want;
         Feedback {
-            arm_done: [
+            arm_done: PerSide::new(
                 self.arm.done(),
                 b_ok(
                     self.b.arm_b_now,
                     self.b.arm_b_target,
-                    self.cfg.arm.resolve(self.targets.arm[1]),
+                    self.cfg.arm.resolve(self.targets.arm.b),
                 ),
-            ],
-            gripper_done: [
+            ),
+            gripper_done: PerSide::new(
                 self.gripper.done(),
                 b_ok(
                     self.b.gripper_b_now,
                     self.b.gripper_b_target,
-                    self.cfg.gripper.resolve(self.targets.gripper[1]),
+                    self.cfg.gripper.resolve(self.targets.gripper.b),
                 ),
-            ],
+            ),
             hip_done: hip_distance(hip_now, self.targets.hip) <= self.cfg.hip_done_tolerance,
-            arm_switch: [arm_a_switch, self.b.arm_contracted],
+            arm_switch: PerSide::new(arm_a_switch, self.b.arm_contracted),
         }
     }
 
@@ -735,10 +735,10 @@ impl BoardA {
     fn dispatch(&mut self, c: Command, now: u32) {
         match c {
             Command::Arm { side, target } => {
-                self.targets.arm[side as usize] = target;
+                self.targets.arm[side] = target;
                 self.contracting = side as usize == 0 && target == ServoTarget::Contract;
             }
-            Command::Gripper { side, target } => self.targets.gripper[side as usize] = target,
+            Command::Gripper { side, target } => self.targets.gripper[side] = target,
             Command::Hip(h) => {
                 self.targets.hip = match (h, preset_angle(h)) {
                     (_, Some(a)) => a,
@@ -842,14 +842,14 @@ impl BoardA {
         self.coord.stop();
         self.waiting_job = None;
         self.side_a.order(0, None, now);
-        self.targets.arm = [
+        self.targets.arm = PerSide::new(
             ServoTarget::Position(self.arm.now()),
             ServoTarget::Position(self.b.arm_b_now),
-        ];
-        self.targets.gripper = [
+        );
+        self.targets.gripper = PerSide::new(
             ServoTarget::Position(self.gripper.now()),
             ServoTarget::Position(self.b.gripper_b_now),
-        ];
+        );
         self.contracting = false;
     }
 
@@ -862,11 +862,11 @@ impl BoardA {
     }
 
     fn arm_targets(&mut self, now: u32) {
-        let arm = self.cfg.arm.resolve(self.targets.arm[0]);
+        let arm = self.cfg.arm.resolve(self.targets.arm.a);
         if self.arm.target() != arm {
             self.arm.set_target(arm, now);
         }
-        let gripper = self.cfg.gripper.resolve(self.targets.gripper[0]);
+        let gripper = self.cfg.gripper.resolve(self.targets.gripper.a);
         if self.gripper.target() != gripper {
             self.gripper.set_target(gripper, now);
         }
@@ -892,8 +892,8 @@ impl BoardA {
                 bolter: live && p.contains(Module::BolterB),
             },
             stop: self.sup.stopped() || self.sup.mode() == Mode::Safed,
-            arm_target: self.cfg.arm.resolve(self.targets.arm[1]),
-            gripper_target: self.cfg.gripper.resolve(self.targets.gripper[1]),
+            arm_target: self.cfg.arm.resolve(self.targets.arm.b),
+            gripper_target: self.cfg.gripper.resolve(self.targets.gripper.b),
             bolter: order.map(|(_, o)| o),
         };
         let due = match self.b_sent {

@@ -10,7 +10,7 @@ use mmic::faults::Fault;
 use mmic::motion::runner::{RunStatus, Runner};
 use mmic::motion::sequencer::{Config, Feedback, Sequencer, Status, Step, Targets};
 use mmic::motion::{map, route, State};
-use mmic::units::Side;
+use mmic::units::{PerSide, Side};
 
 #[derive(Clone, Copy, Debug)]
 enum Ev {
@@ -23,21 +23,21 @@ enum Ev {
 const EVS: [Ev; 4] = [Ev::Done, Ev::Unrelated, Ev::Late, Ev::Idle];
 
 fn feedback(side: Side, ev: Ev) -> Feedback {
-    let s = if side == Side::A { 0 } else { 1 };
+    let s = side;
     match ev {
         Ev::Done => Feedback {
-            arm_done: [true; 2],
-            gripper_done: [true; 2],
+            arm_done: PerSide::both(true),
+            gripper_done: PerSide::both(true),
             hip_done: true,
-            arm_switch: [true; 2],
+            arm_switch: PerSide::both(true),
         },
         Ev::Unrelated => {
             // Everything of the holding side, nothing of the moving side; the hip moves only with S's arm.
             let mut f = Feedback {
-                arm_done: [true; 2],
-                gripper_done: [true; 2],
+                arm_done: PerSide::both(true),
+                gripper_done: PerSide::both(true),
                 hip_done: true,
-                arm_switch: [true; 2],
+                arm_switch: PerSide::both(true),
             };
             f.arm_done[s] = false;
             f.gripper_done[s] = false;
@@ -73,7 +73,7 @@ fn every_move_under_every_signal_interleaving() {
             let mut s = Sequencer::start(cfg, from, to, Targets::home(), u32::MAX - 50).unwrap();
             assert_eq!(s.primitive(), prim);
             let side = s.side();
-            let o = if side == Side::A { 1 } else { 0 };
+            let o = if side == Side::A { Side::B } else { Side::A };
             let turn = prim.number() >= 5;
             let mut now = u32::MAX - 50; // across the clock's wrap
             let mut c = code;
@@ -123,15 +123,15 @@ fn every_move_under_every_signal_interleaving() {
                         completed_steps += 1;
                         let steps = if to.is_matched() { 4 } else { 3 };
                         assert_eq!(completed_steps, steps, "{from}->{to}: done early");
-                        assert_eq!(t.gripper, [ServoTarget::Extend; 2]);
+                        assert_eq!(t.gripper, PerSide::both(ServoTarget::Extend));
                         let want_arm = if to.is_matched() {
                             ServoTarget::Contract
                         } else {
                             ServoTarget::Extend
                         };
-                        assert_eq!(t.arm[1 - o], want_arm);
+                        assert_eq!(t.arm[side], want_arm);
                         if to.is_matched() {
-                            assert_eq!(t.arm, [ServoTarget::Contract; 2]);
+                            assert_eq!(t.arm, PerSide::both(ServoTarget::Contract));
                         }
                         frozen = Some((st, t));
                     }
@@ -155,10 +155,10 @@ fn every_move_under_every_signal_interleaving() {
 #[test]
 fn every_reconfiguration_reaches_its_target() {
     let all = Feedback {
-        arm_done: [true; 2],
-        gripper_done: [true; 2],
+        arm_done: PerSide::both(true),
+        gripper_done: PerSide::both(true),
         hip_done: true,
-        arm_switch: [true; 2],
+        arm_switch: PerSide::both(true),
     };
     for from in State::ALL {
         for to in State::ALL {
@@ -182,7 +182,7 @@ fn every_reconfiguration_reaches_its_target() {
             assert_eq!(visited, route::lookup(from, to).states(), "{from}->{to}");
             // A matched target ends contracted and gripped, with the hip straight again.
             if from.is_matched() && to.is_matched() {
-                assert_eq!(r.targets().arm, [ServoTarget::Contract; 2]);
+                assert_eq!(r.targets().arm, PerSide::both(ServoTarget::Contract));
                 assert_eq!(r.targets().hip.centidegrees(), 18000, "{from}->{to}");
             }
         }
@@ -194,10 +194,10 @@ fn a_failed_primitive_stops_the_reconfiguration() {
     let mut r = Runner::start(Config::default(), State::A, State::M, Targets::home(), 0);
     // Release completes, then the move never finishes.
     let all = Feedback {
-        arm_done: [true; 2],
-        gripper_done: [true; 2],
+        arm_done: PerSide::both(true),
+        gripper_done: PerSide::both(true),
         hip_done: true,
-        arm_switch: [true; 2],
+        arm_switch: PerSide::both(true),
     };
     r.step(10, &all);
     // a -> d moves side B: its arm never reports done.
@@ -224,10 +224,10 @@ fn a_failed_primitive_stops_the_reconfiguration() {
 fn every_pose_reached_is_accepted_by_the_estimator() {
     use mmic::motion::estimate::{consistent, initial_state_consistent, Config as Est, Readings};
     let all = Feedback {
-        arm_done: [true; 2],
-        gripper_done: [true; 2],
+        arm_done: PerSide::both(true),
+        gripper_done: PerSide::both(true),
         hip_done: true,
-        arm_switch: [true; 2],
+        arm_switch: PerSide::both(true),
     };
     let mut poses = 0;
     for from in State::MATCHED {
@@ -243,8 +243,8 @@ fn every_pose_reached_is_accepted_by_the_estimator() {
                     let readings = Readings {
                         gravity_a: None,
                         gravity_b: None,
-                        arm_a_contracted: tg.arm[0] == ServoTarget::Contract,
-                        arm_b_contracted: tg.arm[1] == ServoTarget::Contract,
+                        arm_a_contracted: tg.arm.a == ServoTarget::Contract,
+                        arm_b_contracted: tg.arm.b == ServoTarget::Contract,
                         hip: tg.hip,
                     };
                     let set = consistent(&Est::default(), &readings);

@@ -6,7 +6,7 @@
 use mmic::command::ServoTarget;
 use mmic::motion::sequencer::{Config, Feedback, Sequencer, Status, Targets};
 use mmic::motion::{map, State};
-use mmic::units::Side;
+use mmic::units::{PerSide, Side};
 
 const TICKS: usize = 8;
 
@@ -31,17 +31,21 @@ fn sequencer_always_holds_with_one_closed_gripper() {
             else {
                 panic!("a map move must start");
             };
-            let o = if s.side() == Side::A { 1 } else { 0 };
+            let o = if s.side() == Side::A {
+                Side::B
+            } else {
+                Side::A
+            };
             let mut now = *start;
             let mut ended: Option<(Status, Targets)> = None;
             for &(bits, dt) in ticks.iter() {
                 now = now.wrapping_add(dt as u32);
                 let b = |i: u8| bits & (1 << i) != 0;
                 let fb = Feedback {
-                    arm_done: [b(0), b(1)],
-                    gripper_done: [b(2), b(3)],
+                    arm_done: PerSide::new(b(0), b(1)),
+                    gripper_done: PerSide::new(b(2), b(3)),
                     hip_done: b(4),
-                    arm_switch: [b(5), b(6)],
+                    arm_switch: PerSide::new(b(5), b(6)),
                 };
                 let st = s.step(now, &fb);
                 let t = s.targets();
