@@ -5,7 +5,7 @@ use super::side::{ended, SideConfig};
 use super::{BolterDirection, BolterPair, BolterStep};
 use crate::command::Fasteners;
 use crate::faults::Fault;
-use crate::safety::detect::elapsed;
+use crate::units::Instant;
 use crate::wire::b_command::BolterOrder;
 use crate::wire::heartbeat::BolterAttempt;
 use crate::wire::internal_heartbeat::BolterAux;
@@ -83,7 +83,7 @@ pub struct Coordinator {
     step: BolterStep,
     retrying: bool,
     seq: u8,
-    last: u32,
+    last: Instant,
     waited_ms: u32,
     status: Status,
 }
@@ -111,7 +111,7 @@ impl Coordinator {
             step: BolterStep::Descend,
             retrying: false,
             seq: 0,
-            last: 0,
+            last: Instant::ZERO,
             waited_ms: 0,
             status: Status::Idle,
         }
@@ -143,7 +143,7 @@ impl Coordinator {
     fn goto(&mut self, step: BolterStep, now: u32) {
         self.step = step;
         self.seq = self.seq.wrapping_add(1);
-        self.last = now;
+        self.last = Instant::from_millis(now);
         self.waited_ms = 0;
     }
 
@@ -187,9 +187,9 @@ impl Coordinator {
                 .saturating_add(cfg.link_margin_ms);
             self.waited_ms = self
                 .waited_ms
-                .saturating_add(elapsed(self.last, now))
+                .saturating_add(Instant::from_millis(now).since(self.last).millis())
                 .min(limit.saturating_add(1));
-            self.last = now;
+            self.last = Instant::from_millis(now);
             let side_done = |x: &BolterAux| {
                 reported(x, seq, &o) && ended(o.step, x.threshold_reached, x.locked, x.at_home)
             };

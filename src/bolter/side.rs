@@ -2,7 +2,7 @@
 //! the current sensing, and times out the current-sensed steps.
 
 use super::{BolterDirection, BolterStep, MuxLines};
-use crate::safety::detect::elapsed;
+use crate::units::Instant;
 use crate::wire::b_command::BolterOrder;
 use crate::wire::internal_heartbeat::BolterAux;
 
@@ -58,7 +58,7 @@ impl Default for SideConfig {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct BolterSide {
     order: Option<(u8, BolterOrder)>,
-    last: u32,
+    last: Instant,
     waited_ms: u32,
     threshold: bool,
     locked: bool,
@@ -88,7 +88,7 @@ impl BolterSide {
     pub const fn new() -> BolterSide {
         BolterSide {
             order: None,
-            last: 0,
+            last: Instant::ZERO,
             waited_ms: 0,
             threshold: false,
             locked: false,
@@ -108,7 +108,7 @@ impl BolterSide {
         }
         *self = BolterSide {
             order: order.map(|o| (seq, o)),
-            last: now,
+            last: Instant::from_millis(now),
             ..BolterSide::new()
         };
     }
@@ -124,9 +124,9 @@ impl BolterSide {
         // Clamped just past the limit: the executor has finitely many states.
         self.waited_ms = self
             .waited_ms
-            .saturating_add(elapsed(self.last, now))
+            .saturating_add(Instant::from_millis(now).since(self.last).millis())
             .min(limit.saturating_add(1));
-        self.last = now;
+        self.last = Instant::from_millis(now);
         if self.finished() {
             return;
         }

@@ -17,7 +17,7 @@
 //! assert!(out.micros() > 1500);
 //! ```
 
-use crate::safety::detect::elapsed;
+use crate::units::Instant;
 use crate::units::{HipAngle, PulseWidth};
 
 /// Controller settings.
@@ -75,7 +75,7 @@ pub enum Mode {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct HipController {
     cfg: Config,
-    last: Option<(u32, HipAngle)>,
+    last: Option<(Instant, HipAngle)>,
     velocity: i32,
     integral_q8: i32,
     mode: Mode,
@@ -124,7 +124,7 @@ impl HipController {
         // Velocity estimate from successive readings.
         let mut dt_ms = 0u32;
         if let Some((t0, a0)) = self.last {
-            dt_ms = elapsed(t0, now).min(1000);
+            dt_ms = Instant::from_millis(now).since(t0).millis().min(1000);
             if dt_ms > 0 {
                 // |raw| ≤ 18000 × 1000: no overflow; the estimate stays within the same bound.
                 let raw = (angle_error(a0, measured) as i64 * 1000 / dt_ms as i64) as i32;
@@ -132,7 +132,7 @@ impl HipController {
                 self.velocity += (raw - self.velocity) >> shift;
             }
         }
-        self.last = Some((now, measured));
+        self.last = Some((Instant::from_millis(now), measured));
         let e = angle_error(measured, target);
         let band = c.position_band.max(0);
         let mode = if e.abs() > band {

@@ -3,7 +3,7 @@
 //! [`PulseWidth`] cannot leave 500..=2500 µs). The heartbeat's "current PWM" is [`Interpolator::now`].
 
 use crate::command::ServoTarget;
-use crate::safety::detect::elapsed;
+use crate::units::Instant;
 use crate::units::PulseWidth;
 
 /// Interpolation rate: `step_us` every `period_ms`.
@@ -63,7 +63,7 @@ pub struct Interpolator {
     now: PulseWidth,
     target: PulseWidth,
     rate: Rate,
-    last: u32,
+    last: Instant,
     banked_ms: u32,
 }
 
@@ -74,7 +74,7 @@ impl Interpolator {
             now,
             target: now,
             rate,
-            last: 0,
+            last: Instant::ZERO,
             banked_ms: 0,
         }
     }
@@ -82,7 +82,7 @@ impl Interpolator {
     /// New target from time `t` (ms) on.
     pub fn set_target(&mut self, target: PulseWidth, t: u32) {
         self.target = target;
-        self.last = t;
+        self.last = Instant::from_millis(t);
         self.banked_ms = 0;
     }
 
@@ -90,7 +90,8 @@ impl Interpolator {
     /// target. Returns the pulse to send.
     pub fn tick(&mut self, t: u32) -> PulseWidth {
         let period = self.rate.period_ms.max(1);
-        self.banked_ms = self.banked_ms.saturating_add(elapsed(self.last, t));
+        let t = Instant::from_millis(t);
+        self.banked_ms = self.banked_ms.saturating_add(t.since(self.last).millis());
         self.last = t;
         let periods = self.banked_ms / period;
         self.banked_ms %= period;

@@ -33,8 +33,7 @@ use super::geometry::single_move;
 use super::{Primitive, State};
 use crate::command::{preset_angle, HipTarget, ServoTarget};
 use crate::faults::Fault;
-use crate::safety::detect::elapsed;
-use crate::units::{HipAngle, PerSide, Side};
+use crate::units::{HipAngle, Instant, PerSide, Side};
 
 /// Per-step timeouts, ms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -183,7 +182,7 @@ pub struct Sequencer {
     steps: [Step; 4],
     n_steps: u8,
     at: u8,
-    last: u32,
+    last: Instant,
     waited_ms: u32,
     targets: Targets,
     status: Status,
@@ -215,7 +214,7 @@ impl Sequencer {
             steps,
             n_steps: n,
             at: 0,
-            last: now,
+            last: Instant::from_millis(now),
             waited_ms: 0,
             targets,
             status: Status::Running,
@@ -286,8 +285,9 @@ impl Sequencer {
         if self.status != Status::Running {
             return self.status;
         }
-        self.waited_ms = self.waited_ms.saturating_add(elapsed(self.last, now));
-        self.last = now;
+        let t = Instant::from_millis(now);
+        self.waited_ms = self.waited_ms.saturating_add(t.since(self.last).millis());
+        self.last = t;
         let s = self.side;
         let step = match self.steps.get(self.at as usize) {
             Some(st) => *st,

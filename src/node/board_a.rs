@@ -46,7 +46,9 @@ use crate::refusal::Refusal;
 use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
 use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use crate::safety::ModuleSet;
-use crate::units::{BoardNumber, Electrical, Gravity, HipAngle, Module, PerSide, PulseWidth};
+use crate::units::{
+    BoardNumber, Electrical, Gravity, HipAngle, Instant, Module, PerSide, PulseWidth,
+};
 use crate::wire::b_command::{BCommandRepr, BPower, B_COMMAND_LEN};
 use crate::wire::command::{CommandPacket, CommandRepr, COMMAND_LEN};
 use crate::wire::heartbeat::{BolterAttempt, HeartbeatRepr, HEARTBEAT_LEN};
@@ -293,12 +295,12 @@ pub struct BoardA {
     hip_ctl: HipController,
     b: InternalHeartbeatRepr,
     b_heard: bool,
-    b_sent: Option<(u32, BCommandRepr)>,
+    b_sent: Option<(Instant, BCommandRepr)>,
     contracting: bool,
     refusal: Option<Refusal>,
     moving: bool,
     pair: Option<(crate::command::BolterPair, u8)>,
-    still_since: Option<u32>,
+    still_since: Option<Instant>,
 }
 
 impl BoardA {
@@ -507,11 +509,11 @@ impl BoardA {
         if in_motion {
             self.still_since = None;
         } else if self.still_since.is_none() {
-            self.still_since = Some(now);
+            self.still_since = Some(Instant::from_millis(now));
         }
-        let settled = self
-            .still_since
-            .is_some_and(|t| detect::elapsed(t, now) >= self.cfg.idle_settle_ms);
+        let settled = self.still_since.is_some_and(|t| {
+            Instant::from_millis(now).since(t).millis() >= self.cfg.idle_settle_ms
+        });
         if settled {
             conditions = conditions.union(detect::idle_overcurrent(
                 &self.cfg.safety,
@@ -898,12 +900,14 @@ impl BoardA {
         };
         let due = match self.b_sent {
             None => true,
-            Some((t, last)) => last != cmd || detect::elapsed(t, now) >= self.cfg.b_period_ms,
+            Some((t, last)) => {
+                last != cmd || Instant::from_millis(now).since(t).millis() >= self.cfg.b_period_ms
+            }
         };
         if !due {
             return None;
         }
-        self.b_sent = Some((now, cmd));
+        self.b_sent = Some((Instant::from_millis(now), cmd));
         self.comm.sent(cmd.seq);
         Some(cmd.to_bytes())
     }

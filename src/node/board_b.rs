@@ -31,7 +31,8 @@
 
 use crate::bolter::{BolterSide, Drive, MuxLines, SideConfig, Signals};
 use crate::control::interp::{Interpolator, Rate};
-use crate::safety::detect::{self, elapsed};
+use crate::safety::detect;
+use crate::units::Instant;
 use crate::units::{Electrical, Gravity, PulseWidth};
 use crate::wire::b_command::{BCommandRepr, B_COMMAND_LEN};
 use crate::wire::internal_heartbeat::{InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
@@ -112,8 +113,8 @@ pub struct BoardB {
     gripper: Interpolator,
     bolter: BolterSide,
     last: Option<BCommandRepr>,
-    heard: Option<u32>,
-    sent: Option<u32>,
+    heard: Option<Instant>,
+    sent: Option<Instant>,
     holding: bool,
 }
 
@@ -152,7 +153,7 @@ impl BoardB {
         if let Some(bytes) = inp.command {
             match BCommandRepr::parse(&bytes) {
                 Ok(c) => {
-                    self.heard = Some(now);
+                    self.heard = Some(Instant::from_millis(now));
                     self.holding = false;
                     if c.stop {
                         self.hold(now);
@@ -171,7 +172,7 @@ impl BoardB {
             }
         }
         let silent = match self.heard {
-            Some(t) => elapsed(t, now) > self.cfg.link_timeout_ms,
+            Some(t) => Instant::from_millis(now).since(t).millis() > self.cfg.link_timeout_ms,
             None => false,
         };
         if silent && !self.holding {
@@ -184,9 +185,13 @@ impl BoardB {
         let power = self.last.map(|c| c.power).unwrap_or_default();
         let live = power.regulator && !self.holding;
         let heartbeat = match self.sent {
-            Some(t) if elapsed(t, now) < self.cfg.heartbeat_period_ms => None,
+            Some(t)
+                if Instant::from_millis(now).since(t).millis() < self.cfg.heartbeat_period_ms =>
+            {
+                None
+            }
             _ => {
-                self.sent = Some(now);
+                self.sent = Some(Instant::from_millis(now));
                 Some(self.report(inp).to_bytes())
             }
         };

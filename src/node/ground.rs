@@ -31,8 +31,8 @@
 
 use crate::command::Command;
 use crate::refusal::Refusal;
-use crate::safety::detect::elapsed;
 use crate::units::BoardNumber;
+use crate::units::{Duration, Instant};
 use crate::wire::command::CommandRepr;
 use crate::wire::heartbeat::HeartbeatRepr;
 
@@ -140,7 +140,7 @@ struct Outstanding {
     seq: u16,
     attempts: u8,
     /// When the open attempt was sent; none once it closed.
-    open_since: Option<u32>,
+    open_since: Option<Instant>,
 }
 
 /// The uplink's state.
@@ -151,7 +151,7 @@ pub struct Uplink {
     board: BoardNumber,
     next_seq: u16,
     out: Option<Outstanding>,
-    last_send: Option<u32>,
+    last_send: Option<Instant>,
     eff: Efficiency,
 }
 
@@ -226,8 +226,11 @@ impl Uplink {
     pub fn next_deadline(&self) -> Option<u32> {
         let o = self.out?;
         Some(match (o.open_since, self.last_send) {
-            (Some(t), _) => t.wrapping_add(self.cfg.timeout_ms).wrapping_add(1),
-            (None, Some(t)) => t.wrapping_add(self.cfg.period_ms),
+            (Some(t), _) => t
+                .after(Duration::from_millis(self.cfg.timeout_ms))
+                .millis()
+                .wrapping_add(1),
+            (None, Some(t)) => t.after(Duration::from_millis(self.cfg.period_ms)).millis(),
             (None, None) => 0,
         })
     }
@@ -237,7 +240,7 @@ impl Uplink {
         let mut t = Tick::default();
         let Some(mut o) = self.out else { return t };
         if let Some(sent) = o.open_since {
-            if elapsed(sent, now) > self.cfg.timeout_ms {
+            if Instant::from_millis(now).since(sent).millis() > self.cfg.timeout_ms {
                 o.open_since = None;
                 self.eff.push(false);
                 t.attempt = Some(false);
@@ -245,7 +248,7 @@ impl Uplink {
         }
         let slot_due = self
             .last_send
-            .is_none_or(|l| elapsed(l, now) >= self.cfg.period_ms);
+            .is_none_or(|l| Instant::from_millis(now).since(l).millis() >= self.cfg.period_ms);
         if o.open_since.is_none() && slot_due {
             if o.attempts >= self.cfg.max_attempts.max(1) {
                 self.out = None;
@@ -258,8 +261,8 @@ impl Uplink {
                 return t;
             }
             o.attempts += 1;
-            o.open_since = Some(now);
-            self.last_send = Some(now);
+            o.open_since = Some(Instant::from_millis(now));
+            self.last_send = Some(Instant::from_millis(now));
             t.send = Some(CommandRepr {
                 board: self.board,
                 command: o.command,
@@ -279,7 +282,7 @@ impl Uplink {
             return t;
         }
         if let Some(sent) = o.open_since {
-            let ok = elapsed(sent, now) <= self.cfg.timeout_ms;
+            let ok = Instant::from_millis(now).since(sent).millis() <= self.cfg.timeout_ms;
             self.eff.push(ok);
             t.attempt = Some(ok);
         }

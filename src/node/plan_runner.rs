@@ -39,8 +39,9 @@ use crate::command::{Command, CommandKind};
 use crate::faults::Faults;
 use crate::mode::Mode;
 use crate::refusal::Refusal;
-use crate::safety::detect::{elapsed, hip_distance};
+use crate::safety::detect::hip_distance;
 use crate::units::BoardNumber;
+use crate::units::Instant;
 use crate::wire::command::CommandRepr;
 use crate::wire::heartbeat::HeartbeatRepr;
 
@@ -211,7 +212,13 @@ impl PlanRunner {
                         };
                     }
                 },
-                Phase::Waiting { until } if elapsed(until, now) > 0 || until == now => {
+                Phase::Waiting { until }
+                    if Instant::from_millis(now)
+                        .since(Instant::from_millis(until))
+                        .millis()
+                        > 0
+                        || until == now =>
+                {
                     self.next += 1;
                     self.phase = Phase::Ready;
                     return self.tick(steps, now);

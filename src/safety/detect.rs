@@ -17,7 +17,7 @@
 //! ```
 
 use crate::faults::{Fault, Faults};
-use crate::units::{Electrical, HipAngle, Milliamps, Millivolts};
+use crate::units::{Electrical, HipAngle, Instant, Milliamps, Millivolts};
 
 /// Current limits of the three module classes of Table 8.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -87,22 +87,12 @@ impl Default for Config {
     }
 }
 
-/// Milliseconds from `last` to `now` on the wrapping clock; 0 if the clock went backwards.
-pub const fn elapsed(last: u32, now: u32) -> u32 {
-    let d = now.wrapping_sub(last);
-    if d > i32::MAX as u32 {
-        0
-    } else {
-        d
-    }
-}
-
 /// A condition that must hold continuously for longer than a duration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Debounce {
     /// Time of the previous sample while the condition held.
-    last: Option<u32>,
+    last: Option<Instant>,
     /// How long it has held, saturating.
     held_ms: u32,
 }
@@ -115,8 +105,9 @@ impl Debounce {
             *self = Debounce::default();
             return false;
         }
+        let now = Instant::from_millis(now);
         if let Some(last) = self.last {
-            self.held_ms = self.held_ms.saturating_add(elapsed(last, now));
+            self.held_ms = self.held_ms.saturating_add(now.since(last).millis());
         }
         self.last = Some(now);
         self.held_ms > limit_ms
@@ -152,7 +143,7 @@ impl LowBattery {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct CommMonitor {
-    last_seen: Option<u32>,
+    last_seen: Option<Instant>,
     silent_ms: u32,
     pending: Option<u8>,
     sends: u8,
@@ -164,15 +155,16 @@ pub struct CommMonitor {
 impl CommMonitor {
     /// Advances time; silence counts from the first call (boot) until B's first heartbeat.
     pub fn tick(&mut self, now: u32) {
+        let now = Instant::from_millis(now);
         if let Some(last) = self.last_seen {
-            self.silent_ms = self.silent_ms.saturating_add(elapsed(last, now));
+            self.silent_ms = self.silent_ms.saturating_add(now.since(last).millis());
         }
         self.last_seen = Some(now);
     }
 
     /// Board B's heartbeat arrived, echoing sequence number `ack` ("command received").
     pub fn heartbeat(&mut self, now: u32, ack: u8) {
-        self.last_seen = Some(now);
+        self.last_seen = Some(Instant::from_millis(now));
         self.silent_ms = 0;
         self.acked = Some(ack);
         if self.pending == Some(ack) {
