@@ -25,6 +25,7 @@ pub mod deframer;
 pub mod heartbeat;
 pub mod internal_heartbeat;
 mod layout;
+pub mod opcode;
 
 pub use layout::{ElectricalLayout, FieldSpec, Unit};
 

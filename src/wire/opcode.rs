@@ -1,0 +1,366 @@
+//! The command packet's byte encoding (Table 2 bytes 5–11): the opcodes, the parameter slots,
+//! the slot the exactly-once sequence number takes, and [`encode`]/[`decode`] between a
+//! [`Command`] and its opcode and six parameter bytes. The domain (what a command means) is
+//! [`crate::command`]; this is layout.
+//!
+//! ```
+//! use mmic::command::{Command, HipTarget};
+//! use mmic::wire::opcode;
+//! let (id, params) = opcode::encode(&Command::Hip(HipTarget::Straight));
+//! assert_eq!(id, opcode::HIP + 1);
+//! assert_eq!(opcode::decode(id, params), Ok(Command::Hip(HipTarget::Straight)));
+//! ```
+
+use crate::command::{
+    BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, Reconfiguration,
+    ReconfigurationError, ServoTarget,
+};
+use crate::mode::Mode;
+use crate::motion::{Primitive, State};
+use crate::units::{HipAngle, Module, PulseWidth, Side};
+
+/// Index in the command packet of the first parameter byte (Table 2 byte 6).
+pub const PARAM_OFFSET: usize = 6;
+/// Number of parameter bytes (Table 2 bytes 6–11).
+pub const PARAM_LEN: usize = 6;
+
+/// Heartbeat request.
+pub const HEARTBEAT: u8 = 0x01;
+/// Stop.
+pub const STOP: u8 = 0x02;
+/// Reset (resume after stop).
+pub const RESET: u8 = 0x03;
+/// Assembly system operation fault.
+pub const SYSTEM_FAULT: u8 = 0x04;
+/// Clear latched faults.
+pub const CLEAR_FAULTS: u8 = 0x05;
+/// Mode: Standby, Operational, Safed = base + 0, 1, 2.
+pub const MODE: u8 = 0x10;
+/// Arm A: contract, extend, position = base + 0, 1, 2; arm B at base + 4.
+pub const ARM: u8 = 0x20;
+/// Gripper A: contract, extend, position = base + 0, 1, 2; gripper B at base + 4.
+pub const GRIPPER: u8 = 0x28;
+/// Hip: home, straight, 90° CW, 90° CCW, angle = base + 0..=4.
+pub const HIP: u8 = 0x30;
+/// Bolt pair 1..=4 = base + 0..=3; all = base + 4.
+pub const BOLT: u8 = 0x40;
+/// Unbolt pair 1..=4 = base + 0..=3; all = base + 4.
+pub const UNBOLT: u8 = 0x48;
+/// Bolters down.
+pub const BOLTERS_DOWN: u8 = 0x4f;
+/// Primitive n (1..=8) = base + n.
+pub const PRIMITIVE: u8 = 0x50;
+/// Reconfigure: final state in byte 8, initial in byte 9.
+pub const RECONFIGURE: u8 = 0x60;
+/// Power on module i (Module::ALL order) = base + i; all = base + 7.
+pub const POWER_ON: u8 = 0x70;
+/// Power off module i = base + i; all = base + 7.
+pub const POWER_OFF: u8 = 0x78;
+
+/// A parameter slot of Table 2, as a range of the 6 parameter bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Slot {
+    /// Bytes 6–7: hip target.
+    Hip,
+    /// Bytes 8–9: arm A target, or final (8) / initial (9) state.
+    ArmA,
+    /// Bytes 10–11: arm B target.
+    ArmB,
+}
+
+impl Slot {
+    /// Offset of the slot's low byte among the parameter bytes.
+    pub const fn offset(self) -> usize {
+        match self {
+            Slot::Hip => 0,
+            Slot::ArmA => 2,
+            Slot::ArmB => 4,
+        }
+    }
+
+    /// Slot carrying a servo target for `side`'s arm or gripper.
+    pub const fn for_side(side: Side) -> Slot {
+        match side {
+            Side::A => Slot::ArmA,
+            Side::B => Slot::ArmB,
+        }
+    }
+}
+
+/// The parameter slot that carries a command's exactly-once sequence number
+/// (spec/protocol/README.md): bytes 10–11 (arm B), unless opcode `id` puts a pulse width there
+/// (arm B or gripper B to a position), then bytes 6–7 (hip), which those opcodes leave unused.
+/// Every opcode leaves at least one of the two free, so Table 2 keeps its 14 bytes.
+pub const fn seq_slot(id: u8) -> Slot {
+    const ARM_B_POSITION: u8 = ARM + 4 + 2;
+    const GRIPPER_B_POSITION: u8 = GRIPPER + 4 + 2;
+    match id {
+        ARM_B_POSITION | GRIPPER_B_POSITION => Slot::Hip,
+        _ => Slot::ArmB,
+    }
+}
+
+/// A parameter block that does not decode to a command.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum CommandError {
+    /// Byte 5 holds no assigned opcode.
+    #[error("byte 5: unknown command id {id:#04x}")]
+    UnknownId {
+        /// The refused opcode.
+        id: u8,
+    },
+    /// A parameter byte the command does not use is not zero.
+    #[error("byte {index}: unused by command {id:#04x}, must be 0, found {found:#04x}")]
+    UnusedNotZero {
+        /// Opcode.
+        id: u8,
+        /// Packet byte index (6..=11).
+        index: usize,
+        /// Its value.
+        found: u8,
+    },
+    /// A pulse width outside the servo range.
+    #[error("bytes {index}-{}: pulse width must be {}..={} us, found {found}", index + 1, PulseWidth::MIN_US, PulseWidth::MAX_US)]
+    PulseWidth {
+        /// Packet index of the low byte.
+        index: usize,
+        /// Value found.
+        found: u16,
+    },
+    /// A hip angle at or above 360°.
+    #[error("bytes {index}-{}: hip angle must be < 36000 (0.01 deg), found {found}", index + 1)]
+    HipAngle {
+        /// Packet index of the low byte.
+        index: usize,
+        /// Value found.
+        found: u16,
+    },
+    /// A state byte that is no Table 5 letter.
+    #[error("byte {index}: state must be 'a'..='o' (0x61..=0x6f), found {found:#04x}")]
+    State {
+        /// Packet index.
+        index: usize,
+        /// Value found.
+        found: u8,
+    },
+    /// A well-formed but impossible reconfiguration.
+    #[error("bytes 8-9: {0}")]
+    Reconfiguration(#[from] ReconfigurationError),
+}
+
+fn get_u16(p: &[u8; PARAM_LEN], slot: Slot) -> u16 {
+    let o = slot.offset();
+    u16::from_le_bytes([p[o], p[o + 1]])
+}
+
+fn put_u16(p: &mut [u8; PARAM_LEN], slot: Slot, v: u16) {
+    let o = slot.offset();
+    let b = v.to_le_bytes();
+    p[o] = b[0];
+    p[o + 1] = b[1];
+}
+
+/// `id` is one of the `n` opcodes from `first` on.
+const fn in_block(id: u8, first: u8, n: u8) -> bool {
+    id >= first && id - first < n
+}
+
+/// Arm and gripper opcodes: per module two blocks of four (side A, side B), each contract,
+/// extend, position and one unassigned.
+const fn is_servo(id: u8) -> bool {
+    (in_block(id, ARM, 8) || in_block(id, GRIPPER, 8)) && (id - ARM) % 4 != 3
+}
+
+/// An arm or gripper command; a position uses its side's parameter slot.
+fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+    let base = if id < GRIPPER { ARM } else { GRIPPER };
+    let side = side_of(id, base);
+    let slot = Slot::for_side(side);
+    let (target, used) = match (id - base) % 4 {
+        0 => (ServoTarget::Contract, 0),
+        1 => (ServoTarget::Extend, 0),
+        _ => {
+            let raw = get_u16(p, slot);
+            let pw = PulseWidth::new(raw).map_err(|_| CommandError::PulseWidth {
+                index: PARAM_OFFSET + slot.offset(),
+                found: raw,
+            })?;
+            (ServoTarget::Position(pw), 0b11 << slot.offset())
+        }
+    };
+    let cmd = if base == ARM {
+        Command::Arm { side, target }
+    } else {
+        Command::Gripper { side, target }
+    };
+    Ok((cmd, used))
+}
+
+/// A hip command: the four presets, or an angle in the hip slot.
+fn decode_hip(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+    Ok(match id - HIP {
+        0 => (Command::Hip(HipTarget::Home), 0),
+        1 => (Command::Hip(HipTarget::Straight), 0),
+        2 => (Command::Hip(HipTarget::RightAngleCw), 0),
+        3 => (Command::Hip(HipTarget::RightAngleCcw), 0),
+        _ => {
+            let raw = get_u16(p, Slot::Hip);
+            let a = HipAngle::new(raw).map_err(|_| CommandError::HipAngle {
+                index: PARAM_OFFSET,
+                found: raw,
+            })?;
+            (Command::Hip(HipTarget::Angle(a)), 0b11)
+        }
+    })
+}
+
+/// A bolt or unbolt command: pairs 1..=4, then all four.
+fn decode_bolter(id: u8) -> BolterCommand {
+    let base = if id < UNBOLT { BOLT } else { UNBOLT };
+    let which = match BolterPair::from_number(id - base + 1) {
+        Some(n) => Fasteners::Pair(n),
+        None => Fasteners::All,
+    };
+    if base == BOLT {
+        BolterCommand::Bolt(which)
+    } else {
+        BolterCommand::Unbolt(which)
+    }
+}
+
+/// A reconfiguration: target state in the first parameter byte, initial state in the second
+/// (Table 2's "final state / init state").
+fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+    let at = Slot::ArmA.offset();
+    let state = |i: usize| {
+        State::from_wire(p[i]).ok_or(CommandError::State {
+            index: PARAM_OFFSET + i,
+            found: p[i],
+        })
+    };
+    let target = state(at)?;
+    let initial = state(at + 1)?;
+    Ok((
+        Command::Reconfigure(Reconfiguration::new(initial, target)?),
+        0b11 << at,
+    ))
+}
+
+/// A power command: on or off, one of the seven modules or all.
+fn decode_power(id: u8) -> Command {
+    let on = id < POWER_OFF;
+    let i = (id - POWER_ON) % 8;
+    let target = match Module::from_index(i) {
+        Some(m) => PowerTarget::Module(m),
+        None => PowerTarget::All,
+    };
+    Command::Power { target, on }
+}
+
+fn side_of(id: u8, base: u8) -> Side {
+    if id - base >= 4 {
+        Side::B
+    } else {
+        Side::A
+    }
+}
+
+/// Opcode and the six parameter bytes (packet bytes 6..=11).
+pub fn encode(c: &Command) -> (u8, [u8; PARAM_LEN]) {
+    let mut p = [0u8; PARAM_LEN];
+    let servo = |base: u8, side: Side, target: ServoTarget, p: &mut [u8; PARAM_LEN]| {
+        let side_off = if side == Side::B { 4 } else { 0 };
+        match target {
+            ServoTarget::Contract => base + side_off,
+            ServoTarget::Extend => base + side_off + 1,
+            ServoTarget::Position(pw) => {
+                put_u16(p, Slot::for_side(side), pw.micros());
+                base + side_off + 2
+            }
+        }
+    };
+    let id = match *c {
+        Command::Heartbeat => HEARTBEAT,
+        Command::Stop => STOP,
+        Command::Reset => RESET,
+        Command::SystemFault => SYSTEM_FAULT,
+        Command::ClearFaults => CLEAR_FAULTS,
+        Command::Mode(m) => MODE + m.to_wire() - 1,
+        Command::Arm { side, target } => servo(ARM, side, target, &mut p),
+        Command::Gripper { side, target } => servo(GRIPPER, side, target, &mut p),
+        Command::Hip(h) => match h {
+            HipTarget::Home => HIP,
+            HipTarget::Straight => HIP + 1,
+            HipTarget::RightAngleCw => HIP + 2,
+            HipTarget::RightAngleCcw => HIP + 3,
+            HipTarget::Angle(a) => {
+                put_u16(&mut p, Slot::Hip, a.centidegrees());
+                HIP + 4
+            }
+        },
+        Command::Bolter(b) => match b {
+            BolterCommand::Bolt(Fasteners::Pair(n)) => BOLT + n.number() - 1,
+            BolterCommand::Bolt(Fasteners::All) => BOLT + 4,
+            BolterCommand::Unbolt(Fasteners::Pair(n)) => UNBOLT + n.number() - 1,
+            BolterCommand::Unbolt(Fasteners::All) => UNBOLT + 4,
+            BolterCommand::Down => BOLTERS_DOWN,
+        },
+        Command::Primitive(pr) => PRIMITIVE + pr.number(),
+        Command::Reconfigure(r) => {
+            p[Slot::ArmA.offset()] = r.target().to_wire();
+            p[Slot::ArmA.offset() + 1] = r.initial().to_wire();
+            RECONFIGURE
+        }
+        Command::Power { target, on } => {
+            let base = if on { POWER_ON } else { POWER_OFF };
+            match target {
+                PowerTarget::Module(m) => base + m.index(),
+                PowerTarget::All => base + 7,
+            }
+        }
+    };
+    (id, p)
+}
+
+/// The command for opcode `id` and parameter bytes `p` (packet bytes 6..=11). Each block
+/// of opcodes is recognised from its opcode constant; parameter bytes the command does
+/// not use must be zero.
+pub fn decode(id: u8, p: [u8; PARAM_LEN]) -> Result<Command, CommandError> {
+    // The command, and which parameter bytes it uses as a bit mask over p[0..6].
+    let (cmd, used): (Command, u8) = match id {
+        HEARTBEAT => (Command::Heartbeat, 0),
+        STOP => (Command::Stop, 0),
+        RESET => (Command::Reset, 0),
+        SYSTEM_FAULT => (Command::SystemFault, 0),
+        CLEAR_FAULTS => (Command::ClearFaults, 0),
+        BOLTERS_DOWN => (Command::Bolter(BolterCommand::Down), 0),
+        RECONFIGURE => decode_reconfigure(&p)?,
+        _ if in_block(id, MODE, 3) => match Mode::from_wire(id - MODE + 1) {
+            Some(m) => (Command::Mode(m), 0),
+            None => return Err(CommandError::UnknownId { id }),
+        },
+        _ if is_servo(id) => decode_servo(id, &p)?,
+        _ if in_block(id, HIP, 5) => decode_hip(id, &p)?,
+        _ if in_block(id, BOLT, 5) || in_block(id, UNBOLT, 5) => {
+            (Command::Bolter(decode_bolter(id)), 0)
+        }
+        _ if in_block(id, PRIMITIVE + 1, 8) => match Primitive::from_number(id - PRIMITIVE) {
+            Some(pr) => (Command::Primitive(pr), 0),
+            None => return Err(CommandError::UnknownId { id }),
+        },
+        _ if in_block(id, POWER_ON, 16) => (decode_power(id), 0),
+        _ => return Err(CommandError::UnknownId { id }),
+    };
+    for (i, &b) in p.iter().enumerate() {
+        if used & (1 << i) == 0 && b != 0 {
+            return Err(CommandError::UnusedNotZero {
+                id,
+                index: PARAM_OFFSET + i,
+                found: b,
+            });
+        }
+    }
+    Ok(cmd)
+}
