@@ -414,10 +414,12 @@ impl BoardA {
         let mut out = Outputs::empty();
         self.ingest_b(now, inp.from_b, &mut out);
         // Motion and bolting advance first, so the supervisor sees whether they still run.
+        // The feedback is this tick's readings against the targets in force; a target the
+        // motion sets now is judged from the next tick on (a primitive that issued one is
+        // still running, so the robot counts as moving either way).
         let fb = self.feedback(inp.hip, inp.arm_contracted);
         let events = self.advance(now, &fb, inp.arm_contracted, &mut out);
-        // Whether anything moves, judged on the targets the motion just set.
-        let in_motion = self.moving_now(&self.feedback(inp.hip, inp.arm_contracted));
+        let in_motion = self.moving_now(&fb);
         self.moving = in_motion;
         let conditions = self.detect(now, inp, in_motion);
         let taken = self.take_command(inp.command, in_motion, &mut out);
