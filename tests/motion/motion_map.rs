@@ -153,7 +153,7 @@ fn rendered_grid_is_current_in_spec() {
         std::fs::write(path, &grid).unwrap();
         return;
     }
-    assert_eq!(on_disk, grid, "spec/motion/map.txt is stale; regenerate with: MMIC_REGENERATE=1 cargo test --test motion_map");
+    assert_eq!(on_disk, grid, "spec/motion/map.txt is stale; regenerate with: MMIC_REGENERATE=1 cargo test --test motion motion_map");
     // 72 move cells, 15 diagonal cells; the asterisks are exactly the moves no matched plan uses.
     let used = map::moves()
         .filter(|(f, t, _)| map::used_between_matched(*f, *t))
