@@ -671,52 +671,47 @@ impl BoardA {
         out.to_b = self.b_command(now, p, s.regulator);
     }
 
+    /// A command packet through the exactly-once log, admitted in this one place: not ours
+    /// (ignored), a copy (answered from the log), or to be judged — by the supervisor, after
+    /// the board-level checks it does not make.
     fn receive(&mut self, bytes: &[u8], in_motion: bool) -> Received {
-        let repr = match CommandRepr::parse(bytes) {
-            Ok(r) => r,
-            // Header and checksum held but the opcode or parameters are no command: ours to
-            // answer (with its sequence number, so the ground stops resending it).
-            Err(WireError::Command(ce)) => {
-                // Length, header and checksum held (the command check comes after them).
-                let Ok(p) = crate::wire::check::<CommandPacket>(bytes) else {
-                    return Received::Ignore(Event::Rejected(WireError::Command(ce)));
-                };
-                if p.board_number() != self.cfg.board.get() {
-                    return Received::Ignore(Event::Rejected(WireError::Command(ce)));
-                }
-                let seq = p.seq();
-                return match self.log.admit(seq) {
-                    // The supervisor refuses it like any other command it cannot take.
-                    Admission::Execute => {
-                        Received::Run(seq, Incoming::Malformed(Refusal::for_command_error(&ce)))
-                    }
-                    Admission::Duplicate => Received::Answer(Event::Duplicate { seq }),
-                    Admission::Stale => Received::Answer(Event::Stale { seq }),
-                };
+        let (seq, command) = match CommandRepr::parse(bytes) {
+            Ok(r) if r.board != self.cfg.board => {
+                return Received::Ignore(Event::OtherRobot { board: r.board })
             }
+            Ok(r) => (r.seq, Ok(r.command)),
+            // Length, header and checksum held (the command check comes after them) but the
+            // opcode or parameters are no command: ours to answer, with its sequence number,
+            // so the ground stops resending it.
+            Err(WireError::Command(ce)) => match crate::wire::check::<CommandPacket>(bytes) {
+                Ok(p) if p.board_number() == self.cfg.board.get() => {
+                    (p.seq(), Err(Refusal::for_command_error(&ce)))
+                }
+                _ => return Received::Ignore(Event::Rejected(WireError::Command(ce))),
+            },
             Err(e) => return Received::Ignore(Event::Rejected(e)),
         };
-        if repr.board != self.cfg.board {
-            return Received::Ignore(Event::OtherRobot { board: repr.board });
-        }
-        match self.log.admit(repr.seq) {
-            Admission::Duplicate => return Received::Answer(Event::Duplicate { seq: repr.seq }),
-            Admission::Stale => return Received::Answer(Event::Stale { seq: repr.seq }),
+        match self.log.admit(seq) {
+            Admission::Duplicate => return Received::Answer(Event::Duplicate { seq }),
+            Admission::Stale => return Received::Answer(Event::Stale { seq }),
             Admission::Execute => {}
         }
-        let c = repr.command;
-        let kind = c.kind();
+        let c = match command {
+            // The supervisor refuses it like any other command it cannot take.
+            Err(r) => return Received::Run(seq, Incoming::Malformed(r)),
+            Ok(c) => c,
+        };
         // Board-level checks the supervisor does not make: one motion at a time, and a
         // primitive must be a move from the state the robot is in.
-        if kind.moves() && in_motion && self.sup.mode() == Mode::Operational {
-            return Received::Refuse(repr.seq, c, Refusal::Busy);
+        if c.kind().moves() && in_motion && self.sup.mode() == Mode::Operational {
+            return Received::Refuse(seq, c, Refusal::Busy);
         }
         if let Command::Primitive(pr) = c {
             if self.sup.mode() == Mode::Operational && self.primitive_target(pr).is_none() {
-                return Received::Refuse(repr.seq, c, Refusal::InitialStateMismatch);
+                return Received::Refuse(seq, c, Refusal::InitialStateMismatch);
             }
         }
-        Received::Run(repr.seq, Incoming::Command(c))
+        Received::Run(seq, Incoming::Command(c))
     }
 
     fn primitive_target(&self, pr: crate::motion::Primitive) -> Option<State> {

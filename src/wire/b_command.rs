@@ -79,6 +79,43 @@ pub const FIELDS: &[FieldSpec] = field_table![BCommandPacket;
     ("checksum", checksum, U16, Crc16, "checksum"),
 ];
 
+/// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
+pub mod field {
+    use super::*;
+    use crate::wire::layout::span;
+    use core::ops::Range;
+    /// `header`.
+    pub const HEADER: Range<usize> = span!(BCommandPacket, header, [u8; 4]);
+    /// `seq`.
+    pub const SEQ: Range<usize> = span!(BCommandPacket, seq, u8);
+    /// `flags`.
+    pub const FLAGS: Range<usize> = span!(BCommandPacket, flags, u8);
+    /// `arm_target`.
+    pub const ARM_TARGET: Range<usize> = span!(
+        BCommandPacket,
+        arm_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `gripper_target`.
+    pub const GRIPPER_TARGET: Range<usize> = span!(
+        BCommandPacket,
+        gripper_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `bolter.pair`.
+    pub const BOLTER_PAIR: Range<usize> = span!(BCommandPacket, bolter_pair, u8);
+    /// `bolter.direction`.
+    pub const BOLTER_DIRECTION: Range<usize> = span!(BCommandPacket, bolter_direction, u8);
+    /// `bolter.step`.
+    pub const BOLTER_STEP: Range<usize> = span!(BCommandPacket, bolter_step, u8);
+    /// `checksum`.
+    pub const CHECKSUM: Range<usize> = span!(
+        BCommandPacket,
+        checksum,
+        zerocopy::byteorder::little_endian::U16
+    );
+}
+
 /// Flag bits of byte 5.
 pub mod flags {
     /// Side B's voltage regulator.

@@ -106,6 +106,189 @@ pub const FIELDS: &[FieldSpec] = field_table![HeartbeatPacket;
     ("checksum", checksum, U16, Crc16, "checksum"),
 ];
 
+/// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
+pub mod field {
+    use super::*;
+    use crate::wire::layout::span;
+    use core::ops::Range;
+    /// `faults` (bytes 59–60).
+    pub const FAULTS: Range<usize> = span!(HeartbeatPacket, faults, [u8; 2]);
+    /// `last_seq` (bytes 57–58).
+    pub const LAST_SEQ: Range<usize> = span!(
+        HeartbeatPacket,
+        last_seq,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `header`.
+    pub const HEADER: Range<usize> = span!(HeartbeatPacket, header, [u8; 4]);
+    /// `board`.
+    pub const BOARD: Range<usize> = span!(HeartbeatPacket, board, u8);
+    /// `hip_target`.
+    pub const HIP_TARGET: Range<usize> = span!(
+        HeartbeatPacket,
+        hip_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `hip_now`.
+    pub const HIP_NOW: Range<usize> = span!(
+        HeartbeatPacket,
+        hip_now,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `arm_a_target`.
+    pub const ARM_A_TARGET: Range<usize> = span!(
+        HeartbeatPacket,
+        arm_a_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `arm_a_now`.
+    pub const ARM_A_NOW: Range<usize> = span!(
+        HeartbeatPacket,
+        arm_a_now,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `arm_b_target`.
+    pub const ARM_B_TARGET: Range<usize> = span!(
+        HeartbeatPacket,
+        arm_b_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `arm_b_now`.
+    pub const ARM_B_NOW: Range<usize> = span!(
+        HeartbeatPacket,
+        arm_b_now,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `gripper_a_target`.
+    pub const GRIPPER_A_TARGET: Range<usize> = span!(
+        HeartbeatPacket,
+        gripper_a_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `gripper_a_now`.
+    pub const GRIPPER_A_NOW: Range<usize> = span!(
+        HeartbeatPacket,
+        gripper_a_now,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `gripper_b_target`.
+    pub const GRIPPER_B_TARGET: Range<usize> = span!(
+        HeartbeatPacket,
+        gripper_b_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `gripper_b_now`.
+    pub const GRIPPER_B_NOW: Range<usize> = span!(
+        HeartbeatPacket,
+        gripper_b_now,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_a.v_bat`.
+    pub const ELECTRICAL_A_V_BAT: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_a.v_bat,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_a.i_bat`.
+    pub const ELECTRICAL_A_I_BAT: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_a.i_bat,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_a.i_loc`.
+    pub const ELECTRICAL_A_I_LOC: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_a.i_loc,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_a.i_grip`.
+    pub const ELECTRICAL_A_I_GRIP: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_a.i_grip,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_a.i_3v3`.
+    pub const ELECTRICAL_A_I_3V3: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_a.i_3v3,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_a.v_reg`.
+    pub const ELECTRICAL_A_V_REG: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_a.v_reg,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_a.i_bo`.
+    pub const ELECTRICAL_A_I_BO: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_a.i_bo,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.v_bat`.
+    pub const ELECTRICAL_B_V_BAT: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_b.v_bat,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_bat`.
+    pub const ELECTRICAL_B_I_BAT: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_b.i_bat,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_loc`.
+    pub const ELECTRICAL_B_I_LOC: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_b.i_loc,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_grip`.
+    pub const ELECTRICAL_B_I_GRIP: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_b.i_grip,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_3v3`.
+    pub const ELECTRICAL_B_I_3V3: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_b.i_3v3,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.v_reg`.
+    pub const ELECTRICAL_B_V_REG: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_b.v_reg,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_bo`.
+    pub const ELECTRICAL_B_I_BO: Range<usize> = span!(
+        HeartbeatPacket,
+        electrical_b.i_bo,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `target_state`.
+    pub const TARGET_STATE: Range<usize> = span!(HeartbeatPacket, target_state, u8);
+    /// `command_complete`.
+    pub const COMMAND_COMPLETE: Range<usize> = span!(HeartbeatPacket, command_complete, u8);
+    /// `active_bolter`.
+    pub const ACTIVE_BOLTER: Range<usize> = span!(HeartbeatPacket, active_bolter, u8);
+    /// `bolter_attempt`.
+    pub const BOLTER_ATTEMPT: Range<usize> = span!(HeartbeatPacket, bolter_attempt, u8);
+    /// `empty`.
+    pub const EMPTY: Range<usize> = span!(HeartbeatPacket, empty, u8);
+    /// `refusal`.
+    pub const REFUSAL: Range<usize> = span!(HeartbeatPacket, refusal, u8);
+    /// `mode`.
+    pub const MODE: Range<usize> = span!(HeartbeatPacket, mode, u8);
+    /// `checksum`.
+    pub const CHECKSUM: Range<usize> = span!(
+        HeartbeatPacket,
+        checksum,
+        zerocopy::byteorder::little_endian::U16
+    );
+}
+
 /// The attempt counter is the bolter's ([`crate::bolter`]); the heartbeat reports it.
 pub use crate::bolter::BolterAttempt;
 

@@ -101,6 +101,131 @@ pub const FIELDS: &[FieldSpec] = field_table![InternalHeartbeatPacket;
     ("checksum", checksum, U16, Crc16, "checksum"),
 ];
 
+/// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
+pub mod field {
+    use super::*;
+    use crate::wire::layout::span;
+    use core::ops::Range;
+    /// `header`.
+    pub const HEADER: Range<usize> = span!(InternalHeartbeatPacket, header, [u8; 4]);
+    /// `arm_b_target`.
+    pub const ARM_B_TARGET: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        arm_b_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `arm_b_now`.
+    pub const ARM_B_NOW: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        arm_b_now,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `gripper_b_target`.
+    pub const GRIPPER_B_TARGET: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        gripper_b_target,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `gripper_b_now`.
+    pub const GRIPPER_B_NOW: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        gripper_b_now,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.v_bat`.
+    pub const ELECTRICAL_B_V_BAT: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        electrical_b.v_bat,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_bat`.
+    pub const ELECTRICAL_B_I_BAT: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        electrical_b.i_bat,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_loc`.
+    pub const ELECTRICAL_B_I_LOC: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        electrical_b.i_loc,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_grip`.
+    pub const ELECTRICAL_B_I_GRIP: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        electrical_b.i_grip,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_3v3`.
+    pub const ELECTRICAL_B_I_3V3: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        electrical_b.i_3v3,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.v_reg`.
+    pub const ELECTRICAL_B_V_REG: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        electrical_b.v_reg,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `electrical_b.i_bo`.
+    pub const ELECTRICAL_B_I_BO: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        electrical_b.i_bo,
+        zerocopy::byteorder::little_endian::U16
+    );
+    /// `bolter_aux.step`.
+    pub const BOLTER_AUX_STEP: Range<usize> = span!(InternalHeartbeatPacket, bolter_step, u8);
+    /// `bolter_aux.seq`.
+    pub const BOLTER_AUX_SEQ: Range<usize> = span!(InternalHeartbeatPacket, bolter_seq, u8);
+    /// `bolter_aux.pair`.
+    pub const BOLTER_AUX_PAIR: Range<usize> = span!(InternalHeartbeatPacket, bolter_pair, u8);
+    /// `bolter_aux.direction`.
+    pub const BOLTER_AUX_DIRECTION: Range<usize> =
+        span!(InternalHeartbeatPacket, bolter_direction, u8);
+    /// `bolter_aux.threshold_reached`.
+    pub const BOLTER_AUX_THRESHOLD_REACHED: Range<usize> =
+        span!(InternalHeartbeatPacket, bolter_threshold, u8);
+    /// `bolter_aux.locked`.
+    pub const BOLTER_AUX_LOCKED: Range<usize> = span!(InternalHeartbeatPacket, bolter_locked, u8);
+    /// `bolter_aux.timed_out`.
+    pub const BOLTER_AUX_TIMED_OUT: Range<usize> =
+        span!(InternalHeartbeatPacket, bolter_timed_out, u8);
+    /// `bolter_aux.at_home`.
+    pub const BOLTER_AUX_AT_HOME: Range<usize> = span!(InternalHeartbeatPacket, bolter_at_home, u8);
+    /// `bolter_aux.mux`.
+    pub const BOLTER_AUX_MUX: Range<usize> = span!(InternalHeartbeatPacket, bolter_mux, u8);
+    /// `command_received`.
+    pub const COMMAND_RECEIVED: Range<usize> = span!(InternalHeartbeatPacket, command_received, u8);
+    /// `gravity.sign`.
+    pub const GRAVITY_SIGN: Range<usize> = span!(InternalHeartbeatPacket, g_sign, u8);
+    /// `gravity.axis`.
+    pub const GRAVITY_AXIS: Range<usize> = span!(InternalHeartbeatPacket, g_axis, u8);
+    /// `arm_over_idle`.
+    pub const ARM_OVER_IDLE: Range<usize> = span!(InternalHeartbeatPacket, arm_over_idle, u8);
+    /// `gripper_over_idle`.
+    pub const GRIPPER_OVER_IDLE: Range<usize> =
+        span!(InternalHeartbeatPacket, gripper_over_idle, u8);
+    /// `bolter_over_idle`.
+    pub const BOLTER_OVER_IDLE: Range<usize> = span!(InternalHeartbeatPacket, bolter_over_idle, u8);
+    /// `arm_overcurrent`.
+    pub const ARM_OVERCURRENT: Range<usize> = span!(InternalHeartbeatPacket, arm_overcurrent, u8);
+    /// `gripper_overcurrent`.
+    pub const GRIPPER_OVERCURRENT: Range<usize> =
+        span!(InternalHeartbeatPacket, gripper_overcurrent, u8);
+    /// `bolter_overcurrent`.
+    pub const BOLTER_OVERCURRENT: Range<usize> =
+        span!(InternalHeartbeatPacket, bolter_overcurrent, u8);
+    /// `arm_contracted`.
+    pub const ARM_CONTRACTED: Range<usize> = span!(InternalHeartbeatPacket, arm_contracted, u8);
+    /// `checksum`.
+    pub const CHECKSUM: Range<usize> = span!(
+        InternalHeartbeatPacket,
+        checksum,
+        zerocopy::byteorder::little_endian::U16
+    );
+}
+
 /// Bolter B's progress, the nine "auxiliary variables" A needs to keep both bolters in step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

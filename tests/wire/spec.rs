@@ -344,3 +344,40 @@ fn decisions_match_code() {
         );
     }
 }
+
+/// Each packet's `field` module names the same byte ranges as its `FIELDS` table.
+#[test]
+fn field_modules_agree_with_the_field_tables() {
+    use mmic::wire::{b_command, heartbeat, internal_heartbeat};
+    let range = |fields: &[mmic::wire::FieldSpec], name: &str| {
+        fields
+            .iter()
+            .find(|f| f.name == name)
+            .map(|f| f.range.clone())
+            .unwrap_or_else(|| panic!("no field {name}"))
+    };
+    let hb = heartbeat::FIELDS;
+    assert_eq!(heartbeat::field::MODE, range(hb, "mode"));
+    assert_eq!(heartbeat::field::LAST_SEQ, range(hb, "last_seq"));
+    assert_eq!(heartbeat::field::FAULTS, range(hb, "faults"));
+    assert_eq!(
+        heartbeat::field::ELECTRICAL_B_I_BO,
+        range(hb, "electrical_b.i_bo")
+    );
+    let ih = internal_heartbeat::FIELDS;
+    assert_eq!(
+        internal_heartbeat::field::BOLTER_AUX_MUX,
+        range(ih, "bolter_aux.mux")
+    );
+    assert_eq!(
+        internal_heartbeat::field::ARM_CONTRACTED,
+        range(ih, "arm_contracted")
+    );
+    assert_eq!(
+        internal_heartbeat::field::ELECTRICAL_B_V_BAT,
+        range(ih, "electrical_b.v_bat")
+    );
+    let bc = b_command::FIELDS;
+    assert_eq!(b_command::field::FLAGS, range(bc, "flags"));
+    assert_eq!(b_command::field::CHECKSUM, range(bc, "checksum"));
+}
