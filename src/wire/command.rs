@@ -53,7 +53,7 @@ impl Packet for CommandPacket {
 
 const _: () = assert!(core::mem::size_of::<CommandPacket>() == COMMAND_LEN);
 
-/// Read-only accessors, for a packet whose length, header and checksum [`check`](super::check)
+/// Read-only accessors, for a packet whose length, header and checksum [`check`]
 /// has passed but whose opcode or parameters may not decode: board A still answers such a
 /// packet, with its sequence number, so the ground stops resending it.
 ///
