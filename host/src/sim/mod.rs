@@ -134,9 +134,8 @@ impl SimConfig {
 pub struct Summary {
     /// How each robot's plan ended (none: the time limit came first).
     pub ends: Vec<Option<PlanEnd>>,
-    /// Steps.
-    pub steps: usize,
-    /// The plan's steps, for reports that quote the step that stopped the plan.
+    /// The plan's steps (their number is the plan's length), for reports that quote the step
+    /// that stopped the plan.
     pub plan: Vec<SimStep>,
     /// The state the robot started in.
     pub start_state: State,
@@ -430,7 +429,6 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     let status = statuses[0].lock().map(|s| s.clone()).unwrap_or(Value::Null);
     Ok(Summary {
         ends,
-        steps: cfg.steps.len(),
         plan: cfg.steps.clone(),
         start_state: cfg.start_state,
         wifi_loss: cfg.wifi_loss,

@@ -90,11 +90,11 @@ fn step_ref(s: &Summary, k: usize) -> String {
         Some(st) => format!(
             "step {} of {} (line {}: {})",
             k + 1,
-            s.steps,
+            s.plan.len(),
             st.line,
             st.text.split('#').next().unwrap_or("").trim()
         ),
-        None => format!("step {} of {}", k + 1, s.steps),
+        None => format!("step {} of {}", k + 1, s.plan.len()),
     }
 }
 
@@ -111,7 +111,7 @@ fn fault_list(faults: &mmic::faults::Faults) -> String {
 /// the robot reported).
 pub fn plan_line(s: &Summary) -> String {
     match s.ends.first().copied().flatten() {
-        Some(PlanEnd::Completed) => format!("plan: completed, all {} steps", s.steps),
+        Some(PlanEnd::Completed) => format!("plan: completed, all {} steps", s.plan.len()),
         Some(PlanEnd::Refused {
             step,
             refusal,
