@@ -2,8 +2,9 @@
 //!
 //! Byte 60 holds bits 0–7, byte 61 bits 8–15. One bit per Table 8 row; the overcurrent rows are
 //! split into the idle check and the operational check because the paper describes two checks
-//! with different thresholds and an operator needs to know which fired. Bits 13–15 are
-//! reserved and must be zero. The third fault byte (62) carries the last command's
+//! with different thresholds and an operator needs to know which fired. Bit 13 is the
+//! project's own motion-step timeout, which no Table 8 row describes. Bits 14–15 are reserved
+//! and must be zero. The third fault byte (62) carries the last command's
 //! [`Refusal`](crate::refusal::Refusal).
 //!
 //! ```
@@ -49,6 +50,12 @@ wire_enum! {
         LowBattery = 11 => "low_battery",
         /// Assembly system operation fault, injected by command.
         AssemblySystem = 12 => "assembly_system",
+        /// Not a Table 8 row: a step of a primitive did not finish within its timeout and no
+        /// Table 8 trigger describes why (a gripper or arm that did not reach its target, a
+        /// hip turn that did not end, side B's servos not reporting done). The paper names no
+        /// fault for it; the robot must not go on, so it is this project's own cause, reported
+        /// in its own bit (spec/modes.toml gives its mode).
+        MotionTimeout = 13 => "motion_timeout",
     }
 
     /// Every fault, in bit order.
@@ -68,7 +75,7 @@ pub struct Faults(u32);
 /// Bits set in the fault bytes that name no fault.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[error("fault bytes set reserved bits {reserved:#06x} (only bits 0..=12 name faults)")]
+#[error("fault bytes set reserved bits {reserved:#06x} (only bits 0..=13 name faults)")]
 pub struct ReservedFaultBits {
     /// The reserved bits that were set.
     pub reserved: u32,
@@ -196,7 +203,7 @@ mod tests {
             assert_eq!(f.map(Faults::to_wire), Ok(b));
             assert_eq!(f.map(|f| f.iter().collect::<Faults>()), f);
         }
-        for bit in 13..16 {
+        for bit in Fault::ALL.len()..16 {
             let raw = 1u32 << bit;
             let b = [raw as u8, (raw >> 8) as u8];
             assert_eq!(

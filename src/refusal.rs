@@ -10,7 +10,7 @@
 use crate::wire_enum::wire_enum;
 
 wire_enum! {
-    /// A refused command's reason. Wire value 1..=7; 0 means accepted.
+    /// A refused command's reason. Wire value 1..=8; 0 means accepted.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
     #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -28,13 +28,16 @@ wire_enum! {
         InvalidParameter = 5 => "invalid_parameter",
         /// A motion is running; a new motion command must wait for command complete.
         Busy = 6 => "busy",
-        /// Motion is stopped; send Reset first.
+        /// A Stop interrupted a motion; send Reset to resume it (or change mode to drop it).
         Stopped = 7 => "stopped",
+        /// Reset with nothing to resume: no motion was interrupted by a Stop, or the mode
+        /// changed since (which drops it).
+        NothingToResume = 8 => "nothing_to_resume",
     }
 
     /// All reasons, in wire order.
     const ALL;
-    /// Wire value 1..=7.
+    /// Wire value 1..=8.
     pub const fn to_wire(self) -> u8;
     /// Reason from its wire value; `None` for 0 (accepted) and unknown values.
     pub const fn from_wire(b: u8) -> Option<Self>;

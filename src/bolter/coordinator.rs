@@ -86,6 +86,8 @@ pub struct Coordinator {
     last: Instant,
     waited_ms: u32,
     status: Status,
+    /// Table 1's "move bolters down": the job ends when both bolters have descended.
+    descend_only: bool,
 }
 
 impl Default for Coordinator {
@@ -114,6 +116,7 @@ impl Coordinator {
             last: Instant::ZERO,
             waited_ms: 0,
             status: Status::Idle,
+            descend_only: false,
         }
     }
 
@@ -125,7 +128,36 @@ impl Coordinator {
         };
         self.job = Some(job);
         self.status = Status::Running;
+        self.descend_only = false;
         self.begin_pair(pair, now);
+    }
+
+    /// Starts Table 1's "move bolters down" at `now`: both bolters of the pair the multiplexer
+    /// selects when idle (pair 1, lines low-low; spec/decisions.toml `bolters_down`) descend
+    /// until the current says they touch, and stop there. Nothing engages or rotates; the job
+    /// ends Done when both sides touched or a descent timed out (the sides' reports tell
+    /// which); a timeout is no (un)bolting failure, since nothing was bolted.
+    pub fn start_down(&mut self, now: u32) {
+        self.start(
+            Job {
+                direction: BolterDirection::Bolt,
+                fasteners: Fasteners::Pair(BolterPair::P1),
+            },
+            now,
+        );
+        self.descend_only = true;
+    }
+
+    /// Whether the running or last job is a "move bolters down".
+    pub const fn descend_only(&self) -> bool {
+        self.descend_only
+    }
+
+    /// Resumes at `now` after a pause (a Stop, then Reset): the step in force is ordered again
+    /// (the executors, ordered idle by the Stop, adopt it afresh) and its timeout counts anew.
+    pub fn resume(&mut self, now: u32) {
+        self.last = Instant::from_millis(now);
+        self.waited_ms = 0;
     }
 
     /// Stops: the sides are ordered idle.
@@ -197,7 +229,10 @@ impl Coordinator {
             let a_done = side_done(a);
             let b_done = b.is_some_and(side_done);
             let timed_out = side_timed_out(a) || b.is_some_and(side_timed_out);
-            if timed_out {
+            if self.descend_only && (timed_out || (a_done && b_done)) {
+                // Down and stopped: touching or not, nothing more to do.
+                self.status = Status::Done;
+            } else if timed_out {
                 self.attempt_failed(cfg, now);
             } else if a_done && b_done {
                 self.advance(cfg, now);

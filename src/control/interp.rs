@@ -46,6 +46,17 @@ pub struct Travel {
 }
 
 impl Travel {
+    /// The arms' default travel: contracted 900 µs, extended 2100 µs.
+    pub const ARM: Travel = Travel {
+        contracted: PulseWidth::saturating(900),
+        extended: PulseWidth::saturating(2100),
+    };
+    /// The grippers' default travel: open 1000 µs, closed on a face 2000 µs.
+    pub const GRIPPER: Travel = Travel {
+        contracted: PulseWidth::saturating(1000),
+        extended: PulseWidth::saturating(2000),
+    };
+
     /// The pulse a command's target stands for; partial targets are taken as given.
     pub const fn resolve(&self, t: ServoTarget) -> PulseWidth {
         match t {

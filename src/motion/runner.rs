@@ -103,6 +103,15 @@ impl Runner {
         self.status
     }
 
+    /// Resumes at `now` after a pause: the running primitive re-issues its current step with a
+    /// fresh timeout ([`Sequencer::resume`]).
+    pub fn resume(&mut self, now: u32) {
+        if let Some(s) = self.seq.as_mut() {
+            s.resume(now);
+            self.targets = s.targets();
+        }
+    }
+
     /// Status.
     pub const fn status(&self) -> RunStatus {
         self.status

@@ -1,6 +1,7 @@
 //! Primitive execution: a primitive as a sequence of module steps, run by a state machine that
 //! hands module targets to sides A and B and waits for completion signals, with a timeout per
-//! step that raises the matching Table 8 fault and then issues nothing more.
+//! step that raises a fault (Table 8's "Arm not fully contracted" for an unsensed contraction,
+//! the project's motion timeout otherwise) and then issues nothing more.
 //!
 //! Steps of one primitive, for the moving side S (A for fwd, B for back), the other side O
 //! holding its face throughout:
@@ -276,6 +277,16 @@ impl Sequencer {
         }
     }
 
+    /// Resumes at `now` after a pause (a Stop, then Reset): the current step is issued again
+    /// and its timeout counts afresh, so the time spent stopped is no stall.
+    pub fn resume(&mut self, now: u32) {
+        self.last = Instant::from_millis(now);
+        self.waited_ms = 0;
+        if self.status == Status::Running {
+            self.issue();
+        }
+    }
+
     fn is_turn(&self) -> bool {
         self.primitive.number() >= 5
     }
@@ -322,19 +333,18 @@ impl Sequencer {
         self.status
     }
 
-    /// The Table 8 fault a timed-out step raises (spec/motion/sequencer.md).
-    fn timeout_fault(&self, step: Step, fb: &Feedback) -> Fault {
-        let b_moves = matches!(self.side, Side::B);
+    /// The fault a timed-out step raises (spec/motion/sequencer.md): a Table 8 fault only when
+    /// its trigger holds — a contraction the switch did not sense is "Arm not fully
+    /// contracted" — and otherwise the project's [`Fault::MotionTimeout`]. A hip turn that does
+    /// not end is not "Hip mismatch" (Table 8 checks the hip only when Operational is
+    /// entered), a stall is not an overcurrent unless a current reading says so (the
+    /// overcurrent checks raise those on their own), and side B's servos not reporting done
+    /// is not a communication loss while B's heartbeats and acknowledgements arrive (the
+    /// communication monitor raises that on its own).
+    fn timeout_fault(&self, step: Step, _fb: &Feedback) -> Fault {
         match step {
             Step::Confirm => Fault::ArmNotContracted,
-            Step::Move if self.is_turn() && !fb.hip_done => Fault::HipMismatch,
-            // Side B's completion comes from B's heartbeat: silence there is a link problem.
-            Step::Move if (b_moves || self.to.is_matched()) && !fb.arm_done.b => {
-                Fault::InternalCommLoss
-            }
-            Step::Move => Fault::LocomotionOvercurrent,
-            Step::Release | Step::Grip if b_moves => Fault::InternalCommLoss,
-            Step::Release | Step::Grip => Fault::GripperOvercurrent,
+            Step::Release | Step::Move | Step::Grip => Fault::MotionTimeout,
         }
     }
 }

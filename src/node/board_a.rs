@@ -29,6 +29,7 @@
 //! assert!(out.events.iter().any(|e| matches!(e, mmic::node::board_a::Event::Duplicate { seq: 1 })));
 //! ```
 
+use super::b_link::BLink;
 use super::exactly_once::{Admission, CommandLog};
 use crate::bolter::{
     self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals,
@@ -81,32 +82,25 @@ pub struct Config {
     pub estimate: estimate::Config,
     /// A→B command period, ms (sent sooner when its content changes).
     pub b_period_ms: u32,
-    /// The idle overcurrent check starts this long after the last motion ended, ms. Default
-    /// 600: the sensor front end's 50-sample window at a 10 ms tick (500 ms) plus two of
-    /// board B's heartbeat periods, so no current of the motion is left in the averages.
+    /// The idle overcurrent checks at the start and the end of a reconfiguration (Section 7)
+    /// read the currents once the robot has been still this long, ms. Default 600: the sensor
+    /// front end's 50-sample window at a 10 ms tick (500 ms) plus two of board B's heartbeat
+    /// periods, so no current of the last motion is left in the averages. A reconfiguration
+    /// accepted sooner waits for it before its first primitive; command complete (heartbeat
+    /// byte 54) comes after the check at its end.
     pub idle_settle_ms: u32,
 }
 
 impl Default for Config {
     fn default() -> Config {
-        let pw = |us| match PulseWidth::new(us) {
-            Ok(p) => p,
-            Err(_) => PulseWidth::CENTER,
-        };
         Config {
             board: BoardNumber::ONE,
             safety: detect::Config::default(),
             motion: sequencer::Config::default(),
             bolter: coordinator::Config::default(),
             rate: Rate::default(),
-            arm: Travel {
-                contracted: pw(900),
-                extended: pw(2100),
-            },
-            gripper: Travel {
-                contracted: pw(1000),
-                extended: pw(2000),
-            },
+            arm: Travel::ARM,
+            gripper: Travel::GRIPPER,
             hip: hip::Config::default(),
             hip_done_tolerance: 150,
             estimate: estimate::Config::default(),
@@ -209,6 +203,16 @@ pub enum Event {
     Reached(State),
     /// A bolting job ended: done (`None`) or failed with this fault.
     Bolting(Option<Fault>),
+    /// A "move bolters down" ended: both bolters touched (`contact`), or a descent timed out
+    /// first. Nothing engaged or rotated.
+    BoltersDown {
+        /// Both sides' currents passed the push threshold.
+        contact: bool,
+    },
+    /// A Stop interrupted a motion; it waits for Reset.
+    Paused,
+    /// Reset resumed the motion a Stop interrupted, from the step where it stopped.
+    Resumed,
     /// A pair of a bolting job finished: fastened (or released) at attempt `attempts`, or not.
     Pair {
         /// The pair.
@@ -288,19 +292,63 @@ pub struct BoardA {
     complete: bool,
     coord: Coordinator,
     side_a: BolterSide,
-    waiting_job: Option<Job>,
+    waiting_job: Option<Queued>,
     targets: Targets,
     arm: Interpolator,
     gripper: Interpolator,
     hip_ctl: HipController,
     b: InternalHeartbeatRepr,
     b_heard: bool,
-    b_sent: Option<(Instant, BCommandRepr)>,
+    link: BLink,
     contracting: bool,
     refusal: Option<Refusal>,
     moving: bool,
     pair: Option<(crate::command::BolterPair, u8)>,
     still_since: Option<Instant>,
+    idle_check: Option<IdleCheck>,
+    /// The motion a Stop interrupted, kept for Reset.
+    paused: Option<Paused>,
+    /// Board B holds where it is (the A→B stop flag): set by a Stop or a mode change, cleared
+    /// by the next command that moves side B's modules, Reset, or going home.
+    hold_b: bool,
+}
+
+/// A bolting job that waits for board B's bolter to report idle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Queued {
+    /// Bolt or unbolt.
+    Job(Job),
+    /// Table 1's "move bolters down".
+    Down,
+}
+
+/// Section 7's idle overcurrent check around a reconfiguration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum IdleCheck {
+    /// Accepted: the check runs once the robot is still, then the first primitive starts.
+    Before {
+        /// The state the reconfiguration starts from.
+        from: State,
+        /// Its target state.
+        to: State,
+    },
+    /// The target is reached: the check runs once the robot is still, then command complete.
+    After,
+}
+
+/// Everything of a motion in progress, as a Stop found it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Paused {
+    runner: Option<Runner>,
+    idle_check: Option<IdleCheck>,
+    coord: Coordinator,
+    waiting_job: Option<Queued>,
+    targets: Targets,
+    contracting: bool,
+    pair: Option<(crate::command::BolterPair, u8)>,
 }
 
 impl BoardA {
@@ -329,12 +377,15 @@ impl BoardA {
             hip_ctl: HipController::new(cfg.hip),
             b: InternalHeartbeatRepr::default(),
             b_heard: false,
-            b_sent: None,
+            link: BLink::new(),
             contracting: false,
             refusal: None,
             moving: false,
             pair: None,
             still_since: None,
+            idle_check: None,
+            paused: None,
+            hold_b: false,
         }
     }
 
@@ -365,13 +416,19 @@ impl BoardA {
         self.log.last()
     }
 
-    /// A motion or bolting job was running at the last tick (a reconfiguration, a bolting
-    /// job, or a module still moving to its target).
+    /// A motion or bolting job was running at the last tick (a reconfiguration with its idle
+    /// checks, a bolting job, or a module still moving to its target).
     pub const fn in_motion(&self) -> bool {
         self.moving
     }
 
-    fn moving_now(&self, fb: &Feedback) -> bool {
+    /// A Stop interrupted a motion that waits for Reset.
+    pub const fn paused(&self) -> bool {
+        self.paused.is_some()
+    }
+
+    /// Something physically moves: a primitive, a bolting job, a servo or the hip on its way.
+    fn physically_moving(&self, fb: &Feedback) -> bool {
         self.runner
             .is_some_and(|r| r.status() == RunStatus::Running)
             || self.coord.status() == coordinator::Status::Running
@@ -379,6 +436,18 @@ impl BoardA {
             || !fb.arm_done.all()
             || !fb.gripper_done.all()
             || !fb.hip_done
+    }
+
+    /// Busy with a motion: moving, or a reconfiguration waiting for its idle check.
+    fn moving_now(&self, fb: &Feedback) -> bool {
+        self.physically_moving(fb) || self.idle_check.is_some()
+    }
+
+    /// The robot has been still for `idle_settle_ms`: its averaged currents are at rest.
+    fn at_rest(&self, now: u32) -> bool {
+        self.still_since.is_some_and(|t| {
+            Instant::from_millis(now).since(t).millis() >= self.cfg.idle_settle_ms
+        })
     }
 
     fn feedback(&self, hip_now: HipAngle, arm_a_switch: bool) -> Feedback {
@@ -418,10 +487,15 @@ impl BoardA {
         // motion sets now is judged from the next tick on (a primitive that issued one is
         // still running, so the robot counts as moving either way).
         let fb = self.feedback(inp.hip, inp.arm_contracted);
-        let events = self.advance(now, &fb, inp.arm_contracted, &mut out);
+        if self.physically_moving(&fb) {
+            self.still_since = None;
+        } else if self.still_since.is_none() {
+            self.still_since = Some(Instant::from_millis(now));
+        }
+        let events = self.advance(now, inp, &fb, &mut out);
         let in_motion = self.moving_now(&fb);
         self.moving = in_motion;
-        let conditions = self.detect(now, inp, in_motion);
+        let conditions = self.detect(now, inp);
         let taken = self.take_command(inp.command, in_motion, &mut out);
         let s = self.supervise(
             now,
@@ -458,16 +532,30 @@ impl BoardA {
         }
     }
 
-    /// Advances the reconfiguration, the bolting and the arm contraction check; returns the
-    /// faults they raised this tick (events, not conditions).
-    fn advance(
-        &mut self,
-        now: u32,
-        fb: &Feedback,
-        arm_contracted: bool,
-        out: &mut Outputs,
-    ) -> Faults {
+    /// Advances the reconfiguration (with its idle checks), the bolting and the arm
+    /// contraction check; returns the faults they raised this tick (events, not conditions).
+    fn advance(&mut self, now: u32, inp: &Inputs, fb: &Feedback, out: &mut Outputs) -> Faults {
         let mut faults = Faults::EMPTY;
+        if let Some(IdleCheck::Before { from, to }) = self.idle_check {
+            if self.sup.standby_pending() {
+                // A deferred fault waits for the motion in progress; none has started, so
+                // none starts: the reconfiguration is dropped and Standby comes next tick.
+                self.idle_check = None;
+            } else if self.at_rest(now) {
+                self.idle_check = None;
+                let f = self.idle_faults(inp);
+                if f.is_empty() {
+                    self.runner = Some(Runner::start(self.cfg.motion, from, to, self.targets, now));
+                    if let Some(r) = self.runner {
+                        self.targets = r.targets();
+                    }
+                } else {
+                    // Not gripping, an arm stuck, a bolter caught: starting would drop the
+                    // robot or burn a motor (Section 7). The motion does not start.
+                    faults = faults.union(f);
+                }
+            }
+        }
         if let Some(mut r) = self.runner {
             match r.step(now, fb) {
                 RunStatus::Running => {
@@ -477,8 +565,9 @@ impl BoardA {
                 RunStatus::Complete => {
                     self.targets = r.targets();
                     self.tracked = Some(r.current_state());
-                    self.complete = true;
                     self.runner = None;
+                    // Command complete waits for the idle check at the end.
+                    self.idle_check = Some(IdleCheck::After);
                     out.push(Event::Reached(r.current_state()));
                 }
                 RunStatus::Failed(f) => {
@@ -488,41 +577,47 @@ impl BoardA {
                 }
             }
         }
+        if self.idle_check == Some(IdleCheck::After) && self.at_rest(now) {
+            self.idle_check = None;
+            let f = self.idle_faults(inp);
+            self.complete = f.is_empty();
+            faults = faults.union(f);
+        }
         self.bolting(now, out, &mut faults);
         // Arm contraction check (Table 8): when a commanded contraction of arm A ends.
         if self.contracting && self.arm.done() {
             self.contracting = false;
-            if detect::arm_contraction_fault(true, arm_contracted) {
+            if detect::arm_contraction_fault(true, inp.arm_contracted) {
                 faults = faults.with(Fault::ArmNotContracted);
             }
         }
         faults
     }
 
-    /// The fault conditions holding now: overcurrent (the idle check once the robot has been
-    /// still for `idle_settle_ms`), low battery, lost communication with board B.
-    fn detect(&mut self, now: u32, inp: &Inputs, in_motion: bool) -> Faults {
+    /// Section 7's idle check: side A's currents against the at-rest limits, side B as board B
+    /// judged its own (Table 4 bytes 38–40).
+    fn idle_faults(&self, inp: &Inputs) -> Faults {
+        let b = detect::Over {
+            locomotion: self.b.arm_over_idle,
+            gripper: self.b.gripper_over_idle,
+            bolter: self.b.bolter_over_idle,
+        };
+        detect::idle_overcurrent(&self.cfg.safety, &inp.electrical, b)
+    }
+
+    /// The fault conditions holding now: operational overcurrent (side A from its currents,
+    /// side B as board B judged it: Table 4 bytes 41–43), low battery, lost communication with
+    /// board B. The idle overcurrent check is not one: it runs at the start and the end of a
+    /// reconfiguration only ([`IdleCheck`]).
+    fn detect(&mut self, now: u32, inp: &Inputs) -> Faults {
         let e_b = self.b.electrical_b;
+        let b_over = detect::Over {
+            locomotion: self.b.arm_overcurrent,
+            gripper: self.b.gripper_overcurrent,
+            bolter: self.b.bolter_overcurrent,
+        };
         let mut conditions =
-            detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, &e_b);
-        // The idle check waits until the robot has been still for `idle_settle_ms`: currents
-        // sampled while the last motion ended (still in the moving averages, and B's report
-        // is up to a period old) are no fault.
-        if in_motion {
-            self.still_since = None;
-        } else if self.still_since.is_none() {
-            self.still_since = Some(Instant::from_millis(now));
-        }
-        let settled = self.still_since.is_some_and(|t| {
-            Instant::from_millis(now).since(t).millis() >= self.cfg.idle_settle_ms
-        });
-        if settled {
-            conditions = conditions.union(detect::idle_overcurrent(
-                &self.cfg.safety,
-                &inp.electrical,
-                &e_b,
-            ));
-        }
+            detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, b_over);
         if self
             .battery
             .update(&self.cfg.safety, now, inp.electrical.v_bat, e_b.v_bat)
@@ -612,7 +707,21 @@ impl BoardA {
             initial_state_ok,
         });
         if s.stop_motion {
-            self.stop_all(now);
+            if self.sup.stopped() {
+                // A Stop interrupted a motion: keep it for Reset (a second Stop keeps the first).
+                if self.paused.is_none() {
+                    self.pause();
+                    out.push(Event::Paused);
+                }
+            } else {
+                // A mode change (or a Stop with nothing running) drops what a Stop had kept.
+                self.paused = None;
+            }
+            self.stop_all(now, inp.hip);
+        }
+        if s.resume {
+            self.resume(now);
+            out.push(Event::Resumed);
         }
         if s.go_home {
             self.go_home(now);
@@ -732,6 +841,9 @@ impl BoardA {
     }
 
     fn dispatch(&mut self, c: Command, now: u32) {
+        if c.kind().moves() {
+            self.release_b_hold();
+        }
         match c {
             Command::Arm { side, target } => {
                 self.targets.arm[side] = target;
@@ -746,22 +858,18 @@ impl BoardA {
                 }
             }
             Command::Bolter(b) => {
-                let job = match b {
-                    BolterCommand::Bolt(f) => Job {
+                self.waiting_job = Some(match b {
+                    BolterCommand::Bolt(f) => Queued::Job(Job {
                         direction: BolterDirection::Bolt,
                         fasteners: f,
-                    },
-                    BolterCommand::Unbolt(f) => Job {
+                    }),
+                    BolterCommand::Unbolt(f) => Queued::Job(Job {
                         direction: BolterDirection::Unbolt,
                         fasteners: f,
-                    },
-                    // Both bolters down: the first step of a bolting run on the selected pair.
-                    BolterCommand::Down => Job {
-                        direction: BolterDirection::Bolt,
-                        fasteners: crate::command::Fasteners::Pair(crate::command::BolterPair::P1),
-                    },
-                };
-                self.waiting_job = Some(job);
+                    }),
+                    // Table 1 lists it on its own: both bolters descend and stop there.
+                    BolterCommand::Down => Queued::Down,
+                });
                 self.bolting_start(now);
             }
             Command::Primitive(pr) => {
@@ -777,23 +885,25 @@ impl BoardA {
         }
     }
 
-    fn start_run(&mut self, from: State, to: State, now: u32) {
+    /// A reconfiguration (or primitive) accepted: it starts after the idle check
+    /// ([`IdleCheck::Before`]), in [`BoardA::advance`].
+    fn start_run(&mut self, from: State, to: State, _now: u32) {
         self.target_state = Some(to);
         self.complete = from == to;
         if from != to {
-            self.runner = Some(Runner::start(self.cfg.motion, from, to, self.targets, now));
-            if let Some(r) = self.runner {
-                self.targets = r.targets();
-            }
+            self.idle_check = Some(IdleCheck::Before { from, to });
         }
     }
 
     /// A new job waits until B reports idle, so that B's executor cannot mistake the job's
     /// first order for its previous one (spec/control/bolter.md).
     fn bolting_start(&mut self, now: u32) {
-        if let Some(job) = self.waiting_job {
+        if let Some(q) = self.waiting_job {
             if self.b.bolter_aux.step.is_none() || !self.b_heard {
-                self.coord.start(job, now);
+                match q {
+                    Queued::Job(job) => self.coord.start(job, now),
+                    Queued::Down => self.coord.start_down(now),
+                }
                 self.waiting_job = None;
             }
         }
@@ -802,14 +912,34 @@ impl BoardA {
     fn bolting(&mut self, now: u32, out: &mut Outputs, faults: &mut Faults) {
         self.bolting_start(now);
         let was = self.coord.status();
-        let b = self.b_heard.then_some(&self.b.bolter_aux);
+        // B's report names the A→B packet it adopted its order from; it is about the
+        // coordinator's order when that packet was one of the run that carried the order
+        // (node::b_link), and then it is handed over under the coordinator's number.
+        let b = match self.coord.order() {
+            Some((seq, order)) if self.b_heard && self.link.carried(self.b.bolter_aux.seq, &order) => {
+                Some(crate::wire::internal_heartbeat::BolterAux {
+                    seq,
+                    ..self.b.bolter_aux
+                })
+            }
+            _ => None,
+        };
         let o = self
             .coord
-            .step(&self.cfg.bolter, now, &self.side_a.aux(), b);
+            .step(&self.cfg.bolter, now, &self.side_a.aux(), b.as_ref());
         let order = o.order;
         self.side_a
             .order(order.map_or(0, |(s, _)| s), order.map(|(_, o)| o), now);
-        if let (Some(p), coordinator::Status::Running) = (o.active, o.status) {
+        let down = self.coord.descend_only();
+        if was == coordinator::Status::Running && o.status != coordinator::Status::Running && down
+        {
+            out.push(Event::BoltersDown {
+                contact: self.side_a.aux().threshold_reached
+                    && b.is_some_and(|x| x.threshold_reached),
+            });
+            return;
+        }
+        if let (Some(p), coordinator::Status::Running, false) = (o.active, o.status, down) {
             if let Some((q, attempts)) = self.pair.filter(|(q, _)| *q != p) {
                 out.push(Event::Pair {
                     pair: q,
@@ -834,26 +964,79 @@ impl BoardA {
         }
     }
 
-    fn stop_all(&mut self, now: u32) {
+    /// Keeps the motion in progress for Reset.
+    fn pause(&mut self) {
+        self.paused = Some(Paused {
+            runner: self.runner,
+            idle_check: self.idle_check,
+            coord: self.coord,
+            waiting_job: self.waiting_job,
+            targets: self.targets,
+            contracting: self.contracting,
+            pair: self.pair,
+        });
+    }
+
+    /// Reset: the motion a Stop interrupted goes on from the step where it stopped, with fresh
+    /// step timeouts (the time stopped is no stall).
+    fn resume(&mut self, now: u32) {
+        let Some(p) = self.paused.take() else { return };
+        self.runner = p.runner;
+        self.idle_check = p.idle_check;
+        self.coord = p.coord;
+        self.waiting_job = p.waiting_job;
+        self.targets = p.targets;
+        self.contracting = p.contracting;
+        self.pair = p.pair;
+        self.hold_b = false;
+        if let Some(r) = self.runner.as_mut() {
+            r.resume(now);
+            self.targets = r.targets();
+        }
+        if self.coord.status() == coordinator::Status::Running {
+            self.coord.resume(now);
+        }
+    }
+
+    /// Every actuator holds where it is (Table 1's Stop, Table 7's Safed): the servos at their
+    /// last interpolated pulse, the hip at its reading `hip`, the bolters idle, board B told to
+    /// hold; the motion in progress ends (kept for Reset by [`BoardA::pause`] if a Stop
+    /// interrupted it).
+    fn stop_all(&mut self, now: u32, hip: HipAngle) {
         self.runner = None;
-        self.pair = None;
+        self.idle_check = None;
         self.pair = None;
         self.coord.stop();
         self.waiting_job = None;
         self.side_a.order(0, None, now);
-        self.targets.arm = PerSide::new(
-            ServoTarget::Position(self.arm.now()),
-            ServoTarget::Position(self.b.arm_b_now),
-        );
-        self.targets.gripper = PerSide::new(
-            ServoTarget::Position(self.gripper.now()),
-            ServoTarget::Position(self.b.gripper_b_now),
-        );
+        self.targets = Targets {
+            arm: PerSide::new(
+                ServoTarget::Position(self.arm.now()),
+                ServoTarget::Position(self.b.arm_b_now),
+            ),
+            gripper: PerSide::new(
+                ServoTarget::Position(self.gripper.now()),
+                ServoTarget::Position(self.b.gripper_b_now),
+            ),
+            hip,
+        };
+        self.hold_b = true;
         self.contracting = false;
+    }
+
+    /// A command that moves side B lifts the hold: side B's targets become where B reports it
+    /// held (so only what is commanded now moves).
+    fn release_b_hold(&mut self) {
+        if self.hold_b {
+            self.hold_b = false;
+            self.targets.arm.b = ServoTarget::Position(self.b.arm_b_now);
+            self.targets.gripper.b = ServoTarget::Position(self.b.gripper_b_now);
+        }
     }
 
     fn go_home(&mut self, now: u32) {
         let _ = now;
+        self.hold_b = false;
         self.targets = Targets {
             hip: self.cfg.safety.hip_home,
             ..Targets::home()
@@ -877,34 +1060,22 @@ impl BoardA {
         p: ModuleSet,
         regulator: bool,
     ) -> Option<[u8; B_COMMAND_LEN]> {
-        let order = self.coord.order();
-        let last_seq = self.b_sent.map_or(0, |(_, c)| c.seq);
         let live = self.sup.mode() != Mode::Standby;
-        let cmd = BCommandRepr {
-            // The coordinator's order number while an order runs (B records the packet's
-            // number with the order); otherwise the last number sent.
-            seq: order.map_or(last_seq, |(s, _)| s),
+        let snapshot = BCommandRepr {
+            // Numbered by the link: every new snapshot gets a new number.
+            seq: 0,
             power: BPower {
                 regulator,
                 arm: live && p.contains(Module::ArmB),
                 gripper: live && p.contains(Module::GripperB),
                 bolter: live && p.contains(Module::BolterB),
             },
-            stop: self.sup.stopped() || self.sup.mode() == Mode::Safed,
+            stop: self.hold_b,
             arm_target: self.cfg.arm.resolve(self.targets.arm.b),
             gripper_target: self.cfg.gripper.resolve(self.targets.gripper.b),
-            bolter: order.map(|(_, o)| o),
+            bolter: self.coord.order().map(|(_, o)| o),
         };
-        let due = match self.b_sent {
-            None => true,
-            Some((t, last)) => {
-                last != cmd || Instant::from_millis(now).since(t).millis() >= self.cfg.b_period_ms
-            }
-        };
-        if !due {
-            return None;
-        }
-        self.b_sent = Some((Instant::from_millis(now), cmd));
+        let cmd = self.link.due(now, self.cfg.b_period_ms, snapshot)?;
         self.comm.sent(cmd.seq);
         Some(cmd.to_bytes())
     }

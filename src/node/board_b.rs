@@ -30,7 +30,7 @@
 //! ```
 
 use crate::bolter::{BolterSide, Drive, MuxLines, SideConfig, Signals};
-use crate::control::interp::{Interpolator, Rate};
+use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::safety::detect;
 use crate::units::Instant;
 use crate::units::{Electrical, Gravity, PulseWidth};
@@ -52,6 +52,10 @@ pub struct Config {
     pub bolter: SideConfig,
     /// Current limits for the over-idle and overcurrent flags (Table 4 bytes 38–43).
     pub limits: detect::Config,
+    /// Arm B's travel: it starts contracted, as board A's arm does.
+    pub arm: Travel,
+    /// Gripper B's travel: it starts closed on the face, as board A's gripper does.
+    pub gripper: Travel,
 }
 
 impl Default for Config {
@@ -62,6 +66,8 @@ impl Default for Config {
             rate: Rate::default(),
             bolter: SideConfig::default(),
             limits: detect::Config::default(),
+            arm: Travel::ARM,
+            gripper: Travel::GRIPPER,
         }
     }
 }
@@ -119,12 +125,14 @@ pub struct BoardB {
 }
 
 impl BoardB {
-    /// Startup: servos centred, nothing received.
+    /// Startup: servos at home — arm contracted, gripper closed — as on board A (Section 7:
+    /// "actuators are set to go to their home position"), so that powering up never drives
+    /// side B's servos to mid-travel; nothing received.
     pub const fn new(cfg: Config) -> BoardB {
         BoardB {
             cfg,
-            arm: Interpolator::new(PulseWidth::CENTER, cfg.rate),
-            gripper: Interpolator::new(PulseWidth::CENTER, cfg.rate),
+            arm: Interpolator::new(cfg.arm.contracted, cfg.rate),
+            gripper: Interpolator::new(cfg.gripper.extended, cfg.rate),
             bolter: BolterSide::new(),
             last: None,
             heard: None,
@@ -214,7 +222,9 @@ impl BoardB {
     /// The internal heartbeat for the current state.
     pub fn report(&self, inp: &Inputs) -> InternalHeartbeatRepr {
         let e = &inp.electrical;
-        let (idle, abs) = (&self.cfg.limits.idle, &self.cfg.limits.absolute);
+        // B's own verdicts, against B's limits: board A takes them as they are.
+        let idle = detect::Over::judge(e, &self.cfg.limits.idle);
+        let abs = detect::Over::judge(e, &self.cfg.limits.absolute);
         InternalHeartbeatRepr {
             arm_b_target: self.arm.target(),
             arm_b_now: self.arm.now(),
@@ -224,12 +234,12 @@ impl BoardB {
             bolter_aux: self.bolter.aux(),
             command_received: self.last.map_or(0, |c| c.seq),
             gravity: inp.gravity,
-            arm_over_idle: e.i_loc > idle.locomotion,
-            gripper_over_idle: e.i_grip > idle.gripper,
-            bolter_over_idle: e.i_bo > idle.bolter,
-            arm_overcurrent: e.i_loc > abs.locomotion,
-            gripper_overcurrent: e.i_grip > abs.gripper,
-            bolter_overcurrent: e.i_bo > abs.bolter,
+            arm_over_idle: idle.locomotion,
+            gripper_over_idle: idle.gripper,
+            bolter_over_idle: idle.bolter,
+            arm_overcurrent: abs.locomotion,
+            gripper_overcurrent: abs.gripper,
+            bolter_overcurrent: abs.bolter,
             arm_contracted: inp.arm_contracted,
         }
     }

@@ -27,6 +27,7 @@
 //! assert_eq!(a.mode(), Mode::Operational);
 //! ```
 
+pub mod b_link;
 pub mod board_a;
 pub mod board_b;
 pub mod exactly_once;

@@ -201,60 +201,67 @@ impl CommMonitor {
     }
 }
 
-fn over(e: &Electrical, l: &Limits, loco: Fault, grip: Fault, bolt: Fault) -> Faults {
-    let mut f = Faults::EMPTY;
-    if e.i_loc > l.locomotion {
-        f = f.with(loco);
-    }
-    if e.i_grip > l.gripper {
-        f = f.with(grip);
-    }
-    if e.i_bo > l.bolter {
-        f = f.with(bolt);
-    }
-    f
+/// One side's verdict per module class: above the limit or not.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Over {
+    /// Arm (and, on side A, hip) current: the locomotion modules.
+    pub locomotion: bool,
+    /// Gripper current.
+    pub gripper: bool,
+    /// Bolter current.
+    pub bolter: bool,
 }
 
-/// Operational overcurrent check, performed at all times: any module of either side above its
-/// absolute limit.
-pub fn operational_overcurrent(cfg: &Config, a: &Electrical, b: &Electrical) -> Faults {
-    use Fault::*;
-    let lim = &cfg.absolute;
-    over(
-        a,
-        lim,
-        LocomotionOvercurrent,
-        GripperOvercurrent,
-        BolterOvercurrent,
-    )
-    .union(over(
-        b,
-        lim,
-        LocomotionOvercurrent,
-        GripperOvercurrent,
-        BolterOvercurrent,
-    ))
+impl Over {
+    /// Board A's own verdict on side A's currents: each strictly above its limit.
+    pub const fn judge(e: &Electrical, l: &Limits) -> Over {
+        Over {
+            locomotion: e.i_loc > l.locomotion,
+            gripper: e.i_grip > l.gripper,
+            bolter: e.i_bo > l.bolter,
+        }
+    }
+
+    fn faults(self, loco: Fault, grip: Fault, bolt: Fault) -> Faults {
+        let mut f = Faults::EMPTY;
+        if self.locomotion {
+            f = f.with(loco);
+        }
+        if self.gripper {
+            f = f.with(grip);
+        }
+        if self.bolter {
+            f = f.with(bolt);
+        }
+        f
+    }
 }
 
-/// Idle overcurrent check, at the start and the end of a reconfiguration: any module of either
-/// side drawing more than its at-rest limit (not gripping, arm stuck, bolter caught).
-pub fn idle_overcurrent(cfg: &Config, a: &Electrical, b: &Electrical) -> Faults {
+/// Operational overcurrent check, performed at all times: any module above its absolute
+/// limit — side A judged here from A's currents, side B as board B judged it against its own
+/// limits (Table 4 bytes 41–43, spec/decisions.toml `b_overcurrent_flags`).
+pub fn operational_overcurrent(cfg: &Config, a: &Electrical, b: Over) -> Faults {
     use Fault::*;
-    let lim = &cfg.idle;
-    over(
-        a,
-        lim,
+    let f = (LocomotionOvercurrent, GripperOvercurrent, BolterOvercurrent);
+    Over::judge(a, &cfg.absolute)
+        .faults(f.0, f.1, f.2)
+        .union(b.faults(f.0, f.1, f.2))
+}
+
+/// Idle overcurrent check, at the start and the end of a reconfiguration: any module drawing
+/// more than its at-rest limit (not gripping, arm stuck, bolter caught) — side A judged here,
+/// side B as board B judged it (Table 4 bytes 38–40).
+pub fn idle_overcurrent(cfg: &Config, a: &Electrical, b: Over) -> Faults {
+    use Fault::*;
+    let f = (
         LocomotionOvercurrentIdle,
         GripperOvercurrentIdle,
         BolterOvercurrentIdle,
-    )
-    .union(over(
-        b,
-        lim,
-        LocomotionOvercurrentIdle,
-        GripperOvercurrentIdle,
-        BolterOvercurrentIdle,
-    ))
+    );
+    Over::judge(a, &cfg.idle)
+        .faults(f.0, f.1, f.2)
+        .union(b.faults(f.0, f.1, f.2))
 }
 
 /// Circular distance between two hip angles, in 0.01°, 0..=18000.
@@ -373,7 +380,7 @@ mod tests {
     }
 
     #[test]
-    fn overcurrent_is_strictly_above_the_limit_on_either_side() {
+    fn overcurrent_is_strictly_above_the_limit_on_a_and_as_b_reports_it() {
         let cfg = Config::default();
         let ok = Electrical {
             i_loc: 3000,
@@ -381,19 +388,33 @@ mod tests {
             i_bo: 2000,
             ..Default::default()
         };
-        assert!(operational_overcurrent(&cfg, &ok, &ok).is_empty());
+        let calm = Over::default();
+        assert!(operational_overcurrent(&cfg, &ok, calm).is_empty());
         let hot = Electrical { i_grip: 1501, ..ok };
         assert_eq!(
-            operational_overcurrent(&cfg, &ok, &hot),
+            operational_overcurrent(&cfg, &hot, calm),
             Faults::EMPTY.with(Fault::GripperOvercurrent)
+        );
+        // Side B's own flag counts as B reported it.
+        let b_hot = Over {
+            bolter: true,
+            ..calm
+        };
+        assert_eq!(
+            operational_overcurrent(&cfg, &ok, b_hot),
+            Faults::EMPTY.with(Fault::BolterOvercurrent)
         );
         let rest = Electrical {
             i_loc: 401,
             ..Default::default()
         };
         assert_eq!(
-            idle_overcurrent(&cfg, &rest, &Electrical::default()),
+            idle_overcurrent(&cfg, &rest, calm),
             Faults::EMPTY.with(Fault::LocomotionOvercurrentIdle)
+        );
+        assert_eq!(
+            idle_overcurrent(&cfg, &Electrical::default(), b_hot),
+            Faults::EMPTY.with(Fault::BolterOvercurrentIdle)
         );
     }
 }

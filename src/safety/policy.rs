@@ -7,7 +7,8 @@ use crate::mode::Mode;
 
 /// Table 7, "Command availability": whether `mode` accepts commands of `kind`.
 ///
-/// Standby: mode changes only; Safed: hip and arm actuator commands and mode changes;
+/// Standby: mode changes only; Safed: hip and arm actuator commands, Reset (to resume an arm or
+/// hip motion a Stop interrupted) and mode changes;
 /// Operational: everything. In every mode the supervisory commands are accepted as well:
 /// heartbeat requests are answered and Stop is obeyed (Section 7 and the project's issue),
 /// the assembly-system fault can be injected (it must reach a robot in any mode) and latched
@@ -16,8 +17,9 @@ pub const fn accepts(mode: Mode, kind: CommandKind) -> bool {
     use CommandKind::*;
     match kind {
         Heartbeat | Stop | Mode | SystemFault | ClearFaults => true,
-        Arm | Hip => !matches!(mode, self::Mode::Standby),
-        Gripper | Bolter | Primitive | Reset | PowerControl | Reconfiguration => {
+        // Reset resumes what a Stop interrupted, so it goes wherever something can move.
+        Arm | Hip | Reset => !matches!(mode, self::Mode::Standby),
+        Gripper | Bolter | Primitive | PowerControl | Reconfiguration => {
             matches!(mode, self::Mode::Operational)
         }
     }
@@ -80,7 +82,10 @@ pub const fn fault_action(f: Fault) -> FaultAction {
         | LocomotionOvercurrentIdle
         | LocomotionOvercurrent
         | HipMismatch
-        | InternalCommLoss => FaultAction {
+        | InternalCommLoss
+        // Not Table 8's: a motion step stalled mid-primitive, so hold hip and arms as the
+        // other mid-motion faults do.
+        | MotionTimeout => FaultAction {
             mode: Mode::Safed,
             deferred: false,
         },
@@ -90,8 +95,8 @@ pub const fn fault_action(f: Fault) -> FaultAction {
 /// Conditions that hold over time (a level, not an event): Operational cannot be entered
 /// while one holds. The others are events, raised at one instant: a failed bolting run, an
 /// arm contraction not sensed, a refused reconfiguration, the hip check on entering
-/// Operational, the idle overcurrent checks at the start and end of a reconfiguration, and
-/// the externally injected assembly-system fault.
+/// Operational, the idle overcurrent checks at the start and end of a reconfiguration, a
+/// motion step that timed out, and the externally injected assembly-system fault.
 pub const fn is_condition(f: Fault) -> bool {
     use Fault::*;
     matches!(

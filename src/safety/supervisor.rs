@@ -117,8 +117,12 @@ pub struct Output {
     pub answer: Option<Answer>,
     /// Just entered Operational: send the actuators home (contracted, gripped).
     pub go_home: bool,
-    /// Stop any running motion now (Stop command, or the mode left Operational).
+    /// Hold every actuator where it is now (Stop command, or the mode changed). Whether the
+    /// interrupted motion is kept for [`Reset`](Command::Reset) is [`Supervisor::stopped`]
+    /// after the step: kept while it holds, discarded otherwise.
     pub stop_motion: bool,
+    /// Reset accepted: resume the motion the last Stop interrupted.
+    pub resume: bool,
     /// A deferred fault waits for the running motion to complete.
     pub standby_pending: bool,
 }
@@ -167,7 +171,9 @@ impl Supervisor {
         self.enabled
     }
 
-    /// Whether a Stop is in force (until Reset).
+    /// Whether a Stop interrupted a motion that waits for Reset (Table 1: "After a stop
+    /// command, resume motion"). While it holds, commands that move are refused with
+    /// [`Refusal::Stopped`]; a mode change discards the interrupted motion and clears it.
     pub const fn stopped(&self) -> bool {
         self.stopped
     }
@@ -178,8 +184,13 @@ impl Supervisor {
     }
 
     fn enter(&mut self, mode: Mode, stop: &mut bool) {
-        if self.mode == Mode::Operational && mode != Mode::Operational {
+        if self.mode != mode {
+            // Whatever moved in the old mode stops here; a motion a Stop interrupted is not
+            // resumed in another mode.
             *stop = true;
+            self.stopped = false;
+        }
+        if self.mode == Mode::Operational && mode != Mode::Operational {
             self.standby_pending = false;
         }
         self.mode = mode;
@@ -214,13 +225,20 @@ impl Supervisor {
     pub fn step(&mut self, input: &Input) -> Output {
         let mut stop = false;
         let mut go_home = false;
+        let mut resume = false;
+        let mode_before = self.mode;
         self.raise(input.faults, input.in_motion, &mut stop);
         if self.standby_pending && !input.in_motion && self.mode == Mode::Operational {
             self.enter(Mode::Standby, &mut stop);
         }
         let answer = input
             .command
-            .map(|c| self.command(c, input, &mut stop, &mut go_home));
+            .map(|c| {
+                // A motion is still in progress for the command only if no fault this tick
+                // changed the mode (which stopped it for good).
+                let moving = input.in_motion && self.mode == mode_before;
+                self.command(c, input, moving, &mut stop, &mut go_home, &mut resume)
+            });
         let powered = powered(self.mode, self.enabled);
         Output {
             mode: self.mode,
@@ -230,6 +248,7 @@ impl Supervisor {
             answer,
             go_home,
             stop_motion: stop,
+            resume,
             standby_pending: self.standby_pending,
         }
     }
@@ -238,8 +257,10 @@ impl Supervisor {
         &mut self,
         incoming: Incoming,
         input: &Input,
+        moving: bool,
         stop: &mut bool,
         go_home: &mut bool,
+        resume: &mut bool,
     ) -> Answer {
         let cmd = match incoming {
             Incoming::Command(c) => c,
@@ -254,10 +275,17 @@ impl Supervisor {
         }
         match cmd {
             Command::Stop => {
-                self.stopped = true;
+                // Every actuator holds; a motion in progress waits for Reset. A second Stop
+                // keeps the first one's interrupted motion.
+                // (Nothing moves in Standby, whatever the flag says: nothing to keep there.)
+                self.stopped |= moving && self.mode != Mode::Standby;
                 *stop = true;
             }
-            Command::Reset => self.stopped = false,
+            Command::Reset if !self.stopped => return Answer::Refused(Refusal::NothingToResume),
+            Command::Reset => {
+                self.stopped = false;
+                *resume = true;
+            }
             Command::SystemFault => self.raise(
                 Faults::EMPTY.with(Fault::AssemblySystem),
                 input.in_motion,
@@ -275,7 +303,6 @@ impl Supervisor {
                 }
                 self.enter(Mode::Operational, stop);
                 self.enabled = ModuleSet::ALL;
-                self.stopped = false;
                 if input.hip_at_home {
                     *go_home = true;
                 } else {

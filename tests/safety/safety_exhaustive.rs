@@ -46,10 +46,22 @@ fn start_states() -> Vec<(&'static str, Supervisor)> {
     let mut safed_partial = partial;
     safed_partial.step(&cmd(Command::Mode(Mode::Safed)));
     v.push(("safed, arm A and gripper B off", safed_partial));
+    let in_motion = |c| Input {
+        in_motion: true,
+        ..cmd(c)
+    };
     let mut stopped = op;
-    stopped.step(&cmd(Command::Stop));
+    stopped.step(&in_motion(Command::Stop));
     assert!(stopped.stopped());
-    v.push(("operational, stopped", stopped));
+    v.push(("operational, a motion stopped", stopped));
+    let mut held = op;
+    held.step(&cmd(Command::Stop));
+    assert!(!held.stopped(), "nothing moved: nothing kept");
+    v.push(("operational, stopped while still", held));
+    let mut safed_stopped = s;
+    safed_stopped.step(&in_motion(Command::Stop));
+    assert!(safed_stopped.stopped());
+    v.push(("safed, a motion stopped", safed_stopped));
     let mut pending = op;
     pending.step(&Input {
         faults: Faults::EMPTY.with(Fault::LowBattery),
@@ -193,7 +205,13 @@ fn supervisor_properties_hold_on_the_whole_domain() {
                                             "{}",
                                             ctx()
                                         );
-                                        assert!(!s0.stopped(), "{}", ctx());
+                                        // Not while a Stop keeps a motion (unless a fault just
+                                        // changed the mode, which dropped it).
+                                        assert!(
+                                            !s0.stopped() || out.mode != s0.mode(),
+                                            "{}",
+                                            ctx()
+                                        );
                                     }
                                 }
                                 (Incoming::Command(cm), Answer::Refused(r)) => {
@@ -227,14 +245,35 @@ fn supervisor_properties_hold_on_the_whole_domain() {
                                         Refusal::Stopped => {
                                             assert!(s0.stopped() && k.moves(), "{}", ctx())
                                         }
+                                        // Nothing kept, or a mode change this step dropped it.
+                                        Refusal::NothingToResume => assert!(
+                                            *cm == Command::Reset
+                                                && (!s0.stopped() || out.mode != s0.mode()),
+                                            "{}",
+                                            ctx()
+                                        ),
                                         other => panic!("unexpected refusal {other:?}: {}", ctx()),
                                     }
                                 }
                             }
                         }
-                        // Stop is obeyed and heartbeat requests answered in every mode.
+                        // Stop is obeyed and heartbeat requests answered in every mode. A motion in
+                        // progress (outside Standby) is kept for Reset, as is one kept before in
+                        // the same mode; a mode change drops it.
                         if let Some(Incoming::Command(Command::Stop)) = c {
-                            assert!(out.stop_motion && s.stopped(), "{}", ctx());
+                            let kept = out.mode == s0.mode()
+                                && (s0.stopped() || (in_motion && out.mode != Mode::Standby));
+                            assert!(out.stop_motion, "{}", ctx());
+                            assert_eq!(s.stopped(), kept, "{}", ctx());
+                        }
+                        // Reset resumes exactly what was kept, in the mode it was kept in.
+                        if let Some(Incoming::Command(Command::Reset)) = c {
+                            let resumes = s0.stopped() && out.mode == s0.mode();
+                            assert_eq!(out.resume, resumes, "{}", ctx());
+                            assert!(!s.stopped(), "{}", ctx());
+                        }
+                        if s.mode() != s0.mode() {
+                            assert!(!s.stopped() && out.stop_motion, "{}", ctx());
                         }
                         if let Some(Incoming::Command(Command::Heartbeat)) = c {
                             assert_eq!(

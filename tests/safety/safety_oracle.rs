@@ -77,6 +77,10 @@ impl Oracle {
         if mode != "operational" {
             self.pending = false;
         }
+        if mode != self.mode {
+            // [rules] paused: any mode change drops the paused motion.
+            self.stopped = false;
+        }
         self.mode = mode;
     }
 
@@ -115,6 +119,7 @@ impl Oracle {
         init: bool,
     ) -> (Option<Answer>, bool) {
         let mut go_home = false;
+        let mode_before = self.mode;
         self.raise(faults, in_motion);
         if self.pending && !in_motion && self.mode == "operational" {
             self.go("standby");
@@ -141,7 +146,15 @@ impl Oracle {
                 return Answer::Refused(Refusal::Stopped);
             }
             match cm {
-                Command::Stop => self.stopped = true,
+                // [rules] stop: a motion in progress is kept until Reset.
+                // (A fault that changed the mode this tick already ended the motion.)
+                Command::Stop => {
+                    self.stopped |= in_motion && self.mode != "standby" && self.mode == mode_before
+                }
+                // [rules] reset: refused with nothing to resume.
+                Command::Reset if !self.stopped => {
+                    return Answer::Refused(Refusal::NothingToResume)
+                }
                 Command::Reset => self.stopped = false,
                 Command::SystemFault => {
                     self.raise(&["assembly_system".to_string()].into(), in_motion)
@@ -153,7 +166,6 @@ impl Oracle {
                     }
                     self.go("operational");
                     self.enabled = Module::ALL.iter().map(|m| module_name(*m)).collect();
-                    self.stopped = false;
                     if hip {
                         go_home = true;
                     } else {

@@ -178,6 +178,9 @@ pub fn event_json(e: &Event) -> Value {
         Event::Pair { pair, attempts, ok } => {
             json!({"type": "pair", "pair": pair.number(), "attempts": attempts, "ok": ok})
         }
+        Event::BoltersDown { contact } => json!({"type": "bolters_down", "contact": contact}),
+        Event::Paused => json!({"type": "paused"}),
+        Event::Resumed => json!({"type": "resumed"}),
     }
 }
 
