@@ -924,9 +924,8 @@ impl BoardA {
             }
             _ => None,
         };
-        let o = self
-            .coord
-            .step(&self.cfg.bolter, now, &self.side_a.aux(), b.as_ref());
+        let a_aux = self.side_a.aux();
+        let o = self.coord.step(&self.cfg.bolter, now, &a_aux, b.as_ref());
         let order = o.order;
         self.side_a
             .order(order.map_or(0, |(s, _)| s), order.map(|(_, o)| o), now);
@@ -934,8 +933,7 @@ impl BoardA {
         if was == coordinator::Status::Running && o.status != coordinator::Status::Running && down
         {
             out.push(Event::BoltersDown {
-                contact: self.side_a.aux().threshold_reached
-                    && b.is_some_and(|x| x.threshold_reached),
+                contact: a_aux.threshold_reached && b.is_some_and(|x| x.threshold_reached),
             });
             return;
         }

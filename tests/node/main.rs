@@ -3,4 +3,5 @@
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
 mod node_boards;
+mod node_fidelity;
 mod node_handoff;

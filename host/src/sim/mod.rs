@@ -17,6 +17,7 @@
 
 pub mod bench;
 pub mod clock;
+pub mod lockstep;
 pub mod log;
 pub mod nodes;
 pub mod plant;

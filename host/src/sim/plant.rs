@@ -110,6 +110,9 @@ pub struct Plant {
     pair: Option<MuxLines>,
     /// The state the robot last reached (drives the gravity readings).
     pub state: State,
+    /// Extra current side A's bolter draws at all times, mA: a bolter caught in a fastener
+    /// (Section 7's example for the idle check). 0 = none.
+    pub stuck_bolter_ma: f64,
     gravity: (Option<Gravity>, Option<Gravity>),
 }
 
@@ -140,6 +143,7 @@ impl Plant {
             tries: 0,
             pair: None,
             state,
+            stuck_bolter_ma: 0.0,
             gravity: (None, None),
             cfg,
         };
@@ -230,6 +234,21 @@ impl Plant {
         self.hip = (self.hip + self.hip_speed * dt / 1000.0).rem_euclid(36000.0);
     }
 
+    /// The hip's true angle, 0.01° (what the encoder reads, before its 12-bit rounding).
+    pub fn hip_centidegrees(&self) -> f64 {
+        self.hip
+    }
+
+    /// Side `side`'s (0 = A, 1 = B) arm and gripper positions, as servo pulses (µs).
+    pub fn servos(&self, side: usize) -> (f64, f64) {
+        (self.arm[side % 2], self.gripper[side % 2])
+    }
+
+    /// What side `side`'s bolter motor was last driven to do.
+    pub fn bolter_drive(&self, side: usize) -> Drive {
+        self.bolter[side % 2].drive.unwrap_or(Drive::Idle)
+    }
+
     /// The hip encoder's raw reading (12 bits, 4096 counts per turn, 0 at hip 0°).
     pub fn encoder(&self) -> u16 {
         ((self.hip / 36000.0 * 4096.0).floor() as u32 % 4096) as u16
@@ -265,7 +284,8 @@ impl Plant {
         let i_bo = match drive {
             Drive::Idle => 40.0,
             _ => 450.0,
-        } + if threshold { 900.0 } else { 0.0 };
+        } + if threshold { 900.0 } else { 0.0 }
+            + if side == 0 { self.stuck_bolter_ma } else { 0.0 };
         let i_3v3 = 80.0;
         let i_bat = i_loc + i_grip + i_bo + i_3v3;
         let rest = match self.cfg.low_battery_at {
