@@ -2,6 +2,7 @@
 //! each test is one defect of issue 13 and failed before its fix (spec/decisions.toml and
 //! spec/modes.toml give the readings taken).
 
+use mmic::bolter::Drive;
 use mmic::command::{BolterCommand, Command, Reconfiguration, ServoTarget};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
@@ -11,11 +12,12 @@ use mmic::refusal::Refusal;
 use mmic::units::Side;
 use mmic_host::sim::lockstep::Robot;
 use mmic_host::sim::PlantConfig;
-use mmic::bolter::Drive;
 
 fn operational(state: State) -> Robot {
     let mut r = Robot::new(state, PlantConfig::default());
-    let hb = r.command(Command::Mode(Mode::Operational)).expect("answered");
+    let hb = r
+        .command(Command::Mode(Mode::Operational))
+        .expect("answered");
     assert_eq!((hb.mode, hb.refusal), (Mode::Operational, None));
     assert!(r.run_until(10_000, |r| !r.a.in_motion()), "homed");
     r
@@ -70,13 +72,17 @@ fn reset_resumes_the_reconfiguration_a_stop_interrupted() {
     let (mut r, _) = stopped_mid_turn();
     r.run_for(3_000);
     // While stopped, a new motion is refused: the operator resumes or changes mode.
-    let hb = r.command(reconfigure(State::A, State::M)).expect("answered");
+    let hb = r
+        .command(reconfigure(State::A, State::M))
+        .expect("answered");
     assert_eq!(hb.refusal, Some(Refusal::Stopped));
     let t = r.now;
     accepted(&mut r, Command::Reset);
     assert!(r.events_since(t).any(|e| *e == Event::Resumed));
     assert!(
-        r.run_until(60_000, |r| r.events_since(t).any(|e| *e == Event::Reached(State::B))),
+        r.run_until(60_000, |r| r
+            .events_since(t)
+            .any(|e| *e == Event::Reached(State::B))),
         "resumed to b"
     );
     assert!(r.run_until(5_000, |r| !r.a.in_motion()));
@@ -170,7 +176,10 @@ fn move_bolters_down_only_descends() {
         .any(|e| *e == Event::BoltersDown { contact: true }));
     assert!(drives.contains(&[Drive::Down, Drive::Down]), "both descend");
     assert!(
-        drives.iter().flatten().all(|d| matches!(d, Drive::Down | Drive::Idle)),
+        drives
+            .iter()
+            .flatten()
+            .all(|d| matches!(d, Drive::Down | Drive::Idle)),
         "only descending: {drives:?}"
     );
     // And they stay down: nothing drives them afterwards.
@@ -219,10 +228,17 @@ fn the_idle_check_runs_when_a_reconfiguration_starts_not_while_idle() {
     assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
     let servos = [r.plant.servos(0), r.plant.servos(1)];
     accepted(&mut r, reconfigure(State::A, State::M));
-    assert!(r.run_until(2_000, |r| r.a.faults().contains(Fault::BolterOvercurrentIdle)));
+    assert!(r.run_until(2_000, |r| r
+        .a
+        .faults()
+        .contains(Fault::BolterOvercurrentIdle)));
     assert_eq!(r.a.mode(), Mode::Safed);
     r.run_for(2_000);
-    assert_eq!([r.plant.servos(0), r.plant.servos(1)], servos, "nothing moved");
+    assert_eq!(
+        [r.plant.servos(0), r.plant.servos(1)],
+        servos,
+        "nothing moved"
+    );
 }
 
 /// Defect 9: command complete (heartbeat byte 54) comes after the idle check at the end.
@@ -239,4 +255,31 @@ fn command_complete_follows_the_idle_check_at_the_end() {
     assert!(hb.command_complete);
     let settle = mmic::node::board_a::Config::default().idle_settle_ms;
     assert!(r.now - reached >= settle, "{} ms", r.now - reached);
+}
+
+/// Found in the review (same kind as the defects above): Table 8's "after executing an arm
+/// contraction command, the contraction is not sensed by hardware" holds for either arm, but
+/// board A checked only arm A. Arm B's switch travels in Table 4 byte 44.
+#[test]
+fn an_arm_b_contraction_the_switch_does_not_sense_is_arm_not_contracted() {
+    for side in [Side::A, Side::B] {
+        let mut r = operational(State::A);
+        let arm = |target| Command::Arm { side, target };
+        accepted(&mut r, arm(ServoTarget::Extend));
+        assert!(r.run_until(5_000, |r| !r.a.in_motion()));
+        r.plant.dead_switch[side as usize] = true;
+        accepted(&mut r, arm(ServoTarget::Contract));
+        assert!(
+            r.run_until(5_000, |r| r.a.faults().contains(Fault::ArmNotContracted)),
+            "{side:?}: no fault"
+        );
+        assert_eq!(r.a.mode(), Mode::Safed, "{side:?}");
+        // With a working switch the same contraction is no fault.
+        let mut r = operational(State::A);
+        accepted(&mut r, arm(ServoTarget::Extend));
+        assert!(r.run_until(5_000, |r| !r.a.in_motion()));
+        accepted(&mut r, arm(ServoTarget::Contract));
+        r.run_for(5_000);
+        assert!(r.a.faults().is_empty(), "{side:?}: {:?}", r.a.faults());
+    }
 }

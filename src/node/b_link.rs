@@ -73,10 +73,20 @@ impl BLink {
     /// The command to send at `now` for `snapshot` (whose own `seq` is ignored), or `None` when
     /// nothing is due: new content is sent at once with the next number, unchanged content
     /// every `period_ms` with the number it already has.
-    pub fn due(&mut self, now: u32, period_ms: u32, snapshot: BCommandRepr) -> Option<BCommandRepr> {
+    pub fn due(
+        &mut self,
+        now: u32,
+        period_ms: u32,
+        snapshot: BCommandRepr,
+    ) -> Option<BCommandRepr> {
         let now = Instant::from_millis(now);
         let seq = match self.sent {
-            Some((t, last)) if BCommandRepr { seq: last.seq, ..snapshot } == last => {
+            Some((t, last))
+                if BCommandRepr {
+                    seq: last.seq,
+                    ..snapshot
+                } == last =>
+            {
                 if now.since(t).millis() < period_ms {
                     return None;
                 }
@@ -102,7 +112,8 @@ impl BLink {
     pub fn carried(&self, seq: u8, order: &BolterOrder) -> bool {
         match self.sent {
             Some((_, last)) if last.bolter.as_ref() == Some(order) => {
-                seq != 0 && seq.wrapping_sub(self.order_since) <= last.seq.wrapping_sub(self.order_since)
+                seq != 0
+                    && seq.wrapping_sub(self.order_since) <= last.seq.wrapping_sub(self.order_since)
             }
             _ => false,
         }
@@ -160,7 +171,10 @@ mod tests {
         };
         assert!(link.carried(first, &ORDER) && link.carried(second, &ORDER));
         assert!(!link.carried(a, &ORDER), "sent before the order");
-        assert!(!link.carried(second.wrapping_add(1), &ORDER), "not sent yet");
+        assert!(
+            !link.carried(second.wrapping_add(1), &ORDER),
+            "not sent yet"
+        );
         let other = BolterOrder {
             step: BolterStep::Retract,
             ..ORDER

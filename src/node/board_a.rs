@@ -48,7 +48,7 @@ use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
 use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use crate::safety::ModuleSet;
 use crate::units::{
-    BoardNumber, Electrical, Gravity, HipAngle, Instant, Module, PerSide, PulseWidth,
+    BoardNumber, Electrical, Gravity, HipAngle, Instant, Module, PerSide, PulseWidth, Side,
 };
 use crate::wire::b_command::{BCommandRepr, BPower, B_COMMAND_LEN};
 use crate::wire::command::{CommandPacket, CommandRepr, COMMAND_LEN};
@@ -300,7 +300,7 @@ pub struct BoardA {
     b: InternalHeartbeatRepr,
     b_heard: bool,
     link: BLink,
-    contracting: bool,
+    contracting: PerSide<Contraction>,
     refusal: Option<Refusal>,
     moving: bool,
     pair: Option<(crate::command::BolterPair, u8)>,
@@ -321,6 +321,19 @@ enum Queued {
     Job(Job),
     /// Table 1's "move bolters down".
     Down,
+}
+
+/// Table 8's arm contraction check after a single-module "contract arm" command, per side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Contraction {
+    /// No contraction command to check.
+    Idle,
+    /// The arm is on its way.
+    Moving,
+    /// The arm finished its travel at this time: the switch has the sequencer's confirm time
+    /// (`motion.confirm_ms`) to close, as in a primitive's Confirm step.
+    Confirming(Instant),
 }
 
 /// Section 7's idle overcurrent check around a reconfiguration.
@@ -347,7 +360,7 @@ struct Paused {
     coord: Coordinator,
     waiting_job: Option<Queued>,
     targets: Targets,
-    contracting: bool,
+    contracting: PerSide<Contraction>,
     pair: Option<(crate::command::BolterPair, u8)>,
 }
 
@@ -378,7 +391,7 @@ impl BoardA {
             b: InternalHeartbeatRepr::default(),
             b_heard: false,
             link: BLink::new(),
-            contracting: false,
+            contracting: PerSide::both(Contraction::Idle),
             refusal: None,
             moving: false,
             pair: None,
@@ -445,9 +458,8 @@ impl BoardA {
 
     /// The robot has been still for `idle_settle_ms`: its averaged currents are at rest.
     fn at_rest(&self, now: u32) -> bool {
-        self.still_since.is_some_and(|t| {
-            Instant::from_millis(now).since(t).millis() >= self.cfg.idle_settle_ms
-        })
+        self.still_since
+            .is_some_and(|t| Instant::from_millis(now).since(t).millis() >= self.cfg.idle_settle_ms)
     }
 
     fn feedback(&self, hip_now: HipAngle, arm_a_switch: bool) -> Feedback {
@@ -584,14 +596,31 @@ impl BoardA {
             faults = faults.union(f);
         }
         self.bolting(now, out, &mut faults);
-        // Arm contraction check (Table 8): when a commanded contraction of arm A ends.
-        if self.contracting && self.arm.done() {
-            self.contracting = false;
-            if detect::arm_contraction_fault(true, inp.arm_contracted) {
+        // Arm contraction check (Table 8), on both sides: after a commanded contraction ends,
+        // the switch must close.
+        for side in [Side::A, Side::B] {
+            if self.contraction(side, now, fb) {
                 faults = faults.with(Fault::ArmNotContracted);
             }
         }
         faults
+    }
+
+    /// Advances side `side`'s contraction check; true when it failed.
+    fn contraction(&mut self, side: Side, now: u32, fb: &Feedback) -> bool {
+        let now = Instant::from_millis(now);
+        let (next, failed) = match self.contracting[side] {
+            Contraction::Idle => (Contraction::Idle, false),
+            _ if fb.arm_switch[side] => (Contraction::Idle, false),
+            Contraction::Moving if fb.arm_done[side] => (Contraction::Confirming(now), false),
+            Contraction::Moving => (Contraction::Moving, false),
+            Contraction::Confirming(t) if now.since(t).millis() > self.cfg.motion.confirm_ms => {
+                (Contraction::Idle, true)
+            }
+            c @ Contraction::Confirming(_) => (c, false),
+        };
+        self.contracting[side] = next;
+        failed
     }
 
     /// Section 7's idle check: side A's currents against the at-rest limits, side B as board B
@@ -847,7 +876,11 @@ impl BoardA {
         match c {
             Command::Arm { side, target } => {
                 self.targets.arm[side] = target;
-                self.contracting = side as usize == 0 && target == ServoTarget::Contract;
+                self.contracting[side] = if target == ServoTarget::Contract {
+                    Contraction::Moving
+                } else {
+                    Contraction::Idle
+                };
             }
             Command::Gripper { side, target } => self.targets.gripper[side] = target,
             Command::Hip(h) => {
@@ -916,7 +949,9 @@ impl BoardA {
         // coordinator's order when that packet was one of the run that carried the order
         // (node::b_link), and then it is handed over under the coordinator's number.
         let b = match self.coord.order() {
-            Some((seq, order)) if self.b_heard && self.link.carried(self.b.bolter_aux.seq, &order) => {
+            Some((seq, order))
+                if self.b_heard && self.link.carried(self.b.bolter_aux.seq, &order) =>
+            {
                 Some(crate::wire::internal_heartbeat::BolterAux {
                     seq,
                     ..self.b.bolter_aux
@@ -930,8 +965,7 @@ impl BoardA {
         self.side_a
             .order(order.map_or(0, |(s, _)| s), order.map(|(_, o)| o), now);
         let down = self.coord.descend_only();
-        if was == coordinator::Status::Running && o.status != coordinator::Status::Running && down
-        {
+        if was == coordinator::Status::Running && o.status != coordinator::Status::Running && down {
             out.push(Event::BoltersDown {
                 contact: a_aux.threshold_reached && b.is_some_and(|x| x.threshold_reached),
             });
@@ -1019,7 +1053,7 @@ impl BoardA {
             hip,
         };
         self.hold_b = true;
-        self.contracting = false;
+        self.contracting = PerSide::both(Contraction::Idle);
     }
 
     /// A command that moves side B lifts the hold: side B's targets become where B reports it

@@ -231,14 +231,12 @@ impl Supervisor {
         if self.standby_pending && !input.in_motion && self.mode == Mode::Operational {
             self.enter(Mode::Standby, &mut stop);
         }
-        let answer = input
-            .command
-            .map(|c| {
-                // A motion is still in progress for the command only if no fault this tick
-                // changed the mode (which stopped it for good).
-                let moving = input.in_motion && self.mode == mode_before;
-                self.command(c, input, moving, &mut stop, &mut go_home, &mut resume)
-            });
+        let answer = input.command.map(|c| {
+            // A motion is still in progress for the command only if no fault this tick
+            // changed the mode (which stopped it for good).
+            let moving = input.in_motion && self.mode == mode_before;
+            self.command(c, input, moving, &mut stop, &mut go_home, &mut resume)
+        });
         let powered = powered(self.mode, self.enabled);
         Output {
             mode: self.mode,

@@ -70,7 +70,10 @@ fn board_a_takes_side_b_overcurrent_as_b_judged_it() {
         ..Default::default()
     };
     let quiet = hearing(at_rest, 1_000);
-    assert_eq!((quiet.mode(), quiet.faults()), (Mode::Operational, Faults::EMPTY));
+    assert_eq!(
+        (quiet.mode(), quiet.faults()),
+        (Mode::Operational, Faults::EMPTY)
+    );
     let flagged = hearing(
         InternalHeartbeatRepr {
             bolter_overcurrent: true,

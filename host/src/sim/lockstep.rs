@@ -144,9 +144,7 @@ impl Robot {
         }
         self.to_b = out_a.to_b;
         self.to_a = out_b.heartbeat;
-        let hb = out_a
-            .heartbeat
-            .and_then(|b| HeartbeatRepr::parse(&b).ok());
+        let hb = out_a.heartbeat.and_then(|b| HeartbeatRepr::parse(&b).ok());
         self.out_a = Some(out_a);
         self.out_b = Some(out_b);
         hb

@@ -113,6 +113,8 @@ pub struct Plant {
     /// Extra current side A's bolter draws at all times, mA: a bolter caught in a fastener
     /// (Section 7's example for the idle check). 0 = none.
     pub stuck_bolter_ma: f64,
+    /// Per side (0 = A, 1 = B): the arm's contraction switch is dead and never closes.
+    pub dead_switch: [bool; 2],
     gravity: (Option<Gravity>, Option<Gravity>),
 }
 
@@ -144,6 +146,7 @@ impl Plant {
             pair: None,
             state,
             stuck_bolter_ma: 0.0,
+            dead_switch: [false; 2],
             gravity: (None, None),
             cfg,
         };
@@ -336,7 +339,8 @@ impl Plant {
                 accel,
                 encoder: if side == 0 { self.encoder() } else { 0 },
             },
-            arm_contracted: self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
+            arm_contracted: !self.dead_switch[side]
+                && self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
             bolter: Signals {
                 threshold,
                 locked,
