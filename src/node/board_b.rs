@@ -22,11 +22,11 @@
 //! let hb = InternalHeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
 //! assert_eq!(hb.command_received, 7);              // acknowledged
 //! assert_eq!(hb.arm_b_target.micros(), 2000);
-//! let out = b.tick(400, &Inputs::default());       // arm moving at 500 µs/s
-//! assert_eq!(out.arm.unwrap().micros(), 1700);
+//! let out = b.tick(400, &Inputs::default());       // from home (900 µs) at 500 µs/s
+//! assert_eq!(out.arm.unwrap().micros(), 1100);
 //! let out = b.tick(901, &Inputs::default());       // A silent for over 500 ms: hold
 //! assert!(out.link_lost);
-//! assert_eq!(out.arm.unwrap().micros(), 1700);
+//! assert_eq!(out.arm.unwrap().micros(), 1100);
 //! ```
 
 use crate::bolter::{BolterSide, Drive, MuxLines, SideConfig, Signals};
