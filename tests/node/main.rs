@@ -4,3 +4,4 @@
 
 mod node_boards;
 mod node_handoff;
+mod node_primitives;
