@@ -12,7 +12,7 @@ use mmic::node::board_a::{self, BoardA, Event, Inputs};
 use mmic::node::board_b::{self, BoardB};
 use mmic::refusal::Refusal;
 use mmic::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
-use mmic::wire::command::CommandRepr;
+use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::heartbeat::HeartbeatRepr;
 
 const TICK_MS: u32 = 10;
@@ -67,12 +67,6 @@ impl Rig {
 
     /// One tick of both boards and the plant; board A's events.
     fn tick(&mut self, command: Option<Command>) -> (Option<HeartbeatRepr>, Vec<Event>) {
-        self.t += TICK_MS;
-        if let Some(p) = self.hip_pulse {
-            let speed = (f64::from(p.micros()) - 1500.0) * 10.0;
-            self.hip_cdeg =
-                (self.hip_cdeg + speed * f64::from(TICK_MS) / 1000.0).rem_euclid(36000.0);
-        }
         let packet = command.map(|command| {
             self.seq += 1;
             CommandRepr {
@@ -82,6 +76,20 @@ impl Rig {
             }
             .to_bytes()
         });
+        self.tick_bytes(packet)
+    }
+
+    /// One tick with these command bytes, if any.
+    fn tick_bytes(
+        &mut self,
+        packet: Option<[u8; COMMAND_LEN]>,
+    ) -> (Option<HeartbeatRepr>, Vec<Event>) {
+        self.t += TICK_MS;
+        if let Some(p) = self.hip_pulse {
+            let speed = (f64::from(p.micros()) - 1500.0) * 10.0;
+            self.hip_cdeg =
+                (self.hip_cdeg + speed * f64::from(TICK_MS) / 1000.0).rem_euclid(36000.0);
+        }
         let out_a = self.a.tick(
             self.t,
             &Inputs {
@@ -235,4 +243,24 @@ fn the_first_targets_run_too_and_no_move_is_refused() {
     let mut rig = Rig::new();
     // Primitive 1 (fwdContract) ends in m from d: from a it is no move.
     rig.refused(Primitive::FwdContract, State::M);
+    // A primitive in the old layout (byte 8 zero, sealed): no command, refused as an invalid
+    // parameter with its sequence number, and nothing moves.
+    let mut old = CommandRepr {
+        board: BoardNumber::ONE,
+        command: Command::primitive(Primitive::BackExtend, State::D).unwrap(),
+        seq: 900,
+    }
+    .to_bytes();
+    old[8] = 0;
+    let crc = mmic::wire::checksum::crc16(&old[..12]).to_le_bytes();
+    old[12..].copy_from_slice(&crc);
+    let (hb, _) = rig.tick_bytes(Some(old));
+    let hb = hb.expect("ours: answered");
+    assert_eq!(
+        (hb.last_seq, hb.refusal),
+        (900, Some(Refusal::InvalidParameter))
+    );
+    rig.settle(500);
+    assert!(!rig.a.in_motion());
+    assert_eq!(rig.a.state(), Some(State::A));
 }
