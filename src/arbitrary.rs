@@ -11,7 +11,7 @@
 //! ```
 //!
 //! Every value is built through the type's own checked constructor (`BoardNumber::new`,
-//! `PulseWidth::new`, `Reconfiguration::new`, `Faults::from_wire`, …), so a strategy can only
+//! `PulseWidth::new`, `Reconfiguration::new`, `PrimitiveMove::new`, `Faults::from_wire`, …), so a strategy can only
 //! produce values the library itself would accept; nothing here bypasses a range check.
 //! Numeric ranges are drawn uniformly with their bounds over-weighted, because off-by-one
 //! mistakes live at the bounds (500 and 2500 µs, 0 and 35999 centidegrees, board 1 and 255).
@@ -28,7 +28,7 @@
 use crate::bolter::{BolterDirection, BolterStep, MuxLines};
 use crate::command::{
     BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
-    Reconfiguration, ServoTarget,
+    PrimitiveMove, Reconfiguration, ServoTarget,
 };
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
@@ -233,6 +233,18 @@ arbitrary_boxed!(
     )
 );
 arbitrary_boxed!(
+    PrimitiveMove,
+    // Each primitive equally likely, then each final state it reaches equally likely (3 for
+    // primitives 1-4, 12 for 5-8: both divide 12). Every draw is a valid command.
+    (any::<Primitive>(), 0..12usize).prop_filter_map(
+        "every primitive reaches some state",
+        |(p, i)| {
+            let of_p = move || PrimitiveMove::all().filter(move |m| m.primitive() == p);
+            of_p().nth(i % of_p().count().max(1))
+        }
+    )
+);
+arbitrary_boxed!(
     Command,
     // Thirteen variants, equally likely: the five parameterless ones share one arm of weight 5.
     prop_oneof![
@@ -250,7 +262,7 @@ arbitrary_boxed!(
             .prop_map(|(side, target)| Command::Gripper { side, target }),
         1 => any::<HipTarget>().prop_map(Command::Hip),
         1 => any::<BolterCommand>().prop_map(Command::Bolter),
-        1 => any::<Primitive>().prop_map(Command::Primitive),
+        1 => any::<PrimitiveMove>().prop_map(Command::Primitive),
         1 => any::<Reconfiguration>().prop_map(Command::Reconfigure),
         1 => (any::<PowerTarget>(), any::<bool>())
             .prop_map(|(target, on)| Command::Power { target, on }),

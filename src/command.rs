@@ -4,13 +4,15 @@
 //! discrete choices (side, module, pair, primitive, mode, on/off) live in the opcode and the
 //! parameter bytes 6–11 carry only the quantities Table 2 names for them: the hip target in
 //! bytes 6–7, arm A's in 8–9, arm B's in 10–11, and, for a reconfiguration, the final state in
-//! byte 8 and the initial state in byte 9. Every parameter byte a command does not use must be
-//! zero, so a corrupted or mis-built packet is refused instead of guessed at.
+//! byte 8 and the initial state in byte 9; a primitive names its final state in byte 8 too,
+//! because from a turn state one primitive can reach two states. Every parameter byte a
+//! command does not use must be zero, so a corrupted or mis-built packet is refused instead of
+//! guessed at.
 //!
 //! ```
 //! use mmic::command::{Command, ServoTarget};
 //! use mmic::units::{PulseWidth, Side};
-//! use mmic::motion::State;
+//! use mmic::motion::{Primitive, State};
 //!
 //! let c = Command::Arm { side: Side::B, target: ServoTarget::Position(PulseWidth::new(1200).unwrap()) };
 //! let (opcode, params) = c.encode();
@@ -21,6 +23,11 @@
 //! let r = Command::reconfigure(State::A, State::M).unwrap();
 //! assert_eq!(r.encode(), (0x60, [0, 0, b'm', b'a', 0, 0]));
 //! assert!(Command::reconfigure(State::A, State::D).is_err()); // d is not a final state
+//!
+//! // Primitive 7 (backTurnCW) from e reaches a or d: the packet says which.
+//! let p = Command::primitive(Primitive::BackTurnCw, State::D).unwrap();
+//! assert_eq!(p.encode(), (0x57, [0, 0, b'd', 0, 0, 0]));
+//! assert!(Command::decode(0x57, [0; 6]).is_err()); // no final state: refused
 //! ```
 
 use crate::mode::Mode;
@@ -185,6 +192,104 @@ pub enum ReconfigurationError {
     },
 }
 
+/// A validated primitive command: the primitive (Table 6) and the final state it must end in.
+///
+/// From a turn state a primitive can reach two states (12 such pairs,
+/// spec/motion/ambiguous-primitives.txt), so the number alone leaves the move to chance; the
+/// final state makes every one of the 72 moves of Figure 9 commandable. Built only for a
+/// final state the primitive reaches from some state: where the robot is now is board A's to
+/// check (the move must be the primitive's cell of the map from its tracked state).
+///
+/// ```
+/// use mmic::command::{PrimitiveMove, PrimitiveMoveError};
+/// use mmic::motion::{map, Primitive, State};
+/// let m = PrimitiveMove::new(Primitive::BackTurnCw, State::D).unwrap();
+/// assert_eq!(map::primitive(State::E, m.target()), Some(m.primitive())); // e -> d by 7
+/// assert!(m.is_move_from(State::E) && !m.is_move_from(State::A));
+/// // No state is taken to a match by primitive 3 (an extension ends stretched).
+/// assert_eq!(
+///     PrimitiveMove::new(Primitive::FwdExtend, State::A),
+///     Err(PrimitiveMoveError::Unreachable { primitive: Primitive::FwdExtend, target: State::A })
+/// );
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct PrimitiveMove {
+    primitive: Primitive,
+    target: State,
+}
+
+impl PrimitiveMove {
+    /// Refused when no state is taken to `target` by `primitive` (Figure 9): such a command
+    /// could never run, wherever the robot is.
+    pub const fn new(primitive: Primitive, target: State) -> Result<Self, PrimitiveMoveError> {
+        if crate::motion::map::reaches(primitive, target) {
+            Ok(PrimitiveMove { primitive, target })
+        } else {
+            Err(PrimitiveMoveError::Unreachable { primitive, target })
+        }
+    }
+
+    /// The primitive (Table 6).
+    pub const fn primitive(self) -> Primitive {
+        self.primitive
+    }
+
+    /// The state the primitive must end in (packet byte 8).
+    pub const fn target(self) -> State {
+        self.target
+    }
+
+    /// Whether this is the map's move from `from`: the primitive takes `from` to the target.
+    /// Board A runs the command only then.
+    pub const fn is_move_from(self, from: State) -> bool {
+        match crate::motion::map::primitive(from, self.target) {
+            Some(p) => p as u8 == self.primitive as u8,
+            None => false,
+        }
+    }
+
+    /// Every valid primitive command, primitives in Table 6 order, each one's final states in
+    /// Table 5 order: 60 of them (72 moves, fewer the 12 that share a primitive and a final
+    /// state with another move).
+    pub fn all() -> impl Iterator<Item = PrimitiveMove> {
+        Primitive::ALL.into_iter().flat_map(|primitive| {
+            State::ALL
+                .into_iter()
+                .filter_map(move |target| PrimitiveMove::new(primitive, target).ok())
+        })
+    }
+}
+
+#[cfg(feature = "serde")]
+impl<'de> serde::Deserialize<'de> for PrimitiveMove {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Raw {
+            primitive: Primitive,
+            target: State,
+        }
+        let r = Raw::deserialize(d)?;
+        PrimitiveMove::new(r.primitive, r.target).map_err(serde::de::Error::custom)
+    }
+}
+
+/// A primitive command that cannot be executed from any state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum PrimitiveMoveError {
+    /// No state is taken to `target` by `primitive` (Figure 9).
+    #[error("primitive {primitive} takes no state to {target} (Figure 9)")]
+    Unreachable {
+        /// The primitive.
+        primitive: Primitive,
+        /// The final state named.
+        target: State,
+    },
+}
+
 /// A command to the robot (Table 1, plus `ClearFaults`, which the fault latching of Section 7
 /// needs and the paper does not list).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -225,8 +330,8 @@ pub enum Command {
     Hip(HipTarget),
     /// Bolt, unbolt or lower the bolters.
     Bolter(BolterCommand),
-    /// Execute one motion primitive.
-    Primitive(Primitive),
+    /// Execute one motion primitive, ending in the final state it names.
+    Primitive(PrimitiveMove),
     /// Reconfigure from an initial to a target state.
     Reconfigure(Reconfiguration),
     /// Switch power to one or all modules.
@@ -246,6 +351,17 @@ impl Command {
     ) -> Result<Command, ReconfigurationError> {
         match Reconfiguration::new(initial, target) {
             Ok(r) => Ok(Command::Reconfigure(r)),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// A primitive command; see [`PrimitiveMove::new`].
+    pub const fn primitive(
+        primitive: Primitive,
+        target: State,
+    ) -> Result<Command, PrimitiveMoveError> {
+        match PrimitiveMove::new(primitive, target) {
+            Ok(m) => Ok(Command::Primitive(m)),
             Err(e) => Err(e),
         }
     }
@@ -400,8 +516,11 @@ pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl F
         }
     }
     visit(Command::Bolter(BolterCommand::Down));
+    // Each primitive with its first final state in Table 5 order.
     for p in Primitive::ALL {
-        visit(Command::Primitive(p));
+        if let Some(m) = PrimitiveMove::all().find(|m| m.primitive() == p) {
+            visit(Command::Primitive(m));
+        }
     }
     visit(Command::Reconfigure(Reconfiguration {
         initial: State::A,
@@ -422,7 +541,8 @@ pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl F
 }
 
 /// Calls `visit` with every representable command: each variant class with every pulse width,
-/// every hip angle and every valid reconfiguration: 44,143 calls.
+/// every hip angle, every valid primitive command and every valid reconfiguration: 44,195
+/// calls.
 pub fn for_each_command(mut visit: impl FnMut(Command)) {
     for_each_variant_class(PulseWidth::CENTER, HipAngle::ZERO, |c| match c {
         Command::Arm {
@@ -458,6 +578,11 @@ pub fn for_each_command(mut visit: impl FnMut(Command)) {
                 }
             }
         }
+        Command::Primitive(m) => {
+            for other in PrimitiveMove::all().filter(|o| o.primitive() == m.primitive()) {
+                visit(Command::Primitive(other));
+            }
+        }
         Command::Reconfigure(_) => {
             for initial in State::ALL {
                 for target in State::MATCHED {
@@ -483,8 +608,9 @@ mod tests {
             assert_eq!(Command::decode(id, p), Ok(c), "{c:?}");
             n += 1;
         });
-        // 61 classes; 4 positional servo classes × 2001 widths, 36000 angles, 84 reconfigurations.
-        assert_eq!(n, 61 - 4 - 1 - 1 + 4 * 2001 + 36000 + (15 * 6 - 6));
+        // 61 classes; 4 positional servo classes × 2001 widths, 36000 angles, 60 primitive
+        // commands (8 classes), 84 reconfigurations.
+        assert_eq!(n, 61 - 4 - 1 - 8 - 1 + 4 * 2001 + 36000 + 60 + (15 * 6 - 6));
     }
 
     #[test]
@@ -497,7 +623,7 @@ mod tests {
             assert_eq!((p[at], p[at + 1]), (0, 0), "{c:?}");
             n += 1;
         });
-        assert_eq!(n, 44_143);
+        assert_eq!(n, 44_195);
     }
 
     #[test]
@@ -573,5 +699,68 @@ mod tests {
                 ReconfigurationError::SameState { state: State::A }
             ))
         );
+        assert_eq!(
+            Command::decode(0x60, [0, 0, b'm', 0, 0, 0]),
+            Err(CommandError::MissingState { index: 9 })
+        );
+    }
+
+    #[test]
+    fn a_primitive_names_its_final_state_in_byte_8() {
+        // 7 (backTurnCW): e -> a and e -> d; both commandable, each its own bytes.
+        for (target, byte) in [(State::A, b'a'), (State::D, b'd')] {
+            let c = Command::primitive(Primitive::BackTurnCw, target);
+            assert_eq!(c.map(|c| c.encode()), Ok((0x57, [0, 0, byte, 0, 0, 0])));
+            assert_eq!(
+                Command::decode(0x57, [0, 0, byte, 0, 0, 0]),
+                c.map_err(CommandError::from)
+            );
+        }
+        // The old layout (no final state), a non-letter, a state the primitive reaches from
+        // nowhere, and an initial state in byte 9 (not carried for a primitive).
+        assert_eq!(
+            Command::decode(0x57, [0; 6]),
+            Err(CommandError::MissingState { index: 8 })
+        );
+        assert_eq!(
+            Command::decode(0x57, [0, 0, b'p', 0, 0, 0]),
+            Err(CommandError::State {
+                index: 8,
+                found: b'p'
+            })
+        );
+        assert_eq!(
+            Command::decode(0x57, [0, 0, b'm', 0, 0, 0]),
+            Err(CommandError::Primitive(PrimitiveMoveError::Unreachable {
+                primitive: Primitive::BackTurnCw,
+                target: State::M
+            }))
+        );
+        assert_eq!(
+            Command::decode(0x57, [0, 0, b'd', b'e', 0, 0]),
+            Err(CommandError::UnusedNotZero {
+                id: 0x57,
+                index: 9,
+                found: b'e'
+            })
+        );
+    }
+
+    #[test]
+    fn every_move_of_the_map_is_one_primitive_command() {
+        // 72 moves, 60 commands: a command is (primitive, final state); the robot's state
+        // supplies the row. Each command is the move of exactly the rows it names.
+        let mut moves = 0;
+        for m in PrimitiveMove::all() {
+            for from in State::ALL {
+                let cell = crate::motion::map::primitive(from, m.target());
+                assert_eq!(m.is_move_from(from), cell == Some(m.primitive()));
+                moves += usize::from(m.is_move_from(from));
+            }
+        }
+        assert_eq!((PrimitiveMove::all().count(), moves), (60, 72));
+        for (from, to, p) in crate::motion::map::moves() {
+            assert!(PrimitiveMove::new(p, to).is_ok_and(|m| m.is_move_from(from)));
+        }
     }
 }

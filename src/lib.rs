@@ -67,6 +67,7 @@ const _: () = {
     format::<refusal::Refusal>();
     format::<motion::State>();
     format::<motion::Primitive>();
+    format::<command::PrimitiveMove>();
     format::<bolter::BolterPair>();
     format::<node::board_a::Event>();
     format::<units::PulseWidth>();

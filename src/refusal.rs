@@ -21,6 +21,9 @@ wire_enum! {
         /// Operational refused: a fault condition still holds (see the fault bytes).
         FaultConditionHolds = 2 => "fault_condition_holds",
         /// Reconfiguration refused: its initial state is not the detected state (Table 8).
+        /// Primitive refused: the robot's tracked state is none the primitive takes to the
+        /// final state the command names (Figure 9), so the ground's belief of where the
+        /// robot is does not hold either; no fault is latched (Table 8 names reconfigurations).
         InitialStateMismatch = 3 => "initial_state_mismatch",
         /// Opcode unknown (includes an unknown mode value).
         UnknownCommand = 4 => "unknown_command",

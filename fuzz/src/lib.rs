@@ -19,7 +19,7 @@
 use mmic::bolter::{BolterDirection, BolterStep};
 use mmic::command::{BolterPair, Command, HipTarget, PowerTarget, ServoTarget};
 use mmic::mode::Mode;
-use mmic::motion::State;
+use mmic::motion::{Primitive, State};
 use mmic::units::{BoardNumber, HipAngle, Module, PulseWidth, Side};
 use mmic::wire::b_command::{BCommandRepr, BolterOrder};
 use mmic::wire::command::CommandRepr;
@@ -99,6 +99,11 @@ pub fn valid_packets() -> Vec<(PacketKind, &'static str, Vec<u8>)> {
         cmd(
             "hip-angle-35999",
             Command::Hip(HipTarget::Angle(HipAngle::new(35999).expect("valid angle"))),
+        ),
+        // Primitive 7 (backTurnCW) from e reaches a or d: byte 8 names d.
+        cmd(
+            "primitive-7-to-d",
+            Command::primitive(Primitive::BackTurnCw, State::D).expect("valid primitive command"),
         ),
         cmd(
             "reconfigure-h-to-n",

@@ -72,5 +72,5 @@ fn parser_seeds_are_what_their_names_say() {
             n += 1;
         }
     }
-    assert_eq!(n, 10 * 6);
+    assert_eq!(n, 11 * 6);
 }

@@ -41,7 +41,8 @@ Encode a packet from its JSON form; prints the bytes as lowercase hex on one lin
 The JSON is exactly what `mmic decode` prints: every field, no others (an unknown or
 misspelt field is refused). Values are checked as the robot checks them: pulse widths
 500..=2500 µs, hip angles 0..=35999 (0.01°), boards 1..=255, states 'a'..='o' (Table 5),
-primitives 1..=8 (Table 6), bolter pairs 1..=4. `mmic spec` lists every command's JSON.";
+primitives 1..=8 (Table 6) with a final state the primitive reaches (Figure 9), bolter pairs
+1..=4. `mmic spec` lists every command's JSON.";
 
 const ENCODE_AFTER: &str = "\
 Examples (command packet, Table 2):
@@ -49,7 +50,7 @@ Examples (command packet, Table 2):
   mmic encode command '{\"board\":1,\"command\":{\"arm\":{\"side\":\"a\",\"target\":\"contract\"}}}'
   mmic encode command '{\"board\":1,\"command\":{\"arm\":{\"side\":\"a\",\"target\":{\"position\":1200}}}}'   (1200 µs)
   mmic encode command '{\"board\":1,\"command\":{\"hip\":{\"angle\":9000}}}'   (90.00°)
-  mmic encode command '{\"board\":1,\"command\":{\"primitive\":4}}'
+  mmic encode command '{\"board\":1,\"command\":{\"primitive\":{\"primitive\":4,\"target\":\"d\"}}}'   (primitive 4 ending in d)
   mmic encode command '{\"board\":1,\"command\":{\"reconfigure\":{\"initial\":\"a\",\"target\":\"m\"}}}'
   mmic encode command '{\"board\":1,\"command\":{\"power\":{\"target\":{\"module\":\"hip\"},\"on\":true}}}'
   mmic encode command '{\"board\":1,\"command\":\"stop\",\"seq\":258}'   (exactly-once sequence number; omitted = 0)

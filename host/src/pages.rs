@@ -110,7 +110,9 @@ pub fn commands() -> String {
     let _ = writeln!(
         s,
         "Parameters travel only in the slots Table 2 names; every unused parameter byte must be 0.\n\
-         JSON shows the variant with representative values (1500 µs, 90.00° = 9000).\n"
+         JSON shows the variant with representative values (1500 µs, 90.00° = 9000; each\n\
+         primitive with its first final state in Table 5 order: byte 8 names the state the\n\
+         primitive ends in, spec/motion/ambiguous-primitives.txt says why).\n"
     );
     let _ = writeln!(
         s,

@@ -51,8 +51,28 @@
 //! So may `start S` (a Table 5 state letter): the state the robot is in when the plan starts.
 //! With it, the parser follows the robot's state through the plan ([`Plan::trace`]) and
 //! refuses a reconfiguration that starts from another state than the one the robot will be in,
-//! or a primitive that is no move from there, with the line and column of the step — before
-//! anything is sent. (`mmic sim` traces every plan from its start state, `a` when not given.)
+//! or a primitive that does not take the robot from there to the final state the step names,
+//! with the line and column of the step — before anything is sent. (`mmic sim` traces every
+//! plan from its start state, `a` when not given.)
+//!
+//! A primitive step names its final state (`primitive 7 -> d`, or `primitive backTurnCW d`):
+//! from a turn state one primitive reaches two states (spec/motion/ambiguous-primitives.txt),
+//! and the command carries the one meant. With a `start` header the state may be left out where the
+//! plan's state makes it unambiguous (`start a`, then `primitive 4` is `primitive 4 -> d`); the
+//! parser fills it in from the map, and refuses the step, naming both candidates, where the
+//! primitive reaches two states from there.
+//!
+//! ```
+//! use mmic_host::plan::{self, PlanErrorKind};
+//! use mmic::motion::State;
+//! let p = plan::parse("start a\nprimitive 8\nprimitive 7 -> d\n")?; // a -> e, then e -> d
+//! assert_eq!(p.trace(State::A)?, [State::E, State::D]);
+//! assert_eq!(p.steps[0].action.to_string(), "primitive 8 -> e");
+//! let e = plan::parse("start a\nprimitive 8\nprimitive 7\n").unwrap_err();
+//! assert_eq!((e.line, e.column), (3, 11));
+//! assert!(matches!(e.kind, PlanErrorKind::AmbiguousPrimitive { first: State::A, second: State::D, .. }));
+//! # Ok::<(), plan::PlanError>(())
+//! ```
 //!
 //! ```
 //! let e = mmic_host::plan::parse("start a\nreconfigure a -> m\nreconfigure b -> n\n").unwrap_err();
@@ -71,7 +91,7 @@
 //! | `gripper a\|b contract\|extend\|<µs>` | [`Command::Gripper`], as for `arm` |
 //! | `hip home\|straight\|cw\|ccw\|<degrees>` | [`Command::Hip`]; `45`, `45.5`, `45deg` or `45°`, 0..=359.99, at most 2 decimals |
 //! | `bolt 1\|2\|3\|4\|all`, `unbolt 1\|2\|3\|4\|all`, `bolters down` | [`Command::Bolter`] |
-//! | `primitive 1..8` (or a Table 6 name, e.g. `fwdContract`) | [`Command::Primitive`] |
+//! | `primitive 1..8 [->] <final>` (or a Table 6 name, e.g. `fwdContract`), state `a`..`o` | [`Command::Primitive`]; the final state may be left out where the plan's state settles it |
 //! | `reconfigure <initial> -> <target>`, states `a`..`o` | [`Command::Reconfigure`] |
 //! | `power on\|off <module>\|all` | [`Command::Power`] |
 //! | `wait <duration>`: `500ms`, `2s`, `1.5s`; at most 1 hour, whole milliseconds | [`Action::Wait`] |
@@ -80,8 +100,8 @@
 //! `gripper-a`, `gripper-b`, `bolter-a`, `bolter-b`.
 
 use mmic::command::{
-    BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, ReconfigurationError,
-    ServoTarget,
+    BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove,
+    PrimitiveMoveError, ReconfigurationError, ServoTarget,
 };
 use mmic::mode::Mode;
 use mmic::motion::{Primitive, State};
@@ -248,10 +268,77 @@ pub enum PlanErrorKind {
         /// The line whose step put the robot there; none for the start state.
         since: Option<usize>,
     },
+    /// A primitive step whose final state is not where the primitive takes the robot from the
+    /// state it is in at that point of the plan; the robot would refuse it (initial state
+    /// mismatch).
+    #[error(
+        "primitive {primitive} takes {tracked} to {}, not to {target} (Figure 9); the robot is in {tracked} here ({})",
+        or_list(reaches),
+        since_text(*since)
+    )]
+    WrongFinalState {
+        /// The primitive's number.
+        primitive: u8,
+        /// The final state the step names.
+        target: State,
+        /// The state the plan has the robot in.
+        tracked: State,
+        /// Where the primitive does take the robot from there (one or two states).
+        reaches: Vec<State>,
+        /// The line whose step put the robot there; none for the start state.
+        since: Option<usize>,
+    },
+    /// A primitive step without its final state, where the primitive reaches two states from
+    /// the state the robot is in (spec/motion/ambiguous-primitives.txt): the step must say
+    /// which.
+    #[error(
+        "primitive {primitive} from {tracked} reaches both {first} and {second} (Figure 9): name the final state, e.g. `primitive {primitive} -> {}` (the robot is in {tracked} here, {})",
+        first.letter(),
+        since_text(*since)
+    )]
+    AmbiguousPrimitive {
+        /// The primitive's number.
+        primitive: u8,
+        /// The state the plan has the robot in.
+        tracked: State,
+        /// The first candidate, in Table 5 order.
+        first: State,
+        /// The second candidate.
+        second: State,
+        /// The line whose step put the robot there; none for the start state.
+        since: Option<usize>,
+    },
+    /// A primitive step without its final state in a plan without a `start` header: nothing
+    /// says where the robot is, so nothing can fill the state in.
+    #[error(
+        "primitive {primitive} needs its final state, e.g. `primitive {primitive} -> {}`, or a `start` header to fill it in from",
+        first_final_state(*primitive)
+    )]
+    MissingFinalState {
+        /// The primitive's number.
+        primitive: u8,
+    },
+    /// A final state the primitive reaches from no state at all.
+    #[error("{0}")]
+    Primitive(PrimitiveMoveError),
     /// No step at all: an empty plan is more likely a wrong file than an intent. Reported at
     /// line 1, column 1.
     #[error("the plan has no steps")]
     Empty,
+}
+
+/// The letter of the first state (Table 5 order) primitive number `n` can end in, for
+/// examples in messages.
+fn first_final_state(n: u8) -> char {
+    PrimitiveMove::all()
+        .find(|m| m.primitive().number() == n)
+        .map_or('a', |m| m.target().letter())
+}
+
+/// `a (Xneg match)` or `a (Xneg match) or d (Xneg Xpos stretch)`.
+fn or_list(states: &[State]) -> String {
+    let names: Vec<String> = states.iter().map(State::to_string).collect();
+    names.join(" or ")
 }
 
 fn since_text(since: Option<usize>) -> String {
@@ -291,7 +378,7 @@ pub fn parse(text: &str) -> Result<Plan, PlanError> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut robot: Option<(BoardNumber, usize)> = None;
     let mut start: Option<State> = None;
-    let mut steps = Vec::new();
+    let mut steps: Vec<Pending> = Vec::new();
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let tokens = tokenize(raw);
@@ -328,11 +415,11 @@ pub fn parse(text: &str) -> Result<Plan, PlanError> {
             cur.finish()?;
             continue;
         }
-        let action = step(&mut cur, first)?;
+        let parsed = step(&mut cur, first)?;
         cur.finish()?;
-        steps.push(Step {
+        steps.push(Pending {
             line,
-            action,
+            parsed,
             text: raw.trim().to_string(),
             columns: tokens.iter().map(|t| t.column).collect(),
         });
@@ -344,17 +431,145 @@ pub fn parse(text: &str) -> Result<Plan, PlanError> {
             kind: PlanErrorKind::Empty,
         });
     }
-    let plan = Plan {
+    // Every line parsed: now the robot's state, from a declared start. A step that does not
+    // fit it is an error of the file, found before anything is sent; a primitive without its
+    // final state gets the one the map gives from there, if there is exactly one.
+    let mut at = start.map(|s| (s, None));
+    let mut done = Vec::with_capacity(steps.len());
+    for p in steps {
+        let action = match p.parsed {
+            Parsed::Action(a) => a,
+            Parsed::BarePrimitive(primitive) => {
+                let column = p.columns.get(1).copied().unwrap_or(1);
+                let target = fill_in(primitive, at).map_err(|kind| PlanError {
+                    line: p.line,
+                    column,
+                    kind,
+                })?;
+                Action::Command(Command::Primitive(target))
+            }
+        };
+        let step = Step {
+            line: p.line,
+            action,
+            text: p.text,
+            columns: p.columns,
+        };
+        if let Some(now) = at {
+            at = Some(follow(now, &step)?);
+        }
+        done.push(step);
+    }
+    Ok(Plan {
         robot: robot.map_or(BoardNumber::ONE, |(r, _)| r),
         start,
-        steps,
+        steps: done,
+    })
+}
+
+/// A step as its line parses, before the robot's state is followed through the plan.
+struct Pending {
+    line: usize,
+    parsed: Parsed,
+    text: String,
+    columns: Vec<usize>,
+}
+
+/// What a step's tokens say: an action, or a primitive whose final state the plan's state
+/// must supply.
+enum Parsed {
+    Action(Action),
+    BarePrimitive(Primitive),
+}
+
+/// The one move `primitive` makes from the robot's state `at` (and the line that put it
+/// there), for a step that does not name its final state.
+fn fill_in(
+    primitive: Primitive,
+    at: Option<(State, Option<usize>)>,
+) -> Result<PrimitiveMove, PlanErrorKind> {
+    let number = primitive.number();
+    let Some((tracked, since)) = at else {
+        return Err(PlanErrorKind::MissingFinalState { primitive: number });
     };
-    // With a declared start, a step that does not fit the robot's state is an error of the
-    // file, found before anything is sent.
-    if let Some(start) = start {
-        plan.trace(start)?;
+    let mut ends = mmic::motion::map::targets(tracked, primitive);
+    match (ends.next(), ends.next()) {
+        (Some(to), None) => PrimitiveMove::new(primitive, to).map_err(PlanErrorKind::Primitive),
+        (Some(first), Some(second)) => Err(PlanErrorKind::AmbiguousPrimitive {
+            primitive: number,
+            tracked,
+            first,
+            second,
+            since,
+        }),
+        (None, _) => Err(PlanErrorKind::NoSuchMove {
+            primitive: number,
+            tracked,
+            since,
+        }),
     }
-    Ok(plan)
+}
+
+/// The robot's state after `step`, from `at` (the state, and the line whose step put the robot
+/// there): a reconfiguration must start from it and ends in its target; a primitive must be
+/// the map's move from it to the final state the step names, and ends there; every other step
+/// leaves it as it is (the plan runner sends a step only after the previous one settled).
+fn follow(
+    (tracked, since): (State, Option<usize>),
+    step: &Step,
+) -> Result<(State, Option<usize>), PlanError> {
+    let column = |i: usize| step.columns.get(i).copied().unwrap_or(1);
+    let error = |column: usize, kind: PlanErrorKind| PlanError {
+        line: step.line,
+        column,
+        kind,
+    };
+    match step.action {
+        Action::Command(Command::Reconfigure(r)) => {
+            if tracked != r.initial() {
+                return Err(error(
+                    column(1),
+                    PlanErrorKind::StateMismatch {
+                        found: r.initial(),
+                        tracked,
+                        since,
+                    },
+                ));
+            }
+            Ok((r.target(), Some(step.line)))
+        }
+        Action::Command(Command::Primitive(m)) => {
+            if m.is_move_from(tracked) {
+                return Ok((m.target(), Some(step.line)));
+            }
+            let reaches: Vec<State> = mmic::motion::map::targets(tracked, m.primitive()).collect();
+            let primitive = m.primitive().number();
+            Err(if reaches.is_empty() {
+                error(
+                    column(1),
+                    PlanErrorKind::NoSuchMove {
+                        primitive,
+                        tracked,
+                        since,
+                    },
+                )
+            } else {
+                // The final state is the step's last token.
+                let last = step.columns.last().copied().unwrap_or(1);
+                error(
+                    last,
+                    PlanErrorKind::WrongFinalState {
+                        primitive,
+                        target: m.target(),
+                        tracked,
+                        reaches,
+                        since,
+                    },
+                )
+            })
+        }
+        _ => Ok((tracked, since)),
+    }
 }
 
 impl Plan {
@@ -377,59 +592,17 @@ impl Plan {
 impl Plan {
     /// Follows the robot's state through the plan from `start`, as board A tracks it: a
     /// reconfiguration must start from the state the robot is in and leaves it in its target;
-    /// a primitive must be a move of Figure 9 from that state and leaves it in the move's end
-    /// (unknown where the primitive reaches two states from there, after which reconfigurations
-    /// are taken at their word); every other step leaves the state as it is (the plan runner
-    /// sends a step only after the previous one settled). Returns the state after each step
-    /// (`None` where unknown), or the first step that does not fit, with its line and the
-    /// column of the offending token.
-    pub fn trace(&self, start: State) -> Result<Vec<Option<State>>, PlanError> {
-        let mut at: Option<(State, Option<usize>)> = Some((start, None));
+    /// a primitive must take the robot from that state to the final state the step names
+    /// (Figure 9) and leaves it there; every other step leaves the state as it is (the plan
+    /// runner sends a step only after the previous one settled). Returns the state after each
+    /// step, or the first step that does not fit, with its line and the column of the
+    /// offending token.
+    pub fn trace(&self, start: State) -> Result<Vec<State>, PlanError> {
+        let mut at = (start, None);
         let mut out = Vec::with_capacity(self.steps.len());
         for step in &self.steps {
-            let column = |i: usize| step.columns.get(i).copied().unwrap_or(1);
-            match step.action {
-                Action::Command(Command::Reconfigure(r)) => {
-                    if let Some((tracked, since)) = at {
-                        if tracked != r.initial() {
-                            return Err(PlanError {
-                                line: step.line,
-                                column: column(1),
-                                kind: PlanErrorKind::StateMismatch {
-                                    found: r.initial(),
-                                    tracked,
-                                    since,
-                                },
-                            });
-                        }
-                    }
-                    at = Some((r.target(), Some(step.line)));
-                }
-                Action::Command(Command::Primitive(p)) => {
-                    if let Some((tracked, since)) = at {
-                        let mut ends = State::ALL
-                            .into_iter()
-                            .filter(|&to| mmic::motion::map::primitive(tracked, to) == Some(p));
-                        at = match (ends.next(), ends.next()) {
-                            (Some(to), None) => Some((to, Some(step.line))),
-                            (Some(_), Some(_)) => None,
-                            (None, _) => {
-                                return Err(PlanError {
-                                    line: step.line,
-                                    column: column(1),
-                                    kind: PlanErrorKind::NoSuchMove {
-                                        primitive: p.number(),
-                                        tracked,
-                                        since,
-                                    },
-                                })
-                            }
-                        };
-                    }
-                }
-                _ => {}
-            }
-            out.push(at.map(|(s, _)| s));
+            at = follow(at, step)?;
+            out.push(at.0);
         }
         Ok(out)
     }
@@ -459,7 +632,12 @@ impl Action {
             Command::Bolter(BolterCommand::Bolt(f)) => format!("bolt {}", fasteners(*f)),
             Command::Bolter(BolterCommand::Unbolt(f)) => format!("unbolt {}", fasteners(*f)),
             Command::Bolter(BolterCommand::Down) => "lower both bolters".into(),
-            Command::Primitive(p) => format!("primitive {} ({})", p.number(), p.name()),
+            Command::Primitive(m) => format!(
+                "primitive {} ({}) to {}",
+                m.primitive().number(),
+                m.primitive().name(),
+                m.target()
+            ),
             Command::Reconfigure(r) => format!("reconfigure {} -> {}", r.initial(), r.target()),
             Command::Power { target, on } => format!(
                 "power {} {}",
@@ -504,7 +682,12 @@ impl fmt::Display for Action {
             Command::Bolter(BolterCommand::Bolt(w)) => write!(f, "bolt {}", fastener_word(*w)),
             Command::Bolter(BolterCommand::Unbolt(w)) => write!(f, "unbolt {}", fastener_word(*w)),
             Command::Bolter(BolterCommand::Down) => f.write_str("bolters down"),
-            Command::Primitive(p) => write!(f, "primitive {}", p.number()),
+            Command::Primitive(m) => write!(
+                f,
+                "primitive {} -> {}",
+                m.primitive().number(),
+                m.target().letter()
+            ),
             Command::Reconfigure(r) => write!(
                 f,
                 "reconfigure {} -> {}",
@@ -758,7 +941,7 @@ const PRIMITIVE: &str = "a primitive number 1..=8 or a Table 6 name";
 const STATE: &str = "a state letter a..o (Table 5)";
 const DURATION: &str = "a duration with unit ms or s (e.g. 500ms, 1.5s)";
 
-fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Action, PlanError> {
+fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Parsed, PlanError> {
     let kw = first.text.to_ascii_lowercase();
     let cmd = match kw.as_str() {
         "heartbeat" => Command::Heartbeat,
@@ -827,7 +1010,18 @@ fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Action, PlanError
                         .ok_or_else(|| cur.out_of_range(t, "primitive", "1", "8"))?
                 }
             };
-            Command::Primitive(p)
+            // The final state: `-> s` or `s`; none, to be filled in from the plan's state.
+            if cur.tokens.get(cur.next).is_some_and(|t| t.text == "->") {
+                cur.next += 1;
+            } else if cur.tokens.get(cur.next).is_none() {
+                return Ok(Parsed::BarePrimitive(p));
+            }
+            let target_tok = cur.tokens.get(cur.next).copied();
+            let target = state_token(cur, "primitive")?;
+            Command::primitive(p, target).map_err(|e| {
+                let at = target_tok.unwrap_or(t);
+                cur.error_at(&at, PlanErrorKind::Primitive(e))
+            })?
         }
         "reconfigure" => {
             let initial = state(cur)?;
@@ -859,7 +1053,7 @@ fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Action, PlanError
             };
             Command::Power { target, on }
         }
-        "wait" => return wait(cur),
+        "wait" => return wait(cur).map(Parsed::Action),
         _ => {
             return Err(cur.error_at(
                 first,
@@ -869,7 +1063,7 @@ fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Action, PlanError
             ))
         }
     };
-    Ok(Action::Command(cmd))
+    Ok(Parsed::Action(Action::Command(cmd)))
 }
 
 fn side(cur: &mut Cursor<'_, '_>, step: &'static str) -> Result<Side, PlanError> {

@@ -127,7 +127,7 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
         .map_err(|error| CliError::Plan { path, error })?;
     if a.check_plan {
         let mut path_of_states = vec![start.letter().to_string()];
-        for s in states.iter().flatten() {
+        for s in &states {
             if path_of_states.last().map(String::as_str) != Some(&s.letter().to_string()) {
                 path_of_states.push(s.letter().to_string());
             }

@@ -32,7 +32,7 @@
 
 use core::fmt::Debug;
 use mmic::bolter::{BolterDirection, BolterStep, MuxLines};
-use mmic::command::{for_each_variant_class, BolterPair, Command};
+use mmic::command::{for_each_variant_class, BolterPair, Command, PrimitiveMove};
 use mmic::faults::Faults;
 use mmic::mode::Mode;
 use mmic::motion::State;
@@ -212,7 +212,8 @@ impl<'a> Seed<'a> {
         BolterPair::from_number(self.u8() % 5)
     }
 
-    /// Any command: one of the 61 opcode classes, with sampled parameters.
+    /// Any command: one of the 61 opcode classes, with sampled parameters (a primitive's final
+    /// state among those it reaches).
     pub fn command(&mut self) -> Command {
         let class = self.u8() as usize % 61;
         let (pw, angle) = (self.pulse(), self.angle());
@@ -225,6 +226,12 @@ impl<'a> Seed<'a> {
             }
             i += 1;
         });
+        if let Command::Primitive(m) = chosen {
+            // Any final state the primitive reaches (3 for primitives 1-4, 12 for 5-8).
+            let of_p = || PrimitiveMove::all().filter(move |o| o.primitive() == m.primitive());
+            let i = self.u8() as usize % of_p().count().max(1);
+            chosen = Command::Primitive(of_p().nth(i).unwrap_or(m));
+        }
         if let Command::Reconfigure(_) = chosen {
             // Any matched target other than the initial state.
             let target = if target == initial {

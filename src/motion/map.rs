@@ -5,6 +5,10 @@
 //! assert_eq!(map::primitive(State::A, State::D), Some(Primitive::BackExtend));
 //! assert_eq!(map::primitive(State::A, State::M), None); // needs two primitives
 //! assert_eq!(map::moves().count(), 72);
+//! // From a turn state one primitive may reach two states: a primitive command names its
+//! // final state (spec/motion/ambiguous-primitives.txt).
+//! assert!(map::targets(State::E, Primitive::BackTurnCw).eq([State::A, State::D]));
+//! assert_eq!(map::ambiguous().count(), 12);
 //! ```
 
 use super::geometry::single_move;
@@ -45,6 +49,48 @@ pub fn moves() -> impl Iterator<Item = (State, State, Primitive)> {
         State::ALL
             .into_iter()
             .filter_map(move |t| primitive(f, t).map(|p| (f, t, p)))
+    })
+}
+
+/// The states primitive `p` takes `from` to, in Table 5 order: none, one, or two. Two happen
+/// from the turn states, where the moving side can swing onto the face the other side grips
+/// (a match) or onto the opposite face of that axis (a stretch), with the same rotation of
+/// its arm; the primitive alone does not say which, so a primitive command carries its final
+/// state.
+pub fn targets(from: State, p: Primitive) -> impl Iterator<Item = State> {
+    State::ALL
+        .into_iter()
+        .filter(move |&to| primitive(from, to) == Some(p))
+}
+
+/// Whether some state is taken to `to` by `p`: whether `to` can be the final state of a
+/// primitive command for `p` at all (a command naming another is malformed, whatever state
+/// the robot is in).
+pub const fn reaches(p: Primitive, to: State) -> bool {
+    let mut i = 0;
+    while i < N {
+        if let Some(q) = MAP[i][to.index()] {
+            if q as u8 == p as u8 {
+                return true;
+            }
+        }
+        i += 1;
+    }
+    false
+}
+
+/// The (state, primitive) pairs whose primitive reaches two states, as (from, primitive,
+/// first target, second target) with the targets in Table 5 order; rows in Table 5, then
+/// Table 6 order. There are 12, two from each turn state (spec/motion/ambiguous-primitives.txt).
+pub fn ambiguous() -> impl Iterator<Item = (State, Primitive, State, State)> {
+    State::ALL.into_iter().flat_map(|from| {
+        Primitive::ALL.into_iter().filter_map(move |p| {
+            let mut to = targets(from, p);
+            match (to.next(), to.next()) {
+                (Some(first), Some(second)) => Some((from, p, first, second)),
+                _ => None,
+            }
+        })
     })
 }
 

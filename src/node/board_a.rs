@@ -34,7 +34,7 @@ use super::exactly_once::{Admission, CommandLog};
 use crate::bolter::{
     self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals,
 };
-use crate::command::{preset_angle, BolterCommand, Command, HipTarget, ServoTarget};
+use crate::command::{preset_angle, BolterCommand, Command, HipTarget, PrimitiveMove, ServoTarget};
 use crate::control::hip::{self, HipController};
 use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::faults::{Fault, Faults};
@@ -42,7 +42,7 @@ use crate::mode::Mode;
 use crate::motion::estimate::{self, initial_state_consistent, Readings};
 use crate::motion::runner::{RunStatus, Runner};
 use crate::motion::sequencer::{self, Feedback, Targets};
-use crate::motion::{map, State};
+use crate::motion::State;
 use crate::refusal::Refusal;
 use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
 use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
@@ -840,23 +840,28 @@ impl BoardA {
             Ok(c) => c,
         };
         // Board-level checks the supervisor does not make: one motion at a time, and a
-        // primitive must be a move from the state the robot is in.
+        // primitive must be the map's move from the state the robot is in to the final state
+        // it names.
         if c.kind().moves() && in_motion && self.sup.mode() == Mode::Operational {
             return Received::Refuse(seq, c, Refusal::Busy);
         }
-        if let Command::Primitive(pr) = c {
-            if self.sup.mode() == Mode::Operational && self.primitive_target(pr).is_none() {
+        if let Command::Primitive(m) = c {
+            if self.sup.mode() == Mode::Operational && self.primitive_move(m).is_none() {
+                // The command holds only where the primitive takes some state to its final
+                // state; the robot is in none of them: the ground's belief of where the robot
+                // is does not hold, as with a reconfiguration's initial state.
                 return Received::Refuse(seq, c, Refusal::InitialStateMismatch);
             }
         }
         Received::Run(seq, Incoming::Command(c))
     }
 
-    fn primitive_target(&self, pr: crate::motion::Primitive) -> Option<State> {
+    /// The move a primitive command asks for, as (from, to): from the tracked state to the
+    /// command's final state, when that is the primitive's cell of the map (Figure 9). The
+    /// final state settles the 12 (state, primitive) pairs that reach two states.
+    fn primitive_move(&self, m: PrimitiveMove) -> Option<(State, State)> {
         let from = self.tracked?;
-        State::ALL
-            .into_iter()
-            .find(|&to| map::primitive(from, to) == Some(pr))
+        m.is_move_from(from).then_some((from, m.target()))
     }
 
     fn readings(&self, inp: &Inputs) -> Readings {
@@ -905,8 +910,8 @@ impl BoardA {
                 });
                 self.bolting_start(now);
             }
-            Command::Primitive(pr) => {
-                if let (Some(from), Some(to)) = (self.tracked, self.primitive_target(pr)) {
+            Command::Primitive(m) => {
+                if let Some((from, to)) = self.primitive_move(m) {
                     self.start_run(from, to, now);
                 }
             }

@@ -39,7 +39,8 @@ pub struct CommandPacket {
     pub command: u8,
     /// Bytes 6–7: hip target (0.01°).
     pub hip: U16,
-    /// Bytes 8–9: arm A target (µs), or final state (8) and initial state (9).
+    /// Bytes 8–9: arm A target (µs); or a final state (8: reconfiguration, primitive) and a
+    /// reconfiguration's initial state (9).
     pub arm_a: U16,
     /// Bytes 10–11: arm B target (µs).
     pub arm_b: U16,

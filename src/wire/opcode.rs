@@ -12,8 +12,8 @@
 //! ```
 
 use crate::command::{
-    BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, Reconfiguration,
-    ReconfigurationError, ServoTarget,
+    BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove,
+    PrimitiveMoveError, Reconfiguration, ReconfigurationError, ServoTarget,
 };
 use crate::mode::Mode;
 use crate::motion::{Primitive, State};
@@ -48,7 +48,7 @@ pub const BOLT: u8 = 0x40;
 pub const UNBOLT: u8 = 0x48;
 /// Bolters down.
 pub const BOLTERS_DOWN: u8 = 0x4f;
-/// Primitive n (1..=8) = base + n.
+/// Primitive n (1..=8) = base + n; its final state in byte 8 (byte 9 stays 0).
 pub const PRIMITIVE: u8 = 0x50;
 /// Reconfigure: final state in byte 8, initial in byte 9.
 pub const RECONFIGURE: u8 = 0x60;
@@ -63,7 +63,8 @@ pub const POWER_OFF: u8 = 0x78;
 pub enum Slot {
     /// Bytes 6–7: hip target.
     Hip,
-    /// Bytes 8–9: arm A target, or final (8) / initial (9) state.
+    /// Bytes 8–9: arm A target; or a final state in byte 8 (reconfiguration, primitive) and
+    /// a reconfiguration's initial state in byte 9.
     ArmA,
     /// Bytes 10–11: arm B target.
     ArmB,
@@ -137,6 +138,13 @@ pub enum CommandError {
         /// Value found.
         found: u16,
     },
+    /// A state byte left 0: the command must name a state there (a primitive built for the
+    /// old layout, which carried no final state, lands here).
+    #[error("byte {index}: state missing (0x00), must be 'a'..='o' (0x61..=0x6f)")]
+    MissingState {
+        /// Packet index.
+        index: usize,
+    },
     /// A state byte that is no Table 5 letter.
     #[error("byte {index}: state must be 'a'..='o' (0x61..=0x6f), found {found:#04x}")]
     State {
@@ -148,6 +156,9 @@ pub enum CommandError {
     /// A well-formed but impossible reconfiguration.
     #[error("bytes 8-9: {0}")]
     Reconfiguration(#[from] ReconfigurationError),
+    /// A primitive whose final state it reaches from no state.
+    #[error("byte 8: {0}")]
+    Primitive(#[from] PrimitiveMoveError),
 }
 
 fn get_u16(p: &[u8; PARAM_LEN], slot: Slot) -> u16 {
@@ -230,21 +241,40 @@ fn decode_bolter(id: u8) -> BolterCommand {
     }
 }
 
+/// The state in parameter byte `i`: missing when 0, invalid when no Table 5 letter.
+fn state_at(p: &[u8; PARAM_LEN], i: usize) -> Result<State, CommandError> {
+    let index = PARAM_OFFSET + i;
+    match p[i] {
+        0 => Err(CommandError::MissingState { index }),
+        b => State::from_wire(b).ok_or(CommandError::State { index, found: b }),
+    }
+}
+
 /// A reconfiguration: target state in the first parameter byte, initial state in the second
 /// (Table 2's "final state / init state").
 fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
     let at = Slot::ArmA.offset();
-    let state = |i: usize| {
-        State::from_wire(p[i]).ok_or(CommandError::State {
-            index: PARAM_OFFSET + i,
-            found: p[i],
-        })
-    };
-    let target = state(at)?;
-    let initial = state(at + 1)?;
+    let target = state_at(p, at)?;
+    let initial = state_at(p, at + 1)?;
     Ok((
         Command::Reconfigure(Reconfiguration::new(initial, target)?),
         0b11 << at,
+    ))
+}
+
+/// A primitive: its number in the opcode, its final state in byte 8 (Table 2's "final
+/// state", as for a reconfiguration). The initial state (byte 9) is not carried: a primitive
+/// starts where board A tracks the robot, which checks that the move is the primitive's cell
+/// of the map from there (spec/decisions.toml: primitive-final-state).
+fn decode_primitive(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+    let Some(primitive) = Primitive::from_number(id - PRIMITIVE) else {
+        return Err(CommandError::UnknownId { id });
+    };
+    let at = Slot::ArmA.offset();
+    let target = state_at(p, at)?;
+    Ok((
+        Command::Primitive(PrimitiveMove::new(primitive, target)?),
+        1 << at,
     ))
 }
 
@@ -307,7 +337,10 @@ pub fn encode(c: &Command) -> (u8, [u8; PARAM_LEN]) {
             BolterCommand::Unbolt(Fasteners::All) => UNBOLT + 4,
             BolterCommand::Down => BOLTERS_DOWN,
         },
-        Command::Primitive(pr) => PRIMITIVE + pr.number(),
+        Command::Primitive(m) => {
+            p[Slot::ArmA.offset()] = m.target().to_wire();
+            PRIMITIVE + m.primitive().number()
+        }
         Command::Reconfigure(r) => {
             p[Slot::ArmA.offset()] = r.target().to_wire();
             p[Slot::ArmA.offset() + 1] = r.initial().to_wire();
@@ -346,10 +379,7 @@ pub fn decode(id: u8, p: [u8; PARAM_LEN]) -> Result<Command, CommandError> {
         _ if in_block(id, BOLT, 5) || in_block(id, UNBOLT, 5) => {
             (Command::Bolter(decode_bolter(id)), 0)
         }
-        _ if in_block(id, PRIMITIVE + 1, 8) => match Primitive::from_number(id - PRIMITIVE) {
-            Some(pr) => (Command::Primitive(pr), 0),
-            None => return Err(CommandError::UnknownId { id }),
-        },
+        _ if in_block(id, PRIMITIVE + 1, 8) => decode_primitive(id, &p)?,
         _ if in_block(id, POWER_ON, 16) => (decode_power(id), 0),
         _ => return Err(CommandError::UnknownId { id }),
     };

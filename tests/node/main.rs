@@ -5,3 +5,4 @@
 mod node_boards;
 mod node_fidelity;
 mod node_handoff;
+mod node_primitives;

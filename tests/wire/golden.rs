@@ -13,16 +13,17 @@ use crate::common;
 
 use common::crc16_bitwise;
 use mmic::bolter::{BolterDirection, BolterStep, MuxLines};
-use mmic::command::{BolterPair, Command, ServoTarget};
+use mmic::command::{BolterPair, Command, CommandError, ServoTarget};
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
-use mmic::motion::State;
+use mmic::motion::{Primitive, State};
 use mmic::refusal::Refusal;
 use mmic::units::{Axis, BoardNumber, Electrical, Gravity, HipAngle, PulseWidth, Side, Sign};
 use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder, B_COMMAND_LEN};
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::heartbeat::{BolterAttempt, HeartbeatRepr, HEARTBEAT_LEN};
 use mmic::wire::internal_heartbeat::{BolterAux, InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
+use mmic::wire::WireError;
 
 fn pw(us: u16) -> PulseWidth {
     PulseWidth::new(us).unwrap()
@@ -95,6 +96,49 @@ fn golden_command_reconfigure() {
     assert_crc(&COMMAND_RECONFIGURE);
     assert_eq!(repr.to_bytes(), COMMAND_RECONFIGURE);
     assert_eq!(CommandRepr::parse(&COMMAND_RECONFIGURE), Ok(repr));
+}
+
+/// Robot 2, sequenced command 0x0203: primitive 7 (backTurnCW) ending in state d. From e the
+/// primitive reaches a or d (spec/motion/ambiguous-primitives.txt); byte 8 says which.
+const COMMAND_PRIMITIVE: [u8; COMMAND_LEN] = [
+    b'M', b'I', b'C', b'M', // 0-3 header
+    0x02, // 4 board 2
+    0x57, // 5 opcode: primitive (0x50) + 7
+    0x00, 0x00, // 6-7 hip: unused, zero
+    b'd', // 8 final state 'd' = 0x64
+    0x00, // 9 initial state: not carried for a primitive, zero
+    0x03, 0x02, // 10-11 sequence number 0x0203
+    0xda, 0x2a, // 12-13 CRC-16 0x2ada
+];
+
+/// The same primitive in the layout before final states: byte 8 zero. Sealed correctly, but
+/// no command: the move it meant is not known.
+const COMMAND_PRIMITIVE_NO_STATE: [u8; COMMAND_LEN] = [
+    b'M', b'I', b'C', b'M', // 0-3 header
+    0x02, // 4 board 2
+    0x57, // 5 opcode: primitive 7
+    0x00, 0x00, // 6-7 hip: unused, zero
+    0x00, // 8 final state: missing
+    0x00, // 9 zero
+    0x03, 0x02, // 10-11 sequence number 0x0203
+    0xf9, 0xb9, // 12-13 CRC-16 0xb9f9
+];
+
+#[test]
+fn golden_command_primitive() {
+    let repr = CommandRepr {
+        board: BoardNumber::new(2).unwrap(),
+        command: Command::primitive(Primitive::BackTurnCw, State::D).unwrap(),
+        seq: 0x0203,
+    };
+    assert_crc(&COMMAND_PRIMITIVE);
+    assert_eq!(repr.to_bytes(), COMMAND_PRIMITIVE);
+    assert_eq!(CommandRepr::parse(&COMMAND_PRIMITIVE), Ok(repr));
+    assert_crc(&COMMAND_PRIMITIVE_NO_STATE);
+    assert_eq!(
+        CommandRepr::parse(&COMMAND_PRIMITIVE_NO_STATE),
+        Err(WireError::Command(CommandError::MissingState { index: 8 }))
+    );
 }
 
 /// Exactly-once commanding (spec/protocol/README.md): the arm-B command above as sequenced

@@ -149,10 +149,11 @@ fn mismatch(s: &Summary, step: usize) -> String {
         ))) => {
             format!("the plan expected the robot in {}", r.initial())
         }
-        Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Primitive(p))) => {
+        Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Primitive(m))) => {
             format!(
-                "primitive {} is no move from the state the robot is in",
-                p.number()
+                "primitive {} does not take the robot from the state it is in to {}",
+                m.primitive().number(),
+                m.target()
             )
         }
         _ => "the step does not fit the robot's state".to_string(),

@@ -432,11 +432,14 @@ fn validated_values_are_refused_with_their_numbers() {
     let cmd = |c: Value| json!({"board": 1, "command": c}).to_string();
     let hb = heartbeat();
     let cases: Vec<(&str, String, &str)> = vec![
-        ("command", cmd(json!({"primitive": 9})), "primitive (Table 6) must be in 1..=8, found 9"),
+        ("command", cmd(json!({"primitive": {"primitive": 9, "target": "d"}})), "primitive (Table 6) must be in 1..=8, found 9"),
         // Out of the wire type's range too (negative, beyond u8/u16): still the field's own
         // range message, never serde's "expected u8".
-        ("command", cmd(json!({"primitive": 900})), "primitive (Table 6) must be in 1..=8, found 900"),
-        ("command", cmd(json!({"primitive": -1})), "primitive (Table 6) must be in 1..=8, found -1"),
+        ("command", cmd(json!({"primitive": {"primitive": 900, "target": "d"}})), "primitive (Table 6) must be in 1..=8, found 900"),
+        ("command", cmd(json!({"primitive": {"primitive": -1, "target": "d"}})), "primitive (Table 6) must be in 1..=8, found -1"),
+        // A primitive names its final state; one it reaches from no state is refused.
+        ("command", cmd(json!({"primitive": {"primitive": 4}})), "missing field `target`"),
+        ("command", cmd(json!({"primitive": {"primitive": 3, "target": "a"}})), "primitive 3 fwdExtend takes no state to a (Xneg match) (Figure 9)"),
         (
             "command",
             cmd(json!({"arm": {"side": "a", "target": {"position": -5}}})),
@@ -459,7 +462,7 @@ fn validated_values_are_refused_with_their_numbers() {
         ("command", r#"{"board":-3,"command":"stop"}"#.into(), "board number must be in 1..=255, found -3"),
         ("command", r#"{"board":1,"command":"stop","seq":70000}"#.into(), "sequence number must be in 0..=65535, found 70000"),
         ("command", r#"{"board":1,"command":"stop","seq":-1}"#.into(), "sequence number must be in 0..=65535, found -1"),
-        ("command", cmd(json!({"primitive": 0})), "found 0"),
+        ("command", cmd(json!({"primitive": {"primitive": 0, "target": "d"}})), "found 0"),
         (
             "command",
             cmd(json!({"gripper": {"side": "b", "target": {"position": 499}}})),
@@ -601,7 +604,7 @@ fn help_explains_units_exit_codes_and_gives_examples() {
     for needle in [
         "500..=2500 µs",
         "0.01°",
-        "\"primitive\":4",
+        "\"primitive\":{\"primitive\":4,\"target\":\"d\"}",
         "\"reconfigure\"",
         "b-command",
     ] {

@@ -167,10 +167,16 @@ fn each_step_form_parses_to_its_command() {
         C::Bolter(BolterCommand::Unbolt(Fasteners::All))
     );
     assert_eq!(cmd("bolters down"), C::Bolter(BolterCommand::Down));
-    assert_eq!(cmd("primitive 4"), C::Primitive(Primitive::BackExtend));
+    let prim = |p, s| Command::primitive(p, s).expect("valid primitive command");
     assert_eq!(
-        cmd("primitive fwdturnccw"),
-        C::Primitive(Primitive::FwdTurnCcw)
+        cmd("primitive 4 -> d"),
+        prim(Primitive::BackExtend, State::D)
+    );
+    assert_eq!(cmd("primitive 4 d"), prim(Primitive::BackExtend, State::D));
+    assert_eq!(cmd("primitive 7->D"), prim(Primitive::BackTurnCw, State::D));
+    assert_eq!(
+        cmd("primitive fwdturnccw -> k"),
+        prim(Primitive::FwdTurnCcw, State::K)
     );
     let r = Command::reconfigure(State::A, State::M).expect("valid");
     assert_eq!(cmd("reconfigure a -> m"), r);
@@ -421,6 +427,8 @@ fn errors_name_line_and_column_of_the_offending_token() {
         ("bolt some", 6),
         ("bolters up", 9),
         ("primitive jump", 11),
+        ("primitive 7 -> z", 16),
+        ("primitive 7 ab", 13),
         ("reconfigure p -> a", 13),
         ("reconfigure a to m", 15),
         ("reconfigure a -> mm", 18),
@@ -461,7 +469,10 @@ fn descriptions_are_short_and_specific() {
     assert_eq!(d("wait 250ms"), "wait 250 ms");
     assert_eq!(d("hip 45.5"), "hip to 45.5°");
     assert_eq!(d("mode safed"), "switch to safed mode");
-    assert_eq!(d("primitive 1"), "primitive 1 (fwdContract)");
+    assert_eq!(
+        d("primitive 1 -> m"),
+        "primitive 1 (fwdContract) to m (Xpos match)"
+    );
     assert_eq!(d("bolt all"), "bolt all pairs");
     assert_eq!(d("power off all"), "power off all modules");
     assert_eq!(
@@ -479,24 +490,11 @@ fn a_start_header_round_trips_and_the_state_is_traced_through_the_plan() {
     assert_eq!(p.start, Some(State::A));
     assert_eq!(plan::parse(&p.to_text()).unwrap().start, Some(State::A));
     let states = p.trace(State::A).unwrap();
-    assert_eq!(
-        states,
-        [
-            Some(State::A),
-            Some(State::M),
-            Some(State::M),
-            Some(State::B)
-        ]
-    );
+    assert_eq!(states, [State::A, State::M, State::M, State::B]);
     // The demo plan says where it starts, and traces through three voxels.
     let demo = plan::parse(mmic_host::sim::DEMO_PLAN).unwrap();
     assert_eq!(demo.start, Some(State::A));
-    let ends: Vec<State> = demo
-        .trace(State::A)
-        .unwrap()
-        .into_iter()
-        .flatten()
-        .collect();
+    let ends: Vec<State> = demo.trace(State::A).unwrap();
     assert_eq!(ends.last(), Some(&State::N));
 }
 
@@ -553,4 +551,125 @@ fn a_step_that_does_not_fit_the_state_is_refused_with_line_and_column() {
         plan::parse("start a\nstart b\nstop\n").unwrap_err().kind,
         PlanErrorKind::StartMisplaced
     );
+}
+
+#[test]
+fn every_primitive_command_round_trips_through_the_text() {
+    let steps: Vec<Action> = mmic::command::PrimitiveMove::all()
+        .map(|m| Action::Command(Command::Primitive(m)))
+        .collect();
+    assert_eq!(steps.len(), 60);
+    let text: String = steps.iter().map(|a| format!("{a}\n")).collect();
+    assert!(text.starts_with("primitive 1 -> m\n"), "{text}");
+    let back = plan::parse(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    assert_eq!(actions(&back), steps);
+}
+
+#[test]
+fn a_primitive_step_names_its_final_state_or_the_plan_settles_it() {
+    use mmic::command::PrimitiveMoveError;
+    // Named: no start needed. Left out without a start header: nothing to fill it in from.
+    assert_eq!(
+        cmd("primitive 7 -> d"),
+        Command::primitive(Primitive::BackTurnCw, State::D).unwrap()
+    );
+    assert_eq!(
+        err_at("primitive 7\n", 1, 11),
+        PlanErrorKind::MissingFinalState { primitive: 7 }
+    );
+    assert_eq!(
+        err("primitive fwdContract").to_string(),
+        "line 1, column 11: primitive 1 needs its final state, e.g. `primitive 1 -> m`, or a \
+         `start` header to fill it in from"
+    );
+    assert_eq!(
+        err_at("primitive 7 ->", 1, 15),
+        PlanErrorKind::MissingArgument {
+            step: "primitive",
+            expected: "a state letter a..o (Table 5)"
+        }
+    );
+    // A final state the primitive reaches from nowhere: refused where it stands.
+    assert_eq!(
+        err_at("primitive 3 -> a", 1, 16),
+        PlanErrorKind::Primitive(PrimitiveMoveError::Unreachable {
+            primitive: Primitive::FwdExtend,
+            target: State::A
+        })
+    );
+    // With a start, the one move from there fills it in: a -> e by 8, canonical text names it.
+    let p = plan::parse("start a\nprimitive 8\n").unwrap();
+    assert_eq!(
+        actions(&p),
+        [Action::Command(
+            Command::primitive(Primitive::BackTurnCcw, State::E).unwrap()
+        )]
+    );
+    assert_eq!(p.to_text(), "robot 1\nstart a\nprimitive 8 -> e\n");
+    // A final state the primitive does not reach from the tracked state.
+    let e = err("start a\nprimitive 8\n  primitive 7 -> b\n");
+    assert_eq!((e.line, e.column), (3, 18));
+    assert_eq!(
+        e.kind,
+        PlanErrorKind::WrongFinalState {
+            primitive: 7,
+            target: State::B,
+            tracked: State::E,
+            reaches: vec![State::A, State::D],
+            since: Some(2)
+        }
+    );
+    assert_eq!(
+        e.to_string(),
+        "line 3, column 18: primitive 7 takes e (Xneg Ypos turn) to a (Xneg match) or \
+         d (Xneg Xpos stretch), not to b (Yneg match) (Figure 9); the robot is in e (Xneg Ypos \
+         turn) here (since line 2)"
+    );
+}
+
+/// Each of the 12 ambiguous (state, primitive) pairs: left out, the final state is an error
+/// naming both candidates and the line; named, either candidate is accepted and traced.
+#[test]
+fn an_ambiguous_primitive_must_name_its_final_state() {
+    let mut n = 0;
+    for (from, p, first, second) in mmic::motion::map::ambiguous() {
+        // Reach `from` by primitives whose final state the parser fills in.
+        let route = mmic::motion::route::lookup(State::A, from);
+        let mut text = String::from("start a\nmode operational\n");
+        for q in route.primitives() {
+            text += &format!("primitive {}\n", q.number());
+        }
+        let line = 3 + route.len();
+        let e = err(&format!("{text}primitive {}  # which?\n", p.name()));
+        assert_eq!((e.line, e.column), (line, 11), "{from} by {p}");
+        assert_eq!(
+            e.kind,
+            PlanErrorKind::AmbiguousPrimitive {
+                primitive: p.number(),
+                tracked: from,
+                first,
+                second,
+                since: Some(line - 1)
+            }
+        );
+        let message = e.to_string();
+        for s in [first, second, from] {
+            assert!(message.contains(&s.to_string()), "{message}");
+        }
+        assert!(
+            message.starts_with(&format!("line {line}, column 11: ")),
+            "{message}"
+        );
+        for target in [first, second] {
+            let plan = plan::parse(&format!(
+                "{text}primitive {} -> {}\n",
+                p.number(),
+                target.letter()
+            ))
+            .unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(plan.trace(State::A).unwrap().last(), Some(&target));
+        }
+        n += 1;
+    }
+    assert_eq!(n, 12);
 }
