@@ -335,7 +335,7 @@ impl ControlTask<'_> {
                 hip: f.hip,
                 gravity: f.gravity,
                 arm_contracted: s.arm_contracted,
-                bolter: s.bolter,
+                bolter_at_home: s.bolter_at_home,
             },
         );
         {
@@ -412,7 +412,7 @@ impl BoardBTask {
                     electrical: f.electrical,
                     gravity: f.gravity,
                     arm_contracted: s.arm_contracted,
-                    bolter: s.bolter,
+                    bolter_at_home: s.bolter_at_home,
                 },
             );
             self.plant
