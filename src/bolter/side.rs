@@ -58,10 +58,10 @@ pub struct SideConfig {
     pub push_threshold_ma: Milliamps,
     /// Rotate ends once I_bo ≥ this: the fastener locked (released, when unbolting) and the
     /// head stalls. Default 1200 mA: above the push threshold by more than the moving average
-    /// can carry over from a push that just ended (the filtered current peaks about one sample's
-    /// share, (stall − idle) / 50 ≈ 30 mA, past the push threshold, then falls), so the lag of
-    /// the filter cannot end Rotate as it starts; below the 2000 mA limit for the same reason as
-    /// the push threshold.
+    /// can carry over from a push that just ended (the filtered current peaks at most one
+    /// sample's share of a current under the 2000 mA limit, 2000 / 50 = 40 mA, past the push
+    /// threshold, then falls), so the lag of the filter cannot end Rotate as it starts; below
+    /// the 2000 mA limit for the same reason as the push threshold.
     pub lock_threshold_ma: Milliamps,
 }
 
