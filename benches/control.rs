@@ -1,7 +1,7 @@
 //! One step of each Section 5 piece. Run: `cargo bench --bench control`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Signals};
+use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Sensed};
 use mmic::command::{BolterPair, Fasteners};
 use mmic::control::hip::{Config as HipConfig, HipController};
 use mmic::control::interp::{Interpolator, Rate};
@@ -78,9 +78,8 @@ fn pieces(c: &mut Criterion) {
             side.tick(
                 &cfg.side,
                 t,
-                Signals {
-                    threshold: true,
-                    locked: true,
+                Sensed {
+                    i_bo: cfg.side.lock_threshold_ma.max(cfg.side.push_threshold_ma),
                     at_home: true,
                 },
             );

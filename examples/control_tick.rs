@@ -10,9 +10,7 @@
 //! # instructions per tick = (total of the second − total of the first) / 10000
 //! ```
 
-use mmic::bolter::{
-    BolterDirection, BolterSide, Config as BolterConfig, Coordinator, Job, Signals,
-};
+use mmic::bolter::{BolterDirection, BolterSide, Config as BolterConfig, Coordinator, Job, Sensed};
 use mmic::command::{BolterPair, Fasteners};
 use mmic::control::hip::{Config as HipConfig, HipController};
 use mmic::control::interp::{Interpolator, Rate};
@@ -83,9 +81,9 @@ impl Loop {
         self.side.tick(
             &self.bolter_cfg.side,
             now,
-            Signals {
-                threshold: e.i_bo > 1500,
-                ..Signals::default()
+            Sensed {
+                i_bo: e.i_bo,
+                at_home: false,
             },
         );
         pw + hip_out.micros() as u32 + e.v_bat as u32 + g.map_or(0, |g| g.axis as u32)

@@ -436,3 +436,178 @@ fn check_plan_refuses_a_step_that_does_not_fit_before_anything_runs() {
         "plan OK: 11 steps for robot 1, states a -> m -> b -> n"
     );
 }
+
+/// Board B's internal heartbeats that reached A, as (t_ms, bolter_aux, I_boB).
+fn b_reports(records: &[Value]) -> Vec<(u64, &Value, u64)> {
+    records
+        .iter()
+        .filter(|r| {
+            r["kind"] == "packet"
+                && r["link"] == "serial_ab"
+                && r["from"] == "board_b1"
+                && r["packet"].is_object()
+        })
+        .map(|r| {
+            let p = &r["packet"];
+            (
+                r["t_ms"].as_u64().unwrap(),
+                &p["bolter_aux"],
+                p["electrical_b"]["i_bo"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// The plant's bolter currents sit where the library's thresholds need them: idle under the
+/// idle limit, running below both thresholds, pushing over the push threshold, a locked head
+/// over the lock threshold, both under the bolter's overcurrent limit, and the injected
+/// obstacle over it.
+#[test]
+fn the_plant_bolter_currents_straddle_the_library_thresholds() {
+    use mmic_host::sim::plant::*;
+    let side = mmic::bolter::SideConfig::default();
+    let (push, lock) = (side.push_threshold_ma as f64, side.lock_threshold_ma as f64);
+    let limits = mmic::safety::detect::Config::default();
+    let (idle, absolute) = (limits.idle.bolter as f64, limits.absolute.bolter as f64);
+    assert!(BOLTER_IDLE_MA < idle);
+    assert!(BOLTER_RUNNING_MA < push);
+    assert!(push <= BOLTER_PUSHING_MA && BOLTER_PUSHING_MA <= absolute);
+    assert!(lock <= BOLTER_LOCKED_MA && BOLTER_LOCKED_MA <= absolute);
+    assert!(BOLTER_OBSTACLE_MA > absolute);
+}
+
+#[test]
+fn a_bolt_command_completes_on_the_bolter_current() {
+    let cfg = SimConfig {
+        scale: 20.0,
+        ..SimConfig::with_steps(steps("mode operational\nbolt 2\nwait 1s\n"))
+    };
+    let (s, records) = simulate("bolt_current", cfg);
+    assert!(s.completed(), "{}", report::text(&s));
+    assert!(events(&records, "faults").next().is_none(), "no fault");
+    let pairs: Vec<&Value> = events(&records, "pair").collect();
+    assert_eq!(pairs.len(), 1);
+    assert_eq!(pairs[0]["event"]["ok"], true);
+    assert_eq!(pairs[0]["event"]["pair"], 2);
+    assert_eq!(pairs[0]["event"]["attempts"], 1);
+
+    // Side B's reports: a current-sensed step still running always reads under its threshold
+    // (the decision is the current's), Rotate ran the whole rotation before its current said
+    // locked (the push it follows did not end it through the filter's lag), and I_boB rose
+    // over the push threshold while staying under the overcurrent limit.
+    let side = mmic::bolter::SideConfig::default();
+    let absolute = mmic::safety::detect::Config::default().absolute.bolter as u64;
+    let reports = b_reports(&records);
+    let mut rotate_from = None;
+    let mut rotate_ran = None;
+    let mut max_i_bo = 0;
+    for &(t, aux, i_bo) in &reports {
+        max_i_bo = max_i_bo.max(i_bo);
+        let running = aux["timed_out"] == false;
+        match aux["step"].as_str() {
+            Some("descend" | "descend_engage") if running && aux["threshold_reached"] == false => {
+                assert!(i_bo < side.push_threshold_ma as u64, "{t} ms: {i_bo} mA");
+            }
+            Some("rotate") => {
+                rotate_from.get_or_insert(t);
+                if aux["locked"] == true {
+                    rotate_ran.get_or_insert(t - rotate_from.unwrap());
+                } else if running {
+                    assert!(i_bo < side.lock_threshold_ma as u64, "{t} ms: {i_bo} mA");
+                }
+            }
+            _ => {}
+        }
+    }
+    let ran = rotate_ran.expect("side B reported the fastener locked");
+    eprintln!("Rotate on side B: {ran} ms to locked; largest I_boB {max_i_bo} mA");
+    assert!(
+        ran >= mmic_host::sim::plant::ROTATE_MS as u64 && ran < side.sensed_ms as u64,
+        "Rotate ended after {ran} ms"
+    );
+    assert!(
+        max_i_bo >= side.push_threshold_ma as u64 && max_i_bo <= absolute,
+        "largest I_boB {max_i_bo} mA"
+    );
+}
+
+#[test]
+fn a_jammed_fastener_ends_in_the_bolting_failure_fault_and_standby() {
+    let mut cfg = SimConfig {
+        scale: 20.0,
+        ..SimConfig::with_steps(steps("mode operational\nbolt 1\nwait 1s\n"))
+    };
+    cfg.plant.jammed_fastener_at = Some(0);
+    let (s, records) = simulate("jammed_fastener", cfg);
+    let fault = events(&records, "faults")
+        .find(|e| {
+            e["event"]["faults"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|f| f == "bolting_failure")
+        })
+        .expect("bolting failure raised");
+    let pairs: Vec<&Value> = events(&records, "pair").collect();
+    assert_eq!(pairs.len(), 1, "{pairs:?}");
+    assert_eq!(pairs[0]["event"]["ok"], false);
+    assert_eq!(
+        pairs[0]["event"]["attempts"], 3,
+        "three attempts, then the fault"
+    );
+    let standby = events(&records, "mode")
+        .filter(|e| e["event"]["to"] == "standby")
+        .last()
+        .expect("Standby entered");
+    assert!(standby["t_ms"].as_u64() >= fault["t_ms"].as_u64());
+    assert!(
+        events(&records, "mode").all(|e| e["event"]["to"] != "safed"),
+        "a bolting failure is a Standby fault (Table 8)"
+    );
+    assert_eq!(s.status["mode"], "standby");
+    // Every attempt's Rotate ran into its timeout: no current ever said locked.
+    assert!(b_reports(&records)
+        .iter()
+        .all(|(_, aux, _)| aux["locked"] == false));
+}
+
+#[test]
+fn a_bolter_obstacle_while_bolting_raises_bolter_overcurrent_and_safes_the_robot() {
+    // Bolting starts about 3.6 s in; the obstacle meets bolter A on its way down. (At rest the
+    // idle check, at 200 mA, would see it first.)
+    let at = 4_000;
+    let mut cfg = SimConfig {
+        scale: 20.0,
+        ..SimConfig::with_steps(steps("mode operational\nbolt 1\nwait 1s\n"))
+    };
+    cfg.plant.bolter_obstacle_at = Some(at);
+    let (s, records) = simulate("bolter_obstacle", cfg);
+    let first = events(&records, "faults").next().expect("a fault raised");
+    assert_eq!(
+        first["event"]["faults"],
+        serde_json::json!(["bolter_overcurrent"]),
+        "the absolute check, alone"
+    );
+    let t = first["t_ms"].as_u64().unwrap();
+    // The moving average crosses 2000 mA some 400 ms into the 500 ms obstacle.
+    assert!(t >= at as u64 && t < at as u64 + 500, "at {t} ms");
+    let safed = events(&records, "mode")
+        .find(|e| e["event"]["to"] == "safed")
+        .expect("Safed entered");
+    assert_eq!(
+        safed["t_ms"].as_u64().unwrap(),
+        t,
+        "at once (Table 8: Safed)"
+    );
+    assert!(
+        matches!(
+            s.ends[0],
+            Some(PlanEnd::Interrupted {
+                mode: Mode::Safed,
+                ..
+            })
+        ),
+        "{:?}",
+        s.ends
+    );
+}

@@ -14,7 +14,8 @@ use crate::wire::internal_heartbeat::BolterAux;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
-    /// The sides' step timeouts.
+    /// Side A's step timeouts and current thresholds; the coordinator's own patience with
+    /// side B is derived from the same timeouts.
     pub side: SideConfig,
     /// Extra time the coordinator waits for side B's report beyond the side timeout before it
     /// gives up on the link (internal communication loss). Default 1000 ms.

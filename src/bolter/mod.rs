@@ -19,7 +19,7 @@ mod coordinator;
 mod side;
 
 pub use coordinator::{Config, Coordinator, Job, Output, Status};
-pub use side::{BolterSide, Drive, SideConfig, Signals};
+pub use side::{BolterSide, Drive, Sensed, SideConfig};
 
 wire_enum! {
     /// One of the four bolter pairs of a face, selected through the ADG1604 multiplexer.

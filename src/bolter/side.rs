@@ -1,20 +1,26 @@
-//! One side's bolter: executes the step it was last ordered, latches the step's end signal from
-//! the current sensing, and times out the current-sensed steps.
+//! One side's bolter: executes the step it was last ordered, decides the end of a
+//! current-sensed step from the measured bolter current I_bo against the step's threshold,
+//! latches it, and times out the steps that never end.
 
 use super::{BolterDirection, BolterStep, MuxLines};
-use crate::units::Instant;
+use crate::units::{Instant, Milliamps};
 use crate::wire::b_command::BolterOrder;
 use crate::wire::internal_heartbeat::BolterAux;
 
-/// What the side's bolter hardware reports this tick (from the filtered I_bo and the position).
+/// What the side's bolter hardware reads this tick: the raw material of the step decisions,
+/// not the decisions themselves, so that the thresholds live in one place ([`SideConfig`]) and
+/// the same executor runs on boards A and B.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Signals {
-    /// The bolter current passed its push threshold.
-    pub threshold: bool,
-    /// The current says the fastener is locked (released, when unbolting).
-    pub locked: bool,
-    /// The bolter is in its initial configuration.
+pub struct Sensed {
+    /// The bolter current I_bo, mA, as the sensor front end filtered it (the 50-sample moving
+    /// average of ADS7828 CH6; board A's `Inputs.electrical.i_bo`, board B's likewise). Section
+    /// 5: the bolters push "until the I_boA and I_boB current threshold is met", and "current
+    /// sensing determines if it's locked".
+    pub i_bo: Milliamps,
+    /// The bolter's home switch: it is in its initial configuration. A digital input, not a
+    /// current decision: the steps that end at home carry no asterisk in Figure 8, and the
+    /// paper does not say how home is sensed (spec/decisions.toml, `bolter-home`).
     pub at_home: bool,
 }
 
@@ -34,14 +40,29 @@ pub enum Drive {
     CounterRotateUp,
 }
 
-/// Step timeouts, ms.
+/// The executor's limits: when a current-sensed step has ended, and how long any step may take.
+/// The defaults are spec/control/bolter.toml's (checked by `tests/control/bolter_current.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SideConfig {
-    /// Current-sensed steps (the paper's asterisks): Descend, DescendEngage, Rotate.
+    /// Timeout of the current-sensed steps (the paper's asterisks): Descend, DescendEngage,
+    /// Rotate. Default 4000 ms.
     pub sensed_ms: u32,
-    /// Steps that end at home: Retract, CounterRotate, ReturnHome.
+    /// Timeout of the steps that end at home: Retract, CounterRotate, ReturnHome. Default
+    /// 4000 ms.
     pub home_ms: u32,
+    /// Descend and DescendEngage end once I_bo ≥ this: the bolter is pushing against the
+    /// fastener (it is commanded further down than it can go, so the current rises on contact).
+    /// Default 1000 mA: well above a moving bolter's draw and the 200 mA idle limit, well below
+    /// the 2000 mA bolter overcurrent limit, so a normal push ends long before that fault.
+    pub push_threshold_ma: Milliamps,
+    /// Rotate ends once I_bo ≥ this: the fastener locked (released, when unbolting) and the
+    /// head stalls. Default 1200 mA: above the push threshold by more than the moving average
+    /// can carry over from a push that just ended (the filtered current peaks at most one
+    /// sample's share of a current under the 2000 mA limit, 2000 / 50 = 40 mA, past the push
+    /// threshold, then falls), so the lag of the filter cannot end Rotate as it starts; below
+    /// the 2000 mA limit for the same reason as the push threshold.
+    pub lock_threshold_ma: Milliamps,
 }
 
 impl Default for SideConfig {
@@ -49,6 +70,23 @@ impl Default for SideConfig {
         SideConfig {
             sensed_ms: 4000,
             home_ms: 4000,
+            push_threshold_ma: 1000,
+            lock_threshold_ma: 1200,
+        }
+    }
+}
+
+impl SideConfig {
+    /// The current threshold that ends `step`, for the current-sensed steps (Descend,
+    /// DescendEngage: the push threshold; Rotate: the lock threshold); `None` for the others,
+    /// which no current ends. A step ends when I_bo ≥ the threshold (Section 5: the threshold
+    /// "is met", I_bo "hits the threshold"); the overcurrent checks, by contrast, fire strictly
+    /// above their limits ("rises above").
+    pub const fn threshold(&self, step: BolterStep) -> Option<Milliamps> {
+        match step {
+            BolterStep::Descend | BolterStep::DescendEngage => Some(self.push_threshold_ma),
+            BolterStep::Rotate => Some(self.lock_threshold_ma),
+            _ => None,
         }
     }
 }
@@ -113,8 +151,12 @@ impl BolterSide {
         };
     }
 
-    /// One tick: latches the end signal of the current step, or times it out.
-    pub fn tick(&mut self, cfg: &SideConfig, now: u32, s: Signals) {
+    /// One tick: decides and latches the end signal of the current step, or times it out. In
+    /// a current-sensed step the current latches that step's flag (threshold reached in the
+    /// descents, locked in Rotate) once it reaches the step's threshold; in the other steps, and
+    /// when idle, no current latches anything: a spike there ends nothing. The home switch
+    /// latches `at_home` in any step.
+    pub fn tick(&mut self, cfg: &SideConfig, now: u32, r: Sensed) {
         let Some((_, o)) = self.order else { return };
         let limit = if sensed(o.step) {
             cfg.sensed_ms
@@ -130,9 +172,13 @@ impl BolterSide {
         if self.finished() {
             return;
         }
-        self.threshold |= s.threshold;
-        self.locked |= s.locked;
-        self.at_home |= s.at_home;
+        let reached = cfg.threshold(o.step).is_some_and(|t| r.i_bo >= t);
+        match o.step {
+            BolterStep::Descend | BolterStep::DescendEngage => self.threshold |= reached,
+            BolterStep::Rotate => self.locked |= reached,
+            _ => {}
+        }
+        self.at_home |= r.at_home;
         if !ended(o.step, self.threshold, self.locked, self.at_home) && self.waited_ms > limit {
             self.timed_out = true;
         }

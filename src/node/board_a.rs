@@ -32,7 +32,7 @@
 use super::b_link::BLink;
 use super::exactly_once::{Admission, CommandLog};
 use crate::bolter::{
-    self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Signals,
+    self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Sensed,
 };
 use crate::command::{preset_angle, BolterCommand, Command, HipTarget, PrimitiveMove, ServoTarget};
 use crate::control::hip::{self, HipController};
@@ -126,13 +126,14 @@ pub struct Inputs {
     pub gravity: Option<Gravity>,
     /// Arm A's contraction switch.
     pub arm_contracted: bool,
-    /// Bolter A's signals.
-    pub bolter: Signals,
+    /// Bolter A's home switch: the bolter is in its initial configuration. (The end of a
+    /// current-sensed bolter step is decided from `electrical.i_bo`.)
+    pub bolter_at_home: bool,
 }
 
 impl Inputs {
     /// Nothing received; a full battery, no current; hip at the default home angle (180°),
-    /// arm A contracted.
+    /// arm A contracted, bolter A at home.
     pub const fn at_home() -> Inputs {
         Inputs {
             command: None,
@@ -149,11 +150,7 @@ impl Inputs {
             hip: HipAngle::STRAIGHT,
             gravity: None,
             arm_contracted: true,
-            bolter: Signals {
-                threshold: false,
-                locked: false,
-                at_home: true,
-            },
+            bolter_at_home: true,
         }
     }
 }
@@ -801,7 +798,11 @@ impl BoardA {
         out.hip = (live && p.contains(Module::Hip)).then_some(hip_pulse);
         out.arm = (live && p.contains(Module::ArmA)).then_some(arm_now);
         out.gripper = (live && p.contains(Module::GripperA)).then_some(gripper_now);
-        self.side_a.tick(&self.cfg.bolter.side, now, inp.bolter);
+        let bolter = Sensed {
+            i_bo: inp.electrical.i_bo,
+            at_home: inp.bolter_at_home,
+        };
+        self.side_a.tick(&self.cfg.bolter.side, now, bolter);
         if live && p.contains(Module::BolterA) {
             out.bolter = self.side_a.drive();
         }

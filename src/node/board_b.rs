@@ -29,7 +29,7 @@
 //! assert_eq!(out.arm.unwrap().micros(), 1100);
 //! ```
 
-use crate::bolter::{BolterSide, Drive, MuxLines, SideConfig, Signals};
+use crate::bolter::{BolterSide, Drive, MuxLines, Sensed, SideConfig};
 use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::safety::detect;
 use crate::units::Instant;
@@ -48,7 +48,8 @@ pub struct Config {
     pub link_timeout_ms: u32,
     /// Servo interpolation rate.
     pub rate: Rate,
-    /// Bolter step timeouts.
+    /// Bolter B's step timeouts and current thresholds (the same defaults as side A's,
+    /// board A's `bolter.side`: the two bolters are identical).
     pub bolter: SideConfig,
     /// Current limits for the over-idle and overcurrent flags (Table 4 bytes 38–43).
     pub limits: detect::Config,
@@ -84,8 +85,9 @@ pub struct Inputs {
     pub gravity: Option<Gravity>,
     /// Arm B's contraction switch.
     pub arm_contracted: bool,
-    /// Bolter B's signals.
-    pub bolter: Signals,
+    /// Bolter B's home switch: the bolter is in its initial configuration. (The end of a
+    /// current-sensed bolter step is decided from `electrical.i_bo`.)
+    pub bolter_at_home: bool,
 }
 
 /// One tick's outputs.
@@ -187,7 +189,11 @@ impl BoardB {
             self.holding = true;
             self.hold(now);
         }
-        self.bolter.tick(&self.cfg.bolter, now, inp.bolter);
+        let bolter = Sensed {
+            i_bo: inp.electrical.i_bo,
+            at_home: inp.bolter_at_home,
+        };
+        self.bolter.tick(&self.cfg.bolter, now, bolter);
         let arm_now = self.arm.tick(now);
         let gripper_now = self.gripper.tick(now);
         let power = self.last.map(|c| c.power).unwrap_or_default();

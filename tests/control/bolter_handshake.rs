@@ -1,7 +1,10 @@
 //! The A/B bolter handshake, model-checked by explicit-state search: board A's coordinator and
 //! side-A executor, board B's executor, an A→B link and a B→A link that lose and duplicate
 //! messages (FIFO: a serial line does not reorder), both sides' sensor events in any order, and
-//! time that can jump past every timeout at any moment. Every reachable state is checked:
+//! time that can jump past every timeout at any moment. A side's sensor event is a reading just
+//! at the threshold of every current-sensed step with the home switch closed (whatever step runs,
+//! it ends); every other tick reads a current just below every threshold with the switch open
+//! (no step ends). Every reachable state is checked:
 //!
 //! - side B never runs a step A has not ordered, and is never more than one order behind;
 //! - when B is one order behind while A proceeds normally (not a retry), B's step is finished:
@@ -9,7 +12,7 @@
 //! - from every reachable state the job can still end (Done or Failed): no stuck state;
 //! - a bolting failure is declared only on the last attempt (or when a bolter cannot get home).
 
-use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Signals, Status};
+use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Sensed, Status};
 use mmic::command::{BolterPair, Fasteners};
 use mmic::faults::Fault;
 use mmic::wire::b_command::BolterOrder;
@@ -30,10 +33,16 @@ struct World {
 const JUMP: u32 = 1 << 30; // past every timeout, and the clock cycles through 4 values
 
 fn successors(cfg: &Config, w: &World) -> Vec<World> {
-    let all = Signals {
-        threshold: true,
-        locked: true,
+    let (push, lock) = (cfg.side.push_threshold_ma, cfg.side.lock_threshold_ma);
+    // The end event: I_bo just reaches the higher threshold (so every sensed step's), home.
+    let all = Sensed {
+        i_bo: push.max(lock),
         at_home: true,
+    };
+    // No event: I_bo one mA short of the lower threshold, away from home.
+    let none = Sensed {
+        i_bo: push.min(lock) - 1,
+        at_home: false,
     };
     let mut out = Vec::new();
     // A's control loop: coordinator tick, side A follows, a fresh snapshot goes on the link.
@@ -44,7 +53,7 @@ fn successors(cfg: &Config, w: &World) -> Vec<World> {
         None => (x.a.aux().seq, None),
     };
     x.a.order(seq, order, x.now);
-    x.a.tick(&cfg.side, x.now, Signals::default());
+    x.a.tick(&cfg.side, x.now, none);
     x.ab = Some((seq, order));
     out.push(x);
     // Side A's end signal for its step.
@@ -66,7 +75,7 @@ fn successors(cfg: &Config, w: &World) -> Vec<World> {
     }
     // B sends its heartbeat; B→A delivered (duplicable) or lost.
     let mut x = *w;
-    x.b.tick(&cfg.side, x.now, Signals::default());
+    x.b.tick(&cfg.side, x.now, none);
     x.ba = Some(x.b.aux());
     out.push(x);
     if let Some(aux) = w.ba {

@@ -6,7 +6,7 @@
 //! failure fault, which takes an Operational robot to Standby.
 
 use mmic::bolter::{
-    BolterDirection, BolterSide, BolterStep, Config, Coordinator, Job, Signals, Status,
+    BolterDirection, BolterSide, BolterStep, Config, Coordinator, Job, Sensed, Status,
 };
 use mmic::command::{BolterPair, Command, Fasteners};
 use mmic::faults::{Fault, Faults};
@@ -26,6 +26,30 @@ impl Rng {
 }
 
 const DEMO: [u32; 4] = [2307, 103, 28, 86];
+
+/// A moving bolter's filtered current, mA: under both thresholds.
+const RUNNING_MA: u16 = 450;
+/// A bolter pushing its fastener: over the push threshold, under the lock threshold.
+const PUSHING_MA: u16 = 1100;
+/// A head stalled on a locked (released) fastener: over the lock threshold, under the 2000 mA
+/// overcurrent limit.
+const STALLED_MA: u16 = 1600;
+
+/// What a side's sensors read `t` ms into `step`: the bolter meets its fastener (descents) or
+/// the fastener locks (Rotate, only if `lock`) or the bolter is home (the other steps) after
+/// `after` ms; the current runs at [`RUNNING_MA`] before that.
+fn readings(step: BolterStep, t: u32, after: u32, lock: bool) -> Sensed {
+    let i_bo = match step {
+        BolterStep::Descend | BolterStep::DescendEngage if t >= after => PUSHING_MA,
+        BolterStep::Rotate if lock && t >= after => STALLED_MA,
+        _ => RUNNING_MA,
+    };
+    let at_home = !matches!(
+        step,
+        BolterStep::Descend | BolterStep::DescendEngage | BolterStep::Rotate
+    ) && t >= after;
+    Sensed { i_bo, at_home }
+}
 
 /// Runs one pair; `succeeds[k]` says whether attempt k+1 locks. Returns (attempts, status).
 fn run_pair(cfg: &Config, succeeds: [bool; 3]) -> (u8, Status) {
@@ -58,20 +82,12 @@ fn run_pair(cfg: &Config, succeeds: [bool; 3]) -> (u8, Status) {
         b.order(seq, Some(order), now);
         let t = now - step_since;
         let lock = succeeds[(coord.attempt() - 1) as usize];
-        let sig = match order.step {
-            BolterStep::Descend | BolterStep::DescendEngage => Signals {
-                threshold: t >= 100,
-                ..Signals::default()
-            },
-            BolterStep::Rotate => Signals {
-                locked: lock && t >= 200,
-                ..Signals::default()
-            },
-            _ => Signals {
-                at_home: t >= 100,
-                ..Signals::default()
-            },
+        let after = if order.step == BolterStep::Rotate {
+            200
+        } else {
+            100
         };
+        let sig = readings(order.step, t, after, lock);
         a.tick(&cfg.side, now, sig);
         b.tick(&cfg.side, now, sig);
     }
@@ -87,6 +103,12 @@ fn attempt_histogram_matches_figure_10() {
     let p2 = DEMO[1] as f64 / (total - DEMO[0]) as f64;
     let p3 = DEMO[2] as f64 / (total - DEMO[0] - DEMO[1]) as f64;
     let cfg = Config::default();
+    // The model's currents sit where the plant's do: running under both thresholds, pushing
+    // between them, stalled over the lock threshold and under the overcurrent limit.
+    let limit = mmic::safety::detect::Config::default().absolute.bolter;
+    assert!(RUNNING_MA < cfg.side.push_threshold_ma);
+    assert!((cfg.side.push_threshold_ma..cfg.side.lock_threshold_ma).contains(&PUSHING_MA));
+    assert!((cfg.side.lock_threshold_ma..=limit).contains(&STALLED_MA));
     let mut rng = Rng(0x4d4d_4943_2d49);
     let n = 25_240u32;
     let mut hist = [0u32; 4];
@@ -182,20 +204,7 @@ fn all_four_stops_at_the_first_failing_pair() {
         let t = now - since.1;
         // Pair 3 never releases.
         let lock = order.pair != BolterPair::P3;
-        let sig = match order.step {
-            BolterStep::Descend | BolterStep::DescendEngage => Signals {
-                threshold: t >= 50,
-                ..Signals::default()
-            },
-            BolterStep::Rotate => Signals {
-                locked: lock && t >= 50,
-                ..Signals::default()
-            },
-            _ => Signals {
-                at_home: t >= 50,
-                ..Signals::default()
-            },
-        };
+        let sig = readings(order.step, t, 50, lock);
         a.tick(&cfg.side, now, sig);
         b.tick(&cfg.side, now, sig);
     }

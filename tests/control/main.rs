@@ -1,10 +1,12 @@
-//! Sections 2 and 5, Figures 8 and 10: the hip controller, the sensor front end and the bolter.
+//! Sections 2 and 5, Figures 8 and 10: the hip controller, the sensor front end and the bolter
+//! (its current sensing, A/B handshake and statistics).
 //!
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
 #[path = "../common/mod.rs"]
 mod common;
 
+mod bolter_current;
 mod bolter_handshake;
 mod bolter_statistics;
 mod control_hip;

@@ -106,7 +106,7 @@ impl Robot {
                 hip: fa.hip,
                 gravity: fa.gravity,
                 arm_contracted: sa.arm_contracted,
-                bolter: sa.bolter,
+                bolter_at_home: sa.bolter_at_home,
             },
         );
         let out_b = self.b.tick(
@@ -116,7 +116,7 @@ impl Robot {
                 electrical: fb.electrical,
                 gravity: fb.gravity,
                 arm_contracted: sb.arm_contracted,
-                bolter: sb.bolter,
+                bolter_at_home: sb.bolter_at_home,
             },
         );
         self.plant.drive_a(

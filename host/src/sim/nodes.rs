@@ -338,7 +338,7 @@ impl ControlTask<'_> {
                 hip: f.hip,
                 gravity: f.gravity,
                 arm_contracted: s.arm_contracted,
-                bolter: s.bolter,
+                bolter_at_home: s.bolter_at_home,
             },
         );
         {
@@ -415,7 +415,7 @@ impl BoardBTask {
                     electrical: f.electrical,
                     gravity: f.gravity,
                     arm_contracted: s.arm_contracted,
-                    bolter: s.bolter,
+                    bolter_at_home: s.bolter_at_home,
                 },
             );
             self.plant

@@ -6,13 +6,19 @@
 //! each board's shell passes them through the library's sensor front end
 //! (`mmic::sensors::frontend`, Section 2's 50-sample averages) as the firmware would.
 //!
+//! The bolters report what the firmware's current sensing needs (Section 5): a bolter draws a
+//! running current while it moves, more once it presses its fastener (it is driven further down
+//! than it can go), and more still once the rotating head stalls on a locked fastener; the
+//! firmware decides the end of those steps from I_bo alone. Only "at home" is a switch.
+//!
 //! Simplifications, stated: the gravity readings are those the paper's model predicts for the
 //! state the robot last reached (the plant does not integrate the kinematics); both sides'
 //! bolters share one lock roll per attempt (a face's fastener pair locks or does not);
 //! the lock probability of consecutive attempts on one pair follows Figure 10's demo
-//! (2307/2524, then 103/217, then 28/114).
+//! (2307/2524, then 103/217, then 28/114); unbolting uses the same roll, "locked" then meaning
+//! "released" (the head stalls at the end of the unlocking turn alike).
 
-use mmic::bolter::{Drive, MuxLines, Signals};
+use mmic::bolter::{Drive, MuxLines};
 use mmic::motion::estimate::{self, predict};
 use mmic::motion::State;
 use mmic::sensors::adc::{Channel, Scaling, CODE_MAX};
@@ -34,6 +40,13 @@ pub struct PlantConfig {
     pub low_battery_at: Option<u32>,
     /// At this time (ms) arm A hits an obstacle: its current jumps to 3.5 A for 500 ms.
     pub overcurrent_at: Option<u32>,
+    /// From this time on (ms) no fastener locks (or releases): every rotation runs without the
+    /// stall current, so every attempt times out and the third raises the (un)bolting failure
+    /// fault (Table 8: Standby). Models a jammed fastener or a misplaced voxel (Section 8).
+    pub jammed_fastener_at: Option<u32>,
+    /// At this time (ms) bolter A hits an obstacle: its current jumps to 2.6 A, above the
+    /// 2000 mA bolter limit, for 500 ms (Table 8: bolter module overcurrent, Safed).
+    pub bolter_obstacle_at: Option<u32>,
     /// RNG seed (fastener locks).
     pub seed: u64,
     /// Pulse at which an arm's contraction switch closes (the firmware's "contracted").
@@ -49,6 +62,8 @@ impl Default for PlantConfig {
             drain_mv_per_s: 2.0,
             low_battery_at: None,
             overcurrent_at: None,
+            jammed_fastener_at: None,
+            bolter_obstacle_at: None,
             seed: 1,
             arm_contracted: mmic::node::board_a::Config::default().arm.contracted,
         }
@@ -85,8 +100,9 @@ pub struct Senses {
     pub raw: Raw,
     /// Arm contraction switch.
     pub arm_contracted: bool,
-    /// Bolter signals.
-    pub bolter: Signals,
+    /// Bolter home switch: the bolter is in its initial configuration (its current is among
+    /// the ADC codes, channel I_bo).
+    pub bolter_at_home: bool,
 }
 
 /// The plant.
@@ -119,8 +135,24 @@ pub struct Plant {
 }
 
 const SERVO_US_PER_S: f64 = 2000.0;
-const BOLTER_TRAVEL_MS: f64 = 800.0;
-const ROTATE_MS: f64 = 1000.0;
+/// A bolter's travel between home and its fastener, ms.
+pub const BOLTER_TRAVEL_MS: f64 = 800.0;
+/// How long the heads rotate before a fastener that locks does, ms.
+pub const ROTATE_MS: f64 = 1000.0;
+/// Bolter current, mA: unpowered or holding.
+pub const BOLTER_IDLE_MA: f64 = 40.0;
+/// Moving (translating or rotating freely): under both thresholds and, like the other
+/// modules, no idle fault while it settles.
+pub const BOLTER_RUNNING_MA: f64 = 450.0;
+/// Pressing the fastener: over the push threshold (1000 mA by default), under the 2000 mA
+/// overcurrent limit. (Over the lock threshold too: Rotate never sees it raw, and the filtered
+/// current a push leaves behind ends just past the push threshold.)
+pub const BOLTER_PUSHING_MA: f64 = 1350.0;
+/// The head stalled on a locked (released) fastener: over the lock threshold (1200 mA by
+/// default), under the 2000 mA overcurrent limit.
+pub const BOLTER_LOCKED_MA: f64 = 1600.0;
+/// Bolter A against an obstacle (`bolter_obstacle_at`): over the 2000 mA limit.
+pub const BOLTER_OBSTACLE_MA: f64 = 2600.0;
 /// ADC noise, codes either side.
 const NOISE: i32 = 5;
 
@@ -217,11 +249,17 @@ impl Plant {
             self.tries = 0;
         }
         let rotating = self.bolter.iter().any(|b| b.drive == Some(Drive::Rotate));
+        let jammed = self.cfg.jammed_fastener_at.is_some_and(|t| now >= t);
         if rotating && self.lock.is_none() {
             let p = self.cfg.lock_probability[self.tries.min(2)];
-            let ok = self.rng.f64() < p;
+            // Rolled even when jammed, so that a jam does not shift later rolls.
+            let ok = self.rng.f64() < p && !jammed;
             self.lock = Some(ok);
             self.tries = if ok { 0 } else { self.tries + 1 };
+        }
+        if jammed && self.lock == Some(true) {
+            // Jammed during a rotation: that one does not lock either.
+            self.lock = Some(false);
         }
         if !rotating {
             self.lock = None;
@@ -263,7 +301,7 @@ impl Plant {
         let reg = d.is_some_and(|d| d.regulator);
         let b = self.bolter[side];
         let drive = b.drive.unwrap_or(Drive::Idle);
-        let threshold = drive == Drive::Down && b.pos >= 1.0;
+        let pushing = drive == Drive::Down && b.pos >= 1.0;
         let locked =
             drive == Drive::Rotate && b.rotating_ms >= ROTATE_MS && self.lock == Some(true);
         let hip_moving = side == 0 && self.hip_speed.abs() > 50.0;
@@ -284,11 +322,22 @@ impl Plant {
             } else {
                 0.0
             };
-        let i_bo = match drive {
-            Drive::Idle => 40.0,
-            _ => 450.0,
-        } + if threshold { 900.0 } else { 0.0 }
-            + if side == 0 { self.stuck_bolter_ma } else { 0.0 };
+        let bolter_obstacle = side == 0
+            && self
+                .cfg
+                .bolter_obstacle_at
+                .is_some_and(|t| now >= t && now < t + 500);
+        let i_bo = if bolter_obstacle {
+            BOLTER_OBSTACLE_MA
+        } else if pushing {
+            BOLTER_PUSHING_MA
+        } else if locked {
+            BOLTER_LOCKED_MA
+        } else if drive == Drive::Idle {
+            BOLTER_IDLE_MA
+        } else {
+            BOLTER_RUNNING_MA
+        } + if side == 0 { self.stuck_bolter_ma } else { 0.0 };
         let i_3v3 = 80.0;
         let i_bat = i_loc + i_grip + i_bo + i_3v3;
         let rest = match self.cfg.low_battery_at {
@@ -341,11 +390,7 @@ impl Plant {
             },
             arm_contracted: !self.dead_switch[side]
                 && self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
-            bolter: Signals {
-                threshold,
-                locked,
-                at_home: b.pos <= 0.0,
-            },
+            bolter_at_home: b.pos <= 0.0,
         }
     }
 }

@@ -1,10 +1,15 @@
-//! The bolter state machines under arbitrary inputs: any order bytes, any sensor signals, any
-//! side-B report (corrupted, stale or forged), any tick times with clock wrap. Random under
-//! `cargo test`, Kani-ready (`cargo kani --tests`: proofs over a few ticks; not run here).
+//! The bolter state machines under arbitrary inputs: any order bytes, any bolter current and
+//! home switch, any side-B report (corrupted, stale or forged), any tick times with clock wrap.
+//! Random under `cargo test`, Kani-ready (`cargo kani --tests`: proofs over a few ticks; not run
+//! here).
 //!
 //! - `BolterSide`: never panics; reports exactly the order it adopted and the mux lines of that
 //!   pair; drives the motor only while its step is neither ended nor timed out; a current-sensed
-//!   step whose end signal never came is timed out once more than its limit has elapsed.
+//!   step whose end signal never came is timed out once more than its limit has elapsed; while
+//!   a step runs, its end flag latches exactly when I_bo ≥ the step's threshold (descents: the
+//!   push threshold; Rotate: the lock threshold) or, for the home flag, the switch is closed,
+//!   and no current latches anything in a step that is not current-sensed. The current is
+//!   drawn mostly one mA either side of a threshold, where an off-by-one would show.
 //! - `Coordinator`: never panics; while running, the attempt is 1..=3 and the heartbeat's
 //!   attempt byte equals it; every new sequence number comes with an order whose content
 //!   differs from the previous one (the side executors' resend filter relies on it); a job ends
@@ -14,7 +19,7 @@
 //! in `tests/control/bolter_handshake.rs`.
 
 use mmic::bolter::{
-    BolterDirection, BolterSide, BolterStep, Config, Coordinator, Drive, Job, MuxLines, Signals,
+    BolterDirection, BolterSide, BolterStep, Config, Coordinator, Drive, Job, MuxLines, Sensed,
     Status,
 };
 use mmic::command::{BolterPair, Fasteners};
@@ -50,18 +55,34 @@ fn aux_from(b: (u8, u8, u8, u8, u8)) -> BolterAux {
     }
 }
 
+/// The bolter current of one tick: `sel` picks one mA below, at, or one mA above the push or
+/// the lock threshold, or the arbitrary `raw`.
+fn current(cfg: &mmic::bolter::SideConfig, sel: u8, raw: u16) -> u16 {
+    let t = if sel & 1 == 0 {
+        cfg.push_threshold_ma
+    } else {
+        cfg.lock_threshold_ma
+    };
+    match sel >> 1 & 3 {
+        0 => t.saturating_sub(1),
+        1 => t,
+        2 => t.saturating_add(1),
+        _ => raw,
+    }
+}
+
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(8))]
 fn bolter_side_reports_what_it_runs() {
     bolero::check!()
-        .with_type::<(u32, [(bool, u8, (u8, u8, u8), u8, u16); TICKS])>()
+        .with_type::<(u32, [(bool, u8, (u8, u8, u8), u8, u16, u16); TICKS])>()
         .for_each(|(t0, events)| {
             let cfg = mmic::bolter::Config::default().side;
             let mut side = BolterSide::new();
             let mut now = *t0;
             let mut adopted: Option<(u8, BolterOrder)> = None;
             let mut since = now;
-            for &(new_order, seq, bytes, sig, dt) in events.iter() {
+            for &(new_order, seq, bytes, sig, raw, dt) in events.iter() {
                 now = now.wrapping_add(dt as u32);
                 if new_order {
                     let o = order_from(bytes);
@@ -71,11 +92,12 @@ fn bolter_side_reports_what_it_runs() {
                     }
                     side.order(seq, o, now);
                 }
-                let s = Signals {
-                    threshold: sig & 1 != 0,
-                    locked: sig & 2 != 0,
-                    at_home: sig & 4 != 0,
+                let s = Sensed {
+                    i_bo: current(&cfg, sig, raw),
+                    at_home: sig & 8 != 0,
                 };
+                let before = side.aux();
+                let running = side.drive() != Drive::Idle;
                 side.tick(&cfg, now, s);
                 let aux = side.aux();
                 assert_eq!(aux.step, adopted.map(|(_, o)| o.step));
@@ -90,6 +112,33 @@ fn bolter_side_reports_what_it_runs() {
                     assert_eq!(side.drive(), Drive::Idle);
                     continue;
                 };
+                // The decision: while the step runs, a flag latches exactly on its reading;
+                // once the step has ended or timed out, nothing changes.
+                let descent = matches!(o.step, BolterStep::Descend | BolterStep::DescendEngage);
+                let rotate = o.step == BolterStep::Rotate;
+                let (push, lock) = (cfg.push_threshold_ma, cfg.lock_threshold_ma);
+                let latch = |was: bool, now: bool| was || (running && now);
+                assert_eq!(
+                    aux.threshold_reached,
+                    latch(before.threshold_reached, descent && s.i_bo >= push),
+                    "push threshold {push} mA, I_bo {} mA in {:?}",
+                    s.i_bo,
+                    o.step
+                );
+                assert_eq!(
+                    aux.locked,
+                    latch(before.locked, rotate && s.i_bo >= lock),
+                    "lock threshold {lock} mA, I_bo {} mA in {:?}",
+                    s.i_bo,
+                    o.step
+                );
+                assert_eq!(aux.at_home, latch(before.at_home, s.at_home));
+                if !descent {
+                    assert!(!aux.threshold_reached, "push flag outside a descent");
+                }
+                if !rotate {
+                    assert!(!aux.locked, "lock flag outside Rotate");
+                }
                 let ended = match o.step {
                     BolterStep::Descend | BolterStep::DescendEngage => aux.threshold_reached,
                     BolterStep::Rotate => aux.locked,
@@ -101,10 +150,7 @@ fn bolter_side_reports_what_it_runs() {
                     ended || aux.timed_out,
                     "motor driven after the step ended, or idle while it runs: {aux:?}"
                 );
-                let sensed = matches!(
-                    o.step,
-                    BolterStep::Descend | BolterStep::DescendEngage | BolterStep::Rotate
-                );
+                let sensed = descent || rotate;
                 // Every tick here is at most 65,535 ms after the last, so the elapsed total is
                 // exact while it stays below the clock's half range.
                 if sensed && !ended && now.wrapping_sub(since) > cfg.sensed_ms {
