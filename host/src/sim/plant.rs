@@ -34,6 +34,11 @@ pub struct PlantConfig {
     pub low_battery_at: Option<u32>,
     /// At this time (ms) arm A hits an obstacle: its current jumps to 3.5 A for 500 ms.
     pub overcurrent_at: Option<u32>,
+    /// From this time on (ms) no fastener locks: a jammed fastener, every lock roll fails.
+    pub jammed_fastener_at: Option<u32>,
+    /// At this time (ms) bolter A meets an obstacle: side A's bolter current rises by 2.6 A
+    /// for 500 ms.
+    pub bolter_obstacle_at: Option<u32>,
     /// RNG seed (fastener locks).
     pub seed: u64,
     /// Pulse at which an arm's contraction switch closes (the firmware's "contracted").
@@ -49,6 +54,8 @@ impl Default for PlantConfig {
             drain_mv_per_s: 2.0,
             low_battery_at: None,
             overcurrent_at: None,
+            jammed_fastener_at: None,
+            bolter_obstacle_at: None,
             seed: 1,
             arm_contracted: mmic::node::board_a::Config::default().arm.contracted,
         }
@@ -118,6 +125,18 @@ const BOLTER_TRAVEL_MS: f64 = 800.0;
 const ROTATE_MS: f64 = 1000.0;
 /// ADC noise, codes either side.
 const NOISE: i32 = 5;
+/// How long an injected obstacle lasts, ms.
+const OBSTACLE_MS: u32 = 500;
+
+/// `now` is at or after the injection time `at`, if one is set.
+fn at_or_after(at: Option<u32>, now: u32) -> bool {
+    at.is_some_and(|t| now >= t)
+}
+
+/// `now` is within `ms` of the injection time `at`, if one is set.
+fn within(at: Option<u32>, now: u32, ms: u32) -> bool {
+    at.is_some_and(|t| now >= t && now - t < ms)
+}
 
 impl Plant {
     /// The robot at rest in `state`, arms contracted, grippers closed, hip at 180°.
@@ -212,7 +231,8 @@ impl Plant {
         let rotating = self.bolter.iter().any(|b| b.drive == Some(Drive::Rotate));
         if rotating && self.lock.is_none() {
             let p = self.cfg.lock_probability[self.tries.min(2)];
-            let ok = self.rng.f64() < p;
+            // The roll is drawn even when jammed, so the seed's later rolls stay the same.
+            let ok = self.rng.f64() < p && !at_or_after(self.cfg.jammed_fastener_at, now);
             self.lock = Some(ok);
             self.tries = if ok { 0 } else { self.tries + 1 };
         }
@@ -262,10 +282,12 @@ impl Plant {
             } else {
                 0.0
             };
+        let bolter_obstacle = side == 0 && within(self.cfg.bolter_obstacle_at, now, OBSTACLE_MS);
         let i_bo = match drive {
             Drive::Idle => 40.0,
             _ => 450.0,
-        } + if threshold { 900.0 } else { 0.0 };
+        } + if threshold { 900.0 } else { 0.0 }
+            + if bolter_obstacle { 2600.0 } else { 0.0 };
         let i_3v3 = 80.0;
         let i_bat = i_loc + i_grip + i_bo + i_3v3;
         let rest = match self.cfg.low_battery_at {
