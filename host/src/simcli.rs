@@ -29,7 +29,7 @@ busy host slows the run down instead of making the firmware's timeouts fire. Bef
 is sent, the plan is checked against the robot's state, from its `start` line (`a` if none).";
 
 /// `mmic sim --help`'s part on `--summary-json`, with the refusal names of the library
-/// (spec/modes.toml [refusals]).
+/// (spec/modes.toml `[refusals]`).
 pub fn summary_json_help() -> String {
     let refusals: Vec<&str> = mmic::refusal::Refusal::ALL
         .iter()

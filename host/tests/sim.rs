@@ -560,8 +560,7 @@ fn first_event(records: &[Value], ty: &str, pred: impl Fn(&Value) -> bool) -> Op
 fn step_before(records: &[Value], before: usize) -> Option<String> {
     records[..before]
         .iter()
-        .filter(|r| r["kind"] == "event" && r["event"]["type"] == "step")
-        .last()
+        .rfind(|r| r["kind"] == "event" && r["event"]["type"] == "step")
         .map(|e| e["event"]["text"].as_str().unwrap().to_string())
 }
 

@@ -4,10 +4,10 @@
 //! probability, and gravity readings that follow the state the robot is in. Injected faults
 //! ([`super::inject`]) act here where they are physical: a jammed fastener, a dead
 //! contraction switch, an obstacle on a bolter, gripper or arm, an offset hip encoder, a
-//! sagging battery. It reads out raw:
-//! ADS7828 codes with a few codes of noise, accelerations with noise, the encoder's count;
-//! each board's shell passes them through the library's sensor front end
-//! (`mmic::sensors::frontend`, Section 2's 50-sample averages) as the firmware would.
+//! sagging battery. It reads out raw: ADS7828 codes with a few codes of noise, accelerations
+//! with noise, the encoder's count; each board's shell passes them through the library's
+//! sensor front end (`mmic::sensors::frontend`, Section 2's 50-sample averages) as the
+//! firmware would.
 //!
 //! Simplifications, stated: the gravity readings are those the paper's model predicts for the
 //! state the robot last reached (the plant does not integrate the kinematics); both sides'

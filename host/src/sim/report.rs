@@ -33,7 +33,7 @@ pub fn faults_raised(s: &Summary) -> Vec<String> {
 }
 
 /// Robot 1's refusals in the order board A gave them (its `executed` events): the names of
-/// spec/modes.toml [refusals], repeats included (a `busy` step is sent again and may be
+/// spec/modes.toml `[refusals]`, repeats included (a `busy` step is sent again and may be
 /// refused again).
 pub fn refusals(s: &Summary) -> Vec<String> {
     s.events("executed")
