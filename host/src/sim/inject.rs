@@ -81,7 +81,7 @@ impl Injection {
                     "an obstacle on bolter A: its current rises by 2.6 A for 0.5 s"
                 }
                 Table8::GripperOvercurrent => {
-                    "an obstacle on gripper A: its current jumps to 2 A for 0.5 s"
+                    "an obstacle on gripper A: its current jumps to 2.5 A for 0.5 s"
                 }
                 Table8::LocomotionOvercurrent => {
                     "an obstacle on arm A: its current jumps to 3.5 A for 0.5 s"

@@ -42,8 +42,10 @@ pub struct PlantConfig {
     /// At this time (ms) bolter A meets an obstacle: side A's bolter current rises by 2.6 A
     /// for 500 ms.
     pub bolter_obstacle_at: Option<u32>,
-    /// At this time (ms) gripper A meets an obstacle: its current jumps to 2 A (above the
-    /// 1.5 A absolute limit) for 500 ms.
+    /// At this time (ms) gripper A meets an obstacle: its current jumps to 2.5 A (above the
+    /// 1.5 A absolute limit) for 500 ms. The firmware sees the current through a 50-sample
+    /// average: at 2.5 A it crosses 1.5 A after 30 samples of the pulse, so the obstacle is
+    /// seen even when a loaded host runs a board's 10 ms tick late now and then.
     pub gripper_obstacle_at: Option<u32>,
     /// From this time on (ms) arm A's contraction switch is dead: it never closes.
     pub arm_switch_dead_at: Option<u32>,
@@ -304,7 +306,7 @@ impl Plant {
             } else {
                 0.0
             };
-        let i_grip = if gripper_obstacle { 2000.0 } else { i_grip };
+        let i_grip = if gripper_obstacle { 2500.0 } else { i_grip };
         let bolter_obstacle = side == 0 && within(self.cfg.bolter_obstacle_at, now, OBSTACLE_MS);
         let i_bo = match drive {
             Drive::Idle => 40.0,
