@@ -610,6 +610,16 @@ fn check_case(c: &Case, s: &Summary, records: &[Value], json: &report::SummaryJs
         "the plan completed".into(),
     );
     expect(json.exit == 1, format!("exit {}", json.exit));
+    if c.inject == "initial-state-mismatch" {
+        // The next reconfiguration is the one refused, and the report says why.
+        let line = report::plan_line(s);
+        expect(
+            line.contains("(line 12: reconfigure a -> m): refused (initial_state_mismatch)")
+                && line.contains("the ground sent the reconfiguration from")
+                && line.contains("(initial-state-mismatch injected)"),
+            format!("report: {line}"),
+        );
+    }
     // When board A raised the fault and changed mode, from its events.
     let raised = first_event(records, "faults", |e| {
         e["faults"].as_array().unwrap().iter().any(|f| {

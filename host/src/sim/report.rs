@@ -211,14 +211,31 @@ pub fn plan_line(s: &Summary) -> String {
     }
 }
 
+/// The initial state of the last reconfiguration the ground sent (robot 1, from its `done`
+/// events), as sent: it differs from the plan's when an initial-state-mismatch was injected.
+fn sent_initial(s: &Summary) -> Option<mmic::motion::State> {
+    s.events("done")
+        .filter(|e| e["event"]["robot"] == 1)
+        .filter_map(|e| {
+            serde_json::from_value(e["event"]["command"]["reconfigure"]["initial"].clone()).ok()
+        })
+        .last()
+}
+
 /// What the refused step expected and what the robot last reported.
 fn mismatch(s: &Summary, step: usize) -> String {
     let expected = match s.plan.get(step).map(|st| st.step) {
         Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Reconfigure(
             r,
-        ))) => {
-            format!("the plan expected the robot in {}", r.initial())
-        }
+        ))) => match sent_initial(s).filter(|i| *i != r.initial()) {
+            // An injected initial-state-mismatch: the ground sent another initial state.
+            Some(sent) => format!(
+                "the plan expected the robot in {}, but the ground sent the reconfiguration \
+                 from {sent} (initial-state-mismatch injected)",
+                r.initial()
+            ),
+            None => format!("the plan expected the robot in {}", r.initial()),
+        },
         Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Primitive(p))) => {
             format!(
                 "primitive {} is no move from the state the robot is in",
