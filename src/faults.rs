@@ -67,6 +67,103 @@ wire_enum! {
     impl Display("{}", name);
 }
 
+wire_enum! {
+    /// One row of Table 8 as an operator names it: the fault bits split each overcurrent row
+    /// into its idle and operational checks, and the table prints "Locomotion module
+    /// overcurrent" twice, so the thirteen bits make ten rows. A report that says which of
+    /// the paper's faults happened (and a simulator that injects them) speaks in rows.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+    pub enum Table8 {
+        /// "(Un)Bolting failure".
+        BoltingFailure => "bolting_failure",
+        /// "Arm not fully contracted".
+        ArmNotContracted => "arm_not_contracted",
+        /// "Bolter module overcurrent" (idle or operational check).
+        BolterOvercurrent => "bolter_overcurrent",
+        /// "Gripper module overcurrent" (idle or operational check).
+        GripperOvercurrent => "gripper_overcurrent",
+        /// "Locomotion module overcurrent" (idle or operational check; both printed rows).
+        LocomotionOvercurrent => "locomotion_overcurrent",
+        /// "Hip mismatch".
+        HipMismatch => "hip_mismatch",
+        /// "Initial state mismatch".
+        InitialStateMismatch => "initial_state_mismatch",
+        /// "Internal communication loss".
+        InternalCommLoss => "internal_comm_loss",
+        /// "Low battery".
+        LowBattery => "low_battery",
+        /// "Assembly system operation".
+        AssemblySystem => "assembly_system",
+    }
+
+    /// Every row, in the table's order (the repeated row once).
+    const ALL;
+    /// snake_case name: the operational check's fault name for the overcurrent rows, the
+    /// fault's own name for the others.
+    pub const fn name(self) -> &'static str;
+    impl Display("{}", name);
+}
+
+impl Table8 {
+    /// The row's "Fault" cell as the paper prints it (spec/modes.toml `table8`).
+    pub const fn title(self) -> &'static str {
+        match self {
+            Table8::BoltingFailure => "(Un)Bolting failure",
+            Table8::ArmNotContracted => "Arm not fully contracted",
+            Table8::BolterOvercurrent => "Bolter module overcurrent",
+            Table8::GripperOvercurrent => "Gripper module overcurrent",
+            Table8::LocomotionOvercurrent => "Locomotion module overcurrent",
+            Table8::HipMismatch => "Hip mismatch",
+            Table8::InitialStateMismatch => "Initial state mismatch",
+            Table8::InternalCommLoss => "Internal communication loss",
+            Table8::LowBattery => "Low battery",
+            Table8::AssemblySystem => "Assembly system operation",
+        }
+    }
+}
+
+impl Fault {
+    /// The Table 8 row this bit belongs to: both checks of a module's overcurrent are that
+    /// module's row. The project's own [`Fault::MotionTimeout`] belongs to none.
+    ///
+    /// ```
+    /// use mmic::faults::{Fault, Table8};
+    /// assert_eq!(Fault::BolterOvercurrentIdle.table8(), Some(Table8::BolterOvercurrent));
+    /// assert_eq!(Fault::BolterOvercurrent.table8(), Some(Table8::BolterOvercurrent));
+    /// assert_eq!(Fault::LowBattery.table8().map(Table8::name), Some("low_battery"));
+    /// assert_eq!(Fault::MotionTimeout.table8(), None);
+    /// ```
+    pub const fn table8(self) -> Option<Table8> {
+        Some(match self {
+            Fault::BoltingFailure => Table8::BoltingFailure,
+            Fault::ArmNotContracted => Table8::ArmNotContracted,
+            Fault::BolterOvercurrentIdle | Fault::BolterOvercurrent => Table8::BolterOvercurrent,
+            Fault::GripperOvercurrentIdle | Fault::GripperOvercurrent => Table8::GripperOvercurrent,
+            Fault::LocomotionOvercurrentIdle | Fault::LocomotionOvercurrent => {
+                Table8::LocomotionOvercurrent
+            }
+            Fault::HipMismatch => Table8::HipMismatch,
+            Fault::InitialStateMismatch => Table8::InitialStateMismatch,
+            Fault::InternalCommLoss => Table8::InternalCommLoss,
+            Fault::LowBattery => Table8::LowBattery,
+            Fault::AssemblySystem => Table8::AssemblySystem,
+            Fault::MotionTimeout => return None,
+        })
+    }
+
+    /// The name an operator reads for this bit: its Table 8 row's, or its own for the
+    /// project's motion timeout (the idle and operational checks of a module share a name).
+    pub const fn row_name(self) -> &'static str {
+        match self.table8() {
+            Some(r) => r.name(),
+            None => self.name(),
+        }
+    }
+}
+
 /// A set of faults: the latched fault map, or the conditions holding now.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

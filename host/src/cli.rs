@@ -165,12 +165,14 @@ pub enum Cmd {
 
 /// The command line, with the help texts computed from the library (the map's legend).
 pub fn command() -> clap::Command {
-    <Cli as clap::CommandFactory>::command().mut_subcommand("map", |c| {
-        c.after_help(format!(
-            "The grid's codes:\n{}\nExample: mmic map --json",
-            motion::map_legend()
-        ))
-    })
+    <Cli as clap::CommandFactory>::command()
+        .mut_subcommand("map", |c| {
+            c.after_help(format!(
+                "The grid's codes:\n{}\nExample: mmic map --json",
+                motion::map_legend()
+            ))
+        })
+        .mut_subcommand("sim", |c| c.long_about(crate::simcli::sim_help()))
 }
 
 /// Parses the process's arguments with [`command`]; prints help or the usage error and exits

@@ -48,6 +48,9 @@ pub enum CliError {
         /// Where and why.
         error: crate::plan::PlanError,
     },
+    /// An injection (`mmic sim --inject`, or an alias) was not taken.
+    #[error(transparent)]
+    Inject(#[from] crate::sim::inject::InjectError),
     /// The simulation failed (transport set-up).
     #[error("simulation failed: {0}")]
     Sim(#[source] std::io::Error),
@@ -76,7 +79,7 @@ impl CliError {
         match self {
             CliError::Codec(e) => e.exit_code(),
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
-            CliError::Plan { .. } => EXIT_INPUT,
+            CliError::Plan { .. } | CliError::Inject(_) => EXIT_INPUT,
             CliError::Incomplete(_) => 1,
             CliError::HostBehind { .. } => EXIT_HOST,
             CliError::Write { .. }

@@ -1,7 +1,10 @@
 //! `mmic sim` and `mmic bench`: argument handling around [`crate::sim`].
 
 use crate::error::CliError;
+use crate::exit::EXIT_OK;
+use crate::sim::inject::{InjectError, Injection, Scheduled};
 use crate::sim::{self, report, SimConfig};
+use mmic::faults::Table8;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -9,7 +12,7 @@ fn ms(s: Option<f64>) -> Option<u32> {
     s.map(|s| (s.max(0.0) * 1000.0) as u32)
 }
 
-/// `mmic sim --help`'s description.
+/// `mmic sim --help`'s description (then [`sim_help`] adds the injections).
 pub const SIM_HELP: &str = "\
 Run the host simulator. The four nodes of the paper's Figure 3 run the real mmic library:
 the opsUI plan runner and the server board talk over an OS pipe (the RS232 line), the server
@@ -25,6 +28,58 @@ The clock is paced: simulated time never runs more than 20 ms ahead of the slowe
 busy host slows the run down instead of making the firmware's timeouts fire. Before anything
 is sent, the plan is checked against the robot's state, from its `start` line (`a` if none).";
 
+/// `mmic sim --help`'s part on `--summary-json`, with the refusal names of the library
+/// (spec/modes.toml `[refusals]`).
+pub fn summary_json_help() -> String {
+    let refusals: Vec<&str> = mmic::refusal::Refusal::ALL
+        .iter()
+        .map(|r| r.name())
+        .collect();
+    format!(
+        "\
+--summary-json FILE writes one JSON object when the run ends:
+  {{\"completed\": false, \"mode\": \"safed\", \"faults\": [\"bolter-overcurrent\"],
+   \"refusals\": [\"not_allowed_in_mode\"], \"exit\": 1}}
+completed: every step of the plan done. mode: standby, safed or operational, as the robot
+last reported it (the last heartbeat the ground received). faults: the Table 8 faults board A
+raised, in the order raised, each once, by their --inject names (a module's idle-check and
+operational-check overcurrent bits are both that module's name). refusals: every command
+board A refused, in order, by the names of spec/modes.toml [refusals]:
+  {}.
+exit: the exit code this run of mmic sim returns.",
+        refusals.join(", ")
+    )
+}
+
+/// `mmic sim --help`'s description, with every injection and what it does.
+pub fn sim_help() -> String {
+    let width = Injection::ALL
+        .iter()
+        .map(|i| i.name().len())
+        .max()
+        .unwrap_or(0);
+    let mut t = format!(
+        "{SIM_HELP}\n\n\
+         --inject NAME@SECONDS (repeatable; simulated seconds, decimals allowed) makes one of\n\
+         Table 8's ten faults happen, or sends the operator's Stop or Reset, at that time.\n\
+         Each acts physically where it can, and the firmware must detect it as the robot would:\n"
+    );
+    for i in Injection::ALL {
+        t.push_str(&format!("  {:width$}  {}\n", i.name(), i.effect()));
+    }
+    t.push_str(
+        "Out-of-band commands (assembly-system, stop, reset) take the uplink's next free slot,\n\
+         ahead of the plan's next step and of polling, each with its own sequence number; while\n\
+         an accepted Stop holds, the plan starts no step until an accepted Reset. Table 8's\n\
+         modes: bolting-failure and initial-state-mismatch Standby at once; low-battery and\n\
+         assembly-system Standby once the motion in progress has completed; the others Safed.\n\
+         The hip check runs only when Operational is entered: the demo plan enters it at its\n\
+         first step, so hip-mismatch@0 is the natural use.\n\n",
+    );
+    t.push_str(&summary_json_help());
+    t
+}
+
 /// `mmic sim --help`'s examples and exit codes.
 pub const SIM_AFTER: &str = "\
 Examples:
@@ -32,7 +87,9 @@ Examples:
   mmic sim --plan my.plan --scale 20
   mmic sim --plan my.plan --check-plan       parse it and trace the robot's state, run nothing
   mmic sim --wifi-loss 0.3                   30 % of WiFi packets lost, each way
-  mmic sim --low-battery-at 40 --overcurrent-at 25 --cut-b-at 60   (seconds)
+  mmic sim --inject low-battery@25 --summary-json out.json   the battery sags mid-reconfiguration
+  mmic sim --inject hip-mismatch@0           the hip encoder reads off from power-up
+  mmic sim --inject stop@25 --inject reset@28   the operator stops the motion and resumes it
 
 Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
 2 bad arguments or a malformed plan file, or a step that does not fit the robot's state
@@ -61,13 +118,22 @@ pub struct SimArgs {
     /// Board A <-> board B serial packet loss, 0..1.
     #[arg(long, default_value_t = 0.0, value_parser = probability)]
     pub ab_loss: f64,
-    /// The battery sags below 10 V from this simulated second on.
+    /// Inject a Table 8 fault, or send the operator's Stop or Reset, at a simulated time
+    /// (repeatable); the names and what each does are listed above.
+    #[arg(long = "inject", value_name = "NAME@SECONDS", value_parser = parse_injection)]
+    pub inject: Vec<Scheduled>,
+    /// Write the run's summary as one JSON object to this file (format above).
+    #[arg(long, value_name = "FILE")]
+    pub summary_json: Option<PathBuf>,
+    /// The battery sags below 10 V from this simulated second on (= --inject low-battery@S).
     #[arg(long, value_name = "S")]
     pub low_battery_at: Option<f64>,
-    /// Arm A hits an obstacle (3.5 A for 0.5 s) at this simulated second.
+    /// Arm A hits an obstacle (3.5 A for 0.5 s) at this simulated second
+    /// (= --inject locomotion-overcurrent@S).
     #[arg(long, value_name = "S")]
     pub overcurrent_at: Option<f64>,
-    /// Board B is cut off from board A at this simulated second.
+    /// Board B is cut off from board A at this simulated second
+    /// (= --inject internal-comm-loss@S).
     #[arg(long, value_name = "S")]
     pub cut_b_at: Option<f64>,
     /// Give up after this many simulated seconds.
@@ -83,6 +149,27 @@ pub struct SimArgs {
     /// a step that does not fit the state is reported with its line and column.
     #[arg(long)]
     pub check_plan: bool,
+}
+
+/// `--inject`'s value.
+fn parse_injection(s: &str) -> Result<Scheduled, InjectError> {
+    s.parse()
+}
+
+/// Every injection of the command line: the `--inject` values, then the older options, which
+/// are aliases of theirs.
+fn injections(a: &SimArgs) -> Result<Vec<Scheduled>, InjectError> {
+    let mut all = a.inject.clone();
+    for (seconds, row) in [
+        (a.low_battery_at, Table8::LowBattery),
+        (a.overcurrent_at, Table8::LocomotionOvercurrent),
+        (a.cut_b_at, Table8::InternalCommLoss),
+    ] {
+        if let Some(s) = seconds {
+            all.push(Scheduled::at_seconds(Injection::Fault(row), s)?);
+        }
+    }
+    Ok(all)
 }
 
 fn probability(s: &str) -> Result<f64, String> {
@@ -121,6 +208,7 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let (path, plan) = load_plan(&a)?;
     // Every step must fit the state the robot will be in: refused here, with its line and
     // column, before anything is sent.
+    let scheduled = injections(&a)?;
     let start = plan.start.unwrap_or(SimConfig::DEFAULT_START);
     let states = plan
         .trace(start)
@@ -154,9 +242,9 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     cfg.wifi_loss = a.wifi_loss;
     cfg.serial_loss = a.serial_loss;
     cfg.ab_loss = a.ab_loss;
-    cfg.cut_b_at = ms(a.cut_b_at);
-    cfg.plant.low_battery_at = ms(a.low_battery_at);
-    cfg.plant.overcurrent_at = ms(a.overcurrent_at);
+    for s in scheduled {
+        cfg.inject(s)?;
+    }
     cfg.max_sim_ms = ms(Some(a.max_seconds)).unwrap_or(u32::MAX);
     cfg.log_path = Some(a.out.join("sim.jsonl"));
     cfg.progress = !a.quiet;
@@ -170,6 +258,29 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     for p in plots {
         writeln!(out, "plot: {}", p.display()).map_err(CliError::Output)?;
     }
+    let verdict = verdict(&summary);
+    if let Some(path) = &a.summary_json {
+        let exit = exit_code(&summary);
+        let json = serde_json::to_string_pretty(&report::summary_json(&summary, exit))
+            .map_err(|e| CliError::Output(e.into()))?;
+        std::fs::write(path, json + "\n").map_err(|source| CliError::Write {
+            path: path.clone(),
+            source,
+        })?;
+    }
+    verdict
+}
+
+/// The exit code `mmic sim` returns for this run: 0 completed, 1 incomplete, 4 the host fell
+/// behind (the `exit` of `--summary-json`).
+pub fn exit_code(summary: &sim::Summary) -> u8 {
+    verdict(summary)
+        .err()
+        .map_or(EXIT_OK, |e| CliError::exit_code(&e))
+}
+
+/// How the run ends for the process: completed, incomplete, or not the robot's outcome.
+fn verdict(summary: &sim::Summary) -> Result<(), CliError> {
     if summary.host_fell_behind() {
         // Only an unpaced run can get here; say so rather than report the host's timeouts as
         // the robot's.
@@ -181,7 +292,7 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
         Ok(())
     } else {
         Err(CliError::Incomplete(
-            report::text(&summary)
+            report::text(summary)
                 .lines()
                 .next()
                 .unwrap_or_default()

@@ -7,6 +7,12 @@
 //! ([`settled`]). A step refused as `Busy` is sent again (as a new command) at the next slot;
 //! any other refusal, or a command left unacknowledged, stops the plan with the reason.
 //!
+//! The operator can also act out of band ([`PlanRunner::interject`]): a Stop, a Reset, the
+//! System fault command (Table 1) goes out in the next free slot, ahead of the plan's next
+//! step and of polling, through the same uplink — so one command is outstanding at a time
+//! and every command keeps its own sequence number, exactly once. An accepted Stop holds the
+//! plan (no step is started or finished) until an accepted Reset.
+//!
 //! ```
 //! use mmic::command::Command;
 //! use mmic::mode::Mode;
@@ -35,9 +41,11 @@
 //! ```
 
 use super::ground::{self, Done, Outcome, Uplink};
+use crate::command::Reconfiguration;
 use crate::command::{Command, CommandKind};
 use crate::faults::Faults;
 use crate::mode::Mode;
+use crate::motion::State;
 use crate::refusal::Refusal;
 use crate::safety::detect::hip_distance;
 use crate::units::BoardNumber;
@@ -127,6 +135,44 @@ enum Phase {
     Ended(PlanEnd),
 }
 
+/// What the outstanding command is to the runner.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Sent {
+    /// Step `next`'s command.
+    Step,
+    /// A heartbeat request while a motion settles or a wait runs.
+    Poll,
+    /// An out-of-band command ([`PlanRunner::interject`]).
+    Interjection,
+}
+
+/// Out-of-band commands that may wait for a slot at once ([`PlanRunner::interject`]): an
+/// operator's Stop and Reset and a System fault fit with room to spare.
+pub const INTERJECTIONS: usize = 4;
+
+/// [`PlanRunner::interject`] did not take the command: it is handed back, never dropped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InterjectError {
+    /// [`INTERJECTIONS`] commands already wait for a slot.
+    #[error("{waiting} out-of-band commands already wait for a slot; {command:?} not taken")]
+    Full {
+        /// The command not taken.
+        command: Command,
+        /// How many wait.
+        waiting: usize,
+    },
+    /// The plan has ended, so nothing is sent any more.
+    #[error("the plan has ended ({end:?}); {command:?} not taken")]
+    Ended {
+        /// The command not taken.
+        command: Command,
+        /// How the plan ended.
+        end: PlanEnd,
+    },
+}
+
 /// The runner.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -134,8 +180,37 @@ pub struct PlanRunner {
     up: Uplink,
     next: usize,
     phase: Phase,
-    /// The outstanding command is a poll, not a step.
-    polling: bool,
+    /// What the outstanding command is.
+    sent: Sent,
+    /// Out-of-band commands waiting for a slot, oldest first (filled from index 0).
+    pending: [Option<Command>; INTERJECTIONS],
+    /// An interjected Stop was accepted and no Reset since: the plan waits.
+    held: bool,
+    /// The next reconfiguration step goes out misstated ([`misstated`]).
+    misstate: bool,
+}
+
+/// The same reconfiguration from a wrong initial state: the first matched state (Table 5
+/// order) that is neither its initial nor its target state. A matched state is where a robot
+/// rests between reconfigurations, so this is a belief the opsUI could plausibly hold — and
+/// board A, which tracks the state it is in, refuses it (Table 8's initial state mismatch).
+///
+/// ```
+/// use mmic::command::Reconfiguration;
+/// use mmic::motion::State;
+/// use mmic::node::plan_runner::misstated;
+/// let r = Reconfiguration::new(State::A, State::M).unwrap();
+/// let wrong = misstated(r);
+/// assert_eq!(wrong.target(), State::M);
+/// assert!(wrong.initial() != State::A && wrong.initial().is_matched());
+/// ```
+pub fn misstated(r: Reconfiguration) -> Reconfiguration {
+    State::ALL
+        .into_iter()
+        .filter(|s| s.is_matched() && *s != r.initial())
+        .find_map(|s| Reconfiguration::new(s, r.target()).ok())
+        // Six matched states: there is always one besides the initial and the target.
+        .unwrap_or(r)
 }
 
 /// Does this command start something that must settle before the next step? Every command
@@ -164,7 +239,10 @@ impl PlanRunner {
             up: Uplink::new(cfg, board),
             next: 0,
             phase: Phase::Ready,
-            polling: false,
+            sent: Sent::Step,
+            pending: [None; INTERJECTIONS],
+            held: false,
+            misstate: false,
         }
     }
 
@@ -186,23 +264,92 @@ impl PlanRunner {
         }
     }
 
-    fn submit(&mut self, c: Command, polling: bool) {
+    /// Sends `command` out of band: in the next free slot of the uplink, ahead of the plan's
+    /// next step and of polling (after the command outstanding now, if any, and after those
+    /// interjected before it). It gets its own sequence number and is resent until answered
+    /// like any command; its answer does not advance the plan. An accepted Stop holds the
+    /// plan — no step starts, no motion counts as settled — until an accepted Reset; an
+    /// interjection left unacknowledged ends the plan as [`PlanEnd::Unacknowledged`] (the
+    /// link is gone). Refused, with the command handed back, when [`INTERJECTIONS`] wait
+    /// already or the plan has ended.
+    pub fn interject(&mut self, command: Command) -> Result<(), InterjectError> {
+        if let Some(end) = self.end() {
+            return Err(InterjectError::Ended { command, end });
+        }
+        match self.pending.iter_mut().find(|p| p.is_none()) {
+            Some(slot) => {
+                *slot = Some(command);
+                Ok(())
+            }
+            None => Err(InterjectError::Full {
+                command,
+                waiting: INTERJECTIONS,
+            }),
+        }
+    }
+
+    /// Out-of-band commands waiting for a slot.
+    pub fn interjections_waiting(&self) -> usize {
+        self.pending.iter().filter(|p| p.is_some()).count()
+    }
+
+    /// An accepted out-of-band Stop holds the plan (until an accepted Reset).
+    pub const fn held(&self) -> bool {
+        self.held
+    }
+
+    /// Fault injection for Table 8's initial state mismatch: the next reconfiguration step
+    /// the runner sends goes out with a wrong initial state ([`misstated`]), as if the
+    /// opsUI's belief of where the robot is were wrong. A step already sent keeps its command
+    /// (a resend carries the same bytes).
+    pub fn misstate_next_reconfiguration(&mut self) {
+        self.misstate = true;
+    }
+
+    fn submit(&mut self, c: Command, sent: Sent) {
         // Only called when the uplink is idle.
         if self.up.submit(c).is_ok() {
-            self.polling = polling;
+            self.sent = sent;
+        }
+    }
+
+    /// The oldest waiting interjection, taken out of the queue.
+    fn take_interjection(&mut self) -> Option<Command> {
+        let c = self.pending[0]?;
+        self.pending.rotate_left(1);
+        self.pending[INTERJECTIONS - 1] = None;
+        Some(c)
+    }
+
+    /// Step command `c` as it goes out: misstated if asked for and it is a reconfiguration.
+    fn as_sent(&mut self, c: Command) -> Command {
+        match c {
+            Command::Reconfigure(r) if self.misstate => {
+                self.misstate = false;
+                Command::Reconfigure(misstated(r))
+            }
+            _ => c,
         }
     }
 
     /// Advances to `now`.
     pub fn tick(&mut self, steps: &[PlanStep], now: u32) -> PlanTick {
         let mut t = PlanTick::default();
+        if self.up.is_idle() && self.end().is_none() {
+            if let Some(c) = self.take_interjection() {
+                self.submit(c, Sent::Interjection);
+            }
+        }
         if self.up.is_idle() {
             match self.phase {
                 Phase::Ready => match steps.get(self.next) {
                     None => self.phase = Phase::Ended(PlanEnd::Completed),
+                    // Stopped by the operator: keep polling, start nothing.
+                    Some(_) if self.held => self.submit(Command::Heartbeat, Sent::Poll),
                     Some(PlanStep::Command(c)) => {
                         t.started = Some(self.next);
-                        self.submit(*c, false);
+                        let c = self.as_sent(*c);
+                        self.submit(c, Sent::Step);
                         self.phase = Phase::Sending;
                     }
                     Some(PlanStep::Wait { ms }) => {
@@ -224,7 +371,7 @@ impl PlanRunner {
                     return self.tick(steps, now);
                 }
                 Phase::Waiting { .. } | Phase::Settling { .. } => {
-                    self.submit(Command::Heartbeat, true);
+                    self.submit(Command::Heartbeat, Sent::Poll);
                 }
                 Phase::Sending | Phase::Ended(_) => {}
             }
@@ -256,6 +403,18 @@ impl PlanRunner {
 
     fn finished(&mut self, d: Done, hb: Option<&HeartbeatRepr>) {
         let step = self.next;
+        let sent = core::mem::replace(&mut self.sent, Sent::Step);
+        if sent == Sent::Interjection {
+            match (d.outcome, d.command) {
+                (Outcome::Unacknowledged, _) => {
+                    self.phase = Phase::Ended(PlanEnd::Unacknowledged { step })
+                }
+                (Outcome::Accepted, Command::Stop) => self.held = true,
+                (Outcome::Accepted, Command::Reset) => self.held = false,
+                _ => {}
+            }
+            return;
+        }
         match (self.phase, d.outcome) {
             (_, Outcome::Unacknowledged) => {
                 self.phase = Phase::Ended(PlanEnd::Unacknowledged { step })
@@ -296,7 +455,7 @@ impl PlanRunner {
                         mode: h.mode,
                         faults: h.faults,
                     });
-                } else if polls >= need && hb.is_some_and(settled) {
+                } else if !self.held && polls >= need && hb.is_some_and(settled) {
                     self.next += 1;
                     self.phase = Phase::Ready;
                 } else {
@@ -309,6 +468,225 @@ impl PlanRunner {
             }
             _ => {}
         }
-        self.polling = false;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A settled robot in `mode` answering `sent`.
+    fn answer(sent: &CommandRepr, mode: Mode) -> HeartbeatRepr {
+        HeartbeatRepr {
+            last_seq: sent.seq,
+            mode,
+            ..HeartbeatRepr::default()
+        }
+    }
+
+    /// Ticks every 100 ms from `from` until a packet goes out; answers it 20 ms later as a
+    /// settled robot in `mode` would. Returns what went out and the answer's tick.
+    fn exchange(
+        run: &mut PlanRunner,
+        steps: &[PlanStep],
+        from: u32,
+        mode: Mode,
+    ) -> (u32, Option<CommandRepr>, PlanTick) {
+        let mut now = from;
+        while now < from + 10_000 {
+            if let Some(p) = run.tick(steps, now).send {
+                let t = run.heartbeat(steps, now + 20, &answer(&p, mode));
+                return (now + 20, Some(p), t);
+            }
+            now += 100;
+        }
+        (now, None, PlanTick::default())
+    }
+
+    #[test]
+    fn an_interjection_takes_the_next_slot_ahead_of_the_next_step_and_of_polling() {
+        let steps = [
+            PlanStep::Command(Command::Mode(Mode::Operational)),
+            PlanStep::Wait { ms: 3000 },
+            PlanStep::Command(Command::Mode(Mode::Standby)),
+        ];
+        let mut run = PlanRunner::new(ground::Config::default(), BoardNumber::ONE);
+        let first = run.tick(&steps, 0).send;
+        assert_eq!(first.map(|p| p.command), Some(steps_command(&steps[0])));
+        // Interjected while the step's command is outstanding: it waits for that answer.
+        assert_eq!(run.interject(Command::SystemFault), Ok(()));
+        assert_eq!(run.tick(&steps, 50).send, None, "one command outstanding");
+        let hb = first.map(|p| answer(&p, Mode::Operational));
+        let done = hb.and_then(|hb| run.heartbeat(&steps, 60, &hb).done);
+        assert_eq!(done.map(|d| d.outcome), Some(Outcome::Accepted));
+        // The mode step settles by polling; the interjection goes out in the next slot
+        // instead of that poll, with the next number.
+        let (now, sent, t) = exchange(&mut run, &steps, 100, Mode::Operational);
+        assert_eq!(sent.map(|p| p.command), Some(Command::SystemFault));
+        assert_eq!(sent.map(|p| p.seq), first.map(|p| p.seq + 1));
+        assert_eq!(t.done.map(|d| d.command), Some(Command::SystemFault));
+        assert_eq!(run.interjections_waiting(), 0);
+        assert_eq!(run.step(), 0, "its answer does not advance the plan");
+        // Then polling resumes and the plan runs to its end, each number once.
+        let mut seqs = heapless::Vec::<u16, 64>::new();
+        for p in [first, sent].into_iter().flatten() {
+            let _ = seqs.push(p.seq);
+        }
+        let mut now = now;
+        while run.end().is_none() && now < 60_000 {
+            let (t, p, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+            if let Some(p) = p {
+                let _ = seqs.push(p.seq);
+            }
+            now = t;
+        }
+        assert_eq!(run.end(), Some(PlanEnd::Completed));
+        assert!(seqs.windows(2).all(|w| w[1] == w[0] + 1), "{seqs:?}");
+    }
+
+    fn steps_command(s: &PlanStep) -> Command {
+        match s {
+            PlanStep::Command(c) => *c,
+            PlanStep::Wait { .. } => Command::Heartbeat,
+        }
+    }
+
+    #[test]
+    fn an_accepted_stop_holds_the_plan_until_an_accepted_reset() {
+        let steps = [
+            PlanStep::Wait { ms: 1000 },
+            PlanStep::Command(Command::Mode(Mode::Standby)),
+        ];
+        let mut run = PlanRunner::new(ground::Config::default(), BoardNumber::ONE);
+        // The wait starts and polls; the Stop goes out in the next slot.
+        let (now, sent, _) = exchange(&mut run, &steps, 0, Mode::Operational);
+        assert_eq!(sent.map(|p| p.command), Some(Command::Heartbeat));
+        assert_eq!(run.interject(Command::Stop), Ok(()));
+        let (now, sent, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+        assert_eq!(sent.map(|p| p.command), Some(Command::Stop));
+        assert!(run.held());
+        // The wait ends, but no step starts while held: only polls go out.
+        let mut now = now;
+        for _ in 0..5 {
+            let (t, sent, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+            assert_eq!(sent.map(|p| p.command), Some(Command::Heartbeat));
+            now = t;
+        }
+        assert_eq!(run.step(), 1);
+        assert_eq!(run.interject(Command::Reset), Ok(()));
+        let (now, sent, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+        assert_eq!(sent.map(|p| p.command), Some(Command::Reset));
+        assert!(!run.held());
+        let (_, sent, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+        assert_eq!(sent.map(|p| p.command), Some(Command::Mode(Mode::Standby)));
+    }
+
+    #[test]
+    fn a_held_motion_does_not_count_as_settled() {
+        let steps = [
+            PlanStep::Command(Command::Arm {
+                side: crate::units::Side::A,
+                target: crate::command::ServoTarget::Contract,
+            }),
+            PlanStep::Command(Command::Mode(Mode::Standby)),
+        ];
+        let mut run = PlanRunner::new(ground::Config::default(), BoardNumber::ONE);
+        let (now, _, _) = exchange(&mut run, &steps, 0, Mode::Operational);
+        assert_eq!(run.interject(Command::Stop), Ok(()));
+        let (now, sent, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+        assert_eq!(sent.map(|p| p.command), Some(Command::Stop));
+        // Settled-looking answers while stopped: the step is not finished.
+        let mut now = now;
+        for _ in 0..3 {
+            now = exchange(&mut run, &steps, now + 100, Mode::Operational).0;
+        }
+        assert_eq!(run.step(), 0);
+        assert_eq!(run.interject(Command::Reset), Ok(()));
+        let (now, _, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+        let (_, _, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+        assert_eq!(run.step(), 1, "settled after the reset");
+    }
+
+    #[test]
+    fn interjections_are_handed_back_when_full_or_after_the_end_never_dropped() {
+        let mut run = PlanRunner::new(ground::Config::default(), BoardNumber::ONE);
+        for _ in 0..INTERJECTIONS {
+            assert_eq!(run.interject(Command::SystemFault), Ok(()));
+        }
+        assert_eq!(
+            run.interject(Command::Stop),
+            Err(InterjectError::Full {
+                command: Command::Stop,
+                waiting: INTERJECTIONS
+            })
+        );
+        // Every waiting one goes out, in order, before the (empty) plan completes.
+        let mut sent = 0;
+        let mut now = 0;
+        while run.end().is_none() && now < 60_000 {
+            let (t, p, _) = exchange(&mut run, &[], now, Mode::Standby);
+            sent += p.is_some() as usize;
+            now = t + 100;
+            if p.is_none() {
+                run.tick(&[], now);
+            }
+        }
+        assert_eq!(sent, INTERJECTIONS);
+        assert_eq!(run.end(), Some(PlanEnd::Completed));
+        assert_eq!(
+            run.interject(Command::Reset),
+            Err(InterjectError::Ended {
+                command: Command::Reset,
+                end: PlanEnd::Completed
+            })
+        );
+    }
+
+    #[test]
+    fn an_unacknowledged_interjection_ends_the_plan() {
+        let cfg = ground::Config {
+            max_attempts: 2,
+            ..ground::Config::default()
+        };
+        let steps = [PlanStep::Wait { ms: 60_000 }];
+        let mut run = PlanRunner::new(cfg, BoardNumber::ONE);
+        assert_eq!(run.interject(Command::Stop), Ok(()));
+        let mut end = None;
+        for now in (0..20_000).step_by(100) {
+            end = end.or(run.tick(&steps, now).end);
+        }
+        assert_eq!(end, Some(PlanEnd::Unacknowledged { step: 0 }));
+    }
+
+    #[test]
+    fn a_misstated_reconfiguration_goes_out_once_with_a_wrong_initial_state() {
+        let (a_m, m_b) = (
+            Reconfiguration::new(State::A, State::M),
+            Reconfiguration::new(State::M, State::B),
+        );
+        let (Ok(a_m), Ok(m_b)) = (a_m, m_b) else {
+            panic!("valid reconfigurations");
+        };
+        let steps = [
+            PlanStep::Command(Command::Mode(Mode::Operational)),
+            PlanStep::Command(Command::Reconfigure(a_m)),
+            PlanStep::Command(Command::Reconfigure(m_b)),
+        ];
+        let mut run = PlanRunner::new(ground::Config::default(), BoardNumber::ONE);
+        run.misstate_next_reconfiguration();
+        let mut reconfigurations = heapless::Vec::<Reconfiguration, 8>::new();
+        let mut now = 0;
+        while run.end().is_none() && now < 60_000 {
+            let (t, p, _) = exchange(&mut run, &steps, now, Mode::Operational);
+            if let Some(Command::Reconfigure(r)) = p.map(|p| p.command) {
+                let _ = reconfigurations.push(r);
+            }
+            now = t + 100;
+        }
+        assert_eq!(reconfigurations.len(), 2, "{reconfigurations:?}");
+        assert_eq!(reconfigurations[0], misstated(a_m));
+        assert_ne!(reconfigurations[0].initial(), State::A);
+        assert_eq!(reconfigurations[0].target(), State::M);
+        assert_eq!(reconfigurations[1], m_b, "only the next one");
     }
 }

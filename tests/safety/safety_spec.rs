@@ -2,7 +2,7 @@
 //! deferral and kinds, refusal codes and threshold defaults.
 
 use mmic::command::CommandKind;
-use mmic::faults::Fault;
+use mmic::faults::{Fault, Table8};
 use mmic::mode::Mode;
 use mmic::refusal::Refusal;
 use mmic::safety::detect::Config;
@@ -126,7 +126,12 @@ fn table8_modes_deferral_and_kinds_equal_spec() {
     assert_eq!(s.fault.len(), Fault::ALL.len());
     for (f, row) in Fault::ALL.iter().zip(&s.fault) {
         assert_eq!(f.name(), row.name);
-        assert!(!row.table8.is_empty());
+        // spec/modes.toml writes "none" for the project's own motion timeout.
+        assert_eq!(
+            f.table8().map_or("none", Table8::title),
+            row.table8,
+            "{f}: Table 8 row"
+        );
         let a = fault_action(*f);
         assert_eq!(a.mode.name(), row.mode, "{f}: mode");
         assert_eq!(a.deferred, row.deferred, "{f}: deferred");
@@ -141,6 +146,22 @@ fn table8_modes_deferral_and_kinds_equal_spec() {
         );
     }
     assert!(s.inconsistency.len() >= 2);
+    // Ten rows: every row has a bit, the overcurrent rows two (idle and operational checks),
+    // and each row's name is its operational bit's name or its only bit's.
+    assert_eq!(Table8::ALL.len(), 10);
+    for r in Table8::ALL {
+        let bits: Vec<Fault> = Fault::ALL
+            .into_iter()
+            .filter(|f| f.table8() == Some(r))
+            .collect();
+        assert!(bits.iter().any(|f| f.name() == r.name()), "{r}: {bits:?}");
+        let expected = if r.name().ends_with("_overcurrent") {
+            2
+        } else {
+            1
+        };
+        assert_eq!(bits.len(), expected, "{r}: {bits:?}");
+    }
 }
 
 #[test]

@@ -12,11 +12,15 @@
 //! ```
 //!
 //! Losses are injected per link ([`SimConfig::wifi_loss`], …): a lost packet is logged with
-//! fate `lost` and never written. Board B can be cut off at a time (both serial directions
-//! stop), the battery can be made to sag and arm A can hit an obstacle ([`PlantConfig`]).
+//! fate `lost` and never written. Each of Table 8's ten faults, and the operator's Stop and
+//! Reset, can be injected at a time ([`inject`], [`SimConfig::inject`]): in the plant
+//! ([`PlantConfig`]: a jammed fastener, a dead switch, an obstacle, an offset encoder, a
+//! sagging battery), on the A–B line (cut, both directions) or from the ground (a misstated
+//! reconfiguration, out-of-band commands).
 
 pub mod bench;
 pub mod clock;
+pub mod inject;
 pub mod lockstep;
 pub mod log;
 pub mod nodes;
@@ -66,6 +70,10 @@ pub struct SimConfig {
     pub cut_b_at: Option<u32>,
     /// Plant parameters and injected faults.
     pub plant: PlantConfig,
+    /// Every injection scheduled with [`SimConfig::inject`], in time order: the ground sends
+    /// its out-of-band commands and misstates the next reconfiguration when their time
+    /// comes, and logs each as an `inject` event.
+    pub injections: Vec<inject::Scheduled>,
     /// The state the robot starts in (and board A knows it is in).
     pub start_state: State,
     /// The ground's uplink timing.
@@ -112,6 +120,7 @@ impl SimConfig {
             ab_loss: 0.0,
             cut_b_at: None,
             plant: PlantConfig::default(),
+            injections: Vec::new(),
             start_state: SimConfig::DEFAULT_START,
             // The paper resends until acknowledged; 20 attempts make an unacknowledged command
             // unlikely even at 30 % loss each way (0.51^20 < 2e-6) while still ending a run
@@ -477,6 +486,19 @@ type GroundLink = (
     BoardNumber,
 );
 
+/// The ground's part of an injection: an out-of-band command handed to the plan runner, or
+/// the next reconfiguration misstated; nothing for the plant's and the line's. Returns why
+/// the runner did not take the command, if it did not.
+fn ground_injection(run: &mut PlanRunner, injection: inject::Injection) -> Option<String> {
+    if let Some(c) = injection.command() {
+        return run.interject(c).err().map(|e| e.to_string());
+    }
+    if injection == inject::Injection::Fault(mmic::faults::Table8::InitialStateMismatch) {
+        run.misstate_next_reconfiguration();
+    }
+    None
+}
+
 /// The opsUI: one plan runner per robot, in one thread (one ground process).
 fn ground_loop(
     cfg: &SimConfig,
@@ -500,6 +522,8 @@ fn ground_loop(
         last_heartbeat: None,
     };
     let mut progress = progress::Progress::new(cfg.progress, cfg.steps.clone(), cfg.start_state);
+    // Each robot's next injection (cfg.injections is in time order).
+    let mut next_injection = vec![0usize; runners.len()];
     loop {
         let now = clock.now_ms();
         clock.ready(now);
@@ -510,6 +534,25 @@ fn ground_loop(
         for (i, ((writer, rx, _), run)) in links.iter_mut().zip(runners.iter_mut()).enumerate() {
             if ends[i].is_some() {
                 continue;
+            }
+            while let Some(inj) = cfg
+                .injections
+                .get(next_injection[i])
+                .filter(|s| s.at_ms <= now)
+            {
+                next_injection[i] += 1;
+                let refused = ground_injection(run, inj.injection);
+                if i == 0 {
+                    progress.inject(now, inj.injection);
+                }
+                if let Some(l) = &log {
+                    l.event(
+                        now,
+                        "ground",
+                        json!({"type": "inject", "robot": i + 1, "name": inj.injection.name(),
+                        "at_ms": inj.at_ms, "refused": refused}),
+                    );
+                }
             }
             let mut ticks = vec![run.tick(steps, now)];
             while let Ok(bytes) = rx.try_recv() {

@@ -1,10 +1,13 @@
 //! The robot's physics, as much as the firmware can notice: servos that move at a limited
 //! speed, a continuous hip servo with lag, currents that rise while something moves, pushes
 //! or hits an obstacle, a battery that sags with current and time, fasteners that lock with a
-//! probability, and gravity readings that follow the state the robot is in. It reads out raw:
-//! ADS7828 codes with a few codes of noise, accelerations with noise, the encoder's count;
-//! each board's shell passes them through the library's sensor front end
-//! (`mmic::sensors::frontend`, Section 2's 50-sample averages) as the firmware would.
+//! probability, and gravity readings that follow the state the robot is in. Injected faults
+//! ([`super::inject`]) act here where they are physical: a jammed fastener, a dead
+//! contraction switch, an obstacle on a bolter, gripper or arm, an offset hip encoder, a
+//! sagging battery. It reads out raw: ADS7828 codes with a few codes of noise, accelerations
+//! with noise, the encoder's count; each board's shell passes them through the library's
+//! sensor front end (`mmic::sensors::frontend`, Section 2's 50-sample averages) as the
+//! firmware would.
 //!
 //! The bolters report what the firmware's current sensing needs (Section 5): a bolter draws a
 //! running current while it moves, more once it presses its fastener (it is driven further down
@@ -47,6 +50,19 @@ pub struct PlantConfig {
     /// At this time (ms) bolter A hits an obstacle: its current jumps to 2.6 A, above the
     /// 2000 mA bolter limit, for 500 ms (Table 8: bolter module overcurrent, Safed).
     pub bolter_obstacle_at: Option<u32>,
+    /// At this time (ms) gripper A meets an obstacle: its current jumps to 2.5 A (above the
+    /// 1.5 A absolute limit) for 500 ms. The firmware sees the current through a 50-sample
+    /// average: at 2.5 A it crosses 1.5 A after 30 samples of the pulse, so the obstacle is
+    /// seen even when a loaded host runs a board's 10 ms tick late now and then.
+    pub gripper_obstacle_at: Option<u32>,
+    /// From this time on (ms) arm A's contraction switch is dead: it never closes.
+    pub arm_switch_dead_at: Option<u32>,
+    /// From this time on (ms) the hip encoder reads [`hip_encoder_offset`](Self::hip_encoder_offset)
+    /// off the hip's true angle (a slipped magnet, a bad connection). The firmware's hip check
+    /// looks only when Operational is entered, so from 0 (power-up) it is caught at once.
+    pub hip_encoder_offset_at: Option<u32>,
+    /// The encoder's error once offset, 0.01°.
+    pub hip_encoder_offset: u16,
     /// RNG seed (fastener locks).
     pub seed: u64,
     /// Pulse at which an arm's contraction switch closes (the firmware's "contracted").
@@ -64,6 +80,11 @@ impl Default for PlantConfig {
             overcurrent_at: None,
             jammed_fastener_at: None,
             bolter_obstacle_at: None,
+            gripper_obstacle_at: None,
+            arm_switch_dead_at: None,
+            hip_encoder_offset_at: None,
+            // 30°: three times the hip check's 10° tolerance.
+            hip_encoder_offset: 3000,
             seed: 1,
             arm_contracted: mmic::node::board_a::Config::default().arm.contracted,
         }
@@ -155,6 +176,18 @@ pub const BOLTER_LOCKED_MA: f64 = 1600.0;
 pub const BOLTER_OBSTACLE_MA: f64 = 2600.0;
 /// ADC noise, codes either side.
 const NOISE: i32 = 5;
+/// How long an injected obstacle lasts, ms.
+const OBSTACLE_MS: u32 = 500;
+
+/// `now` is at or after the injection time `at`, if one is set.
+fn at_or_after(at: Option<u32>, now: u32) -> bool {
+    at.is_some_and(|t| now >= t)
+}
+
+/// `now` is within `ms` of the injection time `at`, if one is set.
+fn within(at: Option<u32>, now: u32, ms: u32) -> bool {
+    at.is_some_and(|t| now >= t && now - t < ms)
+}
 
 impl Plant {
     /// The robot at rest in `state`, arms contracted, grippers closed, hip at 180°.
@@ -290,9 +323,15 @@ impl Plant {
         self.bolter[side % 2].drive.unwrap_or(Drive::Idle)
     }
 
-    /// The hip encoder's raw reading (12 bits, 4096 counts per turn, 0 at hip 0°).
-    pub fn encoder(&self) -> u16 {
-        ((self.hip / 36000.0 * 4096.0).floor() as u32 % 4096) as u16
+    /// The hip encoder's raw reading at `now` (12 bits, 4096 counts per turn, 0 at hip 0°),
+    /// offset once [`PlantConfig::hip_encoder_offset_at`] has passed.
+    pub fn encoder(&self, now: u32) -> u16 {
+        let off = if at_or_after(self.cfg.hip_encoder_offset_at, now) {
+            self.cfg.hip_encoder_offset as f64
+        } else {
+            0.0
+        };
+        (((self.hip + off).rem_euclid(36000.0) / 36000.0 * 4096.0).floor() as u32 % 4096) as u16
     }
 
     /// What side `side` (0 = A, 1 = B) reads at `now`.
@@ -305,11 +344,8 @@ impl Plant {
         let locked =
             drive == Drive::Rotate && b.rotating_ms >= ROTATE_MS && self.lock == Some(true);
         let hip_moving = side == 0 && self.hip_speed.abs() > 50.0;
-        let obstacle = side == 0
-            && self
-                .cfg
-                .overcurrent_at
-                .is_some_and(|t| now >= t && now < t + 500);
+        let obstacle = side == 0 && within(self.cfg.overcurrent_at, now, OBSTACLE_MS);
+        let gripper_obstacle = side == 0 && within(self.cfg.gripper_obstacle_at, now, OBSTACLE_MS);
         // Moving draws more, but stays under the idle limits (400 mA locomotion, 200 mA
         // gripper): a servo still settling when the firmware's idle check starts is no fault.
         let i_loc = if reg { 120.0 } else { 0.0 }
@@ -322,6 +358,7 @@ impl Plant {
             } else {
                 0.0
             };
+        let i_grip = if gripper_obstacle { 2500.0 } else { i_grip };
         let bolter_obstacle = side == 0
             && self
                 .cfg
@@ -386,10 +423,11 @@ impl Plant {
             raw: Raw {
                 adc,
                 accel,
-                encoder: if side == 0 { self.encoder() } else { 0 },
+                encoder: if side == 0 { self.encoder(now) } else { 0 },
             },
             arm_contracted: !self.dead_switch[side]
-                && self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0,
+                && self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0
+                && !(side == 0 && at_or_after(self.cfg.arm_switch_dead_at, now)),
             bolter_at_home: b.pos <= 0.0,
         }
     }

@@ -50,6 +50,17 @@ impl Progress {
         }
     }
 
+    /// An injection's time came.
+    pub fn inject(&mut self, now: u32, injection: super::inject::Injection) {
+        if self.on {
+            eprintln!(
+                "[{:>6.1} s] inject {injection}: {}",
+                now as f64 / 1000.0,
+                injection.effect()
+            );
+        }
+    }
+
     /// The latest heartbeat.
     pub fn status(&mut self, now: u32, hb: &HeartbeatRepr, eff: Efficiency) {
         if !self.on {

@@ -1,11 +1,85 @@
 //! Live progress, the end-of-run summary and the plots (Figure 10 and 11 analogues).
 
+use super::inject::Injection;
 use super::Summary;
 use crate::plot::{bar_chart, line_chart_with, LineOptions, Series};
+use mmic::faults::Fault;
 use mmic::node::plan_runner::PlanEnd;
 use mmic::refusal::Refusal;
 use std::fmt::Write as _;
 use std::path::Path;
+
+/// Robot 1's board A in the log (its events carry this node name).
+const BOARD_A1: &str = "board_a1";
+
+/// Robot 1's Table 8 faults in the order board A raised them (its `faults` events; faults of
+/// one tick in bit order), each once, by their `--inject` names: a module's idle-check and
+/// operational-check overcurrent bits are both that module's row. The project's own motion
+/// timeout (no Table 8 row) is `motion-timeout`.
+pub fn faults_raised(s: &Summary) -> Vec<String> {
+    let mut names: Vec<String> = Vec::new();
+    for e in s.events("faults").filter(|e| e["node"] == BOARD_A1) {
+        let bits = e["event"]["faults"].as_array().cloned().unwrap_or_default();
+        for f in bits {
+            let Ok(f) = serde_json::from_value::<Fault>(f) else {
+                continue;
+            };
+            let name = match f.table8() {
+                Some(row) => Injection::Fault(row).name(),
+                None => f.name().replace('_', "-"),
+            };
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+    }
+    names
+}
+
+/// Robot 1's refusals in the order board A gave them (its `executed` events): the names of
+/// spec/modes.toml `[refusals]`, repeats included (a `busy` step is sent again and may be
+/// refused again).
+pub fn refusals(s: &Summary) -> Vec<String> {
+    s.events("executed")
+        .filter(|e| e["node"] == BOARD_A1)
+        .filter_map(|e| e["event"]["refusal"].as_str().map(str::to_string))
+        .collect()
+}
+
+/// The robot's mode as last reported: in the last heartbeat the ground received (board A's
+/// own last status if none arrived).
+pub fn last_mode(s: &Summary) -> String {
+    match s.last_heartbeat {
+        Some(hb) => hb.mode.name().to_string(),
+        None => s.status["mode"].as_str().unwrap_or("standby").to_string(),
+    }
+}
+
+/// `mmic sim --summary-json`: the run as one JSON object, its fields in this order.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SummaryJson {
+    /// Every robot's plan completed.
+    pub completed: bool,
+    /// [`last_mode`].
+    pub mode: String,
+    /// [`faults_raised`].
+    pub faults: Vec<String>,
+    /// [`refusals`].
+    pub refusals: Vec<String>,
+    /// The process's exit code (the caller decides it).
+    pub exit: u8,
+}
+
+/// The run's [`SummaryJson`], given the exit code the process returns.
+pub fn summary_json(s: &Summary, exit: u8) -> SummaryJson {
+    SummaryJson {
+        completed: s.completed(),
+        mode: last_mode(s),
+        faults: faults_raised(s),
+        refusals: refusals(s),
+        exit,
+    }
+}
 
 /// Pairs bolted at the 1st, 2nd and 3rd attempt, and failed (from board A's events).
 pub fn bolting(s: &Summary) -> [u64; 4] {
@@ -141,14 +215,31 @@ pub fn plan_line(s: &Summary) -> String {
     }
 }
 
+/// The initial state of the last reconfiguration the ground sent (robot 1, from its `done`
+/// events), as sent: it differs from the plan's when an initial-state-mismatch was injected.
+fn sent_initial(s: &Summary) -> Option<mmic::motion::State> {
+    s.events("done")
+        .filter(|e| e["event"]["robot"] == 1)
+        .filter_map(|e| {
+            serde_json::from_value(e["event"]["command"]["reconfigure"]["initial"].clone()).ok()
+        })
+        .last()
+}
+
 /// What the refused step expected and what the robot last reported.
 fn mismatch(s: &Summary, step: usize) -> String {
     let expected = match s.plan.get(step).map(|st| st.step) {
         Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Reconfigure(
             r,
-        ))) => {
-            format!("the plan expected the robot in {}", r.initial())
-        }
+        ))) => match sent_initial(s).filter(|i| *i != r.initial()) {
+            // An injected initial-state-mismatch: the ground sent another initial state.
+            Some(sent) => format!(
+                "the plan expected the robot in {}, but the ground sent the reconfiguration \
+                 from {sent} (initial-state-mismatch injected)",
+                r.initial()
+            ),
+            None => format!("the plan expected the robot in {}", r.initial()),
+        },
         Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Primitive(m))) => {
             format!(
                 "primitive {} does not take the robot from the state it is in to {}",
@@ -249,6 +340,28 @@ pub fn text(s: &Summary) -> String {
         "commands: {executed} executed by board A, {dups} copies answered without running, {} executed twice",
         twice.len()
     );
+    let injected: Vec<String> = s
+        .events("inject")
+        .filter(|e| e["event"]["robot"] == 1)
+        .map(|e| {
+            format!(
+                "{}@{}",
+                e["event"]["name"].as_str().unwrap_or("?"),
+                e["event"]["at_ms"].as_f64().unwrap_or(0.0) / 1000.0
+            )
+        })
+        .collect();
+    if !injected.is_empty() {
+        let _ = writeln!(
+            t,
+            "injected: {}; Table 8 faults raised: {}",
+            injected.join(", "),
+            match faults_raised(s) {
+                f if f.is_empty() => "none".to_string(),
+                f => f.join(", "),
+            }
+        );
+    }
     let b = bolting(s);
     let _ = writeln!(
         t,
