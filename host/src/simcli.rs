@@ -89,7 +89,7 @@ Examples:
   mmic sim --wifi-loss 0.3                   30 % of WiFi packets lost, each way
   mmic sim --inject low-battery@25 --summary-json out.json   the battery sags mid-reconfiguration
   mmic sim --inject hip-mismatch@0           the hip encoder reads off from power-up
-  mmic sim --inject stop@25 --inject reset@28   the operator stops the motion and resumes it
+  mmic sim --inject stop@28 --inject reset@31   the operator stops the motion and resumes it
 
 Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
 2 bad arguments or a malformed plan file, or a step that does not fit the robot's state

@@ -622,9 +622,10 @@ enum Reaction {
 }
 
 /// One injection run on the demo plan at a time chosen from a plain demo run's log (scale 20,
-/// seed 1): `mode operational` at 0 s; `bolt all` from about 1.3-2.5 s to 20-21 s (pairs
-/// done about every 4.4 s); `reconfigure a -> m` from about 20.6-21.8 s until m is reached at
-/// about 34.7-36 s. `step` is the text the plan's running step starts with when the
+/// seed 1): `mode operational` at 0 s; `bolt all` from about 1.3 s to 24 s (a pair about every
+/// 5.5 s); `reconfigure a -> m` from about 24.1 s (its first primitive after the idle check)
+/// until m is reached at about 36.3 s. Mid-reconfiguration injections come at 28 s, with
+/// seconds of margin either side. `step` is the text the plan's running step starts with when the
 /// injection fires (none: before the first step).
 struct Case {
     inject: &'static str,
@@ -644,7 +645,7 @@ const CASES: [Case; 10] = [
     // The switch dies during the reconfiguration: the next contraction is not sensed.
     Case {
         inject: "arm-not-contracted",
-        at_s: 24.0,
+        at_s: 28.0,
         step: Some("reconfigure a -> m"),
         reaction: Reaction::Safed,
     },
@@ -658,13 +659,13 @@ const CASES: [Case; 10] = [
     // Obstacles on the gripper and on the arm in the middle of the reconfiguration.
     Case {
         inject: "gripper-overcurrent",
-        at_s: 26.0,
+        at_s: 28.0,
         step: Some("reconfigure a -> m"),
         reaction: Reaction::Safed,
     },
     Case {
         inject: "locomotion-overcurrent",
-        at_s: 26.0,
+        at_s: 28.0,
         step: Some("reconfigure a -> m"),
         reaction: Reaction::Safed,
     },
@@ -685,20 +686,20 @@ const CASES: [Case; 10] = [
     // The A-B line cut in the middle of the reconfiguration.
     Case {
         inject: "internal-comm-loss",
-        at_s: 26.0,
+        at_s: 28.0,
         step: Some("reconfigure a -> m"),
         reaction: Reaction::Safed,
     },
     // The deferred ones in the middle of the reconfiguration: Standby only once m is reached.
     Case {
         inject: "low-battery",
-        at_s: 26.0,
+        at_s: 28.0,
         step: Some("reconfigure a -> m"),
         reaction: Reaction::StandbyDeferred,
     },
     Case {
         inject: "assembly-system",
-        at_s: 26.0,
+        at_s: 28.0,
         step: Some("reconfigure a -> m"),
         reaction: Reaction::StandbyDeferred,
     },
@@ -925,11 +926,11 @@ fn every_table8_fault_injected_on_the_demo_reaches_its_table8_mode() {
 
 #[test]
 fn stop_during_a_reconfiguration_then_reset_resumes_it_and_the_demo_completes() {
-    // Stop in the middle of `reconfigure a -> m` (about 20.6-36 s), Reset 3 s later: the
+    // Stop in the middle of `reconfigure a -> m` (about 24-36 s), Reset 3 s later: the
     // operator's commands go out of band, and Reset resumes the interrupted motion (Table 1).
     let (s, records, json) = inject_demo(
         "inject_stop_reset",
-        &["stop@26".to_string(), "reset@29".to_string()],
+        &["stop@28".to_string(), "reset@31".to_string()],
         200,
     );
     let executed = |c: &str| {

@@ -18,7 +18,8 @@ pub struct Config {
     /// side B is derived from the same timeouts.
     pub side: SideConfig,
     /// Extra time the coordinator waits for side B's report beyond the side timeout before it
-    /// gives up on the link (internal communication loss). Default 1000 ms.
+    /// gives up on the step (motion timeout: the link itself is judged by the communication
+    /// monitor). Default 1000 ms.
     pub link_margin_ms: u32,
     /// Attempts per pair (Table 8: three).
     pub max_attempts: u8,
@@ -54,8 +55,8 @@ pub enum Status {
     Running,
     /// Every pair of the job done.
     Done,
-    /// Stopped on this fault: bolting failure after the last attempt, or internal
-    /// communication loss when side B stopped reporting.
+    /// Stopped on this fault: bolting failure after the last attempt, or the motion timeout
+    /// when side B never reported the step.
     Failed(Fault),
 }
 
@@ -238,8 +239,12 @@ impl Coordinator {
             } else if a_done && b_done {
                 self.advance(cfg, now);
             } else if self.waited_ms > limit {
-                // Side B never reported this step: the link, not the fastener, failed.
-                self.status = Status::Failed(Fault::InternalCommLoss);
+                // Side B never reported this step done or timed out. Not Table 8's internal
+                // communication loss: a silent B or an unacknowledged A->B command raises that
+                // on its own (safety::detect::CommMonitor) within 500 ms, long before this
+                // limit; what is left is a step that did not end (spec/decisions.toml
+                // `motion-timeout`).
+                self.status = Status::Failed(Fault::MotionTimeout);
             }
         }
         Output {

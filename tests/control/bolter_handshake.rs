@@ -135,7 +135,7 @@ fn explore(job: Job) -> (usize, usize, [usize; 3]) {
     let mut edges: Vec<Vec<usize>> = vec![vec![]];
     index.insert(start, 0);
     let mut queue = VecDeque::from([0usize]);
-    let mut terminal = [0usize; 3]; // done, bolting failure, comm loss
+    let mut terminal = [0usize; 3]; // done, bolting failure, side B never reported (motion timeout)
     while let Some(i) = queue.pop_front() {
         let w = states[i];
         check(&w);
@@ -204,7 +204,7 @@ fn handshake_single_pair_bolt_and_unbolt() {
             direction,
             fasteners: Fasteners::Pair(BolterPair::P2),
         });
-        println!("bolter handshake ({direction:?}, one pair): {n} states, {t} transitions, terminal done/bolting-failure/comm-loss {term:?}");
+        println!("bolter handshake ({direction:?}, one pair): {n} states, {t} transitions, terminal done/bolting-failure/motion-timeout {term:?}");
         assert!(
             term.iter().all(|&c| c > 0),
             "every outcome must be reachable: {term:?}"

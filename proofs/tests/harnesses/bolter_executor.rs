@@ -13,7 +13,7 @@
 //! - `Coordinator`: never panics; while running, the attempt is 1..=3 and the heartbeat's
 //!   attempt byte equals it; every new sequence number comes with an order whose content
 //!   differs from the previous one (the side executors' resend filter relies on it); a job ends
-//!   in Done, BoltingFailure or InternalCommLoss only, and stays ended.
+//!   in Done, BoltingFailure or MotionTimeout (side B never reported) only, and stays ended.
 //!
 //! The sequence-level protocol (lossy links, every interleaving) is model-checked exhaustively
 //! in `tests/control/bolter_handshake.rs`.
@@ -239,7 +239,7 @@ fn coordinator_bounded_and_orders_change() {
                     }
                     Status::Done
                     | Status::Failed(Fault::BoltingFailure)
-                    | Status::Failed(Fault::InternalCommLoss) => {
+                    | Status::Failed(Fault::MotionTimeout) => {
                         assert_eq!(out.order, None);
                         assert_eq!(out.active, None);
                         ended = Some(out.status);
