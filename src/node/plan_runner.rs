@@ -659,14 +659,10 @@ mod tests {
     }
 
     #[test]
-    fn a_misstated_reconfiguration_goes_out_once_with_a_wrong_initial_state() {
-        let (a_m, m_b) = (
-            Reconfiguration::new(State::A, State::M),
-            Reconfiguration::new(State::M, State::B),
-        );
-        let (Ok(a_m), Ok(m_b)) = (a_m, m_b) else {
-            panic!("valid reconfigurations");
-        };
+    fn a_misstated_reconfiguration_goes_out_once_with_a_wrong_initial_state(
+    ) -> Result<(), crate::command::ReconfigurationError> {
+        let a_m = Reconfiguration::new(State::A, State::M)?;
+        let m_b = Reconfiguration::new(State::M, State::B)?;
         let steps = [
             PlanStep::Command(Command::Mode(Mode::Operational)),
             PlanStep::Command(Command::Reconfigure(a_m)),
@@ -688,5 +684,6 @@ mod tests {
         assert_ne!(reconfigurations[0].initial(), State::A);
         assert_eq!(reconfigurations[0].target(), State::M);
         assert_eq!(reconfigurations[1], m_b, "only the next one");
+        Ok(())
     }
 }
