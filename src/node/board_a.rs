@@ -913,12 +913,12 @@ impl BoardA {
             }
             Command::Primitive(m) => {
                 if let Some((from, to)) = self.primitive_move(m) {
-                    self.start_run(from, to, now);
+                    self.start_run(from, to);
                 }
             }
             Command::Reconfigure(r) => {
                 let from = self.tracked.unwrap_or(r.initial());
-                self.start_run(from, r.target(), now);
+                self.start_run(from, r.target());
             }
             _ => {}
         }
@@ -926,7 +926,7 @@ impl BoardA {
 
     /// A reconfiguration (or primitive) accepted: it starts after the idle check
     /// ([`IdleCheck::Before`]), in [`BoardA::advance`].
-    fn start_run(&mut self, from: State, to: State, _now: u32) {
+    fn start_run(&mut self, from: State, to: State) {
         self.target_state = Some(to);
         self.complete = from == to;
         if from != to {

@@ -287,11 +287,6 @@ pub const fn bolting_failure(cfg: &Config, consecutive_failed_attempts: u8) -> b
     consecutive_failed_attempts >= cfg.bolting_max_attempts
 }
 
-/// Arm not fully contracted (Table 8): after a contraction finished, the switch is not pressed.
-pub const fn arm_contraction_fault(contraction_finished: bool, switch_pressed: bool) -> bool {
-    contraction_finished && !switch_pressed
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -365,8 +360,6 @@ mod tests {
         let cfg = Config::default();
         assert!(!bolting_failure(&cfg, 0) && !bolting_failure(&cfg, 2));
         assert!(bolting_failure(&cfg, 3) && bolting_failure(&cfg, 4));
-        assert!(arm_contraction_fault(true, false));
-        assert!(!arm_contraction_fault(true, true) && !arm_contraction_fault(false, false));
     }
 
     #[test]
