@@ -1,0 +1,71 @@
+//! Everything that differs between the chips: the pin map. ESP32-C3 by default, ESP32-C6
+//! with the feature `c6` (README.md has the table and the wiring notes).
+
+use esp_hal::gpio::AnyPin;
+pub use esp_hal::gpio::Pin;
+
+/// A side's pins. Board B leaves `hip` unused.
+pub struct Pins {
+    /// I2C bus of the ADS7828, the MPU-6000 and the hip encoder.
+    pub sda: AnyPin<'static>,
+    /// I2C clock.
+    pub scl: AnyPin<'static>,
+    /// Servo pulses (LEDC): arm, gripper, hip.
+    pub servos: [AnyPin<'static>; 3],
+    /// Bolter motor driver: direction, translate enable, rotate enable.
+    pub bolter: [AnyPin<'static>; 3],
+    /// ADG1604 A0, A1.
+    pub mux: [AnyPin<'static>; 2],
+    /// 7.4 V regulator enable.
+    pub regulator: AnyPin<'static>,
+    /// The A–B serial line: TX, RX.
+    pub uart: [AnyPin<'static>; 2],
+    /// Switches: arm contracted, bolter at home.
+    pub switches: [AnyPin<'static>; 2],
+}
+
+/// The chip's name, for the start-up line.
+#[cfg(not(feature = "c6"))]
+pub const CHIP: &str = "ESP32-C3";
+/// The chip's name, for the start-up line.
+#[cfg(feature = "c6")]
+pub const CHIP: &str = "ESP32-C6";
+
+/// Takes the pin map's pins out of `esp_hal::init`'s peripherals (ESP32-C3: GPIO0–10 and
+/// 18–21; 18/19 are the USB pins, so the USB console stops at start-up).
+#[cfg(not(feature = "c6"))]
+#[macro_export]
+macro_rules! take_pins {
+    ($p:ident) => {{
+        use $crate::chip::Pin as _;
+        $crate::chip::Pins {
+            sda: $p.GPIO4.degrade(),
+            scl: $p.GPIO5.degrade(),
+            servos: [$p.GPIO6.degrade(), $p.GPIO7.degrade(), $p.GPIO10.degrade()],
+            bolter: [$p.GPIO0.degrade(), $p.GPIO1.degrade(), $p.GPIO3.degrade()],
+            mux: [$p.GPIO18.degrade(), $p.GPIO19.degrade()],
+            regulator: $p.GPIO2.degrade(),
+            uart: [$p.GPIO21.degrade(), $p.GPIO20.degrade()],
+            switches: [$p.GPIO8.degrade(), $p.GPIO9.degrade()],
+        }
+    }};
+}
+
+/// Takes the pin map's pins out of `esp_hal::init`'s peripherals (ESP32-C6).
+#[cfg(feature = "c6")]
+#[macro_export]
+macro_rules! take_pins {
+    ($p:ident) => {{
+        use $crate::chip::Pin as _;
+        $crate::chip::Pins {
+            sda: $p.GPIO6.degrade(),
+            scl: $p.GPIO7.degrade(),
+            servos: [$p.GPIO18.degrade(), $p.GPIO19.degrade(), $p.GPIO20.degrade()],
+            bolter: [$p.GPIO21.degrade(), $p.GPIO22.degrade(), $p.GPIO23.degrade()],
+            mux: [$p.GPIO0.degrade(), $p.GPIO1.degrade()],
+            regulator: $p.GPIO2.degrade(),
+            uart: [$p.GPIO10.degrade(), $p.GPIO11.degrade()],
+            switches: [$p.GPIO3.degrade(), $p.GPIO14.degrade()],
+        }
+    }};
+}
