@@ -24,7 +24,8 @@
 //! harness against a `VecDeque` model (proofs/tests/harnesses/node.rs).
 //!
 //! Needs atomic loads and stores: available on targets with atomics (ESP32, ESP32-C6, hosts);
-//! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`.
+//! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`, or `portable-atomic`
+//! when another crate (esp-hal on the C3) already selects portable-atomic's backend.
 
 use heapless::spsc;
 
