@@ -17,6 +17,9 @@ pub mod chip;
 #[cfg(target_arch = "riscv32")]
 pub mod hw;
 
+/// The A–B serial line's rate, baud.
+pub const BAUD: u32 = 115_200;
+
 /// Where board A of robot `n` listens for the server board, and the server board's address
 /// (a private 192.168.4.0/24 network on the lab's access point, see README.md).
 pub mod net {
