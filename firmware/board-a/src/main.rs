@@ -77,8 +77,7 @@ async fn main(spawner: Spawner) -> ! {
     let i2c = I2c::new(p.I2C0, i2c_cfg).expect("I2C config");
     let bus = BUS.init(RefCell::new(i2c.with_sda(pins.sda).with_scl(pins.scl)));
     let side = Side::new(bus, hw::switches(pins.switches), true);
-    let outs = hw::Outputs::new(p.LEDC, pins.servos, pins.bolter, pins.mux, pins.regulator)
-        .expect("LEDC config");
+    let outs = hw::Outputs::new(p.LEDC, pins.servos, pins.bolter, pins.mux, pins.regulator);
     let [tx, rx] = pins.uart;
     let uart = Uart::new(p.UART1, UartConfig::default().with_baudrate(support::BAUD))
         .expect("UART config")
@@ -87,7 +86,10 @@ async fn main(spawner: Spawner) -> ! {
     let serial = Serial { uart, rx_errors: 0 };
     let (cmd_in, cmd_out) = RX.init(PacketQueue::new()).split();
     let (hb_in, hb_out) = TX.init(PacketQueue::new()).split();
-    let cfg = board_a::Config { board, ..Default::default() };
+    let cfg = board_a::Config {
+        board,
+        ..Default::default()
+    };
     let ctl = ControlA::new(cfg, frontend::Config::default(), cmd_out, hb_in);
     spawner.spawn(control(ctl, side, outs, serial).expect("control task"));
 
@@ -96,7 +98,8 @@ async fn main(spawner: Spawner) -> ! {
     let sta = StationConfig::default()
         .with_ssid(SSID.try_into().expect("SSID"))
         .with_authentication(auth);
-    let radio_cfg = wifi::ControllerConfig::default().with_initial_config(wifi::Config::Station(sta));
+    let radio_cfg =
+        wifi::ControllerConfig::default().with_initial_config(wifi::Config::Station(sta));
     let controller = wifi::WifiController::new(p.WIFI, radio_cfg).expect("WiFi");
     let ip = StaticConfigV4 {
         address: Ipv4Cidr::new(Ipv4Address::from(net::robot(n)), 24),
@@ -135,7 +138,7 @@ async fn control(
             }
         }
         ticks = ticks.wrapping_add(1);
-        if ticks % STATUS_TICKS == 0 {
+        if ticks.is_multiple_of(STATUS_TICKS) {
             println!(
                 "t={now} mode={:?} gaps={} i2c={:?} rx_err={} b_discarded={} hb_dropped={}",
                 ctl.a.mode(),
@@ -184,7 +187,10 @@ async fn wifi_task(
                 }
             }
         }
-        println!("server gone: discarded={} unconnected={unconnected}", link.discarded());
+        println!(
+            "server gone: discarded={} unconnected={unconnected}",
+            link.discarded()
+        );
         sock.abort();
         let _ = with_timeout(Duration::from_millis(100), sock.flush()).await;
     }

@@ -17,10 +17,14 @@ use esp_hal::uart::{Config as UartConfig, Uart};
 use esp_hal::Blocking;
 use esp_println::println;
 use mmic::node::board_b;
+use mmic::node::board_b::BoardB;
 use mmic::sensors::frontend;
+use mmic::sensors::frontend::{Frontend, WINDOW};
+use mmic::wire::PacketKind;
 use static_cell::StaticCell;
-use support::control::{ControlB, TICK_MS};
+use support::control::{bolter_lines, Actuators, Counters, Sensors, TICK_MS};
 use support::hw::{self, Serial};
+use support::link::{ByteSink, ByteSource, Link};
 use support::sensors::Side;
 
 esp_bootloader_esp_idf::esp_app_desc!();
@@ -43,8 +47,7 @@ async fn main(_spawner: Spawner) -> ! {
     let i2c = I2c::new(p.I2C0, i2c_cfg).expect("I2C config");
     let bus = BUS.init(RefCell::new(i2c.with_sda(pins.sda).with_scl(pins.scl)));
     let mut side: Side<'_, _, Input<'static>> = Side::new(bus, hw::switches(pins.switches), false);
-    let mut outs = hw::Outputs::new(p.LEDC, pins.servos, pins.bolter, pins.mux, pins.regulator)
-        .expect("LEDC config");
+    let mut outs = hw::Outputs::new(p.LEDC, pins.servos, pins.bolter, pins.mux, pins.regulator);
     let [tx, rx] = pins.uart;
     let uart = Uart::new(p.UART1, UartConfig::default().with_baudrate(support::BAUD))
         .expect("UART config")
@@ -59,7 +62,7 @@ async fn main(_spawner: Spawner) -> ! {
         let now = Instant::now().as_millis() as u32;
         ctl.tick(now, &mut side, &mut outs, &mut serial);
         ticks = ticks.wrapping_add(1);
-        if ticks % STATUS_TICKS == 0 {
+        if ticks.is_multiple_of(STATUS_TICKS) {
             println!(
                 "t={now} gaps={} i2c={:?} rx_err={} discarded={} frames={}",
                 ctl.counters.sensor_gaps,
@@ -70,5 +73,67 @@ async fn main(_spawner: Spawner) -> ! {
             );
         }
         ticker.next().await;
+    }
+}
+
+/// Board B's control task.
+pub struct ControlB {
+    /// The library's board B.
+    pub b: BoardB,
+    front: Frontend<WINDOW>,
+    /// Board A's serial line, receive side.
+    pub from_a: Link,
+    /// Counts.
+    pub counters: Counters,
+}
+
+impl ControlB {
+    /// Board B.
+    pub fn new(cfg: board_b::Config, front: frontend::Config) -> Self {
+        ControlB {
+            b: BoardB::new(cfg),
+            front: Frontend::new(front),
+            from_a: Link::new(PacketKind::BCommand),
+            counters: Counters::default(),
+        }
+    }
+
+    /// One tick at `now` ms, as [`ControlA::tick`] (board B has no hip: its encoder reading
+    /// is not used).
+    pub fn tick(
+        &mut self,
+        now: u32,
+        sensors: &mut impl Sensors,
+        out: &mut impl Actuators,
+        uart: &mut (impl ByteSource + ByteSink),
+    ) -> Option<board_b::Outputs> {
+        let r = sensors.read();
+        let Some(adc) = r.adc else {
+            self.counters.sensor_gaps = self.counters.sensor_gaps.saturating_add(1);
+            return None;
+        };
+        // Board B's front end ignores the encoder field (mmic::sensors::frontend::Raw).
+        let f = self.front.push(&frontend::Raw {
+            adc,
+            accel: r.accel,
+            encoder: 0,
+        });
+        let inputs = board_b::Inputs {
+            command: self.from_a.next(uart),
+            electrical: f.electrical,
+            gravity: f.gravity,
+            arm_contracted: r.arm_contracted,
+            bolter_at_home: r.bolter_at_home,
+        };
+        let o = self.b.tick(now, &inputs);
+        out.servos([o.arm, o.gripper, None]);
+        out.regulator(o.regulator);
+        out.bolter(bolter_lines(o.bolter), o.mux);
+        if let Some(hb) = o.heartbeat {
+            if !uart.write(&hb) {
+                self.counters.tx_errors = self.counters.tx_errors.saturating_add(1);
+            }
+        }
+        Some(o)
     }
 }

@@ -4,32 +4,28 @@
 use esp_hal::gpio::AnyPin;
 pub use esp_hal::gpio::Pin;
 
-/// A side's pins. Board B leaves `hip` unused.
+/// A side's pins: the I2C bus (ADS7828, MPU-6000, hip encoder), the servo pulses (arm,
+/// gripper, hip; board B leaves the hip unused), the bolter driver (direction, translate
+/// enable, rotate enable), the ADG1604's A0/A1, the 7.4 V regulator enable, the A–B serial
+/// line (TX, RX) and the switches (arm contracted, bolter at home).
+#[allow(missing_docs)]
 pub struct Pins {
-    /// I2C bus of the ADS7828, the MPU-6000 and the hip encoder.
     pub sda: AnyPin<'static>,
-    /// I2C clock.
     pub scl: AnyPin<'static>,
-    /// Servo pulses (LEDC): arm, gripper, hip.
     pub servos: [AnyPin<'static>; 3],
-    /// Bolter motor driver: direction, translate enable, rotate enable.
     pub bolter: [AnyPin<'static>; 3],
-    /// ADG1604 A0, A1.
     pub mux: [AnyPin<'static>; 2],
-    /// 7.4 V regulator enable.
     pub regulator: AnyPin<'static>,
-    /// The A–B serial line: TX, RX.
     pub uart: [AnyPin<'static>; 2],
-    /// Switches: arm contracted, bolter at home.
     pub switches: [AnyPin<'static>; 2],
 }
 
 /// The chip's name, for the start-up line.
-#[cfg(not(feature = "c6"))]
-pub const CHIP: &str = "ESP32-C3";
-/// The chip's name, for the start-up line.
-#[cfg(feature = "c6")]
-pub const CHIP: &str = "ESP32-C6";
+pub const CHIP: &str = if cfg!(feature = "c6") {
+    "ESP32-C6"
+} else {
+    "ESP32-C3"
+};
 
 /// Takes the pin map's pins out of `esp_hal::init`'s peripherals (ESP32-C3: GPIO0–10 and
 /// 18–21; 18/19 are the USB pins, so the USB console stops at start-up).
@@ -60,8 +56,16 @@ macro_rules! take_pins {
         $crate::chip::Pins {
             sda: $p.GPIO6.degrade(),
             scl: $p.GPIO7.degrade(),
-            servos: [$p.GPIO18.degrade(), $p.GPIO19.degrade(), $p.GPIO20.degrade()],
-            bolter: [$p.GPIO21.degrade(), $p.GPIO22.degrade(), $p.GPIO23.degrade()],
+            servos: [
+                $p.GPIO18.degrade(),
+                $p.GPIO19.degrade(),
+                $p.GPIO20.degrade(),
+            ],
+            bolter: [
+                $p.GPIO21.degrade(),
+                $p.GPIO22.degrade(),
+                $p.GPIO23.degrade(),
+            ],
             mux: [$p.GPIO0.degrade(), $p.GPIO1.degrade()],
             regulator: $p.GPIO2.degrade(),
             uart: [$p.GPIO10.degrade(), $p.GPIO11.degrade()],

@@ -3,10 +3,8 @@
 //! order is the host simulator's (host/src/sim/nodes.rs).
 
 use crate::link::{ByteSink, ByteSource, Link};
-use mmic::bolter::Drive;
-use mmic::bolter::MuxLines;
+use mmic::bolter::{Drive, MuxLines};
 use mmic::node::board_a::{self, BoardA};
-use mmic::node::board_b::{self, BoardB};
 use mmic::node::handoff::{Consumer, Producer};
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::PulseWidth;
@@ -19,18 +17,16 @@ pub const TICK_MS: u32 = 10;
 /// Hand-off queue slots (holds one fewer).
 pub const QUEUE: usize = 8;
 
-/// One tick's readings of a side; `None` where the device did not answer.
+/// One tick's readings of a side, `None` where the device did not answer: ADS7828 codes
+/// CH0..CH7, MPU-6000 accelerations X, Y, Z, the hip encoder's raw angle (board A), and the
+/// arm contraction and bolter home switches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
 pub struct Reading {
-    /// ADS7828 codes CH0..CH7.
     pub adc: Option<[u16; 8]>,
-    /// MPU-6000 accelerations X, Y, Z.
     pub accel: Option<[i16; 3]>,
-    /// Hip encoder raw angle (board A).
     pub encoder: Option<u16>,
-    /// Arm contraction switch.
     pub arm_contracted: bool,
-    /// Bolter home switch.
     pub bolter_at_home: bool,
 }
 
@@ -55,23 +51,21 @@ pub const fn bolter_lines(d: Drive) -> [bool; 3] {
 
 /// A side's outputs.
 pub trait Actuators {
-    /// Servo pulses at 50 Hz (none: no pulse, unpowered): arm, gripper, hip (board A).
-    fn servos(&mut self, arm: Option<PulseWidth>, gripper: Option<PulseWidth>, hip: Option<PulseWidth>);
+    /// Servo pulses at 50 Hz, arm, gripper, hip (board A); none: no pulse, unpowered.
+    fn servos(&mut self, pulses: [Option<PulseWidth>; 3]);
     /// The 7.4 V regulator enable line.
     fn regulator(&mut self, on: bool);
     /// The bolter's drive lines ([`bolter_lines`]) and the ADG1604's A0/A1.
     fn bolter(&mut self, lines: [bool; 3], mux: MuxLines);
 }
 
-/// What the glue counts that the library does not see.
+/// What the glue counts: ticks not run for a missing ADC or encoder reading (README.md,
+/// library gaps), packets the serial line did not take.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[allow(missing_docs)]
 pub struct Counters {
-    /// Ticks not run because the ADC or the encoder did not answer (see README.md, gaps).
     pub sensor_gaps: u32,
-    /// Packets the serial line did not take.
     pub tx_errors: u32,
-    /// Events that did not fit a tick's outputs.
-    pub events_lost: u32,
 }
 
 /// Board A's control task.
@@ -127,7 +121,11 @@ impl<'q> ControlA<'q> {
             self.counters.sensor_gaps = self.counters.sensor_gaps.saturating_add(1);
             return None;
         };
-        let f = self.front.push(&frontend::Raw { adc, accel: r.accel, encoder });
+        let f = self.front.push(&frontend::Raw {
+            adc,
+            accel: r.accel,
+            encoder,
+        });
         let inputs = board_a::Inputs {
             command: self.commands.pop(),
             from_b: self.from_b.next(uart),
@@ -138,7 +136,7 @@ impl<'q> ControlA<'q> {
             bolter_at_home: r.bolter_at_home,
         };
         let o = self.a.tick(now, &inputs);
-        out.servos(o.arm, o.gripper, o.hip);
+        out.servos([o.arm, o.gripper, o.hip]);
         out.regulator(o.regulator);
         out.bolter(bolter_lines(o.bolter), o.mux);
         if let Some(b) = o.to_b {
@@ -151,7 +149,6 @@ impl<'q> ControlA<'q> {
                 self.heartbeats.give_up(full);
             }
         }
-        self.counters.events_lost = self.counters.events_lost.saturating_add(o.events_lost.into());
         Some(o)
     }
 }
@@ -164,62 +161,4 @@ pub fn commands_in(link: &mut Link, bytes: &[u8], q: &mut Producer<'_, COMMAND_L
             q.give_up(full);
         }
     });
-}
-
-/// Board B's control task.
-pub struct ControlB {
-    /// The library's board B.
-    pub b: BoardB,
-    front: Frontend<WINDOW>,
-    /// Board A's serial line, receive side.
-    pub from_a: Link,
-    /// Counts.
-    pub counters: Counters,
-}
-
-impl ControlB {
-    /// Board B.
-    pub fn new(cfg: board_b::Config, front: frontend::Config) -> Self {
-        ControlB {
-            b: BoardB::new(cfg),
-            front: Frontend::new(front),
-            from_a: Link::new(PacketKind::BCommand),
-            counters: Counters::default(),
-        }
-    }
-
-    /// One tick at `now` ms, as [`ControlA::tick`] (board B has no hip: its encoder reading
-    /// is not used).
-    pub fn tick(
-        &mut self,
-        now: u32,
-        sensors: &mut impl Sensors,
-        out: &mut impl Actuators,
-        uart: &mut (impl ByteSource + ByteSink),
-    ) -> Option<board_b::Outputs> {
-        let r = sensors.read();
-        let Some(adc) = r.adc else {
-            self.counters.sensor_gaps = self.counters.sensor_gaps.saturating_add(1);
-            return None;
-        };
-        // Board B's front end ignores the encoder field (mmic::sensors::frontend::Raw).
-        let f = self.front.push(&frontend::Raw { adc, accel: r.accel, encoder: 0 });
-        let inputs = board_b::Inputs {
-            command: self.from_a.next(uart),
-            electrical: f.electrical,
-            gravity: f.gravity,
-            arm_contracted: r.arm_contracted,
-            bolter_at_home: r.bolter_at_home,
-        };
-        let o = self.b.tick(now, &inputs);
-        out.servos(o.arm, o.gripper, None);
-        out.regulator(o.regulator);
-        out.bolter(bolter_lines(o.bolter), o.mux);
-        if let Some(hb) = o.heartbeat {
-            if !uart.write(&hb) {
-                self.counters.tx_errors = self.counters.tx_errors.saturating_add(1);
-            }
-        }
-        Some(o)
-    }
 }

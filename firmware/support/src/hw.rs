@@ -14,36 +14,16 @@ use mmic::bolter::MuxLines;
 use mmic::units::PulseWidth;
 use static_cell::StaticCell;
 
-/// Servo period, µs (50 Hz).
-const PERIOD_US: u32 = 20_000;
-/// Duty resolution: 14 bits.
-const DUTY_MAX: u32 = 1 << 14;
-
-/// LEDC duty of a pulse (none: 0, no pulse).
+/// LEDC duty (14 bits of a 20 ms period) of a pulse; none: 0, no pulse.
 pub const fn duty(p: Option<PulseWidth>) -> u32 {
     match p {
-        Some(p) => p.micros() as u32 * DUTY_MAX / PERIOD_US,
+        Some(p) => p.micros() as u32 * (1 << 14) / 20_000,
         None => 0,
     }
 }
 
-/// Start-up failures.
-#[derive(Debug)]
-pub enum Error {
-    /// LEDC timer or channel configuration.
-    Ledc,
-}
-
 fn out(pin: AnyPin<'static>) -> Output<'static> {
     Output::new(pin, Level::Low, OutputConfig::default())
-}
-
-fn level(high: bool) -> Level {
-    if high {
-        Level::High
-    } else {
-        Level::Low
-    }
 }
 
 /// The side's input switches (pulled up; a closed switch reads low).
@@ -64,14 +44,14 @@ static TIMER: StaticCell<Timer<'static, LowSpeed>> = StaticCell::new();
 
 impl Outputs {
     /// LEDC timer 0 at 50 Hz with channels 0–2 on the servo pins (arm, gripper, hip), every
-    /// line low, no pulse. Call once.
+    /// line low, no pulse. Start-up only (call once; panics on a configuration error).
     pub fn new(
         ledc: LEDC<'static>,
         servos: [AnyPin<'static>; 3],
         bolter: [AnyPin<'static>; 3],
         mux: [AnyPin<'static>; 2],
         regulator: AnyPin<'static>,
-    ) -> Result<Self, Error> {
+    ) -> Self {
         let mut ledc = Ledc::new(ledc);
         ledc.set_global_slow_clock(LSGlobalClkSource::APBClk);
         let t = TIMER.init(ledc.timer::<LowSpeed>(timer::Number::Timer0));
@@ -80,7 +60,7 @@ impl Outputs {
             clock_source: timer::LSClockSource::APBClk,
             frequency: Rate::from_hz(50),
         })
-        .map_err(|_| Error::Ledc)?;
+        .expect("LEDC timer");
         let t: &'static Timer<'static, LowSpeed> = t;
         let [s0, s1, s2] = servos;
         let mut servos = [
@@ -94,40 +74,35 @@ impl Outputs {
                 duty_pct: 0,
                 drive_mode: DriveMode::PushPull,
             };
-            c.configure(cfg).map_err(|_| Error::Ledc)?;
+            c.configure(cfg).expect("LEDC channel");
         }
-        Ok(Outputs {
+        Outputs {
             _ledc: ledc,
             servos,
             bolter: bolter.map(out),
             mux: mux.map(out),
             regulator: out(regulator),
-        })
+        }
     }
 }
 
 impl Actuators for Outputs {
-    fn servos(
-        &mut self,
-        arm: Option<PulseWidth>,
-        gripper: Option<PulseWidth>,
-        hip: Option<PulseWidth>,
-    ) {
-        for (c, p) in self.servos.iter().zip([arm, gripper, hip]) {
+    fn servos(&mut self, pulses: [Option<PulseWidth>; 3]) {
+        for (c, p) in self.servos.iter().zip(pulses) {
             c.set_duty_hw(duty(p));
         }
     }
 
     fn regulator(&mut self, on: bool) {
-        self.regulator.set_level(level(on));
+        self.regulator.set_level(Level::from(on));
     }
 
     fn bolter(&mut self, lines: [bool; 3], mux: MuxLines) {
         for (o, l) in self.bolter.iter_mut().zip(lines) {
-            o.set_level(level(l));
+            o.set_level(Level::from(l));
         }
-        self.mux[0].set_level(level(mux.a0));
-        self.mux[1].set_level(level(mux.a1));
+        self.mux[0].set_level(Level::from(mux.a0));
+        self.mux[1].set_level(Level::from(mux.a1));
     }
 }
 

@@ -1,16 +1,14 @@
 //! The MMIC-I firmware's shared glue: moves bytes and readings between the ESP32's peripherals
 //! and the `mmic` library's pure nodes, and decides nothing (every decision is in `mmic`).
 //!
-//! Hardware-free parts (framing, the tick glue, the server's loop steps) build on the host and
-//! are tested there with mocked peripherals (`tests/`); the esp-hal parts are behind
-//! `cfg(target_arch = "riscv32")`.
+//! Hardware-free parts build on the host and are tested there with mocked peripherals
+//! (`tests/`); the esp-hal parts are behind `cfg(target_arch = "riscv32")`.
 #![no_std]
 
 pub mod control;
 pub mod drivers;
 pub mod link;
 pub mod sensors;
-pub mod server;
 
 #[cfg(target_arch = "riscv32")]
 pub mod chip;
@@ -27,7 +25,7 @@ pub mod net {
     pub const PORT: u16 = 5000;
     /// The server board's address.
     pub const SERVER: [u8; 4] = [192, 168, 4, 2];
-    /// Board A of robot `n` (1..=255 wraps into .11 to .254 by the board number's low bits).
+    /// Board A of robot `n` (192.168.4.(10 + n), wrapping).
     pub const fn robot(n: u8) -> [u8; 4] {
         [192, 168, 4, 10u8.wrapping_add(n)]
     }

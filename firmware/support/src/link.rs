@@ -4,16 +4,15 @@
 use mmic::wire::deframer::{Deframed, Deframer};
 use mmic::wire::PacketKind;
 
-/// A non-blocking byte source: a UART's receive FIFO. `read` returns what is there now (0:
-/// nothing); a receive error is counted by the implementation and reads as 0.
+/// A non-blocking byte source (a UART's receive FIFO).
 pub trait ByteSource {
-    /// Copies up to `buf.len()` received bytes into `buf`.
+    /// Copies what has arrived, up to `buf.len()` bytes (0: nothing; an error counts as 0).
     fn read(&mut self, buf: &mut [u8]) -> usize;
 }
 
-/// A byte sink: a UART's transmitter. Returns false when the bytes did not all go out.
+/// A byte sink (a UART's transmitter).
 pub trait ByteSink {
-    /// Sends `bytes`.
+    /// Sends `bytes`; false when they did not all go out.
     fn write(&mut self, bytes: &[u8]) -> bool;
 }
 
@@ -24,7 +23,7 @@ pub const BUF: usize = 256;
 pub struct Link {
     d: Deframer<BUF>,
     kind: PacketKind,
-    /// Valid packets of another kind (e.g. a command echoed on a heartbeat line).
+    /// Valid packets of another kind, dropped.
     pub other_kind: u32,
 }
 
@@ -62,17 +61,13 @@ impl Link {
     }
 
     /// Pushes all of `bytes` (a TCP read) and hands every packet of this kind to `sink`.
-    pub fn feed<const L: usize>(&mut self, bytes: &[u8], mut sink: impl FnMut([u8; L])) {
-        let (kind, mut other) = (self.kind, 0);
-        self.d.feed(bytes, |e| match e {
-            Deframed::Frame(f) if f.kind() == kind => match f.as_bytes().try_into() {
-                Ok(p) => sink(p),
-                Err(_) => other += 1,
-            },
-            Deframed::Frame(_) => other += 1,
-            Deframed::Discarded(_) => {}
-        });
-        self.other_kind = self.other_kind.saturating_add(other);
+    pub fn feed<const L: usize>(&mut self, mut bytes: &[u8], mut sink: impl FnMut([u8; L])) {
+        while !bytes.is_empty() {
+            bytes = &bytes[self.d.push(bytes)..];
+            while let Some(p) = self.poll(false) {
+                sink(p);
+            }
+        }
     }
 
     fn poll<const L: usize>(&mut self, idle: bool) -> Option<[u8; L]> {

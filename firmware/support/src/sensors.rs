@@ -37,17 +37,13 @@ impl<'b, I: I2c, P: InputPin<Error = Infallible>> Side<'b, I, P> {
 }
 
 fn count<T, E>(r: Result<T, E>, errors: &mut u32) -> Option<T> {
-    if r.is_err() {
-        *errors = errors.saturating_add(1);
-    }
+    *errors = errors.saturating_add(r.is_err().into());
     r.ok()
 }
 
+/// A closed switch reads low (the pins cannot fail: `Infallible`).
 fn closed(p: &mut impl InputPin<Error = Infallible>) -> bool {
-    match p.is_low() {
-        Ok(low) => low,
-        Err(e) => match e {},
-    }
+    matches!(p.is_low(), Ok(true))
 }
 
 impl<I: I2c, P: InputPin<Error = Infallible>> Sensors for Side<'_, I, P> {
@@ -56,7 +52,11 @@ impl<I: I2c, P: InputPin<Error = Infallible>> Sensors for Side<'_, I, P> {
         if !self.imu_ready {
             self.imu_ready = count(self.imu.init(), e_imu).is_some();
         }
-        let accel = if self.imu_ready { count(self.imu.accel(), e_imu) } else { None };
+        let accel = if self.imu_ready {
+            count(self.imu.accel(), e_imu)
+        } else {
+            None
+        };
         Reading {
             adc: count(self.adc.read_all(), e_adc),
             accel,

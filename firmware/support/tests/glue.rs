@@ -43,8 +43,8 @@ struct Outs {
     bolter: Option<([bool; 3], MuxLines)>,
 }
 impl Actuators for Outs {
-    fn servos(&mut self, a: Option<PulseWidth>, g: Option<PulseWidth>, h: Option<PulseWidth>) {
-        self.servos = Some([a, g, h]);
+    fn servos(&mut self, pulses: [Option<PulseWidth>; 3]) {
+        self.servos = Some(pulses);
     }
     fn regulator(&mut self, on: bool) {
         self.regulator = Some(on);
@@ -146,7 +146,10 @@ fn board_a_command_to_heartbeat_through_the_glue() {
     assert!(out.is_some());
     let hb = wifi_out.pop().expect("a heartbeat for the WiFi task");
     let hb = HeartbeatRepr::parse(&hb).expect("a valid heartbeat");
-    assert_eq!((hb.mode, hb.last_seq, hb.refusal), (Mode::Operational, 1, None));
+    assert_eq!(
+        (hb.mode, hb.last_seq, hb.refusal),
+        (Mode::Operational, 1, None)
+    );
     assert_eq!(ctl.a.mode(), Mode::Operational);
     assert_eq!(outs.regulator, out.as_ref().map(|o| o.regulator));
     assert!(outs.servos.is_some() && outs.bolter.is_some());
