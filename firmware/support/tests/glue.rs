@@ -159,3 +159,54 @@ fn board_a_command_to_heartbeat_through_the_glue() {
     assert_eq!(side.errors, [1, 0, 0]);
     assert_eq!(wifi_in.dropped(), 0);
 }
+
+/// Boards A and B over the mocked A–B line for two seconds, with garbage written into B's
+/// heartbeat stream every 50 ms: every heartbeat still arrives (the deframer resyncs and
+/// counts the garbage), so board A never sees an internal communication loss.
+#[test]
+fn garbage_on_the_b_line_resyncs_and_the_link_holds() {
+    use mmic::faults::Fault;
+    use mmic::node::board_b::{self, BoardB};
+    let mut rx: PacketQueue<14, QUEUE> = PacketQueue::new();
+    let mut tx: PacketQueue<HEARTBEAT_LEN, QUEUE> = PacketQueue::new();
+    let (_wifi_in, control_in) = rx.split();
+    let (control_out, _wifi_out) = tx.split();
+    const TICKS: u32 = 200;
+    let mut traffic = tick_traffic(true, false);
+    for _ in 1..TICKS {
+        traffic.extend(tick_traffic(false, false));
+    }
+    let bus = RefCell::new(Mock::new(&traffic));
+    let mut side = Side::new(&bus, [Sw(true), Sw(true)], true);
+    let fcfg = frontend::Config::default();
+    let mut ctl = ControlA::new(board_a::Config::default(), fcfg, control_in, control_out);
+    let mut b = BoardB::new(board_b::Config::default());
+    let mut to_b = Link::new(PacketKind::BCommand);
+    let (mut outs, mut uart) = (Outs::default(), Line::default());
+    let (mut heartbeats, mut garbage) = (0, 0);
+    for k in 0..TICKS {
+        let now = k * 10;
+        assert!(ctl.tick(now, &mut side, &mut outs, &mut uart).is_some());
+        let mut command = None;
+        to_b.feed(&std::mem::take(&mut uart.tx), |p| command = Some(p));
+        let inputs = board_b::Inputs {
+            command,
+            electrical: board_a::Inputs::at_home().electrical,
+            gravity: None,
+            arm_contracted: true,
+            bolter_at_home: true,
+        };
+        if let Some(hb) = b.tick(now, &inputs).heartbeat {
+            uart.rx.extend_from_slice(b"\x55MI\x00zz");
+            garbage += 6;
+            uart.rx.extend_from_slice(&hb);
+            heartbeats += 1;
+        }
+    }
+    assert!(heartbeats >= 35, "{heartbeats}");
+    assert!(!ctl.a.faults().contains(Fault::InternalCommLoss));
+    assert!(ctl.from_b.frames() + 1 >= heartbeats);
+    assert_eq!(ctl.from_b.discarded(), garbage);
+    assert!(to_b.frames() > 0 && to_b.discarded() == 0);
+    bus.borrow_mut().done();
+}
