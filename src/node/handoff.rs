@@ -24,7 +24,9 @@
 //! harness against a `VecDeque` model (proofs/tests/harnesses/node.rs).
 //!
 //! Needs atomic loads and stores: available on targets with atomics (ESP32, ESP32-C6, hosts);
-//! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`.
+//! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`, or
+//! `portable-atomic` when another crate already selects portable-atomic's backend (esp-hal on
+//! the C3 selects `unsafe-assume-single-core`, which `critical-section` may not join).
 
 use heapless::spsc;
 

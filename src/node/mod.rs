@@ -34,7 +34,8 @@ pub mod exactly_once;
 pub mod ground;
 #[cfg(any(
     target_has_atomic = "ptr",
-    feature = "portable-atomic-critical-section"
+    feature = "portable-atomic-critical-section",
+    feature = "portable-atomic"
 ))]
 pub mod handoff;
 pub mod plan_runner;

@@ -1,0 +1,223 @@
+//! Board A (Figures 5 and 6): the robot's primary board. Two embassy tasks stand for the
+//! paper's two cores, joined by the library's hand-off queues: the WiFi task (accepts the
+//! server board's TCP connection, deframes command packets into the rx queue, sends the
+//! heartbeats of the tx queue back) and the 10 ms control task (sensors, `BoardA::tick`,
+//! servos, bolter, regulator, the serial line to board B).
+#![no_std]
+#![no_main]
+
+use core::cell::RefCell;
+use embassy_executor::Spawner;
+use embassy_net::tcp::TcpSocket;
+use embassy_net::{Ipv4Address, Ipv4Cidr, Runner, Stack, StackResources, StaticConfigV4};
+use embassy_time::{with_timeout, Duration, Instant, Ticker, Timer};
+use esp_backtrace as _;
+use esp_hal::clock::CpuClock;
+use esp_hal::gpio::Input;
+use esp_hal::i2c::master::{Config as I2cConfig, I2c};
+use esp_hal::rng::Rng;
+use esp_hal::time::Rate;
+use esp_hal::timer::timg::TimerGroup;
+use esp_hal::uart::{Config as UartConfig, Uart};
+use esp_hal::{ram, Blocking};
+use esp_println::println;
+use esp_radio::wifi::{self, sta::StationConfig, AuthenticationMethodConfig, Interface};
+use mmic::node::board_a;
+use mmic::node::handoff::{Consumer, PacketQueue, Producer};
+use mmic::sensors::frontend;
+use mmic::units::BoardNumber;
+use mmic::wire::command::COMMAND_LEN;
+use mmic::wire::heartbeat::HEARTBEAT_LEN;
+use mmic::wire::PacketKind;
+use static_cell::StaticCell;
+use support::control::{commands_in, ControlA, QUEUE, TICK_MS};
+use support::hw::{self, Serial};
+use support::link::Link;
+use support::net;
+use support::sensors::Side;
+
+esp_bootloader_esp_idf::esp_app_desc!();
+
+/// The robot's number (its board A address, and the commands it takes), at build time.
+const BOARD: &str = match option_env!("MMIC_BOARD") {
+    Some(n) => n,
+    None => "1",
+};
+const SSID: &str = match option_env!("MMIC_SSID") {
+    Some(s) => s,
+    None => "mmic",
+};
+const PASSWORD: &str = match option_env!("MMIC_PASSWORD") {
+    Some(s) => s,
+    None => "mmic-password",
+};
+/// Status line period, ticks.
+const STATUS_TICKS: u32 = 500;
+
+type Bus = RefCell<I2c<'static, Blocking>>;
+static BUS: StaticCell<Bus> = StaticCell::new();
+static RX: StaticCell<PacketQueue<COMMAND_LEN, QUEUE>> = StaticCell::new();
+static TX: StaticCell<PacketQueue<HEARTBEAT_LEN, QUEUE>> = StaticCell::new();
+static NET: StaticCell<StackResources<3>> = StaticCell::new();
+
+#[esp_rtos::main]
+async fn main(spawner: Spawner) -> ! {
+    let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
+    esp_alloc::heap_allocator!(#[ram(reclaimed)] size: 64 * 1024);
+    esp_alloc::heap_allocator!(size: 36 * 1024);
+    let timg0 = TimerGroup::new(p.TIMG0);
+    esp_rtos::start(timg0.timer0, p.FROM_CPU_INTR0);
+    println!("mmic board A{BOARD} on {}", support::chip::CHIP);
+
+    // Start-up: a peripheral that cannot be configured is a build or wiring error.
+    let n: u8 = BOARD.parse().expect("MMIC_BOARD: 1..=255");
+    let board = BoardNumber::new(n).expect("MMIC_BOARD: a board number");
+    let pins = support::take_pins!(p);
+    let i2c_cfg = I2cConfig::default().with_frequency(Rate::from_khz(400));
+    let i2c = I2c::new(p.I2C0, i2c_cfg).expect("I2C config");
+    let bus = BUS.init(RefCell::new(i2c.with_sda(pins.sda).with_scl(pins.scl)));
+    let side = Side::new(bus, hw::switches(pins.switches), true);
+    let outs = hw::Outputs::new(p.LEDC, pins.servos, pins.bolter, pins.mux, pins.regulator);
+    let [tx, rx] = pins.uart;
+    let uart = Uart::new(p.UART1, UartConfig::default().with_baudrate(support::BAUD))
+        .expect("UART config")
+        .with_tx(tx)
+        .with_rx(rx);
+    let serial = Serial { uart, rx_errors: 0 };
+    let (cmd_in, cmd_out) = RX.init(PacketQueue::new()).split();
+    let (hb_in, hb_out) = TX.init(PacketQueue::new()).split();
+    let cfg = board_a::Config {
+        board,
+        ..Default::default()
+    };
+    let ctl = ControlA::new(cfg, frontend::Config::default(), cmd_out, hb_in);
+    spawner.spawn(control(ctl, side, outs, serial).expect("control task"));
+
+    // WiFi: station on the lab's access point, board A at its fixed address.
+    let auth = AuthenticationMethodConfig::Wpa2Personal(PASSWORD.try_into().expect("password"));
+    let sta = StationConfig::default()
+        .with_ssid(SSID.try_into().expect("SSID"))
+        .with_authentication(auth);
+    let radio_cfg =
+        wifi::ControllerConfig::default().with_initial_config(wifi::Config::Station(sta));
+    let controller = wifi::WifiController::new(p.WIFI, radio_cfg).expect("WiFi");
+    let ip = StaticConfigV4 {
+        address: Ipv4Cidr::new(Ipv4Address::from(net::robot(n)), 24),
+        gateway: None,
+        dns_servers: Default::default(),
+    };
+    let rng = Rng::new();
+    let seed = (u64::from(rng.random()) << 32) | u64::from(rng.random());
+    let resources = NET.init(StackResources::new());
+    let (stack, runner) = embassy_net::new(
+        Interface::station(),
+        embassy_net::Config::ipv4_static(ip),
+        resources,
+        seed,
+    );
+    spawner.spawn(connection(controller).expect("connection task"));
+    spawner.spawn(net_task(runner).expect("net task"));
+    wifi_task(stack, cmd_in, hb_out).await
+}
+
+/// The control task: one library tick every 10 ms.
+#[embassy_executor::task]
+async fn control(
+    mut ctl: ControlA<'static>,
+    mut side: Side<'static, I2c<'static, Blocking>, Input<'static>>,
+    mut outs: hw::Outputs,
+    mut serial: Serial,
+) {
+    let mut ticker = Ticker::every(Duration::from_millis(TICK_MS.into()));
+    let mut ticks = 0u32;
+    loop {
+        let now = Instant::now().as_millis() as u32;
+        if let Some(o) = ctl.tick(now, &mut side, &mut outs, &mut serial) {
+            for e in &o.events {
+                println!("t={now} {e:?}");
+            }
+        }
+        ticks = ticks.wrapping_add(1);
+        if ticks.is_multiple_of(STATUS_TICKS) {
+            println!(
+                "t={now} mode={:?} gaps={} i2c={:?} rx_err={} b_discarded={} hb_dropped={}",
+                ctl.a.mode(),
+                ctl.counters.sensor_gaps,
+                side.errors,
+                serial.rx_errors,
+                ctl.from_b.discarded(),
+                ctl.heartbeats_dropped()
+            );
+        }
+        ticker.next().await;
+    }
+}
+
+/// The WiFi task: one server connection at a time; a dropped connection is accepted again.
+async fn wifi_task(
+    stack: Stack<'static>,
+    mut commands: Producer<'static, COMMAND_LEN, QUEUE>,
+    mut heartbeats: Consumer<'static, HEARTBEAT_LEN, QUEUE>,
+) -> ! {
+    let (mut rx_buf, mut tx_buf) = ([0u8; 256], [0u8; 256]);
+    let mut unconnected = 0u32;
+    loop {
+        let mut sock = TcpSocket::new(stack, &mut rx_buf, &mut tx_buf);
+        sock.set_timeout(Some(Duration::from_secs(5)));
+        if sock.accept(net::PORT).await.is_err() {
+            Timer::after_millis(10).await;
+            continue;
+        }
+        // Heartbeats made while no server was connected cannot be delivered (as in the host
+        // simulator's WiFi task): counted, not sent to the next connection.
+        while heartbeats.pop().is_some() {
+            unconnected = unconnected.wrapping_add(1);
+        }
+        let mut link = Link::new(PacketKind::Command);
+        let mut buf = [0u8; 128];
+        'conn: loop {
+            match with_timeout(Duration::from_millis(2), sock.read(&mut buf)).await {
+                Ok(Ok(0)) | Ok(Err(_)) => break 'conn,
+                Ok(Ok(n)) => commands_in(&mut link, &buf[..n], &mut commands),
+                Err(_) => {}
+            }
+            while let Some(hb) = heartbeats.pop() {
+                if !write_all(&mut sock, &hb).await {
+                    break 'conn;
+                }
+            }
+        }
+        println!(
+            "server gone: discarded={} unconnected={unconnected}",
+            link.discarded()
+        );
+        sock.abort();
+        let _ = with_timeout(Duration::from_millis(100), sock.flush()).await;
+    }
+}
+
+async fn write_all(sock: &mut TcpSocket<'_>, mut bytes: &[u8]) -> bool {
+    while !bytes.is_empty() {
+        match sock.write(bytes).await {
+            Ok(0) | Err(_) => return false,
+            Ok(n) => bytes = &bytes[n..],
+        }
+    }
+    true
+}
+
+/// Keeps the station associated: reconnects after a drop.
+#[embassy_executor::task]
+async fn connection(mut controller: wifi::WifiController<'static>) {
+    loop {
+        if controller.connect_async().await.is_ok() {
+            let _ = controller.wait_for_disconnect_async().await;
+        }
+        Timer::after_millis(1000).await;
+    }
+}
+
+#[embassy_executor::task]
+async fn net_task(mut runner: Runner<'static, Interface>) {
+    runner.run().await
+}

@@ -1,0 +1,139 @@
+//! Board B (Figure 7): side B's sensors and outputs, and the serial line to board A. One
+//! embassy task: every 10 ms, read, filter, `BoardB::tick`, drive, send its heartbeat when
+//! the library says one is due (every 50 ms).
+#![no_std]
+#![no_main]
+
+use core::cell::RefCell;
+use embassy_executor::Spawner;
+use embassy_time::{Duration, Instant, Ticker};
+use esp_backtrace as _;
+use esp_hal::clock::CpuClock;
+use esp_hal::gpio::Input;
+use esp_hal::i2c::master::{Config as I2cConfig, I2c};
+use esp_hal::time::Rate;
+use esp_hal::timer::timg::TimerGroup;
+use esp_hal::uart::{Config as UartConfig, Uart};
+use esp_hal::Blocking;
+use esp_println::println;
+use mmic::node::board_b;
+use mmic::node::board_b::BoardB;
+use mmic::sensors::frontend;
+use mmic::sensors::frontend::{Frontend, WINDOW};
+use mmic::wire::PacketKind;
+use static_cell::StaticCell;
+use support::control::{bolter_lines, Actuators, Counters, Sensors, TICK_MS};
+use support::hw::{self, Serial};
+use support::link::{ByteSink, ByteSource, Link};
+use support::sensors::Side;
+
+esp_bootloader_esp_idf::esp_app_desc!();
+
+/// Status line period, ticks.
+const STATUS_TICKS: u32 = 500;
+
+static BUS: StaticCell<RefCell<I2c<'static, Blocking>>> = StaticCell::new();
+
+#[esp_rtos::main]
+async fn main(_spawner: Spawner) -> ! {
+    let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
+    let timg0 = TimerGroup::new(p.TIMG0);
+    esp_rtos::start(timg0.timer0, p.FROM_CPU_INTR0);
+    println!("mmic board B on {}", support::chip::CHIP);
+
+    // Start-up: a peripheral that cannot be configured is a build or wiring error.
+    let pins = support::take_pins!(p);
+    let i2c_cfg = I2cConfig::default().with_frequency(Rate::from_khz(400));
+    let i2c = I2c::new(p.I2C0, i2c_cfg).expect("I2C config");
+    let bus = BUS.init(RefCell::new(i2c.with_sda(pins.sda).with_scl(pins.scl)));
+    let mut side: Side<'_, _, Input<'static>> = Side::new(bus, hw::switches(pins.switches), false);
+    let mut outs = hw::Outputs::new(p.LEDC, pins.servos, pins.bolter, pins.mux, pins.regulator);
+    let [tx, rx] = pins.uart;
+    let uart = Uart::new(p.UART1, UartConfig::default().with_baudrate(support::BAUD))
+        .expect("UART config")
+        .with_tx(tx)
+        .with_rx(rx);
+    let mut serial = Serial { uart, rx_errors: 0 };
+    let mut ctl = ControlB::new(board_b::Config::default(), frontend::Config::default());
+
+    let mut ticker = Ticker::every(Duration::from_millis(TICK_MS.into()));
+    let mut ticks = 0u32;
+    loop {
+        let now = Instant::now().as_millis() as u32;
+        ctl.tick(now, &mut side, &mut outs, &mut serial);
+        ticks = ticks.wrapping_add(1);
+        if ticks.is_multiple_of(STATUS_TICKS) {
+            println!(
+                "t={now} gaps={} i2c={:?} rx_err={} discarded={} frames={}",
+                ctl.counters.sensor_gaps,
+                side.errors,
+                serial.rx_errors,
+                ctl.from_a.discarded(),
+                ctl.from_a.frames()
+            );
+        }
+        ticker.next().await;
+    }
+}
+
+/// Board B's control task.
+pub struct ControlB {
+    /// The library's board B.
+    pub b: BoardB,
+    front: Frontend<WINDOW>,
+    /// Board A's serial line, receive side.
+    pub from_a: Link,
+    /// Counts.
+    pub counters: Counters,
+}
+
+impl ControlB {
+    /// Board B.
+    pub fn new(cfg: board_b::Config, front: frontend::Config) -> Self {
+        ControlB {
+            b: BoardB::new(cfg),
+            front: Frontend::new(front),
+            from_a: Link::new(PacketKind::BCommand),
+            counters: Counters::default(),
+        }
+    }
+
+    /// One tick at `now` ms, as [`ControlA::tick`] (board B has no hip: its encoder reading
+    /// is not used).
+    pub fn tick(
+        &mut self,
+        now: u32,
+        sensors: &mut impl Sensors,
+        out: &mut impl Actuators,
+        uart: &mut (impl ByteSource + ByteSink),
+    ) -> Option<board_b::Outputs> {
+        let r = sensors.read();
+        let Some(adc) = r.adc else {
+            self.counters.sensor_gaps = self.counters.sensor_gaps.saturating_add(1);
+            return None;
+        };
+        // Board B's front end ignores the encoder field (mmic::sensors::frontend::Raw).
+        let f = self.front.push(&frontend::Raw {
+            adc,
+            accel: r.accel,
+            encoder: 0,
+        });
+        let inputs = board_b::Inputs {
+            command: self.from_a.next(uart),
+            electrical: f.electrical,
+            gravity: f.gravity,
+            arm_contracted: r.arm_contracted,
+            bolter_at_home: r.bolter_at_home,
+        };
+        let o = self.b.tick(now, &inputs);
+        out.servos([o.arm, o.gripper, None]);
+        out.regulator(o.regulator);
+        out.bolter(bolter_lines(o.bolter), o.mux);
+        if let Some(hb) = o.heartbeat {
+            if !uart.write(&hb) {
+                self.counters.tx_errors = self.counters.tx_errors.saturating_add(1);
+            }
+        }
+        Some(o)
+    }
+}

@@ -1,0 +1,164 @@
+//! The 10 ms control tick of boards A and B: read the sensors, filter them
+//! ([`Frontend::push`]), step the library's node, drive its outputs, move its packets. The
+//! order is the host simulator's (host/src/sim/nodes.rs).
+
+use crate::link::{ByteSink, ByteSource, Link};
+use mmic::bolter::{Drive, MuxLines};
+use mmic::node::board_a::{self, BoardA};
+use mmic::node::handoff::{Consumer, Producer};
+use mmic::sensors::frontend::{self, Frontend, WINDOW};
+use mmic::units::PulseWidth;
+use mmic::wire::command::COMMAND_LEN;
+use mmic::wire::heartbeat::HEARTBEAT_LEN;
+use mmic::wire::PacketKind;
+
+/// The control period, ms (Section 3).
+pub const TICK_MS: u32 = 10;
+/// Hand-off queue slots (holds one fewer).
+pub const QUEUE: usize = 8;
+
+/// One tick's readings of a side, `None` where the device did not answer: ADS7828 codes
+/// CH0..CH7, MPU-6000 accelerations X, Y, Z, the hip encoder's raw angle (board A), and the
+/// arm contraction and bolter home switches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub struct Reading {
+    pub adc: Option<[u16; 8]>,
+    pub accel: Option<[i16; 3]>,
+    pub encoder: Option<u16>,
+    pub arm_contracted: bool,
+    pub bolter_at_home: bool,
+}
+
+/// A side's sensors.
+pub trait Sensors {
+    /// This tick's readings.
+    fn read(&mut self) -> Reading;
+}
+
+/// The levels of the bolter motor driver's three lines for a drive: (direction, translate
+/// enable, rotate enable). Translation and rotation share the direction line: down and rotate
+/// run forward, up and counter-rotate-up backward (see README.md, pin map).
+pub const fn bolter_lines(d: Drive) -> [bool; 3] {
+    match d {
+        Drive::Idle => [false, false, false],
+        Drive::Down => [true, true, false],
+        Drive::Up => [false, true, false],
+        Drive::Rotate => [true, false, true],
+        Drive::CounterRotateUp => [false, true, true],
+    }
+}
+
+/// A side's outputs.
+pub trait Actuators {
+    /// Servo pulses at 50 Hz, arm, gripper, hip (board A); none: no pulse, unpowered.
+    fn servos(&mut self, pulses: [Option<PulseWidth>; 3]);
+    /// The 7.4 V regulator enable line.
+    fn regulator(&mut self, on: bool);
+    /// The bolter's drive lines ([`bolter_lines`]) and the ADG1604's A0/A1.
+    fn bolter(&mut self, lines: [bool; 3], mux: MuxLines);
+}
+
+/// What the glue counts: ticks not run for a missing ADC or encoder reading (README.md,
+/// library gaps), packets the serial line did not take.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub struct Counters {
+    pub sensor_gaps: u32,
+    pub tx_errors: u32,
+}
+
+/// Board A's control task.
+pub struct ControlA<'q> {
+    /// The library's board A.
+    pub a: BoardA,
+    front: Frontend<WINDOW>,
+    commands: Consumer<'q, COMMAND_LEN, QUEUE>,
+    heartbeats: Producer<'q, HEARTBEAT_LEN, QUEUE>,
+    /// Board B's serial line, receive side.
+    pub from_b: Link,
+    /// Counts.
+    pub counters: Counters,
+}
+
+impl<'q> ControlA<'q> {
+    /// Board A with its ends of the two hand-off queues.
+    pub fn new(
+        cfg: board_a::Config,
+        front: frontend::Config,
+        commands: Consumer<'q, COMMAND_LEN, QUEUE>,
+        heartbeats: Producer<'q, HEARTBEAT_LEN, QUEUE>,
+    ) -> Self {
+        ControlA {
+            a: BoardA::new(cfg),
+            front: Frontend::new(front),
+            commands,
+            heartbeats,
+            from_b: Link::new(PacketKind::InternalHeartbeat),
+            counters: Counters::default(),
+        }
+    }
+
+    /// Heartbeats given up because the WiFi task's queue was full.
+    pub const fn heartbeats_dropped(&self) -> u32 {
+        self.heartbeats.dropped()
+    }
+
+    /// One tick at `now` ms; returns the library's outputs (for logs), none when a reading
+    /// was missing and the tick did not run.
+    pub fn tick(
+        &mut self,
+        now: u32,
+        sensors: &mut impl Sensors,
+        out: &mut impl Actuators,
+        uart: &mut (impl ByteSource + ByteSink),
+    ) -> Option<board_a::Outputs> {
+        let r = sensors.read();
+        // Library gap: `Frontend::Raw` and `board_a::Inputs` have no "no reading" for the ADC
+        // or the hip encoder, so without one the tick is not run (counted) rather than fed an
+        // invented value. Nothing is taken from the queues or the serial line meanwhile.
+        let (Some(adc), Some(encoder)) = (r.adc, r.encoder) else {
+            self.counters.sensor_gaps = self.counters.sensor_gaps.saturating_add(1);
+            return None;
+        };
+        let f = self.front.push(&frontend::Raw {
+            adc,
+            accel: r.accel,
+            encoder,
+        });
+        let inputs = board_a::Inputs {
+            command: self.commands.pop(),
+            from_b: self.from_b.next(uart),
+            electrical: f.electrical,
+            hip: f.hip,
+            gravity: f.gravity,
+            arm_contracted: r.arm_contracted,
+            bolter_at_home: r.bolter_at_home,
+        };
+        let o = self.a.tick(now, &inputs);
+        out.servos([o.arm, o.gripper, o.hip]);
+        out.regulator(o.regulator);
+        out.bolter(bolter_lines(o.bolter), o.mux);
+        if let Some(b) = o.to_b {
+            if !uart.write(&b) {
+                self.counters.tx_errors = self.counters.tx_errors.saturating_add(1);
+            }
+        }
+        if let Some(hb) = o.heartbeat {
+            if let Err(full) = self.heartbeats.push(hb) {
+                self.heartbeats.give_up(full);
+            }
+        }
+        Some(o)
+    }
+}
+
+/// Board A's WiFi task, receive side: command packets from the server's TCP stream into the
+/// control task's queue (a full queue gives the packet up, counted by the library).
+pub fn commands_in(link: &mut Link, bytes: &[u8], q: &mut Producer<'_, COMMAND_LEN, QUEUE>) {
+    link.feed(bytes, |p| {
+        if let Err(full) = q.push(p) {
+            q.give_up(full);
+        }
+    });
+}

@@ -1,0 +1,32 @@
+//! The MMIC-I firmware's shared glue: moves bytes and readings between the ESP32's peripherals
+//! and the `mmic` library's pure nodes, and decides nothing (every decision is in `mmic`).
+//!
+//! Hardware-free parts build on the host and are tested there with mocked peripherals
+//! (`tests/`); the esp-hal parts are behind `cfg(target_arch = "riscv32")`.
+#![no_std]
+
+pub mod control;
+pub mod drivers;
+pub mod link;
+pub mod sensors;
+
+#[cfg(target_arch = "riscv32")]
+pub mod chip;
+#[cfg(target_arch = "riscv32")]
+pub mod hw;
+
+/// The A–B serial line's rate, baud.
+pub const BAUD: u32 = 115_200;
+
+/// Where board A of robot `n` listens for the server board, and the server board's address
+/// (a private 192.168.4.0/24 network on the lab's access point, see README.md).
+pub mod net {
+    /// TCP port of board A's command socket.
+    pub const PORT: u16 = 5000;
+    /// The server board's address.
+    pub const SERVER: [u8; 4] = [192, 168, 4, 2];
+    /// Board A of robot `n` (192.168.4.(10 + n), wrapping).
+    pub const fn robot(n: u8) -> [u8; 4] {
+        [192, 168, 4, 10u8.wrapping_add(n)]
+    }
+}
