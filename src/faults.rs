@@ -56,6 +56,13 @@ wire_enum! {
         /// fault for it; the robot must not go on, so it is this project's own cause, reported
         /// in its own bit (spec/modes.toml gives its mode).
         MotionTimeout = 13 => "motion_timeout",
+        /// Not a Table 8 row: a side's sensors stopped answering — the ADS7828 (every voltage
+        /// and current of the side) or the hip encoder gave no reading for a whole averaging
+        /// window in a row (`sensors::frontend::Config::loss_ticks`). The paper says nothing of a
+        /// failed read; without currents the overcurrent checks are blind and without the hip
+        /// angle the hip cannot be steered, so the robot must not go on (spec/decisions.toml,
+        /// `sensor-loss`).
+        SensorLoss = 14 => "sensor_loss",
     }
 
     /// Every fault, in bit order.
@@ -127,7 +134,8 @@ impl Table8 {
 
 impl Fault {
     /// The Table 8 row this bit belongs to: both checks of a module's overcurrent are that
-    /// module's row. The project's own [`Fault::MotionTimeout`] belongs to none.
+    /// module's row. The project's own [`Fault::MotionTimeout`] and [`Fault::SensorLoss`]
+    /// belong to none.
     ///
     /// ```
     /// use mmic::faults::{Fault, Table8};
@@ -150,12 +158,12 @@ impl Fault {
             Fault::InternalCommLoss => Table8::InternalCommLoss,
             Fault::LowBattery => Table8::LowBattery,
             Fault::AssemblySystem => Table8::AssemblySystem,
-            Fault::MotionTimeout => return None,
+            Fault::MotionTimeout | Fault::SensorLoss => return None,
         })
     }
 
     /// The name an operator reads for this bit: its Table 8 row's, or its own for the
-    /// project's motion timeout (the idle and operational checks of a module share a name).
+    /// project's motion timeout and sensor loss (the idle and operational checks of a module share a name).
     pub const fn row_name(self) -> &'static str {
         match self.table8() {
             Some(r) => r.name(),
@@ -172,7 +180,7 @@ pub struct Faults(u32);
 /// Bits set in the fault bytes that name no fault.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[error("fault bytes set reserved bits {reserved:#06x} (only bits 0..=13 name faults)")]
+#[error("fault bytes set reserved bits {reserved:#06x} (only bits 0..=14 name faults)")]
 pub struct ReservedFaultBits {
     /// The reserved bits that were set.
     pub reserved: u32,

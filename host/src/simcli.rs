@@ -61,7 +61,8 @@ pub fn sim_help() -> String {
     let mut t = format!(
         "{SIM_HELP}\n\n\
          --inject NAME@SECONDS (repeatable; simulated seconds, decimals allowed) makes one of\n\
-         Table 8's ten faults happen, or sends the operator's Stop or Reset, at that time.\n\
+         Table 8's ten faults happen, silences a sensor, or sends the operator's Stop or Reset,\n\
+         at that time.\n\
          Each acts physically where it can, and the firmware must detect it as the robot would:\n"
     );
     for i in Injection::ALL {

@@ -283,3 +283,95 @@ fn an_arm_b_contraction_the_switch_does_not_sense_is_arm_not_contracted() {
         assert!(r.a.faults().is_empty(), "{side:?}: {:?}", r.a.faults());
     }
 }
+
+/// Issue 14 (firmware): a sensor that stops answering is never read as a plausible value.
+/// Side A's ADC silent mid-turn: the averages stand for one window (50 ticks, 500 ms), then
+/// the project's sensor loss takes the robot to Safed and the hip holds. No low battery or
+/// overcurrent is judged from the stale averages.
+#[test]
+fn a_silent_adc_a_is_sensor_loss_after_one_window_then_safed() {
+    let mut r = operational(State::A);
+    accepted(&mut r, reconfigure(State::A, State::B));
+    assert!(r.run_until(40_000, |r| (r.hip() - 18_000.0).abs() > 1_000.0));
+    let t = r.now;
+    r.plant.config_mut().adc_silent_at = [Some(t + 10), None];
+    r.run_for(480);
+    assert_eq!(
+        r.a.mode(),
+        Mode::Operational,
+        "not before the window is over"
+    );
+    r.run_for(40);
+    assert_eq!(r.a.mode(), Mode::Safed);
+    assert_eq!(
+        r.a.faults(),
+        mmic::faults::Faults::EMPTY.with(Fault::SensorLoss)
+    );
+    let at = r.hip();
+    r.run_for(5_000);
+    assert!((r.hip() - at).abs() < 200.0, "hip moved in Safed");
+    assert_eq!(
+        r.a.faults(),
+        mmic::faults::Faults::EMPTY.with(Fault::SensorLoss)
+    );
+}
+
+/// The hip encoder silent mid-turn: the hip gets the stop pulse from the first tick without a
+/// reading (it is not steered from a guessed angle), then sensor loss, Safed.
+#[test]
+fn a_silent_hip_encoder_stops_the_hip_at_once_then_sensor_loss() {
+    let mut r = operational(State::A);
+    accepted(&mut r, reconfigure(State::A, State::B));
+    assert!(r.run_until(40_000, |r| (r.hip() - 18_000.0).abs() > 1_000.0));
+    r.plant.config_mut().encoder_silent_at = Some(r.now + 20);
+    r.tick();
+    assert_ne!(
+        r.out_a.as_ref().and_then(|o| o.hip).map(|p| p.micros()),
+        Some(1500)
+    );
+    r.tick();
+    assert_eq!(
+        r.out_a.as_ref().and_then(|o| o.hip).map(|p| p.micros()),
+        Some(1500)
+    );
+    let at = r.hip();
+    r.run_for(300);
+    assert!((r.hip() - at).abs() < 100.0, "the hip kept turning blind");
+    assert!(r.run_until(300, |r| r.a.mode() == Mode::Safed));
+    assert!(r.a.faults().contains(Fault::SensorLoss));
+}
+
+/// Side B's ADC silent: Table 4 has no byte for it, so board B holds and falls silent, and
+/// board A raises internal comm loss (Safed).
+#[test]
+fn a_silent_adc_b_silences_board_b_and_is_internal_comm_loss() {
+    let mut r = operational(State::A);
+    r.plant.config_mut().adc_silent_at = [None, Some(r.now + 10)];
+    r.run_for(600);
+    assert_eq!(r.out_b.as_ref().and_then(|o| o.heartbeat), None);
+    assert!(r.run_until(3_000, |r| r.a.mode() == Mode::Safed));
+    assert_eq!(
+        r.a.faults(),
+        mmic::faults::Faults::EMPTY.with(Fault::InternalCommLoss)
+    );
+}
+
+/// An ADC that never answers from power-up: sensor loss at once; its empty averages (0 V)
+/// are not judged, so no low battery is raised however long it lasts.
+#[test]
+fn an_adc_silent_from_power_up_is_sensor_loss_never_low_battery() {
+    let plant = PlantConfig {
+        adc_silent_at: [Some(0), None],
+        ..PlantConfig::default()
+    };
+    let mut r = Robot::new(State::A, plant);
+    r.run_for(10_000);
+    assert_eq!(
+        r.a.faults(),
+        mmic::faults::Faults::EMPTY.with(Fault::SensorLoss)
+    );
+    let hb = r
+        .command(Command::Mode(Mode::Operational))
+        .expect("answered");
+    assert_eq!(hb.refusal, Some(Refusal::FaultConditionHolds));
+}

@@ -185,4 +185,22 @@ impl HipController {
         }
         PulseWidth::saturating((STOP_US + out) as u16)
     }
+
+    /// A tick without an angle reading: the stop pulse, and the controller starts afresh
+    /// (no velocity history across the gap, no integral), as a hip driven from a guessed
+    /// angle could turn on unchecked (spec/decisions.toml, `sensor-loss`).
+    ///
+    /// ```
+    /// use mmic::control::hip::HipController;
+    /// use mmic::units::HipAngle;
+    /// let mut c = HipController::new(Default::default());
+    /// let far = HipAngle::wrapping(9000);
+    /// assert_ne!(c.step(far, HipAngle::STRAIGHT, 0).micros(), 1500);
+    /// assert_eq!(c.blind().micros(), 1500);
+    /// assert_eq!(c.velocity(), 0);
+    /// ```
+    pub fn blind(&mut self) -> PulseWidth {
+        *self = HipController::new(self.cfg);
+        PulseWidth::saturating(STOP_US as u16)
+    }
 }

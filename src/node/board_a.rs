@@ -39,7 +39,7 @@ use crate::control::hip::{self, HipController};
 use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
-use crate::motion::estimate::{self, initial_state_consistent, Readings};
+use crate::motion::estimate::{self, initial_state_consistent, Readings, StateSet};
 use crate::motion::runner::{RunStatus, Runner};
 use crate::motion::sequencer::{self, Feedback, Targets};
 use crate::motion::State;
@@ -47,6 +47,7 @@ use crate::refusal::Refusal;
 use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
 use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use crate::safety::ModuleSet;
+use crate::sensors::frontend::Lost;
 use crate::units::{
     BoardNumber, Electrical, Gravity, HipAngle, Instant, Module, PerSide, PulseWidth, Side,
 };
@@ -120,8 +121,10 @@ pub struct Inputs {
     pub from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
     /// Side A's filtered voltages and currents.
     pub electrical: Electrical,
-    /// Hip encoder angle.
-    pub hip: HipAngle,
+    /// Hip encoder angle; `None` when the encoder gave no reading this tick: the hip is then
+    /// not steered (stop pulse), not judged at its target, and not at home
+    /// (spec/decisions.toml, `sensor-loss`).
+    pub hip: Option<HipAngle>,
     /// Gravity in A's IMU frame.
     pub gravity: Option<Gravity>,
     /// Arm A's contraction switch.
@@ -129,6 +132,9 @@ pub struct Inputs {
     /// Bolter A's home switch: the bolter is in its initial configuration. (The end of a
     /// current-sensed bolter step is decided from `electrical.i_bo`.)
     pub bolter_at_home: bool,
+    /// Side A's devices silent for a whole window (the sensor front end's verdict): raises
+    /// [`Fault::SensorLoss`]; with the ADC lost, the checks on `electrical` are not made.
+    pub lost: Lost,
 }
 
 impl Inputs {
@@ -147,10 +153,11 @@ impl Inputs {
                 v_reg: 7_400,
                 i_bo: 0,
             },
-            hip: HipAngle::STRAIGHT,
+            hip: Some(HipAngle::STRAIGHT),
             gravity: None,
             arm_contracted: true,
             bolter_at_home: true,
+            lost: Lost::NONE,
         }
     }
 }
@@ -308,6 +315,9 @@ pub struct BoardA {
     /// Board B holds where it is (the A→B stop flag): set by a Stop or a mode change, cleared
     /// by the next command that moves side B's modules, Reset, or going home.
     hold_b: bool,
+    /// The last hip angle read: the heartbeat's "hip now" and the hold target of a Stop while
+    /// the encoder is silent (the sensor-loss fault tells the ground it is stale).
+    hip_seen: HipAngle,
 }
 
 /// A bolting job that waits for board B's bolter to report idle.
@@ -396,6 +406,7 @@ impl BoardA {
             idle_check: None,
             paused: None,
             hold_b: false,
+            hip_seen: cfg.safety.hip_home,
         }
     }
 
@@ -453,13 +464,14 @@ impl BoardA {
         self.physically_moving(fb) || self.idle_check.is_some()
     }
 
-    /// The robot has been still for `idle_settle_ms`: its averaged currents are at rest.
+    /// The robot has been still for `idle_settle_ms`: its averaged currents are at rest. (The
+    /// idle checks also wait for the ADC to answer: a stale average judges nothing.)
     fn at_rest(&self, now: u32) -> bool {
         self.still_since
             .is_some_and(|t| Instant::from_millis(now).since(t).millis() >= self.cfg.idle_settle_ms)
     }
 
-    fn feedback(&self, hip_now: HipAngle, arm_a_switch: bool) -> Feedback {
+    fn feedback(&self, hip_now: Option<HipAngle>, arm_a_switch: bool) -> Feedback {
         let b_ok =
             |now: PulseWidth, target: PulseWidth, want: PulseWidth| now == target && target == want;
         Feedback {
@@ -479,7 +491,9 @@ impl BoardA {
                     self.cfg.gripper.resolve(self.targets.gripper.b),
                 ),
             ),
-            hip_done: hip_distance(hip_now, self.targets.hip) <= self.cfg.hip_done_tolerance,
+            // An unread hip is not at its target: the motion waits (and times out).
+            hip_done: hip_now
+                .is_some_and(|h| hip_distance(h, self.targets.hip) <= self.cfg.hip_done_tolerance),
             arm_switch: PerSide::new(arm_a_switch, self.b.arm_contracted),
         }
     }
@@ -490,6 +504,9 @@ impl BoardA {
     /// drive the outputs.
     pub fn tick(&mut self, now: u32, inp: &Inputs) -> Outputs {
         let mut out = Outputs::empty();
+        if let Some(h) = inp.hip {
+            self.hip_seen = h;
+        }
         self.ingest_b(now, inp.from_b, &mut out);
         // Motion and bolting advance first, so the supervisor sees whether they still run.
         // The feedback is this tick's readings against the targets in force; a target the
@@ -550,7 +567,7 @@ impl BoardA {
                 // A deferred fault waits for the motion in progress; none has started, so
                 // none starts: the reconfiguration is dropped and Standby comes next tick.
                 self.idle_check = None;
-            } else if self.at_rest(now) {
+            } else if self.at_rest(now) && !inp.lost.adc {
                 self.idle_check = None;
                 let f = self.idle_faults(inp);
                 if f.is_empty() {
@@ -586,7 +603,7 @@ impl BoardA {
                 }
             }
         }
-        if self.idle_check == Some(IdleCheck::After) && self.at_rest(now) {
+        if self.idle_check == Some(IdleCheck::After) && self.at_rest(now) && !inp.lost.adc {
             self.idle_check = None;
             let f = self.idle_faults(inp);
             self.complete = f.is_empty();
@@ -642,13 +659,24 @@ impl BoardA {
             gripper: self.b.gripper_overcurrent,
             bolter: self.b.bolter_overcurrent,
         };
-        let mut conditions =
-            detect::operational_overcurrent(&self.cfg.safety, &inp.electrical, b_over);
-        if self
-            .battery
-            .update(&self.cfg.safety, now, inp.electrical.v_bat, e_b.v_bat)
-        {
-            conditions = conditions.with(Fault::LowBattery);
+        let mut conditions = Faults::EMPTY;
+        if inp.lost.any() {
+            conditions = conditions.with(Fault::SensorLoss);
+        }
+        // Side A's currents and voltages are judged only while the ADC answers: a stale
+        // average (or none) says nothing of now, and sensor loss already stops the robot.
+        if !inp.lost.adc {
+            conditions = conditions.union(detect::operational_overcurrent(
+                &self.cfg.safety,
+                &inp.electrical,
+                b_over,
+            ));
+            if self
+                .battery
+                .update(&self.cfg.safety, now, inp.electrical.v_bat, e_b.v_bat)
+            {
+                conditions = conditions.with(Fault::LowBattery);
+            }
         }
         if self.comm.lost(&self.cfg.safety) {
             conditions = conditions.with(Fault::InternalCommLoss);
@@ -720,7 +748,10 @@ impl BoardA {
         let before = (self.sup.mode(), self.sup.faults());
         let initial_state_ok = match taken.incoming {
             Some(Incoming::Command(Command::Reconfigure(r))) => {
-                let sensed = estimate::consistent(&self.cfg.estimate, &self.readings(inp));
+                // Without a hip reading the state cannot be confirmed from the sensors.
+                let sensed = self.readings(inp).map_or(StateSet::EMPTY, |r| {
+                    estimate::consistent(&self.cfg.estimate, &r)
+                });
                 initial_state_consistent(r.initial(), self.tracked, sensed)
             }
             _ => true,
@@ -729,7 +760,9 @@ impl BoardA {
             faults,
             command: taken.incoming,
             in_motion,
-            hip_at_home: detect::hip_at_home(&self.cfg.safety, inp.hip),
+            hip_at_home: inp
+                .hip
+                .is_some_and(|h| detect::hip_at_home(&self.cfg.safety, h)),
             initial_state_ok,
         });
         if s.stop_motion {
@@ -743,7 +776,7 @@ impl BoardA {
                 // A mode change (or a Stop with nothing running) drops what a Stop had kept.
                 self.paused = None;
             }
-            self.stop_all(now, inp.hip);
+            self.stop_all(now, self.hip_seen);
         }
         if s.resume {
             self.resume(now);
@@ -793,7 +826,10 @@ impl BoardA {
         self.arm_targets(now);
         let arm_now = self.arm.tick(now);
         let gripper_now = self.gripper.tick(now);
-        let hip_pulse = self.hip_ctl.step(self.targets.hip, inp.hip, now);
+        let hip_pulse = match inp.hip {
+            Some(h) => self.hip_ctl.step(self.targets.hip, h, now),
+            None => self.hip_ctl.blind(),
+        };
         out.regulator = s.regulator;
         out.hip = (live && p.contains(Module::Hip)).then_some(hip_pulse);
         out.arm = (live && p.contains(Module::ArmA)).then_some(arm_now);
@@ -865,14 +901,14 @@ impl BoardA {
         m.is_move_from(from).then_some((from, m.target()))
     }
 
-    fn readings(&self, inp: &Inputs) -> Readings {
-        Readings {
+    fn readings(&self, inp: &Inputs) -> Option<Readings> {
+        Some(Readings {
             gravity_a: inp.gravity,
             gravity_b: self.b.gravity,
             arm_a_contracted: inp.arm_contracted,
             arm_b_contracted: self.b.arm_contracted,
-            hip: inp.hip,
-        }
+            hip: inp.hip?,
+        })
     }
 
     fn dispatch(&mut self, c: Command, now: u32) {
@@ -1124,7 +1160,7 @@ impl BoardA {
         HeartbeatRepr {
             board: self.cfg.board,
             hip_target: self.targets.hip,
-            hip_now: inp.hip,
+            hip_now: self.hip_seen,
             arm_a_target: self.arm.target(),
             arm_a_now: self.arm.now(),
             arm_b_target: self.b.arm_b_target,

@@ -32,6 +32,7 @@
 use crate::bolter::{BolterSide, Drive, MuxLines, Sensed, SideConfig};
 use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::safety::detect;
+use crate::sensors::frontend::Lost;
 use crate::units::Instant;
 use crate::units::{Electrical, Gravity, PulseWidth};
 use crate::wire::b_command::{BCommandRepr, B_COMMAND_LEN};
@@ -88,6 +89,12 @@ pub struct Inputs {
     /// Bolter B's home switch: the bolter is in its initial configuration. (The end of a
     /// current-sensed bolter step is decided from `electrical.i_bo`.)
     pub bolter_at_home: bool,
+    /// Side B's devices silent for a whole window (the sensor front end's verdict). With its
+    /// ADC lost, board B holds its actuators and stops its heartbeat: Table 4 has no byte to
+    /// say so, and board A, hearing nothing, raises internal comm loss (Safed) — a side that
+    /// cannot sense its currents is treated as a side that is not there
+    /// (spec/decisions.toml, `sensor-loss`).
+    pub lost: Lost,
 }
 
 /// One tick's outputs.
@@ -185,7 +192,8 @@ impl BoardB {
             Some(t) => Instant::from_millis(now).since(t).millis() > self.cfg.link_timeout_ms,
             None => false,
         };
-        if silent && !self.holding {
+        let blind = inp.lost.adc;
+        if (silent || blind) && !self.holding {
             self.holding = true;
             self.hold(now);
         }
@@ -204,6 +212,8 @@ impl BoardB {
             {
                 None
             }
+            // Blind: say nothing rather than report stale currents as B's own verdicts.
+            _ if blind => None,
             _ => {
                 self.sent = Some(Instant::from_millis(now));
                 Some(self.report(inp).to_bytes())
@@ -220,7 +230,7 @@ impl BoardB {
             },
             mux: self.bolter.mux(),
             heartbeat,
-            link_lost: self.holding,
+            link_lost: silent,
             rejected,
         }
     }

@@ -85,7 +85,10 @@ pub const fn fault_action(f: Fault) -> FaultAction {
         | InternalCommLoss
         // Not Table 8's: a motion step stalled mid-primitive, so hold hip and arms as the
         // other mid-motion faults do.
-        | MotionTimeout => FaultAction {
+        | MotionTimeout
+        // Not Table 8's: a side's ADC or hip encoder silent for a window. Like losing board
+        // B, the robot no longer knows its currents or its hip: hold everything.
+        | SensorLoss => FaultAction {
             mode: Mode::Safed,
             deferred: false,
         },
@@ -106,5 +109,6 @@ pub const fn is_condition(f: Fault) -> bool {
             | LocomotionOvercurrent
             | InternalCommLoss
             | LowBattery
+            | SensorLoss
     )
 }

@@ -6,17 +6,40 @@
 //! angles across the 0°/360° seam is wrong (359° and 1° would give 180°), and the hip
 //! controller smooths its own velocity estimate (spec/decisions.toml, `sensor-filtering`).
 //!
+//! A device that does not answer gives no reading (`None`), never a made-up one. What follows
+//! is decided here, in one place (spec/decisions.toml, `sensor-loss`): a missing ADC or IMU
+//! sample leaves its averages as they were, for at most [`Config::loss_ticks`] ticks in a row
+//! (one window); past that the ADC is reported [`Lost`] (the board raises
+//! `Fault::SensorLoss`) and the IMU's stale average is dropped (gravity unknown). A missing
+//! hip reading is `hip: None` at once — the hip is not steered blind — and [`Lost`] after as
+//! many ticks. Before its first sample a device counts as lost.
+//!
 //! ```
 //! use mmic::sensors::frontend::{Frontend, Raw};
 //! use mmic::units::{Axis, Sign};
 //!
 //! let mut f = Frontend::<50>::new(Default::default());
 //! // 10.0 V battery (code 2730 of 15 V full scale), gravity along −Y.
-//! let raw = Raw { adc: [2730, 0, 0, 0, 0, 0, 0, 0], accel: Some([10, -16384, 0]), encoder: 2048 };
+//! let raw = Raw {
+//!     adc: Some([2730, 0, 0, 0, 0, 0, 0, 0]),
+//!     accel: Some([10, -16384, 0]),
+//!     encoder: Some(2048),
+//! };
 //! let out = f.push(&raw);
 //! assert_eq!(out.electrical.v_bat, 10_000);
 //! assert_eq!(out.gravity.map(|g| (g.axis, g.sign)), Some((Axis::Y, Sign::Negative)));
-//! assert_eq!(out.hip.centidegrees(), 18000);
+//! assert_eq!(out.hip.map(|h| h.centidegrees()), Some(18000));
+//! assert!(!out.lost.any());
+//!
+//! // The ADC and the encoder stop answering: the averages stand, the hip is unknown at once…
+//! let silent = Raw { adc: None, accel: None, encoder: None };
+//! let out = f.push(&silent);
+//! assert_eq!((out.electrical.v_bat, out.hip, out.lost.any()), (10_000, None, false));
+//! // …and after a whole window of silence both are lost.
+//! for _ in 1..50 {
+//!     f.push(&silent);
+//! }
+//! assert!(f.push(&silent).lost.adc && f.lost().encoder);
 //! ```
 
 use super::adc::{self, Scaling};
@@ -27,41 +50,87 @@ use crate::units::{Electrical, Gravity, HipAngle};
 pub const WINDOW: usize = 50;
 
 /// Front-end configuration.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Config {
     /// ADS7828 channel scaling.
     pub scaling: Scaling,
     /// Raw encoder reading at hip 0° (board A only; board B has no encoder).
     pub encoder_zero: u16,
+    /// The side has a hip encoder (board A): its silence counts as a loss. Board B: `false`.
+    pub hip_encoder: bool,
+    /// Ticks in a row without a reading after which a device is lost. Default 50: one
+    /// window of the moving average, 500 ms at the 10 ms tick — an average older than its
+    /// own window no longer describes the present.
+    pub loss_ticks: u16,
 }
 
-/// One tick's raw readings of a side.
+impl Default for Config {
+    /// Board A's: default scaling, encoder zero 0, with the hip encoder, 50 ticks.
+    fn default() -> Config {
+        Config {
+            scaling: Scaling::default(),
+            encoder_zero: 0,
+            hip_encoder: true,
+            loss_ticks: WINDOW as u16,
+        }
+    }
+}
+
+/// One tick's raw readings of a side; `None` where the device did not answer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Raw {
     /// ADS7828 codes, CH0..CH7 (12-bit; larger values are clamped by the scaling).
-    pub adc: [u16; 8],
-    /// IMU accelerations (X, Y, Z); `None` when the IMU did not answer this tick.
+    pub adc: Option<[u16; 8]>,
+    /// IMU accelerations (X, Y, Z).
     pub accel: Option<[i16; 3]>,
     /// Raw hip encoder reading (board A; ignored on board B).
-    pub encoder: u16,
+    pub encoder: Option<u16>,
+}
+
+/// Devices that gave no reading for [`Config::loss_ticks`] ticks in a row (or none yet).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Lost {
+    /// The ADS7828: every voltage and current of the side is stale.
+    pub adc: bool,
+    /// The hip encoder (board A).
+    pub encoder: bool,
+}
+
+impl Lost {
+    /// Nothing lost.
+    pub const NONE: Lost = Lost {
+        adc: false,
+        encoder: false,
+    };
+
+    /// Some device is lost.
+    pub const fn any(self) -> bool {
+        self.adc || self.encoder
+    }
 }
 
 /// The filtered readings a board node takes as input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Filtered {
-    /// Voltages and currents from the averaged codes.
+    /// Voltages and currents from the averaged codes: the last samples received, at most
+    /// `loss_ticks` old unless `lost.adc` (all zero before the first sample).
     pub electrical: Electrical,
-    /// Gravity direction from the averaged accelerations; `None` before any IMU sample, or
-    /// while they average to zero.
+    /// Gravity direction from the averaged accelerations; `None` before any IMU sample, after
+    /// `loss_ticks` ticks without one, or while they average to zero.
     pub gravity: Option<Gravity>,
-    /// Hip angle from this tick's encoder reading.
-    pub hip: HipAngle,
+    /// Hip angle from this tick's encoder reading; `None` when there was none.
+    pub hip: Option<HipAngle>,
+    /// Devices silent for too long.
+    pub lost: Lost,
 }
 
-/// A side's `N`-sample moving averages (the paper's `N` is 50).
+/// A side's `N`-sample moving averages (the paper's `N` is 50), and how long each device has
+/// been silent.
 #[derive(Debug, Clone, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Frontend<const N: usize> {
@@ -69,6 +138,16 @@ pub struct Frontend<const N: usize> {
     adc: [MovingAverage<N>; 8],
     /// Accelerations offset by 32768 so that the unsigned filter averages them exactly.
     accel: [MovingAverage<N>; 3],
+    /// Ticks in a row without a reading (saturating), per device: ADC, IMU, encoder.
+    silent: Silence,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Silence {
+    adc: u16,
+    imu: u16,
+    encoder: u16,
 }
 
 /// Offsets an i16 into u16 order-preservingly (−32768 → 0).
@@ -81,32 +160,64 @@ const fn resign(u: u16) -> i16 {
     (u ^ 0x8000) as i16
 }
 
+/// One more tick of silence, or none when the device answered.
+const fn count(silent: u16, answered: bool) -> u16 {
+    if answered {
+        0
+    } else {
+        silent.saturating_add(1)
+    }
+}
+
 impl<const N: usize> Frontend<N> {
-    /// Empty filters.
+    /// Empty filters; every device lost until its first reading.
     pub const fn new(cfg: Config) -> Self {
         Frontend {
             cfg,
             adc: [const { MovingAverage::new() }; 8],
             accel: [const { MovingAverage::new() }; 3],
+            silent: Silence {
+                adc: u16::MAX,
+                imu: u16::MAX,
+                encoder: u16::MAX,
+            },
         }
     }
 
-    /// Feeds one tick's raw readings and returns the filtered values. A tick without an IMU
-    /// sample leaves the acceleration averages as they were.
+    /// Feeds one tick's raw readings and returns the filtered values. A missing ADC or IMU
+    /// sample leaves its averages as they were; after `loss_ticks` missing samples in a row
+    /// the IMU's averages are dropped and the ADC is reported lost.
     pub fn push(&mut self, raw: &Raw) -> Filtered {
-        for (f, &code) in self.adc.iter_mut().zip(raw.adc.iter()) {
-            f.push(code);
+        self.silent = Silence {
+            adc: count(self.silent.adc, raw.adc.is_some()),
+            imu: count(self.silent.imu, raw.accel.is_some()),
+            encoder: count(self.silent.encoder, raw.encoder.is_some()),
+        };
+        if let Some(codes) = raw.adc {
+            for (f, &code) in self.adc.iter_mut().zip(codes.iter()) {
+                f.push(code);
+            }
         }
         if let Some(accel) = raw.accel {
             for (f, &a) in self.accel.iter_mut().zip(accel.iter()) {
                 f.push(unsign(a));
             }
+        } else if self.silent.imu >= self.cfg.loss_ticks {
+            self.accel = [const { MovingAverage::new() }; 3];
         }
         self.filtered(raw.encoder)
     }
 
+    /// The devices silent for `loss_ticks` ticks in a row (or not heard yet).
+    pub const fn lost(&self) -> Lost {
+        Lost {
+            adc: self.silent.adc >= self.cfg.loss_ticks,
+            encoder: self.cfg.hip_encoder && self.silent.encoder >= self.cfg.loss_ticks,
+        }
+    }
+
     /// The filtered values now, with `encoder` as the hip reading.
-    pub fn filtered(&self, encoder: u16) -> Filtered {
+    pub fn filtered(&self, encoder: Option<u16>) -> Filtered {
         let codes = self.adc.each_ref().map(|f| f.mean().unwrap_or(0));
         let accel = if self.accel[0].is_empty() {
             None
@@ -120,7 +231,8 @@ impl<const N: usize> Frontend<N> {
         Filtered {
             electrical: adc::electrical(&self.cfg.scaling, codes),
             gravity: accel.and_then(imu::gravity),
-            hip: encoder::hip_angle(encoder, self.cfg.encoder_zero),
+            hip: encoder.map(|e| encoder::hip_angle(e, self.cfg.encoder_zero)),
+            lost: self.lost(),
         }
     }
 }
@@ -131,9 +243,9 @@ mod tests {
 
     fn raw(code: u16) -> Raw {
         Raw {
-            adc: [code; 8],
+            adc: Some([code; 8]),
             accel: Some([0, 0, 16384]),
-            encoder: 0,
+            encoder: Some(0),
         }
     }
 
@@ -162,9 +274,9 @@ mod tests {
         let mut f = Frontend::<4>::new(Config::default());
         let g = |f: &mut Frontend<4>, a| {
             f.push(&Raw {
-                adc: [0; 8],
+                adc: Some([0; 8]),
                 accel: Some(a),
-                encoder: 0,
+                encoder: Some(0),
             })
             .gravity
         };
@@ -184,8 +296,74 @@ mod tests {
         r.accel = None;
         assert_eq!(f.push(&r).gravity, None);
         f.push(&raw(0));
-        let before = f.filtered(0);
+        let before = f.filtered(Some(0));
         assert!(before.gravity.is_some());
         assert_eq!(f.push(&r).gravity, before.gravity);
+    }
+
+    #[test]
+    fn a_device_is_lost_after_exactly_loss_ticks_silent_ticks_and_found_at_its_next_reading() {
+        let cfg = Config {
+            loss_ticks: 5,
+            ..Config::default()
+        };
+        let mut f = Frontend::<50>::new(cfg);
+        assert_eq!(
+            f.lost(),
+            Lost {
+                adc: true,
+                encoder: true
+            },
+            "not heard yet"
+        );
+        let out = f.push(&raw(1000));
+        assert_eq!(out.lost, Lost::NONE);
+        let full = out.electrical;
+        for k in 1..=6u16 {
+            let out = f.push(&Raw {
+                adc: None,
+                accel: None,
+                encoder: None,
+            });
+            assert_eq!(out.lost.adc, k >= 5, "k = {k}");
+            assert_eq!(out.lost.encoder, k >= 5, "k = {k}");
+            assert_eq!(out.hip, None);
+            // The stale average stands (it is never replaced by an invented value)…
+            assert_eq!(out.electrical, full);
+            // …the IMU's is dropped once lost.
+            assert_eq!(out.gravity.is_some(), k < 5, "k = {k}");
+        }
+        let out = f.push(&Raw {
+            encoder: None,
+            ..raw(1000)
+        });
+        assert_eq!(
+            out.lost,
+            Lost {
+                adc: false,
+                encoder: true
+            }
+        );
+        assert!(
+            out.gravity.is_some(),
+            "a new IMU sample gives gravity again"
+        );
+        assert_eq!(f.push(&raw(1000)).lost, Lost::NONE);
+    }
+
+    #[test]
+    fn a_side_without_a_hip_encoder_never_loses_it() {
+        let cfg = Config {
+            hip_encoder: false,
+            ..Config::default()
+        };
+        let mut f = Frontend::<50>::new(cfg);
+        for _ in 0..200 {
+            let out = f.push(&Raw {
+                encoder: None,
+                ..raw(7)
+            });
+            assert_eq!(out.lost, Lost::NONE);
+        }
     }
 }

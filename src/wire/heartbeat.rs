@@ -415,7 +415,7 @@ impl HeartbeatRepr {
             return Err(field_err(KIND, at!(empty), "empty", "0", p.empty as u32));
         }
         let faults = Faults::from_wire(p.faults)
-            .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=13 only", e.reserved))?;
+            .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=14 only", e.reserved))?;
         let refusal = opt!(refusal, "0 (accepted) or 1..=8", Refusal::from_wire);
         let mode = Mode::from_wire(p.mode).ok_or_else(|| {
             field_err(

@@ -337,9 +337,9 @@ impl FilteredSide {
         adc[Channel::IBo as usize] = ((ma as u32 * CODE_MAX as u32 + fs / 2) / fs) as u16;
         self.frontend
             .push(&Raw {
-                adc,
+                adc: Some(adc),
                 accel: None,
-                encoder: 0,
+                encoder: None,
             })
             .electrical
             .i_bo

@@ -95,7 +95,7 @@ impl Rig {
             &Inputs {
                 command: packet,
                 from_b: self.to_a.take(),
-                hip: HipAngle::wrapping(self.hip_cdeg as u16),
+                hip: Some(HipAngle::wrapping(self.hip_cdeg as u16)),
                 arm_contracted: self.switch(0),
                 ..Inputs::at_home()
             },

@@ -43,14 +43,6 @@ const BOARD: &str = match option_env!("MMIC_BOARD") {
     Some(n) => n,
     None => "1",
 };
-const SSID: &str = match option_env!("MMIC_SSID") {
-    Some(s) => s,
-    None => "mmic",
-};
-const PASSWORD: &str = match option_env!("MMIC_PASSWORD") {
-    Some(s) => s,
-    None => "mmic-password",
-};
 /// Status line period, ticks.
 const STATUS_TICKS: u32 = 500;
 
@@ -94,9 +86,10 @@ async fn main(spawner: Spawner) -> ! {
     spawner.spawn(control(ctl, side, outs, serial).expect("control task"));
 
     // WiFi: station on the lab's access point, board A at its fixed address.
-    let auth = AuthenticationMethodConfig::Wpa2Personal(PASSWORD.try_into().expect("password"));
+    let auth =
+        AuthenticationMethodConfig::Wpa2Personal(net::PASSWORD.try_into().expect("password"));
     let sta = StationConfig::default()
-        .with_ssid(SSID.try_into().expect("SSID"))
+        .with_ssid(net::SSID.try_into().expect("SSID"))
         .with_authentication(auth);
     let radio_cfg =
         wifi::ControllerConfig::default().with_initial_config(wifi::Config::Station(sta));
@@ -132,17 +125,15 @@ async fn control(
     let mut ticks = 0u32;
     loop {
         let now = Instant::now().as_millis() as u32;
-        if let Some(o) = ctl.tick(now, &mut side, &mut outs, &mut serial) {
-            for e in &o.events {
-                println!("t={now} {e:?}");
-            }
+        let o = ctl.tick(now, &mut side, &mut outs, &mut serial);
+        for e in &o.events {
+            println!("t={now} {e:?}");
         }
         ticks = ticks.wrapping_add(1);
         if ticks.is_multiple_of(STATUS_TICKS) {
             println!(
-                "t={now} mode={:?} gaps={} i2c={:?} rx_err={} b_discarded={} hb_dropped={}",
+                "t={now} mode={:?} i2c={:?} rx_err={} b_discarded={} hb_dropped={}",
                 ctl.a.mode(),
-                ctl.counters.sensor_gaps,
                 side.errors,
                 serial.rx_errors,
                 ctl.from_b.discarded(),

@@ -54,7 +54,12 @@ async fn main(_spawner: Spawner) -> ! {
         .with_tx(tx)
         .with_rx(rx);
     let mut serial = Serial { uart, rx_errors: 0 };
-    let mut ctl = ControlB::new(board_b::Config::default(), frontend::Config::default());
+    // Board B has no hip encoder: its silence is no loss.
+    let front = frontend::Config {
+        hip_encoder: false,
+        ..frontend::Config::default()
+    };
+    let mut ctl = ControlB::new(board_b::Config::default(), front);
 
     let mut ticker = Ticker::every(Duration::from_millis(TICK_MS.into()));
     let mut ticks = 0u32;
@@ -64,8 +69,7 @@ async fn main(_spawner: Spawner) -> ! {
         ticks = ticks.wrapping_add(1);
         if ticks.is_multiple_of(STATUS_TICKS) {
             println!(
-                "t={now} gaps={} i2c={:?} rx_err={} discarded={} frames={}",
-                ctl.counters.sensor_gaps,
+                "t={now} i2c={:?} rx_err={} discarded={} frames={}",
                 side.errors,
                 serial.rx_errors,
                 ctl.from_a.discarded(),
@@ -98,32 +102,23 @@ impl ControlB {
         }
     }
 
-    /// One tick at `now` ms, as [`ControlA::tick`] (board B has no hip: its encoder reading
-    /// is not used).
+    /// One tick at `now` ms, as `support::control::ControlA::tick`.
     pub fn tick(
         &mut self,
         now: u32,
         sensors: &mut impl Sensors,
         out: &mut impl Actuators,
         uart: &mut (impl ByteSource + ByteSink),
-    ) -> Option<board_b::Outputs> {
+    ) -> board_b::Outputs {
         let r = sensors.read();
-        let Some(adc) = r.adc else {
-            self.counters.sensor_gaps = self.counters.sensor_gaps.saturating_add(1);
-            return None;
-        };
-        // Board B's front end ignores the encoder field (mmic::sensors::frontend::Raw).
-        let f = self.front.push(&frontend::Raw {
-            adc,
-            accel: r.accel,
-            encoder: 0,
-        });
+        let f = self.front.push(&r.raw);
         let inputs = board_b::Inputs {
             command: self.from_a.next(uart),
             electrical: f.electrical,
             gravity: f.gravity,
             arm_contracted: r.arm_contracted,
             bolter_at_home: r.bolter_at_home,
+            lost: f.lost,
         };
         let o = self.b.tick(now, &inputs);
         out.servos([o.arm, o.gripper, None]);
@@ -134,6 +129,6 @@ impl ControlB {
                 self.counters.tx_errors = self.counters.tx_errors.saturating_add(1);
             }
         }
-        Some(o)
+        o
     }
 }

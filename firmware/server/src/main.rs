@@ -29,14 +29,6 @@ use support::net;
 
 esp_bootloader_esp_idf::esp_app_desc!();
 
-const SSID: &str = match option_env!("MMIC_SSID") {
-    Some(s) => s,
-    None => "mmic",
-};
-const PASSWORD: &str = match option_env!("MMIC_PASSWORD") {
-    Some(s) => s,
-    None => "mmic-password",
-};
 /// How long a visit waits for the connection and for the heartbeat (the host simulator's
 /// `visit_ms`).
 const VISIT: Duration = Duration::from_millis(200);
@@ -74,9 +66,10 @@ async fn main(spawner: Spawner) -> ! {
     let ops = OpsUi(rx, tx);
 
     // Start-up: WiFi station on the lab's access point at the server's fixed address.
-    let auth = AuthenticationMethodConfig::Wpa2Personal(PASSWORD.try_into().expect("password"));
+    let auth =
+        AuthenticationMethodConfig::Wpa2Personal(net::PASSWORD.try_into().expect("password"));
     let sta = StationConfig::default()
-        .with_ssid(SSID.try_into().expect("SSID"))
+        .with_ssid(net::SSID.try_into().expect("SSID"))
         .with_authentication(auth);
     let radio_cfg =
         wifi::ControllerConfig::default().with_initial_config(wifi::Config::Station(sta));

@@ -17,15 +17,14 @@ pub const TICK_MS: u32 = 10;
 /// Hand-off queue slots (holds one fewer).
 pub const QUEUE: usize = 8;
 
-/// One tick's readings of a side, `None` where the device did not answer: ADS7828 codes
-/// CH0..CH7, MPU-6000 accelerations X, Y, Z, the hip encoder's raw angle (board A), and the
-/// arm contraction and bolter home switches.
+/// One tick's readings of a side: the devices' ([`frontend::Raw`]: ADS7828 codes CH0..CH7,
+/// MPU-6000 accelerations X, Y, Z, the hip encoder's raw angle on board A; `None` where the
+/// device did not answer — the library decides what follows), and the arm contraction and
+/// bolter home switches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(missing_docs)]
 pub struct Reading {
-    pub adc: Option<[u16; 8]>,
-    pub accel: Option<[i16; 3]>,
-    pub encoder: Option<u16>,
+    pub raw: frontend::Raw,
     pub arm_contracted: bool,
     pub bolter_at_home: bool,
 }
@@ -59,12 +58,10 @@ pub trait Actuators {
     fn bolter(&mut self, lines: [bool; 3], mux: MuxLines);
 }
 
-/// What the glue counts: ticks not run for a missing ADC or encoder reading (README.md,
-/// library gaps), packets the serial line did not take.
+/// What the glue counts: packets the serial line did not take (failed sensor reads: `Side`).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[allow(missing_docs)]
 pub struct Counters {
-    pub sensor_gaps: u32,
     pub tx_errors: u32,
 }
 
@@ -104,28 +101,16 @@ impl<'q> ControlA<'q> {
         self.heartbeats.dropped()
     }
 
-    /// One tick at `now` ms; returns the library's outputs (for logs), none when a reading
-    /// was missing and the tick did not run.
+    /// One tick at `now` ms; returns the library's outputs (for logs).
     pub fn tick(
         &mut self,
         now: u32,
         sensors: &mut impl Sensors,
         out: &mut impl Actuators,
         uart: &mut (impl ByteSource + ByteSink),
-    ) -> Option<board_a::Outputs> {
+    ) -> board_a::Outputs {
         let r = sensors.read();
-        // Library gap: `Frontend::Raw` and `board_a::Inputs` have no "no reading" for the ADC
-        // or the hip encoder, so without one the tick is not run (counted) rather than fed an
-        // invented value. Nothing is taken from the queues or the serial line meanwhile.
-        let (Some(adc), Some(encoder)) = (r.adc, r.encoder) else {
-            self.counters.sensor_gaps = self.counters.sensor_gaps.saturating_add(1);
-            return None;
-        };
-        let f = self.front.push(&frontend::Raw {
-            adc,
-            accel: r.accel,
-            encoder,
-        });
+        let f = self.front.push(&r.raw);
         let inputs = board_a::Inputs {
             command: self.commands.pop(),
             from_b: self.from_b.next(uart),
@@ -134,6 +119,7 @@ impl<'q> ControlA<'q> {
             gravity: f.gravity,
             arm_contracted: r.arm_contracted,
             bolter_at_home: r.bolter_at_home,
+            lost: f.lost,
         };
         let o = self.a.tick(now, &inputs);
         out.servos([o.arm, o.gripper, o.hip]);
@@ -149,7 +135,7 @@ impl<'q> ControlA<'q> {
                 self.heartbeats.give_up(full);
             }
         }
-        Some(o)
+        o
     }
 }
 

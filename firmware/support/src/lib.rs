@@ -25,6 +25,16 @@ pub mod net {
     pub const PORT: u16 = 5000;
     /// The server board's address.
     pub const SERVER: [u8; 4] = [192, 168, 4, 2];
+    /// The lab network's name, at build time (`MMIC_SSID`).
+    pub const SSID: &str = match option_env!("MMIC_SSID") {
+        Some(s) => s,
+        None => "mmic",
+    };
+    /// Its password, at build time (`MMIC_PASSWORD`).
+    pub const PASSWORD: &str = match option_env!("MMIC_PASSWORD") {
+        Some(s) => s,
+        None => "mmic-password",
+    };
     /// Board A of robot `n` (192.168.4.(10 + n), wrapping).
     pub const fn robot(n: u8) -> [u8; 4] {
         [192, 168, 4, 10u8.wrapping_add(n)]

@@ -1,6 +1,7 @@
 //! A side's sensors through the drivers: the ADS7828, the MPU-6000 and (board A) the hip
 //! encoder on one shared I2C bus, and the two switches. A device that does not answer gives
-//! "no reading" (`None`), counted per device.
+//! "no reading" (`None`), counted per device; the library decides what follows
+//! (`mmic::sensors::frontend`, spec/decisions.toml `sensor-loss`).
 
 use crate::control::{Reading, Sensors};
 use crate::drivers::{ads7828::Ads7828, encoder::HipEncoder, mpu6000::Mpu6000};
@@ -9,6 +10,7 @@ use core::convert::Infallible;
 use embedded_hal::digital::InputPin;
 use embedded_hal::i2c::I2c;
 use embedded_hal_bus::i2c::RefCellDevice;
+use mmic::sensors::frontend::Raw;
 
 /// A side's sensors on bus `I` with switches `P` (closed: low).
 pub struct Side<'b, I, P> {
@@ -58,9 +60,11 @@ impl<I: I2c, P: InputPin<Error = Infallible>> Sensors for Side<'_, I, P> {
             None
         };
         Reading {
-            adc: count(self.adc.read_all(), e_adc),
-            accel,
-            encoder: self.encoder.as_mut().and_then(|e| count(e.angle(), e_enc)),
+            raw: Raw {
+                adc: count(self.adc.read_all(), e_adc),
+                accel,
+                encoder: self.encoder.as_mut().and_then(|e| count(e.angle(), e_enc)),
+            },
             arm_contracted: closed(&mut self.switches[0]),
             bolter_at_home: closed(&mut self.switches[1]),
         }

@@ -240,14 +240,15 @@ fn drivers_feed_the_library_front_end() {
     assert_eq!((accel, angle), (Ok([10, -16384, 0]), Ok(2048)));
     let mut f = Frontend::<50>::new(Default::default());
     let out = f.push(&Raw {
-        adc: codes.unwrap_or_default(),
+        adc: codes.ok(),
         accel: accel.ok(),
-        encoder: angle.unwrap_or_default(),
+        encoder: angle.ok(),
     });
     assert_eq!(out.electrical.v_bat, 10_000);
     assert_eq!(
         out.gravity.map(|g| (g.axis, g.sign)),
         Some((Axis::Y, Sign::Negative))
     );
-    assert_eq!(out.hip.centidegrees(), 18_000);
+    assert_eq!(out.hip.map(|h| h.centidegrees()), Some(18_000));
+    assert!(!out.lost.any());
 }

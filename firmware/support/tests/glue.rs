@@ -1,7 +1,8 @@
 //! Board A's shell glue on the host with mocked peripherals: a command arrives over "TCP" (cut
 //! and behind garbage), crosses the hand-off queue, one control tick reads the sensors over a
 //! mocked I2C bus (the drivers' exact traffic), drives the outputs, and the heartbeat comes
-//! back through the other queue. And: a missing ADC reading is never turned into a value.
+//! back through the other queue. And: a missing ADC reading is never turned into a value — the
+//! library gets "no reading" and raises its sensor loss (spec/decisions.toml, `sensor-loss`).
 
 use core::cell::RefCell;
 use core::convert::Infallible;
@@ -123,6 +124,13 @@ fn board_a_command_to_heartbeat_through_the_glue() {
     let (mut outs, mut uart) = (Outs::default(), Line::default());
     uart.rx = b"\x00\xffMI noise".to_vec(); // garbage on board B's line
 
+    // Tick 1: the ADC does not answer (never heard): the tick runs, the library gets no
+    // reading and raises sensor loss; nothing is driven in Standby, nothing answered.
+    let out = ctl.tick(0, &mut side, &mut outs, &mut uart);
+    assert!(ctl.a.faults().contains(mmic::faults::Fault::SensorLoss));
+    assert_eq!(outs.servos, Some([None; 3]));
+    assert!(out.heartbeat.is_none() && wifi_out.pop().is_none());
+
     // The WiFi task: the server's packet, behind garbage and cut in two TCP reads.
     let cmd = CommandRepr {
         board: BoardNumber::ONE,
@@ -136,22 +144,18 @@ fn board_a_command_to_heartbeat_through_the_glue() {
     commands_in(&mut tcp, &cmd[6..], &mut wifi_in);
     assert_eq!((tcp.frames(), tcp.discarded()), (1, 5));
 
-    // Tick 1: the ADC does not answer: no tick, no value made up, the command waits.
-    assert!(ctl.tick(0, &mut side, &mut outs, &mut uart).is_none());
-    assert_eq!(ctl.counters.sensor_gaps, 1);
-    assert!(wifi_out.pop().is_none() && outs.servos.is_none());
-
-    // Tick 2: the command runs and its heartbeat reaches the WiFi task's queue.
+    // Tick 2: the ADC answers, so no condition holds: the command runs and its heartbeat
+    // reaches the WiFi task's queue, still reporting the latched sensor loss.
     let out = ctl.tick(10, &mut side, &mut outs, &mut uart);
-    assert!(out.is_some());
     let hb = wifi_out.pop().expect("a heartbeat for the WiFi task");
     let hb = HeartbeatRepr::parse(&hb).expect("a valid heartbeat");
     assert_eq!(
         (hb.mode, hb.last_seq, hb.refusal),
         (Mode::Operational, 1, None)
     );
+    assert!(hb.faults.contains(mmic::faults::Fault::SensorLoss));
     assert_eq!(ctl.a.mode(), Mode::Operational);
-    assert_eq!(outs.regulator, out.as_ref().map(|o| o.regulator));
+    assert_eq!(outs.regulator, Some(out.regulator));
     assert!(outs.servos.is_some() && outs.bolter.is_some());
     // The garbage on B's line was dropped and counted when the line went idle.
     assert_eq!(ctl.from_b.discarded(), 10);
@@ -186,7 +190,7 @@ fn garbage_on_the_b_line_resyncs_and_the_link_holds() {
     let (mut heartbeats, mut garbage) = (0, 0);
     for k in 0..TICKS {
         let now = k * 10;
-        assert!(ctl.tick(now, &mut side, &mut outs, &mut uart).is_some());
+        ctl.tick(now, &mut side, &mut outs, &mut uart);
         let mut command = None;
         to_b.feed(&std::mem::take(&mut uart.tx), |p| command = Some(p));
         let inputs = board_b::Inputs {
@@ -195,6 +199,7 @@ fn garbage_on_the_b_line_resyncs_and_the_link_holds() {
             gravity: None,
             arm_contracted: true,
             bolter_at_home: true,
+            lost: frontend::Lost::NONE,
         };
         if let Some(hb) = b.tick(now, &inputs).heartbeat {
             uart.rx.extend_from_slice(b"\x55MI\x00zz");

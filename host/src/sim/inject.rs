@@ -1,5 +1,6 @@
-//! Fault injection: each of Table 8's ten faults, and the operator's Stop and Reset, at a
-//! simulated time (`mmic sim --inject NAME@SECONDS`).
+//! Fault injection: each of Table 8's ten faults, a sensor that stops answering (the ADC of
+//! either side, the hip encoder: the project's sensor loss), and the operator's Stop and
+//! Reset, at a simulated time (`mmic sim --inject NAME@SECONDS`).
 //!
 //! A fault acts physically where it can, so that the firmware has to detect it the way the
 //! robot would: a jammed fastener, a dead contraction switch, an obstacle on a bolter, a
@@ -14,7 +15,7 @@
 //! assert_eq!(s.at_ms, 25_500);
 //! assert_eq!(s.injection.name(), "low-battery");
 //! assert!("low-batery@3".parse::<Scheduled>().unwrap_err().to_string().contains("valid names: bolting-failure, "));
-//! assert_eq!(Injection::ALL.len(), 12);
+//! assert_eq!(Injection::ALL.len(), 15);
 //! ```
 
 use super::SimConfig;
@@ -27,15 +28,29 @@ use std::str::FromStr;
 pub enum Injection {
     /// A Table 8 fault, made to happen.
     Fault(Table8),
+    /// A sensor stops answering from then on (no Table 8 row: the firmware's sensor loss).
+    Silent(Device),
     /// The operator's Stop (Table 1: emergency stop of the current motion), out of band.
     Stop,
     /// The operator's Reset (Table 1: after a stop, resume motion), out of band.
     Reset,
 }
 
+/// A sensor that can fall silent.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Device {
+    /// Side A's ADS7828 (every voltage and current of side A).
+    AdcA,
+    /// Side B's ADS7828.
+    AdcB,
+    /// The hip encoder (side A).
+    Encoder,
+}
+
 impl Injection {
-    /// Every injection: Table 8's rows in the table's order, then Stop and Reset.
-    pub const ALL: [Injection; 12] = [
+    /// Every injection: Table 8's rows in the table's order, the silent sensors, then Stop
+    /// and Reset.
+    pub const ALL: [Injection; 15] = [
         Injection::Fault(Table8::BoltingFailure),
         Injection::Fault(Table8::ArmNotContracted),
         Injection::Fault(Table8::BolterOvercurrent),
@@ -46,6 +61,9 @@ impl Injection {
         Injection::Fault(Table8::InternalCommLoss),
         Injection::Fault(Table8::LowBattery),
         Injection::Fault(Table8::AssemblySystem),
+        Injection::Silent(Device::AdcA),
+        Injection::Silent(Device::AdcB),
+        Injection::Silent(Device::Encoder),
         Injection::Stop,
         Injection::Reset,
     ];
@@ -55,6 +73,9 @@ impl Injection {
     pub fn name(self) -> String {
         match self {
             Injection::Fault(r) => r.name().replace('_', "-"),
+            Injection::Silent(Device::AdcA) => "adc-a-silent".to_string(),
+            Injection::Silent(Device::AdcB) => "adc-b-silent".to_string(),
+            Injection::Silent(Device::Encoder) => "encoder-silent".to_string(),
             Injection::Stop => "stop".to_string(),
             Injection::Reset => "reset".to_string(),
         }
@@ -96,6 +117,15 @@ impl Injection {
                 Table8::LowBattery => "the battery sags below 10 V from then on",
                 Table8::AssemblySystem => "the ground sends the System fault command",
             },
+            Injection::Silent(Device::AdcA) => {
+                "side A's ADC stops answering: sensor loss after 0.5 s (Safed)"
+            }
+            Injection::Silent(Device::AdcB) => {
+                "side B's ADC stops answering: B falls silent, internal comm loss (Safed)"
+            }
+            Injection::Silent(Device::Encoder) => {
+                "the hip encoder stops answering: hip stopped at once, sensor loss after 0.5 s"
+            }
             Injection::Stop => "the ground sends Stop",
             Injection::Reset => "the ground sends Reset",
         }
@@ -107,7 +137,7 @@ impl Injection {
             Injection::Fault(Table8::AssemblySystem) => Some(Command::SystemFault),
             Injection::Stop => Some(Command::Stop),
             Injection::Reset => Some(Command::Reset),
-            Injection::Fault(_) => None,
+            Injection::Fault(_) | Injection::Silent(_) => None,
         }
     }
 
@@ -281,6 +311,9 @@ impl SimConfig {
                 Table8::LowBattery => once(&mut p.low_battery_at, s)?,
                 Table8::InitialStateMismatch | Table8::AssemblySystem => {}
             },
+            Injection::Silent(Device::AdcA) => once(&mut p.adc_silent_at[0], s)?,
+            Injection::Silent(Device::AdcB) => once(&mut p.adc_silent_at[1], s)?,
+            Injection::Silent(Device::Encoder) => once(&mut p.encoder_silent_at, s)?,
             Injection::Stop | Injection::Reset => {}
         }
         self.injections.push(s);

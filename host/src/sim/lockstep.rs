@@ -75,7 +75,10 @@ impl Robot {
             out_b: None,
             sensors: (
                 Frontend::new(frontend::Config::default()),
-                Frontend::new(frontend::Config::default()),
+                Frontend::new(frontend::Config {
+                    hip_encoder: false,
+                    ..frontend::Config::default()
+                }),
             ),
             to_b: None,
             to_a: None,
@@ -107,6 +110,7 @@ impl Robot {
                 gravity: fa.gravity,
                 arm_contracted: sa.arm_contracted,
                 bolter_at_home: sa.bolter_at_home,
+                lost: fa.lost,
             },
         );
         let out_b = self.b.tick(
@@ -117,6 +121,7 @@ impl Robot {
                 gravity: fb.gravity,
                 arm_contracted: sb.arm_contracted,
                 bolter_at_home: sb.bolter_at_home,
+                lost: fb.lost,
             },
         );
         self.plant.drive_a(

@@ -12,10 +12,10 @@
 //! ```
 //!
 //! Losses are injected per link ([`SimConfig::wifi_loss`], …): a lost packet is logged with
-//! fate `lost` and never written. Each of Table 8's ten faults, and the operator's Stop and
-//! Reset, can be injected at a time ([`inject`], [`SimConfig::inject`]): in the plant
-//! ([`PlantConfig`]: a jammed fastener, a dead switch, an obstacle, an offset encoder, a
-//! sagging battery), on the A–B line (cut, both directions) or from the ground (a misstated
+//! fate `lost` and never written. Each of Table 8's ten faults, a silent sensor, and the
+//! operator's Stop and Reset, can be injected at a time ([`inject`], [`SimConfig::inject`]):
+//! in the plant ([`PlantConfig`]: a jammed fastener, a dead switch, an obstacle, an offset or
+//! silent encoder, a silent ADC, a sagging battery), on the A–B line (cut, both directions) or from the ground (a misstated
 //! reconfiguration, out-of-band commands).
 
 pub mod bench;

@@ -339,6 +339,7 @@ impl ControlTask<'_> {
                 gravity: f.gravity,
                 arm_contracted: s.arm_contracted,
                 bolter_at_home: s.bolter_at_home,
+                lost: f.lost,
             },
         );
         {
@@ -399,7 +400,10 @@ impl BoardBTask {
     /// Runs until the run stops.
     pub fn run(mut self, node: Node<'_>) {
         let mut was_lost = false;
-        let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
+        let mut sensors = Frontend::<WINDOW>::new(frontend::Config {
+            hip_encoder: false,
+            ..frontend::Config::default()
+        });
         node.every_tick(|now| {
             let command = self.from_a.try_recv().ok().and_then(|v| v.try_into().ok());
             let s = self
@@ -416,6 +420,7 @@ impl BoardBTask {
                     gravity: f.gravity,
                     arm_contracted: s.arm_contracted,
                     bolter_at_home: s.bolter_at_home,
+                    lost: f.lost,
                 },
             );
             self.plant

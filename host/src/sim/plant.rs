@@ -63,6 +63,12 @@ pub struct PlantConfig {
     pub hip_encoder_offset_at: Option<u32>,
     /// The encoder's error once offset, 0.01°.
     pub hip_encoder_offset: u16,
+    /// From this time on (ms) the ADS7828 of side A, B (index 0, 1) does not answer: no
+    /// voltage or current reading at all (an I2C fault). Not a Table 8 fault: the firmware's
+    /// sensor loss (spec/decisions.toml, `sensor-loss`).
+    pub adc_silent_at: [Option<u32>; 2],
+    /// From this time on (ms) the hip encoder does not answer.
+    pub encoder_silent_at: Option<u32>,
     /// RNG seed (fastener locks).
     pub seed: u64,
     /// Pulse at which an arm's contraction switch closes (the firmware's "contracted").
@@ -85,6 +91,8 @@ impl Default for PlantConfig {
             hip_encoder_offset_at: None,
             // 30°: three times the hip check's 10° tolerance.
             hip_encoder_offset: 3000,
+            adc_silent_at: [None; 2],
+            encoder_silent_at: None,
             seed: 1,
             arm_contracted: mmic::node::board_a::Config::default().arm.contracted,
         }
@@ -308,6 +316,12 @@ impl Plant {
         self.hip = (self.hip + self.hip_speed * dt / 1000.0).rem_euclid(36000.0);
     }
 
+    /// The configuration, to schedule a fault at a time chosen during a run (the lock-step
+    /// tests: "from now on the ADC is silent").
+    pub fn config_mut(&mut self) -> &mut PlantConfig {
+        &mut self.cfg
+    }
+
     /// The hip's true angle, 0.01° (what the encoder reads, before its 12-bit rounding).
     pub fn hip_centidegrees(&self) -> f64 {
         self.hip
@@ -421,9 +435,10 @@ impl Plant {
         });
         Senses {
             raw: Raw {
-                adc,
+                adc: (!at_or_after(self.cfg.adc_silent_at[side], now)).then_some(adc),
                 accel,
-                encoder: if side == 0 { self.encoder(now) } else { 0 },
+                encoder: (side == 0 && !at_or_after(self.cfg.encoder_silent_at, now))
+                    .then(|| self.encoder(now)),
             },
             arm_contracted: !self.dead_switch[side]
                 && self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0
