@@ -107,7 +107,15 @@ class Yamcs:
         return f"http://127.0.0.1:{self.http_port}"
 
     # -- set-up ---------------------------------------------------------------------------------
+    def _prune(self, keep: int = 5) -> None:
+        """Remove all but the newest `keep` earlier run directories (about 7 MB each)."""
+        runs = sorted(self.run_dir.parent.glob("yamcs-*"), key=lambda p: p.stat().st_mtime)
+        for old in runs[:-keep] if len(runs) > keep else []:
+            shutil.rmtree(old, ignore_errors=True)
+
     def _render(self) -> None:
+        if self.run_dir.parent.name == "ground" and self.run_dir.parent.parent.name == "target":
+            self._prune()
         if self.run_dir.exists():
             shutil.rmtree(self.run_dir)
         etc = self.run_dir / "etc"

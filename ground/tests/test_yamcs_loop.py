@@ -11,18 +11,15 @@ One YAMCS for the whole module (started by ground/yamcs_harness.py with the exam
 from __future__ import annotations
 
 import datetime as dt
+import os
 import queue
 import sys
 import threading
 import time
-from pathlib import Path
 
 import pytest
-
-
-from yamcs_harness import INSTANCE, Yamcs  # noqa: E402
-
-from fake_robot import APID, HK_SID, FakeRobot  # noqa: E402
+from fake_robot import APID, HK_SID, FakeRobot  # ground/tests (conftest.py puts ground/ on the path)
+from yamcs_harness import DEFAULT_MDB, INSTANCE, Yamcs
 
 HK = ["/MMIC/hk_sid", "/MMIC/battery_voltage", "/MMIC/mode", "/MMIC/fault_bitmap",
       "/MMIC/met_coarse", "/MMIC/met_fine", "/MMIC/msg_type_counter"]
@@ -32,7 +29,8 @@ STEP = 10.0  # seconds any single wait may take
 
 @pytest.fixture(scope="module")
 def yamcs():
-    y = Yamcs(max_lifetime=300)
+    # GROUND_MDB: another XTCE with the same names (e.g. a mutated copy, to see these tests fail)
+    y = Yamcs(os.environ.get("GROUND_MDB", DEFAULT_MDB), max_lifetime=300)
     y.start()
     print(f"\nYAMCS ready in {y.start_seconds:.1f} s, RSS {(y.rss_kib() or 0) // 1024} MiB, {y.url}")
     try:
