@@ -100,6 +100,7 @@ class Yamcs:
         self.proc: subprocess.Popen | None = None
         self.log_path = self.run_dir / "yamcs.log"
         self.start_seconds: float | None = None
+        self.stop_seconds: float | None = None
         self.client = None
 
     @property
@@ -178,6 +179,14 @@ class Yamcs:
         p, self.proc = self.proc, None
         if p is None or p.poll() is not None:
             return
+        t0 = time.monotonic()
+        try:
+            self._kill(p, grace)
+        finally:
+            self.stop_seconds = time.monotonic() - t0
+
+    @staticmethod
+    def _kill(p: subprocess.Popen, grace: float) -> None:
         for sig, wait in ((signal.SIGTERM, grace), (signal.SIGKILL, 5.0)):
             try:
                 os.killpg(p.pid, sig)  # the group led by our `timeout` process (start_new_session)

@@ -152,3 +152,35 @@ class FakeRobot:
                 self.report(1, rx.request_id)
                 self.report(8, rx.request_id, code=self.failure_code)
             self.tcs.put(rx)
+
+
+def main() -> None:
+    """By hand: send a TM(3,25) every second and answer every TC, for --seconds."""
+    import argparse
+    import time
+
+    ap = argparse.ArgumentParser(description=main.__doc__)
+    ap.add_argument("--tm-port", type=int, required=True, help="YAMCS's UDP TM port")
+    ap.add_argument("--tc-port", type=int, required=True, help="the UDP port YAMCS sends TCs to")
+    ap.add_argument("--answer", default="complete", choices=["complete", "fail-acceptance", "fail-completion", "silent"])
+    ap.add_argument("--seconds", type=int, default=60)
+    a = ap.parse_args()
+    robot = FakeRobot(a.tm_port, a.tc_port, answer=a.answer)
+    t0 = time.monotonic()
+    try:
+        while (met := time.monotonic() - t0) < a.seconds:
+            robot.send_hk(3600 + int(met) % 200, 2, 0, met)
+            while not robot.tcs.empty():
+                rx = robot.tcs.get()
+                print(f"TC {rx.raw.hex()} -> {a.answer}", flush=True)
+            for e in robot.errors:
+                print("refused TC:", e, flush=True)
+            robot.errors.clear()
+            time.sleep(1)
+    except KeyboardInterrupt:
+        pass
+    robot.close()
+
+
+if __name__ == "__main__":
+    main()
