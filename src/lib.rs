@@ -44,6 +44,7 @@ pub mod faults;
 pub mod mode;
 pub mod motion;
 pub mod node;
+pub mod pus;
 pub mod refusal;
 pub mod safety;
 pub mod sensors;

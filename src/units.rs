@@ -215,6 +215,19 @@ impl Instant {
         Instant(self.0.wrapping_add(d.0))
     }
 
+    /// Whether `deadline` has come (`self` is at or after it on the wrapping clock, within
+    /// half the wrap).
+    ///
+    /// ```
+    /// use mmic::units::Instant;
+    /// let t = |ms| Instant::from_millis(ms);
+    /// assert!(t(10).reached(t(10)) && t(11).reached(t(10)) && !t(9).reached(t(10)));
+    /// assert!(t(5).reached(t(u32::MAX - 5))); // across the wrap
+    /// ```
+    pub const fn reached(self, deadline: Instant) -> bool {
+        self.0.wrapping_sub(deadline.0) <= i32::MAX as u32
+    }
+
     /// Time from `earlier` to `self` on the wrapping clock; zero if `self` is earlier (a
     /// difference of more than half the wrap is read as the clock having gone backwards).
     pub const fn since(self, earlier: Instant) -> Duration {

@@ -294,6 +294,10 @@ pub struct BoardA {
     tracked: Option<State>,
     target_state: Option<State>,
     complete: bool,
+    /// A single-module motion (arm, gripper, hip, bolter) runs: when it ends with no fault
+    /// raised and no stop, the heartbeat's "command complete" (byte 54) is set, as a
+    /// reconfiguration's is (spec/decisions.toml, `command-complete`).
+    single: bool,
     coord: Coordinator,
     side_a: BolterSide,
     waiting_job: Option<Queued>,
@@ -369,6 +373,7 @@ struct Paused {
     targets: Targets,
     contracting: PerSide<Contraction>,
     pair: Option<(crate::command::BolterPair, u8)>,
+    single: bool,
 }
 
 impl BoardA {
@@ -385,6 +390,7 @@ impl BoardA {
             tracked: None,
             target_state: None,
             complete: false,
+            single: false,
             coord: Coordinator::new(),
             side_a: BolterSide::new(),
             waiting_job: None,
@@ -520,6 +526,10 @@ impl BoardA {
         }
         let events = self.advance(now, inp, &fb, &mut out);
         let in_motion = self.moving_now(&fb);
+        if self.single && !in_motion {
+            self.single = false;
+            self.complete = true;
+        }
         self.moving = in_motion;
         let conditions = self.detect(now, inp);
         let taken = self.take_command(inp.command, in_motion, &mut out);
@@ -808,6 +818,8 @@ impl BoardA {
         }
         let new_faults = Faults::from_iter(s.faults.iter().filter(|f| !before.1.contains(*f)));
         if !new_faults.is_empty() {
+            // A motion that raised a fault does not complete.
+            self.single = false;
             out.push(Event::Faults(new_faults));
         }
         s
@@ -914,6 +926,10 @@ impl BoardA {
     fn dispatch(&mut self, c: Command, now: u32) {
         if c.kind().moves() {
             self.release_b_hold();
+            if !matches!(c, Command::Primitive(_) | Command::Reconfigure(_)) {
+                self.complete = false;
+                self.single = true;
+            }
         }
         match c {
             Command::Arm { side, target } => {
@@ -1048,6 +1064,7 @@ impl BoardA {
             targets: self.targets,
             contracting: self.contracting,
             pair: self.pair,
+            single: self.single,
         });
     }
 
@@ -1062,6 +1079,7 @@ impl BoardA {
         self.targets = p.targets;
         self.contracting = p.contracting;
         self.pair = p.pair;
+        self.single = p.single;
         self.hold_b = false;
         if let Some(r) = self.runner.as_mut() {
             r.resume(now);
@@ -1080,6 +1098,7 @@ impl BoardA {
         self.runner = None;
         self.idle_check = None;
         self.pair = None;
+        self.single = false;
         self.coord.stop();
         self.waiting_job = None;
         self.side_a.order(0, None, now);

@@ -31,6 +31,7 @@ pub mod b_link;
 pub mod board_a;
 pub mod board_b;
 pub mod exactly_once;
+pub mod gateway;
 pub mod ground;
 #[cfg(any(
     target_has_atomic = "ptr",

@@ -1,0 +1,546 @@
+//! The server board as a PUS gateway: PUS-C telecommands from the ground in, the legacy
+//! 14-byte commands to board A out, and the ST[1], ST[3], ST[5] and ST[17] telemetry back.
+//!
+//! Board A and its link stay as the paper has them. For each robot the gateway does what the
+//! opsUI did — the legacy [`Uplink`] numbers each command, resends it until board A
+//! acknowledges it and polls for heartbeats — and turns the outcomes into reports: ST[1] from
+//! the uplink's outcome and the heartbeat's "command complete", ST[3] from the latest
+//! heartbeat every collection interval, ST[5] from what changed between two heartbeats
+//! ([`crate::pus::event`]). No robot behaviour is decided here (spec/decisions.toml,
+//! `pus-gateway`).
+//!
+//! Exactly once: a telecommand is keyed on (APID, source ID, sequence count). A copy of a
+//! telecommand still in the key log is never run again; its latest report is sent again. The
+//! same key with other content is refused (`KEY_REUSED`). The legacy numbering below it keeps
+//! board A's guarantee (one sequence number, one execution).
+//!
+//! ```
+//! use mmic::command::Command;
+//! use mmic::node::gateway::{Gateway, Tc};
+//! use mmic::pus::request::Request;
+//! use mmic::pus::verification::{RequestId, Stage};
+//! use mmic::units::BoardNumber;
+//! use mmic::wire::heartbeat::HeartbeatRepr;
+//!
+//! let mut g: Gateway<2, 4, 8> = Gateway::new(Default::default());
+//! g.add(BoardNumber::ONE);
+//! let tc = Tc { request: RequestId { apid: 0x101, seq_count: 1 }, source_id: 7, ack: 0b1001,
+//!               request_of: Ok(Request::Function(Command::Stop)) };
+//! let out = g.tc(&tc);
+//! assert_eq!(out.reports[0].stage(), Some((Stage::Acceptance, true)));
+//! let out = g.tick(0);
+//! let sent = out.to_robots[0].1;
+//! assert_eq!(sent.command, Command::Stop);
+//! // Board A answers: accepted, so started and (Stop being instantaneous) completed.
+//! let hb = HeartbeatRepr { last_seq: sent.seq, ..HeartbeatRepr::default() };
+//! let out = g.heartbeat(5, &hb);
+//! let stages: Vec<_> = out.reports.iter().filter_map(|r| r.stage()).collect();
+//! assert_eq!(stages, [(Stage::Completion, true)]); // start success not asked (ack 0b1001)
+//! ```
+
+use crate::command::Command;
+use crate::faults::Faults;
+use crate::node::ground::{self, Done, Outcome, Uplink};
+use crate::pus::event;
+use crate::pus::housekeeping::{self, DEFAULT_INTERVAL_MS, REPORT_LEN};
+use crate::pus::request::{Request, RequestError, ST_HOUSEKEEPING, ST_TEST, ST_VERIFICATION};
+use crate::pus::verification::{
+    Failure, Report, RequestId, Stage, ABANDONED, FAILURE_LEN, KEY_REUSED, QUEUE_FULL,
+    UNACKNOWLEDGED,
+};
+use crate::pus::{robot_apid, robot_of_apid};
+use crate::units::{BoardNumber, Instant};
+use crate::wire::command::CommandRepr;
+use crate::wire::heartbeat::HeartbeatRepr;
+use heapless::{Deque, Vec};
+
+/// A telecommand the CCSDS layer accepted (header, CRC and APID checked), with its request
+/// already read ([`Request::parse`]) or refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Tc {
+    /// Its request ID (APID and sequence count).
+    pub request: RequestId,
+    /// Its source ID (PUS-C TC secondary header).
+    pub source_id: u16,
+    /// Acknowledgement flags: bit 0 acceptance, 1 start, 2 progress, 3 completion (success
+    /// reports are sent only when asked; failure reports always).
+    pub ack: u8,
+    /// The request, or why it is none.
+    pub request_of: Result<Request, RequestError>,
+}
+
+/// Largest source data of a report the gateway makes.
+pub const MAX_TM_DATA: usize = REPORT_LEN;
+
+/// A report to send to the ground: service, subservice, source data, on the robot's APID.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct TmOut {
+    /// APID (the robot's).
+    pub apid: u16,
+    /// Service type.
+    pub service: u8,
+    /// Subservice type.
+    pub subservice: u8,
+    /// Destination ID: the source ID of the TC it answers, 0 for unsolicited reports.
+    pub destination: u16,
+    /// Source data.
+    pub data: Vec<u8, MAX_TM_DATA>,
+}
+
+impl TmOut {
+    fn new(apid: u16, service: u8, subservice: u8, destination: u16, data: &[u8]) -> TmOut {
+        let mut v = Vec::new();
+        // Every report the gateway builds fits (MAX_TM_DATA is the longest).
+        let _ = v.extend_from_slice(data.get(..data.len().min(MAX_TM_DATA)).unwrap_or(&[]));
+        TmOut {
+            apid,
+            service,
+            subservice,
+            destination,
+            data: v,
+        }
+    }
+
+    /// For an ST[1] report: its stage and whether it reports success.
+    pub fn stage(&self) -> Option<(Stage, bool)> {
+        if self.service != ST_VERIFICATION {
+            return None;
+        }
+        Report::parse(self.subservice, &self.data)
+            .ok()
+            .map(|r| (r.stage, r.failure.is_none()))
+    }
+}
+
+/// Timing and sizes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Config {
+    /// The legacy uplink's resend timing towards board A.
+    pub uplink: ground::Config,
+    /// A heartbeat is asked for this often while nothing else is sent, ms.
+    pub poll_ms: u32,
+    /// Initial housekeeping collection interval, ms.
+    pub hk_interval_ms: u32,
+    /// Periodic housekeeping on at start.
+    pub hk_enabled: bool,
+}
+
+impl Default for Config {
+    /// Resend every 250 ms with a 200 ms timeout, up to 10 attempts; poll every 250 ms;
+    /// housekeeping every second, on.
+    fn default() -> Config {
+        Config {
+            uplink: ground::Config {
+                period_ms: 250,
+                timeout_ms: 200,
+                max_attempts: 10,
+            },
+            poll_ms: 250,
+            hk_interval_ms: DEFAULT_INTERVAL_MS,
+            hk_enabled: true,
+        }
+    }
+}
+
+/// What a call asks the shell to do.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Out<const M: usize> {
+    /// Send these legacy commands, each to its robot's board A (one per robot at most).
+    pub to_robots: Vec<(BoardNumber, CommandRepr), M>,
+    /// Send these reports to the ground, in order.
+    pub reports: Vec<TmOut, M>,
+    /// Reports or commands that did not fit (none while robots ≤ 16; counted, not silent).
+    pub overflow: u16,
+}
+
+impl<const M: usize> Out<M> {
+    fn push(&mut self, tm: TmOut) {
+        if self.reports.push(tm).is_err() {
+            self.overflow = self.overflow.saturating_add(1);
+        }
+    }
+}
+
+/// What the key log remembers of a telecommand.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct Entry {
+    key: (u16, u16),
+    request: Request,
+    /// The latest report made for it (sent again for a copy).
+    last: Option<Report>,
+}
+
+/// A telecommand on its way: queued, sent to board A, or running there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct Job {
+    request: RequestId,
+    source_id: u16,
+    ack: u8,
+    command: Command,
+    /// Are-you-alive: answer TM(17,2) when board A answers.
+    alive: bool,
+}
+
+/// One robot's side of the gateway.
+#[derive(Debug, Clone)]
+struct Robot<const Q: usize, const K: usize> {
+    board: BoardNumber,
+    uplink: Uplink,
+    queue: Deque<Job, Q>,
+    sent: Option<(u16, Job)>,
+    /// A motion board A accepted, until "command complete", a fault or a mode change.
+    running: Option<Job>,
+    log: Deque<Entry, K>,
+    last: Option<HeartbeatRepr>,
+    stopped: bool,
+    hk_enabled: bool,
+    hk_interval_ms: u32,
+    hk_next: Option<Instant>,
+    next_poll: Option<Instant>,
+}
+
+/// The gateway for up to `R` robots, `Q` waiting telecommands and `K` remembered keys each.
+#[derive(Debug, Clone)]
+pub struct Gateway<const R: usize, const Q: usize, const K: usize> {
+    cfg: Config,
+    robots: Vec<Robot<Q, K>, R>,
+}
+
+/// Reports per call.
+const M: usize = 16;
+
+fn report(stage: Stage, request: RequestId, failure: Option<Failure>) -> Report {
+    Report {
+        stage,
+        request,
+        failure,
+    }
+}
+
+impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
+    /// No robots yet.
+    pub const fn new(cfg: Config) -> Self {
+        Gateway {
+            cfg,
+            robots: Vec::new(),
+        }
+    }
+
+    /// Serves robot `board`; false when all `R` places are taken (or it is served already).
+    pub fn add(&mut self, board: BoardNumber) -> bool {
+        if self.robots.iter().any(|r| r.board == board) {
+            return false;
+        }
+        self.robots
+            .push(Robot {
+                board,
+                uplink: Uplink::new(self.cfg.uplink, board),
+                queue: Deque::new(),
+                sent: None,
+                running: None,
+                log: Deque::new(),
+                last: None,
+                stopped: false,
+                hk_enabled: self.cfg.hk_enabled,
+                hk_interval_ms: self.cfg.hk_interval_ms,
+                hk_next: None,
+                next_poll: None,
+            })
+            .is_ok()
+    }
+
+    /// The latest heartbeat of robot `board`.
+    pub fn latest(&self, board: BoardNumber) -> Option<&HeartbeatRepr> {
+        self.robots
+            .iter()
+            .find(|r| r.board == board)
+            .and_then(|r| r.last.as_ref())
+    }
+
+    /// A telecommand from the ground.
+    pub fn tc(&mut self, tc: &Tc) -> Out<M> {
+        let mut out = Out::default();
+        let apid = tc.request.apid;
+        let Some(r) =
+            robot_of_apid(apid).and_then(|b| self.robots.iter_mut().find(|r| r.board == b))
+        else {
+            // The CCSDS layer admits only the APIDs of robots served; nothing to answer.
+            return out;
+        };
+        let key = (tc.source_id, tc.request.seq_count);
+        let send = |r: &mut Robot<Q, K>, out: &mut Out<M>, rep: Report, ack: u8| {
+            r.remember(key, rep);
+            r.verify(out, rep, ack, tc.source_id);
+        };
+        let request = match tc.request_of {
+            Ok(q) => q,
+            Err(e) => {
+                let f = Failure {
+                    code: e.code(),
+                    data: 0,
+                };
+                r.verify(
+                    &mut out,
+                    report(Stage::Acceptance, tc.request, Some(f)),
+                    tc.ack,
+                    tc.source_id,
+                );
+                return out;
+            }
+        };
+        if let Some(e) = r.log.iter().find(|e| e.key == key).copied() {
+            if e.request == request {
+                // A copy: not run again; its latest report again, for a ground that lost it.
+                if let Some(rep) = e.last {
+                    r.verify(&mut out, rep, 0xF, tc.source_id);
+                }
+            } else {
+                let f = Failure {
+                    code: KEY_REUSED,
+                    data: u32::from(tc.request.seq_count),
+                };
+                r.verify(
+                    &mut out,
+                    report(Stage::Acceptance, tc.request, Some(f)),
+                    tc.ack,
+                    tc.source_id,
+                );
+            }
+            return out;
+        }
+        if r.log.is_full() {
+            r.log.pop_front();
+        }
+        let _ = r.log.push_back(Entry {
+            key,
+            request,
+            last: None,
+        });
+        let accepted = report(Stage::Acceptance, tc.request, None);
+        let done = |r: &mut Robot<Q, K>, out: &mut Out<M>| {
+            send(r, out, accepted, tc.ack);
+            send(r, out, report(Stage::Start, tc.request, None), tc.ack);
+            send(r, out, report(Stage::Completion, tc.request, None), tc.ack);
+        };
+        let job = |command, alive| Job {
+            request: tc.request,
+            source_id: tc.source_id,
+            ack: tc.ack,
+            command,
+            alive,
+        };
+        match request {
+            Request::HkEnable => {
+                r.hk_enabled = true;
+                done(r, &mut out);
+            }
+            Request::HkDisable => {
+                r.hk_enabled = false;
+                done(r, &mut out);
+            }
+            Request::HkInterval { ms } => {
+                r.hk_interval_ms = ms;
+                r.hk_next = None;
+                done(r, &mut out);
+            }
+            Request::Function(c) => r.enqueue(&mut out, job(c, false), key),
+            Request::AreYouAlive => r.enqueue(&mut out, job(Command::Heartbeat, true), key),
+        }
+        out
+    }
+
+    /// Time passes: resends and their timeouts, polls, housekeeping reports; the legacy
+    /// commands due now, at most one per robot (the server board visits them in turn,
+    /// Figure 4).
+    pub fn tick(&mut self, now: u32) -> Out<M> {
+        let mut out = Out::default();
+        let cfg = self.cfg;
+        for r in self.robots.iter_mut() {
+            if r.uplink.is_idle() {
+                r.submit_next(now, &cfg);
+            }
+            let t = r.uplink.tick(now);
+            if let Some(d) = t.done {
+                r.finished(&mut out, d);
+            }
+            if let Some(send) = t.send {
+                if out.to_robots.push((r.board, send)).is_err() {
+                    out.overflow = out.overflow.saturating_add(1);
+                }
+            }
+            r.housekeeping(now, &mut out);
+        }
+        out
+    }
+
+    /// A heartbeat from board A of `hb.board`.
+    pub fn heartbeat(&mut self, now: u32, hb: &HeartbeatRepr) -> Out<M> {
+        let mut out = Out::default();
+        let Some(r) = self.robots.iter_mut().find(|r| r.board == hb.board) else {
+            return out;
+        };
+        let t = r.uplink.heartbeat(now, hb);
+        if let Some(prev) = r.last {
+            let apid = robot_apid(r.board);
+            for e in event::between(&prev, hb, r.stopped) {
+                out.push(TmOut::new(apid, 5, e.severity(), 0, &e.to_bytes()));
+            }
+            r.progress(&mut out, &prev, hb);
+        }
+        r.stopped = false;
+        r.last = Some(*hb);
+        if let Some(d) = t.done {
+            r.finished(&mut out, d);
+        }
+        out
+    }
+}
+
+impl<const Q: usize, const K: usize> Robot<Q, K> {
+    fn apid(&self) -> u16 {
+        robot_apid(self.board)
+    }
+
+    /// Records `rep` as the latest report of the telecommand keyed `key`.
+    fn remember(&mut self, key: (u16, u16), rep: Report) {
+        if let Some(e) = self.log.iter_mut().find(|e| e.key == key) {
+            e.last = Some(rep);
+        }
+    }
+
+    /// Sends an ST[1] report: failures always, successes when `ack` asks for the stage.
+    fn verify<const M2: usize>(&self, out: &mut Out<M2>, rep: Report, ack: u8, dest: u16) {
+        let bit = match rep.stage {
+            Stage::Acceptance => 0,
+            Stage::Start => 1,
+            Stage::Completion => 3,
+        };
+        if rep.failure.is_some() || ack & (1 << bit) != 0 {
+            let mut b = [0u8; FAILURE_LEN];
+            let n = rep.emit(&mut b);
+            out.push(TmOut::new(
+                self.apid(),
+                ST_VERIFICATION,
+                rep.subservice(),
+                dest,
+                b.get(..n).unwrap_or(&[]),
+            ));
+        }
+    }
+
+    fn report<const M2: usize>(&mut self, out: &mut Out<M2>, job: &Job, rep: Report) {
+        self.remember((job.source_id, job.request.seq_count), rep);
+        self.verify(out, rep, job.ack, job.source_id);
+    }
+
+    fn enqueue<const M2: usize>(&mut self, out: &mut Out<M2>, job: Job, key: (u16, u16)) {
+        match self.queue.push_back(job) {
+            Ok(()) => {
+                let rep = report(Stage::Acceptance, job.request, None);
+                self.remember(key, rep);
+                self.verify(out, rep, job.ack, job.source_id);
+            }
+            Err(_) => {
+                let f = Failure {
+                    code: QUEUE_FULL,
+                    data: Q as u32,
+                };
+                let rep = report(Stage::Acceptance, job.request, Some(f));
+                self.remember(key, rep);
+                self.verify(out, rep, job.ack, job.source_id);
+            }
+        }
+    }
+
+    /// The uplink is idle: the next telecommand, else a poll when one is due.
+    fn submit_next(&mut self, now: u32, cfg: &Config) {
+        let t = Instant::from_millis(now);
+        if let Some(job) = self.queue.pop_front() {
+            if let Ok(seq) = self.uplink.submit(job.command) {
+                if job.command == Command::Stop {
+                    self.stopped = true;
+                }
+                self.sent = Some((seq, job));
+            }
+            return;
+        }
+        let due = self.next_poll.is_none_or(|p| t.reached(p));
+        if due && self.uplink.submit(Command::Heartbeat).is_ok() {
+            self.next_poll = Some(Instant::from_millis(now.wrapping_add(cfg.poll_ms)));
+        }
+    }
+
+    /// The uplink finished a command: start (or failure) reports, completion for what does
+    /// not move.
+    fn finished<const M2: usize>(&mut self, out: &mut Out<M2>, d: Done) {
+        let Some((seq, job)) = self.sent else { return };
+        if seq != d.seq {
+            return;
+        }
+        self.sent = None;
+        let req = job.request;
+        match d.outcome {
+            Outcome::Accepted => {
+                self.report(out, &job, report(Stage::Start, req, None));
+                if job.alive {
+                    out.push(TmOut::new(self.apid(), ST_TEST, 2, job.source_id, &[]));
+                }
+                if job.command.kind().moves() {
+                    self.running = Some(job);
+                } else {
+                    self.report(out, &job, report(Stage::Completion, req, None));
+                }
+            }
+            Outcome::Refused(r) => {
+                self.report(
+                    out,
+                    &job,
+                    report(Stage::Start, req, Some(Failure::refused(r))),
+                );
+            }
+            Outcome::Unacknowledged => {
+                let f = Failure {
+                    code: UNACKNOWLEDGED,
+                    data: u32::from(d.attempts),
+                };
+                self.report(out, &job, report(Stage::Start, req, Some(f)));
+            }
+        }
+    }
+
+    /// A running motion: complete, failed by a fault, or abandoned by a mode change.
+    fn progress<const M2: usize>(
+        &mut self,
+        out: &mut Out<M2>,
+        prev: &HeartbeatRepr,
+        hb: &HeartbeatRepr,
+    ) {
+        let Some(job) = self.running else { return };
+        let raised = Faults::from_iter(hb.faults.iter().filter(|f| !prev.faults.contains(*f)));
+        let failure = match raised.iter().next() {
+            Some(f) => Some(Failure::fault(f, hb.faults)),
+            None if hb.mode != prev.mode => Some(Failure {
+                code: ABANDONED,
+                data: u32::from(hb.mode.to_wire()),
+            }),
+            None if hb.command_complete => None,
+            None => return,
+        };
+        self.running = None;
+        self.report(out, &job, report(Stage::Completion, job.request, failure));
+    }
+
+    fn housekeeping<const M2: usize>(&mut self, now: u32, out: &mut Out<M2>) {
+        let t = Instant::from_millis(now);
+        let due = self.hk_next.is_none_or(|n| t.reached(n));
+        if !self.hk_enabled || !due {
+            return;
+        }
+        if let Some(hb) = self.last {
+            let mut b = [0u8; REPORT_LEN];
+            housekeeping::emit(&hb, &mut b);
+            out.push(TmOut::new(self.apid(), ST_HOUSEKEEPING, 25, 0, &b));
+            self.hk_next = Some(Instant::from_millis(now.wrapping_add(self.hk_interval_ms)));
+        }
+    }
+}

@@ -1,0 +1,402 @@
+//! ST[8] function management: every Table 1 command as a function with typed arguments, the
+//! application data of TC(8,1) "perform a function".
+//!
+//! The application data is the function ID (one byte) and then that function's arguments,
+//! big-endian, fixed length per function (spec/ccsds/functions.toml lists them with their
+//! ranges; a test holds this module to it). Decoding builds the library's [`Command`] through
+//! its own constructors, so a PUS function is exactly the legacy command it names — the
+//! legacy ⇄ PUS mapping is this one table, with no second meaning of any command. Table 1's
+//! Heartbeat request is no function: ST[17] are-you-alive replaces it.
+//!
+//! ```
+//! use mmic::command::Command;
+//! use mmic::motion::State;
+//! use mmic::pus::function::{self, FunctionError};
+//!
+//! let c = Command::reconfigure(State::A, State::M).unwrap();
+//! let mut buf = [0u8; function::MAX_LEN];
+//! let n = function::encode(&c, &mut buf).unwrap();
+//! assert_eq!(&buf[..n], &[9, b'a', b'm']); // function 9, initial a, target m
+//! assert_eq!(function::decode(&buf[..n]), Ok(c));
+//! // Each bad input is refused by name, with the numbers.
+//! assert_eq!(
+//!     function::decode(&[9, b'a']),
+//!     Err(FunctionError::Length { function: 9, expected: 3, found: 2 })
+//! );
+//! ```
+
+use crate::bolter::BolterPair;
+use crate::command::{
+    BolterCommand, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove, PrimitiveMoveError,
+    Reconfiguration, ReconfigurationError, ServoTarget,
+};
+use crate::mode::Mode;
+use crate::motion::{Primitive, State};
+use crate::units::{HipAngle, Module, PulseWidth, Side};
+
+/// The longest application data of a function: ID and arguments.
+pub const MAX_LEN: usize = 5;
+
+crate::wire_enum::wire_enum! {
+    /// A function of ST[8], in Table 1's order; the value is its function ID.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+    pub enum FunctionId: u8 {
+        /// Move one arm: side, target kind, pulse.
+        Arm = 1 => "arm",
+        /// Move one gripper: side, target kind, pulse.
+        Gripper = 2 => "gripper",
+        /// Rotate the hip: target kind, angle.
+        Hip = 3 => "hip",
+        /// Bolt, unbolt, or lower the bolters: operation, pair.
+        Bolter = 4 => "bolter",
+        /// One motion primitive: primitive, final state.
+        Primitive = 5 => "primitive",
+        /// Emergency stop of the current motion.
+        Stop = 6 => "stop",
+        /// Resume the motion a stop interrupted.
+        Reset = 7 => "reset",
+        /// Power one or all modules: target, on.
+        Power = 8 => "power_control",
+        /// Reconfigure: initial state, target state.
+        Reconfiguration = 9 => "reconfiguration",
+        /// Change operating mode: mode.
+        Mode = 10 => "mode",
+        /// Trigger the assembly system operation fault.
+        SystemFault = 11 => "system_fault",
+        /// Clear the latched faults whose conditions no longer hold (extension).
+        ClearFaults = 12 => "clear_faults",
+    }
+
+    /// Every function, in ID order.
+    const ALL;
+    /// The function ID.
+    pub const fn id(self) -> u8;
+    /// The ID's function.
+    pub const fn from_id(b: u8) -> Option<Self>;
+    /// Its name: Table 1's kind, as in spec/commands.toml.
+    pub const fn name(self) -> &'static str;
+}
+
+impl FunctionId {
+    /// Length of its arguments, bytes.
+    pub const fn args_len(self) -> usize {
+        match self {
+            FunctionId::Arm | FunctionId::Gripper => 4,
+            FunctionId::Hip => 3,
+            FunctionId::Bolter
+            | FunctionId::Primitive
+            | FunctionId::Power
+            | FunctionId::Reconfiguration => 2,
+            FunctionId::Mode => 1,
+            FunctionId::Stop
+            | FunctionId::Reset
+            | FunctionId::SystemFault
+            | FunctionId::ClearFaults => 0,
+        }
+    }
+
+    /// The function of a command; none for the Heartbeat request (ST[17] instead).
+    pub const fn of(c: &Command) -> Option<FunctionId> {
+        Some(match c {
+            Command::Heartbeat => return None,
+            Command::Arm { .. } => FunctionId::Arm,
+            Command::Gripper { .. } => FunctionId::Gripper,
+            Command::Hip(_) => FunctionId::Hip,
+            Command::Bolter(_) => FunctionId::Bolter,
+            Command::Primitive(_) => FunctionId::Primitive,
+            Command::Stop => FunctionId::Stop,
+            Command::Reset => FunctionId::Reset,
+            Command::Power { .. } => FunctionId::Power,
+            Command::Reconfigure(_) => FunctionId::Reconfiguration,
+            Command::Mode(_) => FunctionId::Mode,
+            Command::SystemFault => FunctionId::SystemFault,
+            Command::ClearFaults => FunctionId::ClearFaults,
+        })
+    }
+}
+
+/// Why application data is no function.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FunctionError {
+    /// No application data at all: not even a function ID.
+    #[error("no function ID: the application data is empty")]
+    Empty,
+    /// The function ID names no function.
+    #[error("unknown function ID {id} (valid: 1..=12)")]
+    UnknownFunction {
+        /// The ID found.
+        id: u8,
+    },
+    /// The application data is not the function's length.
+    #[error("function {function}: application data of {found} bytes, expected {expected}")]
+    Length {
+        /// The function ID.
+        function: u8,
+        /// ID and arguments.
+        expected: usize,
+        /// Bytes found.
+        found: usize,
+    },
+    /// An argument outside its range (spec/ccsds/functions.toml).
+    #[error("function {function}: argument {argument} = {value} out of range {min}..={max}")]
+    OutOfRange {
+        /// The function ID.
+        function: u8,
+        /// The argument's name.
+        argument: &'static str,
+        /// The value found.
+        value: u16,
+        /// Its smallest valid value.
+        min: u16,
+        /// Its largest valid value.
+        max: u16,
+    },
+    /// Each argument in range, together no reconfiguration (Section 6).
+    #[error("function 9: {0}")]
+    Reconfiguration(ReconfigurationError),
+    /// Each argument in range, together no primitive command (Figure 9).
+    #[error("function 5: {0}")]
+    Primitive(PrimitiveMoveError),
+    /// The Heartbeat request has no function: ST[17] are-you-alive replaces it.
+    #[error("the heartbeat request is no ST[8] function: use TC(17,1)")]
+    NoFunction,
+    /// The caller's buffer is shorter than the application data.
+    #[error("buffer of {found} bytes, need {needed}")]
+    Buffer {
+        /// Bytes needed.
+        needed: usize,
+        /// Bytes given.
+        found: usize,
+    },
+}
+
+/// An argument `value` checked against `min..=max`.
+const fn arg(
+    f: FunctionId,
+    argument: &'static str,
+    value: u16,
+    min: u16,
+    max: u16,
+) -> Result<u16, FunctionError> {
+    if value >= min && value <= max {
+        Ok(value)
+    } else {
+        Err(FunctionError::OutOfRange {
+            function: f.id(),
+            argument,
+            value,
+            min,
+            max,
+        })
+    }
+}
+
+/// Servo target kinds: contract, extend, position (pulse given).
+const SERVO_KINDS: u16 = 2;
+/// Hip target kinds: home, straight, right angle CW, right angle CCW, angle (given).
+const HIP_KINDS: u16 = 4;
+/// Bolter operations: bolt, unbolt, down.
+const BOLTER_OPS: u16 = 2;
+
+fn side(f: FunctionId, b: u8) -> Result<Side, FunctionError> {
+    Ok(if arg(f, "side", b.into(), 0, 1)? == 0 {
+        Side::A
+    } else {
+        Side::B
+    })
+}
+
+fn servo(f: FunctionId, kind: u8, pulse: u16) -> Result<ServoTarget, FunctionError> {
+    Ok(match arg(f, "target", kind.into(), 0, SERVO_KINDS)? {
+        0 | 1 => {
+            arg(f, "pulse", pulse, 0, 0)?;
+            if kind == 0 {
+                ServoTarget::Contract
+            } else {
+                ServoTarget::Extend
+            }
+        }
+        _ => ServoTarget::Position(match PulseWidth::new(pulse) {
+            Ok(p) => p,
+            Err(_) => {
+                return Err(range_err(
+                    f,
+                    "pulse",
+                    pulse,
+                    PulseWidth::MIN_US,
+                    PulseWidth::MAX_US,
+                ))
+            }
+        }),
+    })
+}
+
+const fn range_err(
+    f: FunctionId,
+    argument: &'static str,
+    value: u16,
+    min: u16,
+    max: u16,
+) -> FunctionError {
+    FunctionError::OutOfRange {
+        function: f.id(),
+        argument,
+        value,
+        min,
+        max,
+    }
+}
+
+fn state(f: FunctionId, argument: &'static str, b: u8) -> Result<State, FunctionError> {
+    State::from_wire(b).ok_or(range_err(f, argument, b.into(), b'a'.into(), b'o'.into()))
+}
+
+/// Power targets: 0 all, then the modules in `Module::ALL` order (1 hip … 7 bolter B).
+const fn power_target(t: PowerTarget) -> u8 {
+    match t {
+        PowerTarget::All => 0,
+        PowerTarget::Module(m) => m as u8 + 1,
+    }
+}
+
+/// Decodes TC(8,1) application data into the command it names; refuses, by name, anything
+/// else: no ID, an unknown ID, a wrong length, an argument out of range, a combination of
+/// arguments that is no command.
+pub fn decode(data: &[u8]) -> Result<Command, FunctionError> {
+    let (&id, a) = data.split_first().ok_or(FunctionError::Empty)?;
+    let f = FunctionId::from_id(id).ok_or(FunctionError::UnknownFunction { id })?;
+    if a.len() != f.args_len() {
+        return Err(FunctionError::Length {
+            function: id,
+            expected: 1 + f.args_len(),
+            found: data.len(),
+        });
+    }
+    let b = |i: usize| a.get(i).copied().unwrap_or(0);
+    let w = |i: usize| u16::from_be_bytes([b(i), b(i + 1)]);
+    Ok(match f {
+        FunctionId::Arm => Command::Arm {
+            side: side(f, b(0))?,
+            target: servo(f, b(1), w(2))?,
+        },
+        FunctionId::Gripper => Command::Gripper {
+            side: side(f, b(0))?,
+            target: servo(f, b(1), w(2))?,
+        },
+        FunctionId::Hip => {
+            let kind = arg(f, "target", b(0).into(), 0, HIP_KINDS)?;
+            if kind < HIP_KINDS {
+                arg(f, "angle", w(1), 0, 0)?;
+            }
+            Command::Hip(match kind {
+                0 => HipTarget::Home,
+                1 => HipTarget::Straight,
+                2 => HipTarget::RightAngleCw,
+                3 => HipTarget::RightAngleCcw,
+                _ => HipTarget::Angle(match HipAngle::new(w(1)) {
+                    Ok(h) => h,
+                    Err(_) => return Err(range_err(f, "angle", w(1), 0, HipAngle::TURN - 1)),
+                }),
+            })
+        }
+        FunctionId::Bolter => {
+            let op = arg(f, "operation", b(0).into(), 0, BOLTER_OPS)?;
+            let pair = arg(f, "pair", b(1).into(), 0, if op == 2 { 0 } else { 4 })?;
+            let fasteners = match BolterPair::from_number(pair as u8) {
+                Some(p) => Fasteners::Pair(p),
+                None => Fasteners::All,
+            };
+            Command::Bolter(match op {
+                0 => BolterCommand::Bolt(fasteners),
+                1 => BolterCommand::Unbolt(fasteners),
+                _ => BolterCommand::Down,
+            })
+        }
+        FunctionId::Primitive => {
+            let p =
+                Primitive::from_number(b(0)).ok_or(range_err(f, "primitive", b(0).into(), 1, 8))?;
+            let s = state(f, "final_state", b(1))?;
+            Command::Primitive(PrimitiveMove::new(p, s).map_err(FunctionError::Primitive)?)
+        }
+        FunctionId::Stop => Command::Stop,
+        FunctionId::Reset => Command::Reset,
+        FunctionId::Power => {
+            let t = arg(f, "target", b(0).into(), 0, Module::ALL.len() as u16)?;
+            let on = arg(f, "on", b(1).into(), 0, 1)? == 1;
+            let target = match t.checked_sub(1).and_then(|i| Module::ALL.get(i as usize)) {
+                Some(&m) => PowerTarget::Module(m),
+                None => PowerTarget::All,
+            };
+            Command::Power { target, on }
+        }
+        FunctionId::Reconfiguration => {
+            let (i, t) = (state(f, "initial", b(0))?, state(f, "target", b(1))?);
+            Command::Reconfigure(
+                Reconfiguration::new(i, t).map_err(FunctionError::Reconfiguration)?,
+            )
+        }
+        FunctionId::Mode => {
+            Command::Mode(Mode::from_wire(b(0)).ok_or(range_err(f, "mode", b(0).into(), 1, 3))?)
+        }
+        FunctionId::SystemFault => Command::SystemFault,
+        FunctionId::ClearFaults => Command::ClearFaults,
+    })
+}
+
+/// Writes a command's TC(8,1) application data into `out`; returns its length.
+pub fn encode(c: &Command, out: &mut [u8]) -> Result<usize, FunctionError> {
+    let f = FunctionId::of(c).ok_or(FunctionError::NoFunction)?;
+    let mut a = [0u8; MAX_LEN];
+    a[0] = f.id();
+    let servo = |t: &ServoTarget| match t {
+        ServoTarget::Contract => (0u8, 0u16),
+        ServoTarget::Extend => (1, 0),
+        ServoTarget::Position(p) => (2, p.micros()),
+    };
+    let args: [u8; 4] = match c {
+        Command::Arm { side, target } | Command::Gripper { side, target } => {
+            let (k, p) = servo(target);
+            let [hi, lo] = p.to_be_bytes();
+            [(*side == Side::B) as u8, k, hi, lo]
+        }
+        Command::Hip(h) => {
+            let (k, v) = match h {
+                HipTarget::Home => (0u8, 0u16),
+                HipTarget::Straight => (1, 0),
+                HipTarget::RightAngleCw => (2, 0),
+                HipTarget::RightAngleCcw => (3, 0),
+                HipTarget::Angle(a) => (4, a.centidegrees()),
+            };
+            let [hi, lo] = v.to_be_bytes();
+            [k, hi, lo, 0]
+        }
+        Command::Bolter(b) => {
+            let pair = |f: &Fasteners| match f {
+                Fasteners::All => 0,
+                Fasteners::Pair(p) => p.number(),
+            };
+            match b {
+                BolterCommand::Bolt(x) => [0, pair(x), 0, 0],
+                BolterCommand::Unbolt(x) => [1, pair(x), 0, 0],
+                BolterCommand::Down => [2, 0, 0, 0],
+            }
+        }
+        Command::Primitive(m) => [m.primitive().number(), m.target().to_wire(), 0, 0],
+        Command::Power { target, on } => [power_target(*target), *on as u8, 0, 0],
+        Command::Reconfigure(r) => [r.initial().to_wire(), r.target().to_wire(), 0, 0],
+        Command::Mode(m) => [m.to_wire(), 0, 0, 0],
+        _ => [0; 4],
+    };
+    let n = 1 + f.args_len();
+    for (d, s) in a.iter_mut().skip(1).zip(args.iter()) {
+        *d = *s;
+    }
+    let found = out.len();
+    let dst = out
+        .get_mut(..n)
+        .ok_or(FunctionError::Buffer { needed: n, found })?;
+    dst.copy_from_slice(a.get(..n).unwrap_or(&[]));
+    Ok(n)
+}

@@ -1,0 +1,279 @@
+//! The PUS gateway against hand-made heartbeats of board A: every ST[1] path, exactly-once
+//! on the request key, housekeeping on its interval, events, are-you-alive. (The gateway with
+//! the whole simulated robot: host/tests/pus.rs.)
+
+use mmic::command::{Command, Reconfiguration};
+use mmic::faults::{Fault, Faults};
+use mmic::mode::Mode;
+use mmic::motion::State;
+use mmic::node::gateway::{Config, Gateway, Out, Tc, TmOut};
+use mmic::pus::request::Request;
+use mmic::pus::verification::{Report, RequestId, Stage};
+use mmic::refusal::Refusal;
+use mmic::units::BoardNumber;
+use mmic::wire::command::CommandRepr;
+use mmic::wire::heartbeat::HeartbeatRepr;
+
+type G = Gateway<2, 4, 8>;
+
+fn gateway() -> G {
+    let mut g = G::new(Config {
+        hk_enabled: false,
+        ..Config::default()
+    });
+    assert!(g.add(BoardNumber::ONE));
+    assert!(!g.add(BoardNumber::ONE), "a robot is served once");
+    g
+}
+
+fn tc(seq: u16, q: Request) -> Tc {
+    Tc {
+        request: RequestId {
+            apid: 0x101,
+            seq_count: seq,
+        },
+        source_id: 9,
+        ack: 0b1111,
+        request_of: Ok(q),
+    }
+}
+
+fn reports(out: &Out<16>) -> Vec<(Stage, Option<u16>, u16)> {
+    out.reports
+        .iter()
+        .filter(|t| t.service == 1)
+        .map(|t| {
+            let r = Report::parse(t.subservice, &t.data).unwrap();
+            (r.stage, r.failure.map(|f| f.code), r.request.seq_count)
+        })
+        .collect()
+}
+
+/// The legacy command the gateway sends at `now`.
+fn sent(g: &mut G, now: u32) -> CommandRepr {
+    let out = g.tick(now);
+    assert_eq!(out.to_robots.len(), 1, "{out:?}");
+    out.to_robots[0].1
+}
+
+fn answer(seq: u16) -> HeartbeatRepr {
+    HeartbeatRepr {
+        last_seq: seq,
+        mode: Mode::Operational,
+        ..HeartbeatRepr::default()
+    }
+}
+
+#[test]
+fn a_motion_completes_when_board_a_says_so() {
+    let mut g = gateway();
+    let r = Command::Reconfigure(Reconfiguration::new(State::A, State::M).unwrap());
+    assert_eq!(
+        reports(&g.tc(&tc(1, Request::Function(r)))),
+        [(Stage::Acceptance, None, 1)]
+    );
+    let c = sent(&mut g, 0);
+    assert_eq!(c.command, r);
+    let out = g.heartbeat(10, &answer(c.seq));
+    assert_eq!(reports(&out), [(Stage::Start, None, 1)]);
+    // Polls: not complete yet, then complete.
+    let p = sent(&mut g, 300);
+    assert_eq!(p.command, Command::Heartbeat);
+    assert!(reports(&g.heartbeat(310, &answer(p.seq))).is_empty());
+    let p = sent(&mut g, 600);
+    let done = HeartbeatRepr {
+        command_complete: true,
+        ..answer(p.seq)
+    };
+    assert_eq!(
+        reports(&g.heartbeat(610, &done)),
+        [(Stage::Completion, None, 1)]
+    );
+}
+
+#[test]
+fn a_fault_or_a_mode_change_fails_a_running_motion() {
+    for (faults, mode, code) in [
+        (
+            Faults::EMPTY.with(Fault::HipMismatch),
+            Mode::Safed,
+            0x0100 + u16::from(Fault::HipMismatch.bit()),
+        ),
+        (Faults::EMPTY, Mode::Standby, 0x0201),
+    ] {
+        let mut g = gateway();
+        g.tc(&tc(
+            1,
+            Request::Function(Command::Hip(mmic::command::HipTarget::RightAngleCw)),
+        ));
+        let c = sent(&mut g, 0);
+        g.heartbeat(10, &answer(c.seq));
+        let p = sent(&mut g, 300);
+        let hb = HeartbeatRepr {
+            faults,
+            mode,
+            ..answer(p.seq)
+        };
+        let out = g.heartbeat(310, &hb);
+        assert_eq!(reports(&out), [(Stage::Completion, Some(code), 1)]);
+    }
+}
+
+#[test]
+fn a_refusal_is_a_start_failure_with_the_refusal_code() {
+    let mut g = gateway();
+    g.tc(&tc(1, Request::Function(Command::Reset)));
+    let c = sent(&mut g, 0);
+    let hb = HeartbeatRepr {
+        refusal: Some(Refusal::NothingToResume),
+        ..answer(c.seq)
+    };
+    assert_eq!(reports(&g.heartbeat(10, &hb)), [(Stage::Start, Some(8), 1)]);
+}
+
+#[test]
+fn an_unanswered_command_is_reported_unacknowledged_never_dropped() {
+    let mut g = gateway();
+    g.tc(&tc(1, Request::Function(Command::Stop)));
+    let mut sends = 0;
+    let mut failure = None;
+    for t in (0..10_000).step_by(10) {
+        let out = g.tick(t);
+        sends += out
+            .to_robots
+            .iter()
+            .filter(|(_, c)| c.command == Command::Stop)
+            .count();
+        if let Some(r) = reports(&out).first() {
+            failure = Some(*r);
+            break;
+        }
+    }
+    assert_eq!(sends, 10, "every attempt made");
+    assert_eq!(failure, Some((Stage::Start, Some(0x0200), 1)));
+}
+
+#[test]
+fn a_copy_runs_once_and_gets_its_latest_report_again() {
+    let mut g = gateway();
+    let t = tc(1, Request::Function(Command::Stop));
+    g.tc(&t);
+    let c = sent(&mut g, 0);
+    g.heartbeat(10, &answer(c.seq));
+    // The ground resends the TC (it lost the reports): not queued again, the completion
+    // report comes back.
+    let out = g.tc(&t);
+    assert_eq!(reports(&out), [(Stage::Completion, None, 1)]);
+    let p = sent(&mut g, 300);
+    assert_eq!(p.command, Command::Heartbeat, "the Stop was not sent again");
+    // The same key with another command is refused by name.
+    let out = g.tc(&tc(1, Request::Function(Command::Reset)));
+    assert_eq!(reports(&out), [(Stage::Acceptance, Some(0x0308), 1)]);
+}
+
+#[test]
+fn a_full_queue_refuses_at_acceptance() {
+    let mut g = gateway();
+    for seq in 1..=4 {
+        assert_eq!(
+            reports(&g.tc(&tc(seq, Request::Function(Command::Stop)))),
+            [(Stage::Acceptance, None, seq)]
+        );
+    }
+    assert_eq!(
+        reports(&g.tc(&tc(5, Request::Function(Command::Stop)))),
+        [(Stage::Acceptance, Some(0x0307), 5)]
+    );
+}
+
+#[test]
+fn success_reports_only_when_asked_failures_always() {
+    let mut g = gateway();
+    let quiet = Tc {
+        ack: 0,
+        ..tc(1, Request::Function(Command::Stop))
+    };
+    assert!(reports(&g.tc(&quiet)).is_empty());
+    let bad = Tc {
+        ack: 0,
+        request_of: Err(mmic::pus::request::RequestError::UnknownService { service: 9 }),
+        ..quiet
+    };
+    assert_eq!(reports(&g.tc(&bad)), [(Stage::Acceptance, Some(0x0301), 1)]);
+}
+
+#[test]
+fn housekeeping_comes_every_interval_and_can_be_switched_off() {
+    let mut g = gateway();
+    let hk = |out: &Out<16>| {
+        out.reports
+            .iter()
+            .filter(|t: &&TmOut| (t.service, t.subservice) == (3, 25))
+            .count()
+    };
+    g.tc(&tc(1, Request::HkEnable));
+    let c = sent(&mut g, 0);
+    g.heartbeat(10, &answer(c.seq));
+    let mut times = vec![];
+    for t in (20..5_000).step_by(10) {
+        let out = g.tick(t);
+        if hk(&out) > 0 {
+            times.push(t);
+        }
+        for (_, c) in out.to_robots {
+            g.heartbeat(t + 5, &answer(c.seq));
+        }
+    }
+    assert_eq!(times, [20, 1020, 2020, 3020, 4020]);
+    g.tc(&tc(2, Request::HkInterval { ms: 500 }));
+    let mut n = 0;
+    for t in (5_000..7_000).step_by(10) {
+        n += hk(&g.tick(t));
+    }
+    assert_eq!(n, 4);
+    assert_eq!(reports(&g.tc(&tc(3, Request::HkDisable))).len(), 3);
+    assert!((7_000..10_000).step_by(10).all(|t| hk(&g.tick(t)) == 0));
+}
+
+#[test]
+fn are_you_alive_is_answered_once_board_a_answers() {
+    let mut g = gateway();
+    g.tc(&tc(1, Request::AreYouAlive));
+    let c = sent(&mut g, 0);
+    assert_eq!(c.command, Command::Heartbeat);
+    let out = g.heartbeat(10, &answer(c.seq));
+    let kinds: Vec<(u8, u8)> = out
+        .reports
+        .iter()
+        .map(|t| (t.service, t.subservice))
+        .collect();
+    assert_eq!(kinds, [(1, 3), (17, 2), (1, 7)]);
+}
+
+#[test]
+fn events_come_from_what_changed_between_heartbeats() {
+    let mut g = gateway();
+    g.tc(&tc(1, Request::AreYouAlive));
+    let c = sent(&mut g, 0);
+    g.heartbeat(10, &answer(c.seq));
+    let p = sent(&mut g, 300);
+    let hb = HeartbeatRepr {
+        mode: Mode::Safed,
+        faults: Faults::EMPTY.with(Fault::LowBattery),
+        ..answer(p.seq)
+    };
+    let out = g.heartbeat(310, &hb);
+    let events: Vec<(u8, Vec<u8>)> = out
+        .reports
+        .iter()
+        .filter(|t| t.service == 5)
+        .map(|t| (t.subservice, t.data.to_vec()))
+        .collect();
+    assert_eq!(
+        events,
+        [
+            (3, vec![0x01, 0x0B, 3, 0, 0, 0]),
+            (1, vec![0x00, 0x01, 2, 3, 0, 0])
+        ]
+    );
+}

@@ -1,0 +1,12 @@
+//! PUS-C services (src/pus/) and the PUS gateway (src/node/gateway.rs): the code equals
+//! spec/ccsds/, every command round-trips as a function, every bad input is refused by name.
+//!
+//! One test binary per area, each file a module.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod function;
+mod gateway;
+mod housekeeping;
+mod spec;
