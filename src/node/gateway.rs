@@ -52,7 +52,7 @@ use crate::pus::{robot_apid, robot_of_apid};
 use crate::units::{BoardNumber, Instant};
 use crate::wire::command::CommandRepr;
 use crate::wire::heartbeat::HeartbeatRepr;
-use heapless::{Deque, Vec};
+use heapless::Vec;
 
 /// A telecommand the CCSDS layer accepted (header, CRC and APID checked), with its request
 /// already read ([`Request::parse`]) or refused.
@@ -117,7 +117,8 @@ impl TmOut {
 pub struct Config {
     /// The legacy uplink's resend timing towards board A.
     pub uplink: ground::Config,
-    /// A heartbeat is asked for this often while nothing else is sent, ms.
+    /// A heartbeat is asked for this often while nothing else is sent, ms; 0: never (then
+    /// motions are not seen to complete: for models of the command path alone).
     pub poll_ms: u32,
     /// Initial housekeeping collection interval, ms.
     pub hk_interval_ms: u32,
@@ -182,15 +183,15 @@ struct Job {
 }
 
 /// One robot's side of the gateway.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 struct Robot<const Q: usize, const K: usize> {
     board: BoardNumber,
     uplink: Uplink,
-    queue: Deque<Job, Q>,
+    queue: Vec<Job, Q>,
     sent: Option<(u16, Job)>,
     /// A motion board A accepted, until "command complete", a fault or a mode change.
     running: Option<Job>,
-    log: Deque<Entry, K>,
+    log: Vec<Entry, K>,
     last: Option<HeartbeatRepr>,
     stopped: bool,
     hk_enabled: bool,
@@ -200,7 +201,7 @@ struct Robot<const Q: usize, const K: usize> {
 }
 
 /// The gateway for up to `R` robots, `Q` waiting telecommands and `K` remembered keys each.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct Gateway<const R: usize, const Q: usize, const K: usize> {
     cfg: Config,
     robots: Vec<Robot<Q, K>, R>,
@@ -235,10 +236,10 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
             .push(Robot {
                 board,
                 uplink: Uplink::new(self.cfg.uplink, board),
-                queue: Deque::new(),
+                queue: Vec::new(),
                 sent: None,
                 running: None,
-                log: Deque::new(),
+                log: Vec::new(),
                 last: None,
                 stopped: false,
                 hk_enabled: self.cfg.hk_enabled,
@@ -247,6 +248,34 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
                 next_poll: None,
             })
             .is_ok()
+    }
+
+    /// The earliest time from `now` on when something is due: a queued telecommand, a resend
+    /// or its timeout, a poll, a housekeeping report (for a caller that sleeps until then, and
+    /// for models that jump time). `now` itself when something is due already.
+    pub fn next_deadline(&self, now: u32) -> Option<u32> {
+        let wait = |t: u32| {
+            let d = t.wrapping_sub(now);
+            if d > i32::MAX as u32 {
+                0
+            } else {
+                d
+            }
+        };
+        let mut best: Option<u32> = None;
+        for r in &self.robots {
+            let idle = r.uplink.is_idle();
+            let times = [
+                (idle && !r.queue.is_empty()).then_some(now),
+                r.uplink.next_deadline(),
+                (idle && self.cfg.poll_ms > 0).then(|| r.next_poll.map_or(now, Instant::millis)),
+                (r.hk_enabled && r.last.is_some()).then(|| r.hk_next.map_or(now, Instant::millis)),
+            ];
+            for d in times.into_iter().flatten().map(wait) {
+                best = Some(best.map_or(d, |b| b.min(d)));
+            }
+        }
+        best.map(|d| now.wrapping_add(d))
     }
 
     /// The latest heartbeat of robot `board`.
@@ -309,9 +338,9 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
             return out;
         }
         if r.log.is_full() {
-            r.log.pop_front();
+            r.log.remove(0);
         }
-        let _ = r.log.push_back(Entry {
+        let _ = r.log.push(Entry {
             key,
             request,
             last: None,
@@ -434,7 +463,7 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
     }
 
     fn enqueue<const M2: usize>(&mut self, out: &mut Out<M2>, job: Job, key: (u16, u16)) {
-        match self.queue.push_back(job) {
+        match self.queue.push(job) {
             Ok(()) => {
                 let rep = report(Stage::Acceptance, job.request, None);
                 self.remember(key, rep);
@@ -455,7 +484,8 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
     /// The uplink is idle: the next telecommand, else a poll when one is due.
     fn submit_next(&mut self, now: u32, cfg: &Config) {
         let t = Instant::from_millis(now);
-        if let Some(job) = self.queue.pop_front() {
+        if !self.queue.is_empty() {
+            let job = self.queue.remove(0);
             if let Ok(seq) = self.uplink.submit(job.command) {
                 if job.command == Command::Stop {
                     self.stopped = true;
@@ -464,7 +494,7 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
             }
             return;
         }
-        let due = self.next_poll.is_none_or(|p| t.reached(p));
+        let due = cfg.poll_ms > 0 && self.next_poll.is_none_or(|p| t.reached(p));
         if due && self.uplink.submit(Command::Heartbeat).is_ok() {
             self.next_poll = Some(Instant::from_millis(now.wrapping_add(cfg.poll_ms)));
         }

@@ -4,3 +4,4 @@
 
 mod protocol_exactly_once;
 mod protocol_paper;
+mod protocol_pus;
