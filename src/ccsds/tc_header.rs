@@ -48,7 +48,7 @@ const _: () = assert!(core::mem::size_of::<TcSecondaryLayout>() == TC_SECONDARY_
 /// the acceptance report, bit 0 for the completion report, so acceptance alone is `0b0001`.
 /// The Python `spacepackets` package and the Flight Software Framework use the same values;
 /// the Rust `spacepackets` 0.19 names the bits the other way round (its `acceptance` is
-/// `0b1000`), which `tests/ccsds/spacepackets.rs` measures.
+/// `0b1000`), which `tests/ccsds/interop_spacepackets.rs` measures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
