@@ -90,7 +90,11 @@ fn tm_build(c: &mut Criterion) {
     let mut theirs = [0u8; 128];
     let n = r.emit(&mut ours).unwrap();
     assert_eq!(build_theirs(&mut theirs).unwrap(), n);
-    assert_eq!(ours[..n], theirs[..n], "both sides must build the same octets");
+    assert_eq!(
+        ours[..n],
+        theirs[..n],
+        "both sides must build the same octets"
+    );
     let mut g = c.benchmark_group("pus-tm-build (81 B)");
     g.bench_function("spacepackets PusTmCreator::write_to_slice", |b| {
         let mut out = [0u8; 128];

@@ -109,7 +109,7 @@ pub fn pus_oracle(kind: PacketType, b: &[u8], accepted: &[u16]) -> Result<(), Pa
         });
     }
     let apid = ((b[0] & 0x07) as u16) << 8 | b[1] as u16;
-    if !accepted.iter().any(|&a| a == apid) {
+    if !accepted.contains(&apid) {
         return Err(PacketError::Apid { kind, found: apid });
     }
     Ok(())

@@ -43,7 +43,7 @@ pub struct TcSecondaryLayout {
 
 const _: () = assert!(core::mem::size_of::<TcSecondaryLayout>() == TC_SECONDARY_LEN);
 
-/// Which ST[1] verification reports the sender asks for. The low nibble of octet 0, with the
+/// Which ST\[1\] verification reports the sender asks for. The low nibble of octet 0, with the
 /// standard's bit numbering (bit 0 = most significant): bit 3, the least significant, asks for
 /// the acceptance report, bit 0 for the completion report, so acceptance alone is `0b0001`.
 /// The Python `spacepackets` package and the Flight Software Framework use the same values;

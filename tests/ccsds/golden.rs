@@ -14,6 +14,7 @@ use mmic::ccsds::tm_header::TmSecondaryHeader;
 use mmic::ccsds::{EmitError, PacketError};
 
 #[test]
+#[allow(clippy::unusual_byte_groupings)] // grouped as the header's fields
 fn tc_17_1_are_you_alive() {
     let bytes = tc_bytes(&ping());
     #[rustfmt::skip]
@@ -67,6 +68,7 @@ fn tc_8_1_with_application_data() {
 }
 
 #[test]
+#[allow(clippy::unusual_byte_groupings)] // grouped as the header's fields
 fn tm_17_2_i_am_alive() {
     let bytes = tm_bytes(&alive());
     #[rustfmt::skip]

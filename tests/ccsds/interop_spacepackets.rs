@@ -152,7 +152,7 @@ fn ack_flags_bit_order_differs() {
         ..AckFlags::NONE
     };
     assert_eq!(ours.bits(), 0b0001);
-    assert_eq!(AckFlags::from_bits(0b1000).completion, true);
+    assert!(AckFlags::from_bits(0b1000).completion);
 }
 
 /// The bad inputs of `spec/ccsds/bad-inputs.toml` that spacepackets 0.19's readers
