@@ -202,3 +202,22 @@ fn error_messages_carry_the_numbers() {
         "TM packet: APID 0x042 is not one this receiver accepts"
     );
 }
+
+#[test]
+fn reprs_as_json() {
+    // The Reprs serialize (feature serde) for host tools and logs; the value types read back.
+    let json = serde_json::to_string(&ping()).unwrap();
+    assert_eq!(
+        json,
+        r#"{"apid":66,"seq_count":7,"header":{"ack":{"acceptance":true,"start":true,"progress":true,"completion":true},"service":17,"subservice":1,"source_id":0},"app_data":[]}"#
+    );
+    let h: TmSecondaryHeader = serde_json::from_str(
+        r#"{"time_ref_status":0,"service":17,"subservice":2,"counter":3,"destination_id":0,"time":{"coarse":90,"fine":32768}}"#,
+    )
+    .unwrap();
+    assert_eq!(h, alive().header);
+    let e = serde_json::from_str::<Apid>("2048")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("APID must be in 0..=2047, found 2048"), "{e}");
+}
