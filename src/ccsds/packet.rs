@@ -25,8 +25,10 @@ pub(crate) trait FixedHeader:
     const MAX_DATA_LEN: usize = MAX_PACKET_LEN - Self::MIN_PACKET_LEN;
 }
 
-/// A packet that passed every check.
+/// A packet that passed every check: what the views `Tc` and `Tm` hold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct Checked<'a, H> {
+    pub bytes: &'a [u8],
     pub header: &'a H,
     pub primary: PrimaryHeader,
     pub data: &'a [u8],
@@ -109,6 +111,7 @@ pub(crate) fn check<'a, H: FixedHeader>(
         });
     }
     Ok(Checked {
+        bytes,
         header,
         primary,
         data,
@@ -148,3 +151,44 @@ pub(crate) fn write<H: FixedHeader>(
     *pec_out = pec(body).to_be_bytes();
     Ok(len)
 }
+
+/// The accessors every checked view (`Tc`, `Tm`: a `Checked` in field 0) has alike.
+macro_rules! view_accessors {
+    () => {
+        /// The whole packet.
+        pub fn as_bytes(&self) -> &'a [u8] {
+            self.0.bytes
+        }
+
+        /// The primary header.
+        pub fn primary(&self) -> PrimaryHeader {
+            self.0.primary
+        }
+
+        /// The APID (one of those the parser accepted).
+        pub fn apid(&self) -> Apid {
+            Apid::masked(self.0.primary.apid)
+        }
+
+        /// The packet sequence count.
+        pub fn seq_count(&self) -> SeqCount {
+            SeqCount::masked(self.0.primary.seq_count)
+        }
+
+        /// Service type ID.
+        pub fn service(&self) -> u8 {
+            self.0.header.secondary.service
+        }
+
+        /// Message subtype ID.
+        pub fn subservice(&self) -> u8 {
+            self.0.header.secondary.subservice
+        }
+
+        /// The packet error control as carried (and checked).
+        pub fn pec(&self) -> u16 {
+            self.0.pec
+        }
+    };
+}
+pub(crate) use view_accessors;

@@ -22,7 +22,7 @@
 //! ```
 
 use super::error::{EmitError, PacketError};
-use super::packet::{check, packet_len, write, FixedHeader};
+use super::packet::{check, packet_len, view_accessors, write, Checked, FixedHeader};
 use super::primary::{Apid, PacketType, PrimaryHeader, PrimaryLayout, SeqCount};
 use super::tc_header::{TcSecondaryHeader, TcSecondaryLayout};
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -78,76 +78,30 @@ pub mod field {
 /// data is not judged here: its service and subservice decide what it must be, which is the
 /// services layer's business; they read it from [`Tc::app_data`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Tc<'a> {
-    bytes: &'a [u8],
-    header: &'a TcHeaderLayout,
-    primary: PrimaryHeader,
-    app_data: &'a [u8],
-    pec: u16,
-}
+pub struct Tc<'a>(Checked<'a, TcHeaderLayout>);
 
 impl<'a> Tc<'a> {
+    view_accessors!();
+
     /// Checks `bytes` as one whole telecommand (see [`PacketError`] for the checks and their
     /// order) whose APID is one of `accepted`.
     pub fn new_checked(bytes: &'a [u8], accepted: &[u16]) -> Result<Tc<'a>, PacketError> {
-        let c = check::<TcHeaderLayout>(bytes, accepted)?;
-        Ok(Tc {
-            bytes,
-            header: c.header,
-            primary: c.primary,
-            app_data: c.data,
-            pec: c.pec,
-        })
-    }
-
-    /// The whole packet.
-    pub fn as_bytes(&self) -> &'a [u8] {
-        self.bytes
-    }
-
-    /// The primary header.
-    pub fn primary(&self) -> PrimaryHeader {
-        self.primary
-    }
-
-    /// The APID (one of those the parser accepted).
-    pub fn apid(&self) -> Apid {
-        Apid::masked(self.primary.apid)
-    }
-
-    /// The packet sequence count.
-    pub fn seq_count(&self) -> SeqCount {
-        SeqCount::masked(self.primary.seq_count)
+        check::<TcHeaderLayout>(bytes, accepted).map(Tc)
     }
 
     /// The secondary header.
     pub fn secondary(&self) -> TcSecondaryHeader {
-        TcSecondaryHeader::from(&self.header.secondary)
-    }
-
-    /// Service type ID.
-    pub fn service(&self) -> u8 {
-        self.header.secondary.service
-    }
-
-    /// Message subtype ID.
-    pub fn subservice(&self) -> u8 {
-        self.header.secondary.subservice
+        TcSecondaryHeader::from(&self.0.header.secondary)
     }
 
     /// Source ID.
     pub fn source_id(&self) -> u16 {
-        self.header.secondary.source_id.get()
+        self.0.header.secondary.source_id.get()
     }
 
     /// The application data (between the secondary header and the CRC).
     pub fn app_data(&self) -> &'a [u8] {
-        self.app_data
-    }
-
-    /// The packet error control as carried (and checked).
-    pub fn pec(&self) -> u16 {
-        self.pec
+        self.0.data
     }
 
     /// The packet's fields.
@@ -156,7 +110,7 @@ impl<'a> Tc<'a> {
             apid: self.apid(),
             seq_count: self.seq_count(),
             header: self.secondary(),
-            app_data: self.app_data,
+            app_data: self.0.data,
         }
     }
 }

@@ -24,7 +24,7 @@
 //! ```
 
 use super::error::{EmitError, PacketError};
-use super::packet::{check, packet_len, write, FixedHeader};
+use super::packet::{check, packet_len, view_accessors, write, Checked, FixedHeader};
 use super::primary::{Apid, PacketType, PrimaryHeader, PrimaryLayout, SeqCount};
 use super::tm_header::{TmSecondaryHeader, TmSecondaryLayout};
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -85,86 +85,40 @@ pub mod field {
 /// A telemetry packet whose every [`PacketError`] check has passed, over its bytes (the ground
 /// side's parser, and the simulator's; the robot only emits telemetry).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Tm<'a> {
-    bytes: &'a [u8],
-    header: &'a TmHeaderLayout,
-    primary: PrimaryHeader,
-    source_data: &'a [u8],
-    pec: u16,
-}
+pub struct Tm<'a>(Checked<'a, TmHeaderLayout>);
 
 impl<'a> Tm<'a> {
+    view_accessors!();
+
     /// Checks `bytes` as one whole telemetry packet (see [`PacketError`] for the checks and their
     /// order) whose APID is one of `accepted`.
     pub fn new_checked(bytes: &'a [u8], accepted: &[u16]) -> Result<Tm<'a>, PacketError> {
-        let c = check::<TmHeaderLayout>(bytes, accepted)?;
-        Ok(Tm {
-            bytes,
-            header: c.header,
-            primary: c.primary,
-            source_data: c.data,
-            pec: c.pec,
-        })
-    }
-
-    /// The whole packet.
-    pub fn as_bytes(&self) -> &'a [u8] {
-        self.bytes
-    }
-
-    /// The primary header.
-    pub fn primary(&self) -> PrimaryHeader {
-        self.primary
-    }
-
-    /// The APID (one of those the parser accepted).
-    pub fn apid(&self) -> Apid {
-        Apid::masked(self.primary.apid)
-    }
-
-    /// The packet sequence count.
-    pub fn seq_count(&self) -> SeqCount {
-        SeqCount::masked(self.primary.seq_count)
+        check::<TmHeaderLayout>(bytes, accepted).map(Tm)
     }
 
     /// The secondary header.
     pub fn secondary(&self) -> TmSecondaryHeader {
-        TmSecondaryHeader::from(&self.header.secondary)
-    }
-
-    /// Service type ID.
-    pub fn service(&self) -> u8 {
-        self.header.secondary.service
-    }
-
-    /// Message subtype ID.
-    pub fn subservice(&self) -> u8 {
-        self.header.secondary.subservice
+        TmSecondaryHeader::from(&self.0.header.secondary)
     }
 
     /// Message type counter.
     pub fn counter(&self) -> u16 {
-        self.header.secondary.counter.get()
+        self.0.header.secondary.counter.get()
     }
 
     /// Destination ID.
     pub fn destination_id(&self) -> u16 {
-        self.header.secondary.destination_id.get()
+        self.0.header.secondary.destination_id.get()
     }
 
     /// Time the packet was made.
     pub fn time(&self) -> crate::ccsds::cuc::Cuc {
-        crate::ccsds::cuc::Cuc::from(&self.header.secondary.time)
+        crate::ccsds::cuc::Cuc::from(&self.0.header.secondary.time)
     }
 
     /// The source data (between the time field and the CRC).
     pub fn source_data(&self) -> &'a [u8] {
-        self.source_data
-    }
-
-    /// The packet error control as carried (and checked).
-    pub fn pec(&self) -> u16 {
-        self.pec
+        self.0.data
     }
 
     /// The packet's fields.
@@ -173,7 +127,7 @@ impl<'a> Tm<'a> {
             apid: self.apid(),
             seq_count: self.seq_count(),
             header: self.secondary(),
-            source_data: self.source_data,
+            source_data: self.0.data,
         }
     }
 }
