@@ -38,6 +38,7 @@ mod wire_enum;
 #[cfg(feature = "proptest")]
 pub mod arbitrary;
 pub mod bolter;
+pub mod ccsds;
 pub mod command;
 pub mod control;
 pub mod faults;
@@ -73,4 +74,9 @@ const _: () = {
     format::<node::board_a::Event>();
     format::<units::PulseWidth>();
     format::<units::HipAngle>();
+    format::<ccsds::tc::TcRepr<'static>>();
+    format::<ccsds::tm::TmRepr<'static>>();
+    format::<ccsds::PacketError>();
+    format::<ccsds::PusError>();
+    format::<ccsds::EmitError>();
 };

@@ -17,6 +17,12 @@
 //! ```
 
 use mmic::bolter::{BolterDirection, BolterStep};
+use mmic::ccsds::cuc::Cuc;
+use mmic::ccsds::primary::{Apid, PacketType, SeqCount};
+use mmic::ccsds::tc::TcRepr;
+use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
+use mmic::ccsds::tm::TmRepr;
+use mmic::ccsds::tm_header::TmSecondaryHeader;
 use mmic::command::{BolterPair, Command, HipTarget, PowerTarget, ServoTarget};
 use mmic::mode::Mode;
 use mmic::motion::{Primitive, State};
@@ -30,13 +36,97 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 5] = [
+pub const TARGETS: [&str; 7] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
     "b_command_parser",
     "deframer_stream",
+    "pus_tc_parser",
+    "pus_tm_parser",
 ];
+
+/// Target name of the CCSDS/PUS parser for `kind`.
+pub fn pus_target(kind: PacketType) -> &'static str {
+    match kind {
+        PacketType::Tc => TARGETS[5],
+        PacketType::Tm => TARGETS[6],
+    }
+}
+
+/// Valid PUS packets, named: a telecommand and a telemetry packet without and with user data.
+pub fn valid_pus_packets() -> Vec<(PacketType, &'static str, Vec<u8>)> {
+    let apid = Apid::new(0x042).expect("11 bits");
+    let tc = |name, seq, service, subservice, app_data: &[u8]| {
+        let r = TcRepr {
+            apid,
+            seq_count: SeqCount::new(seq).expect("14 bits"),
+            header: TcSecondaryHeader {
+                ack: AckFlags::ALL,
+                service,
+                subservice,
+                source_id: 1,
+            },
+            app_data,
+        };
+        let mut out = vec![0u8; r.len()];
+        r.emit(&mut out).expect("fits");
+        (PacketType::Tc, name, out)
+    };
+    let tm = |name, seq, service, subservice, source_data: &[u8]| {
+        let r = TmRepr {
+            apid,
+            seq_count: SeqCount::new(seq).expect("14 bits"),
+            header: TmSecondaryHeader {
+                time_ref_status: Default::default(),
+                service,
+                subservice,
+                counter: seq,
+                destination_id: 1,
+                time: Cuc::from_millis(90_500),
+            },
+            source_data,
+        };
+        let mut out = vec![0u8; r.len()];
+        r.emit(&mut out).expect("fits");
+        (PacketType::Tm, name, out)
+    };
+    vec![
+        tc("tc-17-1-ping", 7, 17, 1, &[]),
+        tc("tc-8-1-function", 8, 8, 1, &[0x60, b'm', b'a']),
+        tm("tm-17-2-alive", 9, 17, 2, &[]),
+        tm("tm-3-25-housekeeping", 10, 3, 25, &[1, 2, 3, 4, 5, 6, 7, 8]),
+    ]
+}
+
+/// The near misses of each valid PUS packet: name suffix, the check that must refuse it, and
+/// the octets.
+pub fn pus_near_misses(packet: &[u8]) -> Vec<(&'static str, &'static str, Vec<u8>)> {
+    let n = packet.len();
+    let with = |at: usize, f: &dyn Fn(u8) -> u8| {
+        let mut b = packet.to_vec();
+        b[at] = f(b[at]);
+        mmic_proofs::ccsds::reseal(&mut b);
+        b
+    };
+    let mut long = packet.to_vec();
+    long.push(0);
+    let mut checksum = packet.to_vec();
+    checksum[n - 1] ^= 0x01;
+    let mut apid = packet.to_vec();
+    apid[1] ^= 0x01;
+    mmic_proofs::ccsds::reseal(&mut apid);
+    vec![
+        ("-truncated", "truncated", packet[..7].to_vec()),
+        ("-version-miss", "version", with(0, &|b| b | 0x20)),
+        ("-type-miss", "packet-type", with(0, &|b| b ^ 0x10)),
+        ("-segment-miss", "sequence-flags", with(2, &|b| b & 0x3f)),
+        ("-long", "length", long),
+        ("-pus-a", "pus-version", with(6, &|b| (b & 0x0f) | 0x10)),
+        ("-checksum-miss", "checksum", checksum),
+        ("-apid-miss", "apid", apid),
+    ]
+}
 
 /// One seed file.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -206,6 +296,21 @@ pub fn seeds() -> Vec<SeedFile> {
         b[at] = value;
         seal(*kind, &mut b);
         push("-field-miss", b);
+    }
+    for (kind, name, bytes) in valid_pus_packets() {
+        let target = pus_target(kind);
+        out.push(SeedFile {
+            target,
+            name: name.to_string(),
+            bytes: bytes.clone(),
+        });
+        for (suffix, _, b) in pus_near_misses(&bytes) {
+            out.push(SeedFile {
+                target,
+                name: format!("{name}{suffix}"),
+                bytes: b,
+            });
+        }
     }
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.
     let packet = |k: PacketKind| {

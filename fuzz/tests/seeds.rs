@@ -74,3 +74,28 @@ fn parser_seeds_are_what_their_names_say() {
     }
     assert_eq!(n, 11 * 6);
 }
+
+#[test]
+fn pus_seeds_are_what_their_names_say() {
+    use mmic::ccsds::primary::PacketType;
+    use mmic_fuzz::{pus_near_misses, pus_target, valid_pus_packets};
+    let mut n = 0;
+    for (kind, name, bytes) in valid_pus_packets() {
+        let apids = [0x042];
+        let accepted = mmic_proofs::ccsds::check_pus_parse_with(kind, &bytes, &apids);
+        assert!(accepted, "{name} refused");
+        for (suffix, check, b) in pus_near_misses(&bytes) {
+            assert!(!mmic_proofs::ccsds::check_pus_parse_with(kind, &b, &apids));
+            let e = match kind {
+                PacketType::Tc => mmic::ccsds::tc::TcRepr::parse(&b, &apids).err(),
+                PacketType::Tm => mmic::ccsds::tm::TmRepr::parse(&b, &apids).err(),
+            };
+            assert_eq!(e.map(|e| e.name()), Some(check), "{name}{suffix}");
+            assert!(seeds().iter().any(|s| s.target == pus_target(kind)
+                && s.name == format!("{name}{suffix}")
+                && s.bytes == b));
+            n += 1;
+        }
+    }
+    assert_eq!(n, 4 * 8);
+}

@@ -7,21 +7,51 @@
 //!   then its first `LEN` bytes with the right header and a correct checksum written over them
 //!   must be accepted canonically or refused on a field (`check_round_trip`), which lets the
 //!   fuzzer mutate the fields of a seed packet without every mutation dying at the checksum.
+//! * `pus_tc_parser`, `pus_tm_parser`: the input (cut to `MAX_PACKET` octets) must get
+//!   exactly the oracle's verdict from the CCSDS/PUS parser (`check_pus_parse`), and when
+//!   accepted re-emit identically; then, if long enough, the same octets with the length field
+//!   and CRC rewritten over them (`reseal`) and their own APID accepted, which lets mutations
+//!   reach the checks after the checksum.
 //! * `deframer_stream`: four bytes of chunk plan, then the stream, fed as it is to deframers
 //!   with the smallest (66) and a larger (256) buffer, and once more after `build_stream` has
 //!   turned it into packets with sound framing, garbage and near misses; `run_deframer` checks
 //!   byte conservation, frame contents and offsets, and that nothing is left after `resync`.
 
+use mmic::ccsds::primary::{PacketType, PrimaryHeader};
 use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
 use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
 use mmic::wire::MAX_PACKET_LEN;
+use mmic_proofs::ccsds::{check_pus_parse, check_pus_parse_with, min_len, reseal, MAX_PACKET};
 use mmic_proofs::{build_stream, check_parse, check_round_trip, run_deframer, Repr};
 
 fn parser<R: Repr>(input: &[u8]) {
     check_parse::<R>(input);
     check_round_trip::<R>(input);
+}
+
+fn pus_parser(kind: PacketType, input: &[u8]) {
+    let input = &input[..input.len().min(MAX_PACKET)];
+    check_pus_parse(kind, input);
+    if input.len() >= min_len(kind) {
+        let mut buf = [0u8; MAX_PACKET];
+        let packet = &mut buf[..input.len()];
+        packet.copy_from_slice(input);
+        reseal(packet);
+        let apid = PrimaryHeader::read(packet).map_or(0, |h| h.apid);
+        check_pus_parse_with(kind, packet, &[apid]);
+    }
+}
+
+#[test]
+fn pus_tc_parser() {
+    bolero::check!().for_each(|input: &[u8]| pus_parser(PacketType::Tc, input));
+}
+
+#[test]
+fn pus_tm_parser() {
+    bolero::check!().for_each(|input: &[u8]| pus_parser(PacketType::Tm, input));
 }
 
 #[test]

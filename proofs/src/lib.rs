@@ -30,6 +30,8 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod ccsds;
+
 use core::fmt::Debug;
 use mmic::bolter::{BolterDirection, BolterStep, MuxLines};
 use mmic::command::{for_each_variant_class, BolterPair, Command, PrimitiveMove};

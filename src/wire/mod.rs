@@ -24,7 +24,7 @@ pub mod command;
 pub mod deframer;
 pub mod heartbeat;
 pub mod internal_heartbeat;
-mod layout;
+pub(crate) mod layout;
 pub mod opcode;
 
 pub use layout::{ElectricalLayout, FieldSpec, Unit};

@@ -3,6 +3,7 @@
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
 mod bolter_executor;
+mod ccsds;
 mod control_hip;
 mod control_interp;
 mod deframer;
