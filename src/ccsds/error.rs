@@ -174,6 +174,10 @@ pub enum PusError {
     /// The space packet or its PUS secondary header.
     #[error(transparent)]
     Packet(#[from] PacketError),
+    /// The service, subservice or application data (the services layer,
+    /// [`crate::pus::request`]).
+    #[error(transparent)]
+    Request(#[from] crate::pus::request::RequestError),
 }
 
 impl PusError {
@@ -181,6 +185,7 @@ impl PusError {
     pub const fn name(&self) -> &'static str {
         match self {
             PusError::Packet(e) => e.name(),
+            PusError::Request(e) => e.name(),
         }
     }
 }

@@ -38,6 +38,12 @@
 //! assert_eq!(stages, [(Stage::Completion, true)]); // start success not asked (ack 0b1001)
 //! ```
 
+use crate::ccsds::cuc::Cuc;
+use crate::ccsds::primary::{Apid, SeqCount};
+use crate::ccsds::tc::TcRepr;
+use crate::ccsds::tm::TmRepr;
+use crate::ccsds::tm_header::TmSecondaryHeader;
+use crate::ccsds::{EmitError, PacketError};
 use crate::command::Command;
 use crate::faults::Faults;
 use crate::node::ground::{self, Done, Outcome, Uplink};
@@ -98,6 +104,17 @@ impl TmOut {
             subservice,
             destination,
             data: v,
+        }
+    }
+
+    /// The index of its message type among the robot's counters.
+    const fn type_index(&self) -> usize {
+        match (self.service, self.subservice) {
+            (1, s) if s <= 8 => s as usize - 1,
+            (3, _) => 8,
+            (5, s) if s >= 1 && s <= 4 => 8 + s as usize,
+            (17, _) => 13,
+            _ => 15,
         }
     }
 
@@ -198,6 +215,10 @@ struct Robot<const Q: usize, const K: usize> {
     hk_interval_ms: u32,
     hk_next: Option<Instant>,
     next_poll: Option<Instant>,
+    /// Telemetry: the APID's packet sequence count, and a message type counter per report type
+    /// ([`TmOut::type_index`]).
+    tm_seq: SeqCount,
+    counters: [u16; 16],
 }
 
 /// The gateway for up to `R` robots, `Q` waiting telecommands and `K` remembered keys each.
@@ -246,6 +267,8 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
                 hk_interval_ms: self.cfg.hk_interval_ms,
                 hk_next: None,
                 next_poll: None,
+                tm_seq: SeqCount::default(),
+                counters: [0; 16],
             })
             .is_ok()
     }
@@ -284,6 +307,58 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
             .iter()
             .find(|r| r.board == board)
             .and_then(|r| r.last.as_ref())
+    }
+
+    /// A telecommand packet from the ground: checked (CCSDS and PUS headers, CRC, one of the
+    /// served robots' APIDs; a packet that fails is refused whole, as its request ID cannot be
+    /// trusted, and the caller counts it), then its request read and served as [`Gateway::tc`].
+    pub fn tc_packet(&mut self, bytes: &[u8]) -> Result<Out<M>, PacketError> {
+        let apids: Vec<u16, R> = self.robots.iter().map(|r| robot_apid(r.board)).collect();
+        let p = TcRepr::parse(bytes, &apids)?;
+        let h = p.header;
+        Ok(self.tc(&Tc {
+            request: RequestId {
+                apid: p.apid.get(),
+                seq_count: p.seq_count.get(),
+            },
+            source_id: h.source_id,
+            ack: h.ack.bits(),
+            request_of: Request::parse(h.service, h.subservice, p.app_data),
+        }))
+    }
+
+    /// Writes a report as a PUS-C telemetry packet stamped `now` (ms since the gateway's
+    /// power-on: spec/decisions.toml, `ccsds-time`), numbering it in its APID's sequence and
+    /// its message type's counter; returns its length.
+    pub fn encode(&mut self, tm: &TmOut, now: u32, out: &mut [u8]) -> Result<usize, EmitError> {
+        let r = robot_of_apid(tm.apid).and_then(|b| self.robots.iter_mut().find(|r| r.board == b));
+        let (seq, counter) = match r {
+            Some(r) => {
+                let seq = r.tm_seq;
+                let c = r.counters.get_mut(tm.type_index());
+                let counter = c.as_deref().copied().unwrap_or(0);
+                if let Some(c) = c {
+                    *c = c.wrapping_add(1);
+                }
+                r.tm_seq = seq.wrapping_next();
+                (seq, counter)
+            }
+            None => (SeqCount::default(), 0),
+        };
+        TmRepr {
+            apid: Apid::new(tm.apid).unwrap_or_default(),
+            seq_count: seq,
+            header: TmSecondaryHeader {
+                time_ref_status: Default::default(),
+                service: tm.service,
+                subservice: tm.subservice,
+                counter,
+                destination_id: tm.destination,
+                time: Cuc::from_instant(Instant::from_millis(now)),
+            },
+            source_data: &tm.data,
+        }
+        .emit(out)
     }
 
     /// A telecommand from the ground.

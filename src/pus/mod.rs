@@ -1,4 +1,4 @@
-//! PUS-C services (ECSS-E-ST-70-41C) of the robot, over the CCSDS packets of `crate::ccsds`:
+//! PUS-C services (ECSS-E-ST-70-41C) of the robot, over the CCSDS packets of [`crate::ccsds`]:
 //! what each telecommand means and what each report carries.
 //!
 //! The services map onto the library's existing logic — no behaviour is implemented twice:
@@ -28,7 +28,35 @@ pub mod housekeeping;
 pub mod request;
 pub mod verification;
 
+use crate::ccsds::tc::TcRepr;
+use crate::ccsds::PusError;
 use crate::units::BoardNumber;
+use request::Request;
+
+/// Reads a telecommand whole: the packet's CCSDS and PUS checks (for the `apids` given), then
+/// its service, subservice and application data as one [`Request`]. Every refusal names its
+/// check ([`PusError::name`]; spec/ccsds/bad-inputs.toml has a packet for each).
+///
+/// ```
+/// use mmic::command::Command;
+/// use mmic::pus::{read_tc, request::Request};
+/// let stop = [0x19, 0x01, 0xC0, 0x01, 0x00, 0x07, 0x2F, 0x08, 0x01, 0x00, 0x00, 0x06, 0x00, 0x00];
+/// let mut p = stop;
+/// let crc = mmic::ccsds::pec(&p[..12]).to_be_bytes();
+/// p[12..].copy_from_slice(&crc);
+/// let (tc, request) = read_tc(&p, &[0x101]).unwrap();
+/// assert_eq!((tc.seq_count.get(), request), (1, Request::Function(Command::Stop)));
+/// p[11] = 13; // an unknown function, CRC rewritten
+/// let crc = mmic::ccsds::pec(&p[..12]).to_be_bytes();
+/// p[12..].copy_from_slice(&crc);
+/// assert_eq!(read_tc(&p, &[0x101]).unwrap_err().name(), "unknown-function");
+/// ```
+pub fn read_tc<'a>(bytes: &'a [u8], apids: &[u16]) -> Result<(TcRepr<'a>, Request), PusError> {
+    let tc = TcRepr::parse(bytes, apids)?;
+    let h = tc.header;
+    let request = Request::parse(h.service, h.subservice, tc.app_data)?;
+    Ok((tc, request))
+}
 
 /// The APID of robot 1 is `ROBOT_APID_BASE + 1`.
 pub const ROBOT_APID_BASE: u16 = 0x100;

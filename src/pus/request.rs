@@ -107,6 +107,31 @@ pub enum RequestError {
 }
 
 impl RequestError {
+    /// Every check's name, as [`RequestError::name`] gives them.
+    pub const NAMES: [&'static str; 6] = [
+        "unknown-service",
+        "unknown-subservice",
+        "app-data-length",
+        "argument-out-of-range",
+        "unknown-function",
+        "no-such-command",
+    ];
+
+    /// The check's name (spec/ccsds/bad-inputs.toml).
+    pub const fn name(&self) -> &'static str {
+        match self {
+            RequestError::UnknownService { .. } => "unknown-service",
+            RequestError::UnknownSubservice { .. } => "unknown-subservice",
+            RequestError::Length { .. }
+            | RequestError::Function(FunctionError::Length { .. })
+            | RequestError::Function(FunctionError::Empty) => "app-data-length",
+            RequestError::OutOfRange { .. }
+            | RequestError::Function(FunctionError::OutOfRange { .. }) => "argument-out-of-range",
+            RequestError::Function(FunctionError::UnknownFunction { .. }) => "unknown-function",
+            RequestError::Function(_) => "no-such-command",
+        }
+    }
+
     /// The ST[1] failure code of this refusal (spec/ccsds/services.toml, failure codes).
     pub const fn code(&self) -> u16 {
         match self {

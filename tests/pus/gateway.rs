@@ -277,3 +277,69 @@ fn events_come_from_what_changed_between_heartbeats() {
         ]
     );
 }
+
+/// Packets end to end: a TC(8,1) as bytes in; TM packets out, numbered per APID (sequence
+/// count 0, 1, 2, …) and per message type, stamped with the gateway's clock; a corrupted TC
+/// refused whole (no report: its request ID cannot be trusted).
+#[test]
+fn packets_in_and_out() {
+    use mmic::ccsds::primary::{Apid, SeqCount};
+    use mmic::ccsds::tc::TcRepr;
+    use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
+    use mmic::ccsds::tm::TmRepr;
+    let mut g = gateway();
+    let mut buf = [0u8; 64];
+    let n = TcRepr {
+        apid: Apid::new(0x101).unwrap(),
+        seq_count: SeqCount::new(5).unwrap(),
+        header: TcSecondaryHeader {
+            ack: AckFlags::ALL,
+            service: 8,
+            subservice: 1,
+            source_id: 3,
+        },
+        app_data: &[6],
+    }
+    .emit(&mut buf)
+    .unwrap();
+    let mut bad = buf;
+    bad[n - 1] ^= 1;
+    assert_eq!(g.tc_packet(&bad[..n]).unwrap_err().name(), "checksum");
+    let other = TcRepr::parse(&buf[..n], &[0x101]).unwrap();
+    assert_eq!(
+        TcRepr {
+            apid: Apid::new(0x102).unwrap(),
+            ..other
+        }
+        .emit(&mut bad),
+        Ok(n)
+    );
+    assert_eq!(
+        g.tc_packet(&bad[..n]).unwrap_err().name(),
+        "apid",
+        "robot 2 is not served"
+    );
+    let out = g.tc_packet(&buf[..n]).unwrap();
+    assert_eq!(reports(&out), [(Stage::Acceptance, None, 5)]);
+    let c = sent(&mut g, 0);
+    let mut more = g.heartbeat(1234, &answer(c.seq)).reports.to_vec();
+    let mut all = out.reports.to_vec();
+    all.append(&mut more);
+    let mut tm = [0u8; 128];
+    for (k, r) in all.iter().enumerate() {
+        let n = g.encode(r, 1234, &mut tm).unwrap();
+        let p = TmRepr::parse(&tm[..n], &[0x101]).unwrap();
+        assert_eq!(
+            (p.seq_count.get(), p.header.service, p.header.subservice),
+            (k as u16, 1, r.subservice)
+        );
+        assert_eq!(
+            (p.header.destination_id, p.header.counter),
+            (3, 0),
+            "one report of each type"
+        );
+        assert_eq!(p.header.time.to_millis(), 1234);
+        assert_eq!(p.source_data, &r.data[..]);
+    }
+    assert_eq!(all.len(), 3, "acceptance, start, completion");
+}

@@ -19,7 +19,7 @@ use mmic::node::ground;
 use mmic::pus::request::Request;
 use mmic::pus::verification::{Report, RequestId, Stage, UNACKNOWLEDGED};
 use mmic::units::BoardNumber;
-use mmic::wire::command::{CommandRepr, COMMAND_LEN};
+use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 use stateright::{Checker, Model, Property};
 
