@@ -324,9 +324,7 @@ impl Model for PusModel {
             ),
             Property::sometimes(
                 "a resent telecommand suppressed after it ran",
-                |_, s: &State| {
-                    s.resent > 0 && s.executed.iter().any(|&e| e == 1) && s.up.is_empty()
-                },
+                |_, s: &State| s.resent > 0 && s.executed.contains(&1) && s.up.is_empty(),
             ),
         ]
     }
