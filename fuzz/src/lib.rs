@@ -36,7 +36,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 7] = [
+pub const TARGETS: [&str; 8] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -44,6 +44,7 @@ pub const TARGETS: [&str; 7] = [
     "deframer_stream",
     "pus_tc_parser",
     "pus_tm_parser",
+    "pus_request",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -52,6 +53,64 @@ pub fn pus_target(kind: PacketType) -> &'static str {
         PacketType::Tc => TARGETS[5],
         PacketType::Tm => TARGETS[6],
     }
+}
+
+/// Seeds of `pus_request`: service, subservice and application data of a valid request of
+/// each kind, and near misses (one argument out of range, one octet short).
+pub fn pus_requests() -> Vec<(&'static str, Vec<u8>)> {
+    let mut out = vec![
+        ("are-you-alive", vec![17, 1]),
+        ("hk-enable", vec![3, 5, 1, 1]),
+        ("hk-interval", vec![3, 31, 1, 1, 0, 0, 0x03, 0xE8]),
+        ("hk-interval-too-short", vec![3, 31, 1, 1, 0, 0, 0, 50]),
+        ("unknown-service", vec![9, 1]),
+    ];
+    let commands = [
+        ("stop", Command::Stop),
+        (
+            "arm-position",
+            Command::Arm {
+                side: Side::B,
+                target: ServoTarget::Position(PulseWidth::CENTER),
+            },
+        ),
+        (
+            "hip-angle",
+            Command::Hip(HipTarget::Angle(HipAngle::wrapping(4500))),
+        ),
+        (
+            "reconfigure",
+            Command::reconfigure(State::A, State::M).expect("matched"),
+        ),
+        (
+            "power",
+            Command::Power {
+                target: PowerTarget::Module(Module::BolterB),
+                on: true,
+            },
+        ),
+        ("mode", Command::Mode(Mode::Operational)),
+    ];
+    for (name, c) in commands {
+        let mut buf = [0u8; mmic::pus::function::MAX_LEN];
+        let n = mmic::pus::function::encode(&c, &mut buf).expect("a function");
+        let mut v = vec![8, 1];
+        v.extend_from_slice(&buf[..n]);
+        out.push((name, v.clone()));
+        v.pop();
+        out.push((
+            match name {
+                "stop" => "stop-no-id",
+                "arm-position" => "arm-position-short",
+                "hip-angle" => "hip-angle-short",
+                "reconfigure" => "reconfigure-short",
+                "power" => "power-short",
+                _ => "mode-short",
+            },
+            v,
+        ));
+    }
+    out
 }
 
 /// Valid PUS packets, named: a telecommand and a telemetry packet without and with user data.
@@ -311,6 +370,14 @@ pub fn seeds() -> Vec<SeedFile> {
                 bytes: b,
             });
         }
+    }
+    // The services layer: service, subservice, then the application data.
+    for (name, bytes) in pus_requests() {
+        out.push(SeedFile {
+            target: TARGETS[7],
+            name: name.to_string(),
+            bytes,
+        });
     }
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.
     let packet = |k: PacketKind| {

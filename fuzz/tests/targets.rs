@@ -12,6 +12,9 @@
 //!   accepted re-emit identically; then, if long enough, the same octets with the length field
 //!   and CRC rewritten over them (`reseal`) and their own APID accepted, which lets mutations
 //!   reach the checks after the checksum.
+//! * `pus_request`: service, subservice and application data through the services layer's
+//!   `Request::parse` (`mmic_proofs::pus::check_request`): refused by a named check, or read
+//!   canonically (an accepted function encodes back to the same octets).
 //! * `deframer_stream`: four bytes of chunk plan, then the stream, fed as it is to deframers
 //!   with the smallest (66) and a larger (256) buffer, and once more after `build_stream` has
 //!   turned it into packets with sound framing, garbage and near misses; `run_deframer` checks
@@ -52,6 +55,16 @@ fn pus_tc_parser() {
 #[test]
 fn pus_tm_parser() {
     bolero::check!().for_each(|input: &[u8]| pus_parser(PacketType::Tm, input));
+}
+
+/// The services layer: two octets of service and subservice, then the application data.
+#[test]
+fn pus_request() {
+    bolero::check!().for_each(|input: &[u8]| {
+        if let [service, subservice, data @ ..] = input {
+            mmic_proofs::pus::check_request(*service, *subservice, data);
+        }
+    });
 }
 
 #[test]

@@ -3,7 +3,8 @@
 //!
 //! The robot has no absolute clock, only each board's millisecond counter since power-on
 //! ([`crate::units::Instant`], a `u32` that wraps after 2³² ms ≈ 49.7 days). So the epoch is
-//! **board A's power-on** (mission elapsed time): an agency-defined epoch, level 2. The
+//! **the power-on of the node that makes the telemetry** — the server board as PUS gateway
+//! (`crate::node::gateway`) — mission elapsed time: an agency-defined epoch, level 2. The
 //! P-field is implicit (not in the packet, as ECSS-E-ST-70-41C §7.4.3.1 allows when the time
 //! format is fixed per mission); were it sent it would be [`P_FIELD`] = `0x2E`: no extension
 //! (bit 0 = 0), time code ID `010` (agency-defined epoch), 4 coarse octets (`11`), 2 fine
@@ -11,7 +12,7 @@
 //!
 //! Milliseconds convert **to the nearest** fine unit (resolution 15.26 µs, so the error is at
 //! most 7.6 µs), and back to the nearest millisecond; every millisecond count survives the
-//! round trip. The coarse field counts seconds modulo 2³² (136 years). Board A's `u32` clock
+//! round trip. The coarse field counts seconds modulo 2³² (136 years). The `u32` clock
 //! wraps first, after 49.7 days: [`Cuc::from_instant`] then starts again at 0, a jump back the
 //! ground sees; a caller that counts the wraps passes the widened count to
 //! [`Cuc::from_millis`], which takes a `u64`.
@@ -51,7 +52,7 @@ pub struct CucLayout {
 
 const _: () = assert!(core::mem::size_of::<CucLayout>() == CUC_LEN);
 
-/// Mission elapsed time since board A's power-on.
+/// Mission elapsed time since the power-on of the node that stamps the packet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

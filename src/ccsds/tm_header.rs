@@ -82,7 +82,7 @@ pub struct TmSecondaryHeader {
     pub counter: u16,
     /// Destination ID.
     pub destination_id: u16,
-    /// When the packet was made, since board A's power-on.
+    /// When the packet was made, since its maker's power-on (the gateway's).
     pub time: Cuc,
 }
 

@@ -10,6 +10,7 @@ mod deframer;
 mod motion_sequencer;
 mod node;
 mod packets;
+mod pus;
 mod safety_timers;
 mod sensors_frontend;
 mod sensors_moving_average;
