@@ -36,7 +36,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 8] = [
+pub const TARGETS: [&str; 10] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -45,6 +45,8 @@ pub const TARGETS: [&str; 8] = [
     "pus_tc_parser",
     "pus_tm_parser",
     "pus_request",
+    "pus_housekeeping",
+    "pus_verification",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -377,6 +379,48 @@ pub fn seeds() -> Vec<SeedFile> {
             target: TARGETS[7],
             name: name.to_string(),
             bytes,
+        });
+    }
+    // TM(3,25) source data: the report of a heartbeat, and one field out of range.
+    let mut hk = [0u8; mmic::pus::housekeeping::REPORT_LEN];
+    mmic::pus::housekeeping::emit(&HeartbeatRepr::default(), &mut hk);
+    out.push(SeedFile {
+        target: TARGETS[8],
+        name: "default-heartbeat".into(),
+        bytes: hk.to_vec(),
+    });
+    let mut bad = hk;
+    bad[2] = 9; // mode 9
+    out.push(SeedFile {
+        target: TARGETS[8],
+        name: "mode-out-of-range".into(),
+        bytes: bad.to_vec(),
+    });
+    // TM(1,x): the subservice, then the source data of a success and a failure report.
+    for (name, sub, failure) in [
+        ("completion-success", 7u8, None),
+        ("start-failure", 4, Some(6u8)),
+    ] {
+        let r = mmic::pus::verification::Report {
+            stage: if sub == 7 {
+                mmic::pus::verification::Stage::Completion
+            } else {
+                mmic::pus::verification::Stage::Start
+            },
+            request: mmic::pus::verification::RequestId {
+                apid: 0x101,
+                seq_count: 9,
+            },
+            failure: failure.map(mmic::pus::verification::Failure::refusal),
+        };
+        let mut b = [0u8; mmic::pus::verification::FAILURE_LEN];
+        let n = r.emit(&mut b);
+        let mut v = vec![sub];
+        v.extend_from_slice(&b[..n]);
+        out.push(SeedFile {
+            target: TARGETS[9],
+            name: name.into(),
+            bytes: v,
         });
     }
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.

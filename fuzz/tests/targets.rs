@@ -15,6 +15,8 @@
 //! * `pus_request`: service, subservice and application data through the services layer's
 //!   `Request::parse` (`mmic_proofs::pus::check_request`): refused by a named check, or read
 //!   canonically (an accepted function encodes back to the same octets).
+//! * `pus_housekeeping`, `pus_verification`: TM(3,25) and TM(1,x) source data through the
+//!   ground side's readers: refused, or read into a value that writes back exactly the input.
 //! * `deframer_stream`: four bytes of chunk plan, then the stream, fed as it is to deframers
 //!   with the smallest (66) and a larger (256) buffer, and once more after `build_stream` has
 //!   turned it into packets with sound framing, garbage and near misses; `run_deframer` checks
@@ -63,6 +65,24 @@ fn pus_request() {
     bolero::check!().for_each(|input: &[u8]| {
         if let [service, subservice, data @ ..] = input {
             mmic_proofs::pus::check_request(*service, *subservice, data);
+        }
+    });
+}
+
+/// TM(3,25) source data through `housekeeping::parse`.
+#[test]
+fn pus_housekeeping() {
+    bolero::check!().for_each(|input: &[u8]| {
+        mmic_proofs::pus::check_housekeeping(input);
+    });
+}
+
+/// A subservice octet, then TM(1,x) source data through `verification::Report::parse`.
+#[test]
+fn pus_verification() {
+    bolero::check!().for_each(|input: &[u8]| {
+        if let [subservice, data @ ..] = input {
+            mmic_proofs::pus::check_verification(*subservice, data);
         }
     });
 }
