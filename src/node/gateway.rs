@@ -206,8 +206,10 @@ struct Robot<const Q: usize, const K: usize> {
     uplink: Uplink,
     queue: Vec<Job, Q>,
     sent: Option<(u16, Job)>,
-    /// A motion board A accepted, until "command complete", a fault or a mode change.
-    running: Option<Job>,
+    /// The motions board A accepted (with the legacy number it accepted each under), until
+    /// "command complete", a fault or a mode change. Several at once only where board A runs
+    /// them together (single-module moves in Safed); "command complete" ends them all.
+    running: Vec<(u16, Job), Q>,
     log: Vec<Entry, K>,
     last: Option<HeartbeatRepr>,
     stopped: bool,
@@ -259,7 +261,7 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
                 uplink: Uplink::new(self.cfg.uplink, board),
                 queue: Vec::new(),
                 sent: None,
-                running: None,
+                running: Vec::new(),
                 log: Vec::new(),
                 last: None,
                 stopped: false,
@@ -591,7 +593,14 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
                     out.push(TmOut::new(self.apid(), ST_TEST, 2, job.source_id, &[]));
                 }
                 if job.command.kind().moves() {
-                    self.running = Some(job);
+                    if self.running.push((seq, job)).is_err() {
+                        // More motions at once than the queue holds: say so, never lose one.
+                        let f = Failure {
+                            code: QUEUE_FULL,
+                            data: Q as u32,
+                        };
+                        self.report(out, &job, report(Stage::Completion, req, Some(f)));
+                    }
                 } else {
                     self.report(out, &job, report(Stage::Completion, req, None));
                 }
@@ -613,14 +622,21 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
         }
     }
 
-    /// A running motion: complete, failed by a fault, or abandoned by a mode change.
+    /// The running motions: complete, failed by a fault, or abandoned by a mode change. Only a
+    /// heartbeat that answers a command sent after the latest of them counts: one delayed from
+    /// before (or the answer to a copy, numbered 0) says nothing of them.
     fn progress<const M2: usize>(
         &mut self,
         out: &mut Out<M2>,
         prev: &HeartbeatRepr,
         hb: &HeartbeatRepr,
     ) {
-        let Some(job) = self.running else { return };
+        let Some(&(newest, _)) = self.running.last() else {
+            return;
+        };
+        if hb.last_seq == 0 || hb.last_seq.wrapping_sub(newest) >= 0x8000 {
+            return;
+        }
         let raised = Faults::from_iter(hb.faults.iter().filter(|f| !prev.faults.contains(*f)));
         let failure = match raised.iter().next() {
             Some(f) => Some(Failure::fault(f, hb.faults)),
@@ -631,8 +647,9 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
             None if hb.command_complete => None,
             None => return,
         };
-        self.running = None;
-        self.report(out, &job, report(Stage::Completion, job.request, failure));
+        for (_, job) in core::mem::take(&mut self.running) {
+            self.report(out, &job, report(Stage::Completion, job.request, failure));
+        }
     }
 
     fn housekeeping<const M2: usize>(&mut self, now: u32, out: &mut Out<M2>) {

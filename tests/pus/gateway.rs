@@ -343,3 +343,51 @@ fn packets_in_and_out() {
     }
     assert_eq!(all.len(), 3, "acceptance, start, completion");
 }
+
+/// Two motions board A runs together (single-module moves) both complete when it says so; a
+/// heartbeat answering a command from before them (delayed on the link) completes nothing.
+#[test]
+fn motions_run_together_complete_together_and_stale_answers_say_nothing() {
+    use mmic::command::ServoTarget;
+    use mmic::units::Side;
+    let mut g = gateway();
+    let p0 = sent(&mut g, 0);
+    assert_eq!(p0.command, Command::Heartbeat, "the first poll");
+    let arm = Command::Arm {
+        side: Side::A,
+        target: ServoTarget::Extend,
+    };
+    let grip = Command::Gripper {
+        side: Side::B,
+        target: ServoTarget::Contract,
+    };
+    g.tc(&tc(1, Request::Function(arm)));
+    g.tc(&tc(2, Request::Function(grip)));
+    g.heartbeat(5, &answer(p0.seq));
+    // The uplink transmits once per period (250 ms).
+    let c1 = sent(&mut g, 300);
+    assert_eq!(
+        reports(&g.heartbeat(305, &answer(c1.seq))),
+        [(Stage::Start, None, 1)]
+    );
+    let c2 = sent(&mut g, 600);
+    assert_eq!(
+        reports(&g.heartbeat(605, &answer(c2.seq))),
+        [(Stage::Start, None, 2)]
+    );
+    // A late copy of the first poll's answer, "complete" from before: nothing.
+    let stale = HeartbeatRepr {
+        command_complete: true,
+        ..answer(p0.seq)
+    };
+    assert!(reports(&g.heartbeat(610, &stale)).is_empty());
+    let p = sent(&mut g, 900);
+    let done = HeartbeatRepr {
+        command_complete: true,
+        ..answer(p.seq)
+    };
+    assert_eq!(
+        reports(&g.heartbeat(910, &done)),
+        [(Stage::Completion, None, 1), (Stage::Completion, None, 2)]
+    );
+}
