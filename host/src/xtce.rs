@@ -23,7 +23,9 @@ use std::fmt::Write;
 const APID_MIN: u16 = ROBOT_APID_BASE + 1;
 const APID_MAX: u16 = ROBOT_APID_BASE + 255;
 
-/// How long each ST[1] stage may take (ISO 8601 durations), and relative to what.
+/// How long each ST[1] stage may take after the command's release (ISO 8601 durations). All
+/// windows are relative to the release: a window relative to the last verifier opens only once
+/// that verifier passed, too late for reports sent together (TC(3,x): TM(1,1), (1,3), (1,7) at once).
 const ACCEPT_WINDOW: &str = "PT10S";
 const START_WINDOW: &str = "PT30S";
 const COMPLETE_WINDOW: &str = "PT300S";
@@ -793,7 +795,7 @@ pub fn generate() -> Result<String, String> {
         Some("Started"),
         &[3],
         START_WINDOW,
-        "timeLastVerifierPassed",
+        "commandRelease",
         true,
         false,
     );
@@ -803,7 +805,7 @@ pub fn generate() -> Result<String, String> {
         None,
         &[7],
         COMPLETE_WINDOW,
-        "timeLastVerifierPassed",
+        "commandRelease",
         true,
         false,
     );
