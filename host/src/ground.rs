@@ -169,14 +169,15 @@ fn tc(json: &str) -> Vec<u8> {
 
 /// Heartbeats with the edge values of every housekeeping parameter.
 pub fn edge_heartbeats() -> Vec<HeartbeatRepr> {
+    // Seven different values per side, so that two fields swapped anywhere show.
     let e = |v: u16| Electrical {
         v_bat: v,
-        i_bat: v,
-        i_loc: v,
-        i_grip: v,
-        i_3v3: v,
-        v_reg: v,
-        i_bo: v,
+        i_bat: !v,
+        i_loc: v.wrapping_add(1),
+        i_grip: !v.wrapping_add(1),
+        i_3v3: v ^ 0x0F0F,
+        v_reg: v.rotate_left(3),
+        i_bo: v.wrapping_add(7),
     };
     let pw = |us| PulseWidth::new(us).unwrap_or(PulseWidth::CENTER);
     let all = Faults::from_iter(Fault::ALL);
