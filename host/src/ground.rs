@@ -274,9 +274,12 @@ pub fn hk_stream() -> Vec<(Vec<u8>, Value)> {
     out
 }
 
+/// Packets, each with a line saying what it is.
+pub type Labelled = Vec<(String, Vec<u8>)>;
+
 /// Every kind of TM the gateway emits, from one scripted session: TM(1,1/2/3/4/7/8), (3,25),
 /// (5,1..4), (17,2). Returns (what, packet) in order.
-pub fn session() -> (Vec<(String, Vec<u8>)>, Vec<(String, Vec<u8>)>) {
+pub fn session() -> (Labelled, Labelled) {
     let mut b = Bench::new(1000, 300);
     let mut tcs = Vec::new();
     let step =

@@ -163,7 +163,7 @@ fn ack_of(v: &Value) -> Result<AckFlags, PusCodecError> {
         Value::String(s) if s == "all" => Ok(AckFlags::ALL),
         Value::String(s) if s == "none" => Ok(AckFlags::NONE),
         Value::Number(_) => Ok(AckFlags::from_bits(
-            uint(v, "ack", 15, |r| tc_input(r))? as u8,
+            uint(v, "ack", 15, tc_input)? as u8,
         )),
         Value::Object(_) => serde_json::from_value(v.clone()).map_err(|e| tc_input(format!("ack: {e}"))),
         _ => Err(tc_input(format!(
@@ -207,7 +207,7 @@ fn function_data(name: &str, args: Option<&Value>) -> Result<Vec<u8>, PusCodecEr
             Value::String(s) if s.chars().count() == 1 && s.is_ascii() => {
                 u64::from(s.as_bytes()[0])
             }
-            _ => uint(v, &a.name, max, |r| tc_input(r))?,
+            _ => uint(v, &a.name, max, tc_input)?,
         };
         if a.bits() == 16 {
             data.extend_from_slice(&(n as u16).to_be_bytes());
@@ -645,7 +645,7 @@ pub fn decode_tm(bytes: &[u8], apids: &[u16]) -> Result<Value, PusCodecError> {
 
 /// Encodes a telemetry packet from its JSON form: the header keys (APID 257, counts 0,
 /// time 0 unless given) and the source data as `source_data` (hex), `housekeeping` (a
-/// heartbeat's JSON, TM(3,25)) or `report` (ST[1]), the first of these given; the packet must
+/// heartbeat's JSON, TM(3,25)) or `report` (ST\[1\]), the first of these given; the packet must
 /// decode (the robot's TM only), and every other key given must agree with it (so `decode
 /// pus-tm`'s output encodes back to the same bytes).
 pub fn encode_tm(json: &str) -> Result<Vec<u8>, PusCodecError> {

@@ -1,4 +1,4 @@
-//! The reviewable tables of spec/ that the PUS tools read: the ST[8] argument table
+//! The reviewable tables of spec/ that the PUS tools read: the ST\[8\] argument table
 //! (spec/ccsds/functions.toml), the services, failure codes and events
 //! (spec/ccsds/services.toml) and the fault names (spec/faults.toml). They are compiled in
 //! (`include_str!`) and parsed once, so the XTCE generator and the PUS codec have no second
@@ -19,7 +19,7 @@ pub const SERVICES_TOML: &str = include_str!("../../spec/ccsds/services.toml");
 /// spec/faults.toml.
 pub const FAULTS_TOML: &str = include_str!("../../spec/faults.toml");
 
-/// One argument of an ST[8] function.
+/// One argument of an ST\[8\] function.
 #[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
 pub struct Arg {
     /// Its name.
@@ -51,7 +51,7 @@ impl Arg {
     }
 }
 
-/// One ST[8] function.
+/// One ST\[8\] function.
 #[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
 pub struct Function {
     /// Function ID.
@@ -95,7 +95,7 @@ pub struct TmRow {
     pub source_data: String,
 }
 
-/// One row of the ST[1] failure code table.
+/// One row of the ST\[1\] failure code table.
 #[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
 pub struct FailureRow {
     /// A code (`0x0200`) or a family (`1..=255`, `0x0100 + n`).
@@ -106,7 +106,7 @@ pub struct FailureRow {
     pub data: String,
 }
 
-/// One ST[5] event definition.
+/// One ST\[5\] event definition.
 #[derive(Debug, Clone, Deserialize, PartialEq)]
 pub struct EventRow {
     /// Its ID (`0x0001`) or family (`0x0100 + n`).
@@ -205,7 +205,7 @@ fn parse_code(text: &str) -> Option<u16> {
     }
 }
 
-/// Every ST[1] failure code with its label, ascending: each row of services.toml's failure
+/// Every ST\[1\] failure code with its label, ascending: each row of services.toml's failure
 /// table expanded (refusal codes with the library's refusal names, fault codes with the fault
 /// names of spec/faults.toml, the single codes with the library's constants' names).
 /// A row the generator cannot name is an error (services.toml grew a code: name it here).

@@ -1,5 +1,5 @@
 //! `mmic xtce`: the XTCE 1.2 mission database of the robot's PUS-C packets, generated from the
-//! library and spec/ — the TM(3,25) layout from `mmic::pus::housekeeping::FIELDS`, the ST[8]
+//! library and spec/ — the TM(3,25) layout from `mmic::pus::housekeeping::FIELDS`, the ST\[8\]
 //! functions and their argument ranges from spec/ccsds/functions.toml, the failure codes and
 //! events from spec/ccsds/services.toml, the fault names from spec/faults.toml, modes,
 //! refusals and states from the library. The committed copy is spec/ccsds/mmic.xtce.xml
@@ -23,7 +23,7 @@ use std::fmt::Write;
 const APID_MIN: u16 = ROBOT_APID_BASE + 1;
 const APID_MAX: u16 = ROBOT_APID_BASE + 255;
 
-/// How long each ST[1] stage may take after the command's release (ISO 8601 durations). All
+/// How long each ST\[1\] stage may take after the command's release (ISO 8601 durations). All
 /// windows are relative to the release: a window relative to the last verifier opens only once
 /// that verifier passed, too late for reports sent together (TC(3,x): TM(1,1), (1,3), (1,7) at once).
 const ACCEPT_WINDOW: &str = "PT10S";
@@ -230,7 +230,6 @@ fn verifier(
     name: Option<&str>,
     subservices: &[u32],
     window: &str,
-    relative: &str,
     fail_on_timeout: bool,
     ret: bool,
 ) {
@@ -256,7 +255,7 @@ fn verifier(
     x.line(
         5,
         &format!(
-            "<CheckWindow timeToStopChecking=\"{window}\" timeWindowIsRelativeTo=\"{relative}\" />"
+            "<CheckWindow timeToStopChecking=\"{window}\" timeWindowIsRelativeTo=\"commandRelease\" />"
         ),
     );
     if ret {
@@ -785,7 +784,6 @@ pub fn generate() -> Result<String, String> {
         None,
         &[1],
         ACCEPT_WINDOW,
-        "commandRelease",
         true,
         false,
     );
@@ -795,7 +793,6 @@ pub fn generate() -> Result<String, String> {
         Some("Started"),
         &[3],
         START_WINDOW,
-        "commandRelease",
         true,
         false,
     );
@@ -805,7 +802,6 @@ pub fn generate() -> Result<String, String> {
         None,
         &[7],
         COMPLETE_WINDOW,
-        "commandRelease",
         true,
         false,
     );
@@ -815,7 +811,6 @@ pub fn generate() -> Result<String, String> {
         None,
         &fail_subs,
         FAILED_WINDOW,
-        "commandRelease",
         false,
         true,
     );

@@ -1,11 +1,11 @@
 //! The server board as a PUS gateway: PUS-C telecommands from the ground in, the legacy
-//! 14-byte commands to board A out, and the ST[1], ST[3], ST[5] and ST[17] telemetry back.
+//! 14-byte commands to board A out, and the ST\[1\], ST\[3\], ST\[5\] and ST\[17\] telemetry back.
 //!
 //! Board A and its link stay as the paper has them. For each robot the gateway does what the
 //! opsUI did — the legacy [`Uplink`] numbers each command, resends it until board A
-//! acknowledges it and polls for heartbeats — and turns the outcomes into reports: ST[1] from
-//! the uplink's outcome and the heartbeat's "command complete", ST[3] from the latest
-//! heartbeat every collection interval, ST[5] from what changed between two heartbeats
+//! acknowledges it and polls for heartbeats — and turns the outcomes into reports: ST\[1\] from
+//! the uplink's outcome and the heartbeat's "command complete", ST\[3\] from the latest
+//! heartbeat every collection interval, ST\[5\] from what changed between two heartbeats
 //! ([`crate::pus::event`]). No robot behaviour is decided here (spec/decisions.toml,
 //! `pus-gateway`).
 //!
@@ -118,7 +118,7 @@ impl TmOut {
         }
     }
 
-    /// For an ST[1] report: its stage and whether it reports success.
+    /// For an ST\[1\] report: its stage and whether it reports success.
     pub fn stage(&self) -> Option<(Stage, bool)> {
         if self.service != ST_VERIFICATION {
             return None;
@@ -512,7 +512,7 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
         }
     }
 
-    /// Sends an ST[1] report: failures always, successes when `ack` asks for the stage.
+    /// Sends an ST\[1\] report: failures always, successes when `ack` asks for the stage.
     fn verify<const M2: usize>(&self, out: &mut Out<M2>, rep: Report, ack: u8, dest: u16) {
         let bit = match rep.stage {
             Stage::Acceptance => 0,

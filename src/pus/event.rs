@@ -1,4 +1,4 @@
-//! ST[5] event reporting: every fault raised, every mode change, every bolting attempt's
+//! ST\[5\] event reporting: every fault raised, every mode change, every bolting attempt's
 //! result, and faults cleared — read from two consecutive heartbeats of board A.
 //!
 //! The legacy link carries no event stream, only heartbeats, so the gateway derives the

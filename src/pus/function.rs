@@ -1,4 +1,4 @@
-//! ST[8] function management: every Table 1 command as a function with typed arguments, the
+//! ST\[8\] function management: every Table 1 command as a function with typed arguments, the
 //! application data of TC(8,1) "perform a function".
 //!
 //! The application data is the function ID (one byte) and then that function's arguments,
@@ -6,7 +6,7 @@
 //! ranges; a test holds this module to it). Decoding builds the library's [`Command`] through
 //! its own constructors, so a PUS function is exactly the legacy command it names — the
 //! legacy ⇄ PUS mapping is this one table, with no second meaning of any command. Table 1's
-//! Heartbeat request is no function: ST[17] are-you-alive replaces it.
+//! Heartbeat request is no function: ST\[17\] are-you-alive replaces it.
 //!
 //! ```
 //! use mmic::command::Command;
@@ -38,7 +38,7 @@ use crate::units::{HipAngle, Module, PulseWidth, Side};
 pub const MAX_LEN: usize = 5;
 
 crate::wire_enum::wire_enum! {
-    /// A function of ST[8], in Table 1's order; the value is its function ID.
+    /// A function of ST\[8\], in Table 1's order; the value is its function ID.
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
     #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     pub enum FunctionId: u8 {
@@ -96,7 +96,7 @@ impl FunctionId {
         }
     }
 
-    /// The function of a command; none for the Heartbeat request (ST[17] instead).
+    /// The function of a command; none for the Heartbeat request (ST\[17\] instead).
     pub const fn of(c: &Command) -> Option<FunctionId> {
         Some(match c {
             Command::Heartbeat => return None,
@@ -159,7 +159,7 @@ pub enum FunctionError {
     /// Each argument in range, together no primitive command (Figure 9).
     #[error("function 5: {0}")]
     Primitive(PrimitiveMoveError),
-    /// The Heartbeat request has no function: ST[17] are-you-alive replaces it.
+    /// The Heartbeat request has no function: ST\[17\] are-you-alive replaces it.
     #[error("the heartbeat request is no ST[8] function: use TC(17,1)")]
     NoFunction,
     /// The caller's buffer is shorter than the application data.

@@ -1,4 +1,4 @@
-//! ST[3] housekeeping: the heartbeat's content (Table 3) as the parameters of one
+//! ST\[3\] housekeeping: the heartbeat's content (Table 3) as the parameters of one
 //! housekeeping report structure, TM(3,25), sent periodically without being asked.
 //!
 //! The paper's opsUI polled every 1.2 s for a heartbeat; here the gateway keeps the latest one

@@ -2,10 +2,10 @@
 //! what each telecommand means and what each report carries.
 //!
 //! The services map onto the library's existing logic — no behaviour is implemented twice:
-//! an ST[8] function is the [`crate::command::Command`] of Table 1 it names
-//! ([`function`]), an ST[3] housekeeping report is the heartbeat's content
-//! ([`housekeeping`]), an ST[5] event is a change between two heartbeats ([`event`]), and the
-//! ST[1] verification reports carry the library's refusal and fault codes ([`verification`]).
+//! an ST\[8\] function is the [`crate::command::Command`] of Table 1 it names
+//! ([`function`]), an ST\[3\] housekeeping report is the heartbeat's content
+//! ([`housekeeping`]), an ST\[5\] event is a change between two heartbeats ([`event`]), and the
+//! ST\[1\] verification reports carry the library's refusal and fault codes ([`verification`]).
 //! [`request`] turns a telecommand's service, subservice and application data into one
 //! request, refusing every bad input by name. spec/ccsds/ is the reviewable table of all of it.
 //!

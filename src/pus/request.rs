@@ -27,15 +27,15 @@ use super::function::{self, FunctionError};
 use super::housekeeping::{MAX_INTERVAL_MS, MIN_INTERVAL_MS, ROBOT_SID};
 use crate::command::Command;
 
-/// ST[1] request verification.
+/// ST\[1\] request verification.
 pub const ST_VERIFICATION: u8 = 1;
-/// ST[3] housekeeping.
+/// ST\[3\] housekeeping.
 pub const ST_HOUSEKEEPING: u8 = 3;
-/// ST[5] event reporting.
+/// ST\[5\] event reporting.
 pub const ST_EVENT: u8 = 5;
-/// ST[8] function management.
+/// ST\[8\] function management.
 pub const ST_FUNCTION: u8 = 8;
-/// ST[17] test.
+/// ST\[17\] test.
 pub const ST_TEST: u8 = 17;
 
 /// What a telecommand asks.
@@ -132,7 +132,7 @@ impl RequestError {
         }
     }
 
-    /// The ST[1] failure code of this refusal (spec/ccsds/services.toml, failure codes).
+    /// The ST\[1\] failure code of this refusal (spec/ccsds/services.toml, failure codes).
     pub const fn code(&self) -> u16 {
         match self {
             RequestError::UnknownService { .. } => 0x0301,

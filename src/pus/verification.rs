@@ -1,4 +1,4 @@
-//! ST[1] request verification: the reports that tell the ground what became of a telecommand,
+//! ST\[1\] request verification: the reports that tell the ground what became of a telecommand,
 //! and the failure codes they carry — the library's own refusal and fault codes.
 //!
 //! Source data: the request ID (the TC's packet ID and sequence control, 4 bytes), then for a
@@ -104,7 +104,7 @@ impl Failure {
     }
 }
 
-/// One ST[1] report.
+/// One ST\[1\] report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Report {
@@ -121,7 +121,7 @@ pub const SUCCESS_LEN: usize = 4;
 /// Source data of a failure report, bytes.
 pub const FAILURE_LEN: usize = 10;
 
-/// Why source data is no ST[1] report of ours.
+/// Why source data is no ST\[1\] report of ours.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum VerificationError {
