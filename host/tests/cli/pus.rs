@@ -8,35 +8,8 @@ use mmic_host::{ground, spec, xtce};
 use serde::Deserialize;
 use serde_json::{json, Value};
 use std::path::PathBuf;
-use std::process::{Command as Proc, Output};
 
-fn mmic(args: &[&str]) -> Output {
-    Proc::new(env!("CARGO_BIN_EXE_mmic"))
-        .args(args)
-        .output()
-        .expect("run mmic")
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = mmic(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap().trim().to_string()
-}
-
-fn refused(args: &[&str], code: i32, needle: &str) {
-    let o = mmic(args);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(code), "{args:?}: {err}");
-    assert!(
-        err.contains(needle),
-        "{args:?}: stderr {err:?} lacks {needle:?}"
-    );
-    assert!(o.stdout.is_empty());
-}
+use crate::cli::{fails as refused, ok};
 
 fn repo(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
