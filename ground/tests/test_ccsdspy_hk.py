@@ -1,72 +1,71 @@
-"""ccsdspy (NASA) decodes a recorded stream of PUS-C TM(3,25) packets with a definition built from a
-field list (ground/ccsds/hk-3-25.csv through ground/ccsdspy_defs.py); values and CRCs are checked."""
+"""ccsdspy (NASA) decodes a TM(3,25) stream recorded from the Rust side (`mmic ground fixtures`:
+the real PUS gateway reporting heartbeats with the edge values of every parameter) with a packet
+definition generated from the library (spec/ccsds/hk-3-25.ccsdspy.csv = `mmic xtce --ccsdspy`,
+through ground/ccsdspy_defs.py); every value is compared with what the Rust side wrote it
+carries (hk.json, `mmic decode pus-tm`'s form)."""
 from __future__ import annotations
-
-from pathlib import Path
 
 import pytest
 from ccsdspy_defs import fields_from_csv, fixed_length
-from fake_robot import APID, HK_SID, FakeRobot, crc16_ccitt_false, cuc, hk_source_data
+import json
 
-FIELDS = Path(__file__).resolve().parents[1] / "ccsds" / "hk-3-25.csv"
-SENT = [  # battery mV, mode, fault bitmap, MET seconds
-    (3700, 2, 0x00000000, 1.5),
-    (0, 0, 0x00000001, 2.25),
-    (65535, 3, 0xFFFFFFFF, 3.0),
-    (4123, 1, 0x80000000, 4294967295 + 65535 / 65536),
-    (3321, 2, 0x00A5005A, 10.0078125),
-]
-
-
-class OfflineRobot(FakeRobot):
-    """The fake robot's packet builder, without sockets."""
-
-    def __post_init__(self):
-        import threading
-
-        self._lock = threading.Lock()
+from rust_side import CCSDSPY_CSV, ROBOT_APID, crc16_ccitt_false, mmic
 
 
 @pytest.fixture
-def recording(tmp_path):
-    robot = OfflineRobot(tm_port=0, tc_port=0)
-    packets = [robot.tm(3, 25, hk_source_data(mv, mode, faults), met) for mv, mode, faults, met in SENT]
-    path = tmp_path / "hk.bin"
-    path.write_bytes(b"".join(packets))
-    return path, packets
+def recording(rust_fixtures):
+    raw = (rust_fixtures / "hk.bin").read_bytes()
+    expected = json.loads((rust_fixtures / "hk.json").read_text())
+    n = len(expected)
+    size = len(raw) // n
+    assert size * n == len(raw) and all(e["len"] == size for e in expected)
+    return rust_fixtures / "hk.bin", [raw[i * size:(i + 1) * size] for i in range(n)], expected
+
+
+def test_the_committed_field_list_is_what_mmic_generates():
+    assert CCSDSPY_CSV.read_text() == mmic("xtce", "--ccsdspy").stdout
 
 
 def test_ccsdspy_decodes_the_recorded_hk_stream(recording):
-    path, packets = recording
-    d = fixed_length(fields_from_csv(FIELDS)).load(str(path), include_primary_header=True)
-    n = len(SENT)
-    assert list(d["CCSDS_APID"]) == [APID] * n
+    path, packets, expected = recording
+    assert len(packets) >= 4
+    d = fixed_length(fields_from_csv(CCSDSPY_CSV)).load(str(path), include_primary_header=True)
+    n = len(packets)
+    assert list(d["CCSDS_APID"]) == [ROBOT_APID] * n
     assert list(d["CCSDS_PACKET_LENGTH"]) == [len(packets[0]) - 7] * n
-    assert list(d["CCSDS_SEQUENCE_COUNT"]) == list(range(n))
+    assert list(d["CCSDS_SEQUENCE_COUNT"]) == [e["seq_count"] for e in expected]
     assert list(d["pus_version"]) == [2] * n
     assert (list(d["service"]), list(d["subservice"])) == ([3] * n, [25] * n)
-    assert list(d["msg_type_counter"]) == list(range(n))
-    assert list(d["hk_sid"]) == [HK_SID] * n
-    assert list(d["battery_voltage"]) == [s[0] for s in SENT]
-    assert list(d["mode"]) == [s[1] for s in SENT]
-    assert list(d["fault_bitmap"]) == [s[2] for s in SENT]
-    times = [cuc(s[3]) for s in SENT]
-    assert list(d["met_coarse"]) == [int.from_bytes(t[:4], "big") for t in times]
-    assert list(d["met_fine"]) == [int.from_bytes(t[4:], "big") for t in times]
+    assert list(d["msg_type_counter"]) == [e["counter"] for e in expected]
+    assert list(d["destination_id"]) == [e["destination_id"] for e in expected]
+    assert list(d["met_coarse"]) == [e["time"]["coarse"] for e in expected]
+    assert list(d["met_fine"]) == [e["time"]["fine"] for e in expected]
+    assert list(d["hk_sid"]) == [1] * n
+    names = list(expected[0]["parameters"])
+    assert len(names) == 33
+    for name in names:
+        assert list(d[name]) == [e["parameters"][name] for e in expected], name
     assert list(d["crc"]) == [crc16_ccitt_false(p[:-2]) for p in packets]
+    # The edge values are really there (not a stream of defaults).
+    assert {e["parameters"]["last_seq"] for e in expected} >= {0, 65535}
+    assert {e["parameters"]["v_bat_a"] for e in expected} >= {0, 65535}
 
 
 def test_a_corrupted_packet_is_noticed(recording, tmp_path):
-    _, packets = recording
+    _, packets, expected = recording
     bad = bytearray(b"".join(packets))
-    bad[len(packets[0]) + 21] ^= 0x10  # battery voltage of the second packet
+    size = len(packets[0])
+    bad[size + 20 + 1] ^= 0x01  # the second packet's mode
     path = tmp_path / "bad.bin"
     path.write_bytes(bytes(bad))
-    d = fixed_length(fields_from_csv(FIELDS)).load(str(path), include_primary_header=True)
-    raw = [bytes(bad[i * len(packets[0]):(i + 1) * len(packets[0])]) for i in range(len(packets))]
+    d = fixed_length(fields_from_csv(CCSDSPY_CSV)).load(str(path), include_primary_header=True)
+    raw = [bytes(bad[i * size:(i + 1) * size]) for i in range(len(packets))]
     crc_ok = [crc16_ccitt_false(p[:-2]) == c for p, c in zip(raw, d["crc"])]
-    assert crc_ok == [True, False, True, True, True]
-    assert list(d["battery_voltage"]) != [s[0] for s in SENT]
+    assert crc_ok == [i != 1 for i in range(len(packets))]
+    assert list(d["mode"]) != [e["parameters"]["mode"] for e in expected]
+    # and our decoder refuses that packet by name
+    r = mmic("decode", "pus-tm", raw[1].hex(), check=False)
+    assert r.returncode == 1 and "checksum" in r.stderr
 
 
 def test_the_definition_refuses_overlaps():

@@ -1,36 +1,44 @@
-"""End-to-end loop: fake robot (PUS-C over UDP) <-> YAMCS 5.12.8 <-> yamcs-client.
+"""End-to-end loop: the Rust side (PUS-C over UDP) <-> YAMCS 5.12.8 with the generated XTCE <-> yamcs-client.
 
-One YAMCS for the whole module (started by ground/yamcs_harness.py with the example XTCE).
-(a) TM(3,25) values sent by the robot come back equal through a parameter subscription; a packet
-    with a bad CRC or another APID is not taken; the CUC mission-elapsed time becomes UTC through
-    the time correlation service.
-(b) TC(8,1) issued through yamcs-client reaches the robot as a valid PUS-C TC; the robot's ST[1]
-    reports drive the XTCE verifiers: (1,1)+(1,7) -> completed, (1,2) -> failed, a report with
-    another request ID does nothing; an out-of-range argument is refused by YAMCS.
+One YAMCS for the whole module (ground/yamcs_harness.py), loaded with spec/ccsds/mmic.xtce.xml (`mmic
+xtce`; GROUND_MDB: another file, e.g. a mutated copy, to see these tests fail). The robot is the
+Rust stand-in `mmic ground robot` (the real PUS gateway + a trivial board A; $GROUND_ROBOT swaps in
+another command line, see ground/README.md). Raw TM injected by the tests is made by `mmic encode
+pus-tm` or by the gateway (`mmic ground fixtures`), sent as robot 2 (APID 0x102) so as not to disturb
+robot 1's sequence counts.
+(a) TM(3,25) values (the edge values of all 33 parameters) come back equal through a parameter
+    subscription; bad CRC and APIDs outside 0x101..=0x1FF are not taken; units; MET -> UTC.
+(b) TCs issued through yamcs-client reach the robot as the bytes YAMCS recorded; the gateway's ST[1]
+    reports drive the XTCE verifiers: are-you-alive, mode operational then a reconfiguration complete;
+    a reconfiguration in Standby fails with board A's refusal code; a reconfiguration to a stretch state
+    fails at acceptance; reports with another request ID do nothing; a TC nobody answers fails on the
+    acceptance timeout (yamcs.onTimeout=FAIL); housekeeping is switched off and on by TC; an
+    out-of-range argument is refused by YAMCS; the robot's HK read back equals what it sent.
 """
 from __future__ import annotations
 
 import datetime as dt
+import json
 import os
 import queue
+import socket
 import sys
 import threading
 import time
 
 import pytest
-from fake_robot import APID, HK_SID, FakeRobot  # ground/tests (conftest.py puts ground/ on the path)
-from yamcs_harness import DEFAULT_MDB, INSTANCE, Yamcs
+from rust_side import XTCE, RobotProcess, decode_tm, encode_tm, jsonl
+from yamcs_harness import INSTANCE, Yamcs
 
-HK = ["/MMIC/hk_sid", "/MMIC/battery_voltage", "/MMIC/mode", "/MMIC/fault_bitmap",
-      "/MMIC/met_coarse", "/MMIC/met_fine", "/MMIC/msg_type_counter"]
-CMD = "/MMIC/PERFORM_FUNCTION"
+
+ROBOT2 = 0x102
 STEP = 10.0  # seconds any single wait may take
+HEADER = ["ccsds_apid", "ccsds_seq_count", "met_coarse", "met_fine", "msg_type_counter", "hk_sid"]
 
 
 @pytest.fixture(scope="module")
 def yamcs():
-    # GROUND_MDB: another XTCE with the same names (e.g. a mutated copy, to see these tests fail)
-    y = Yamcs(os.environ.get("GROUND_MDB", DEFAULT_MDB), max_lifetime=300)
+    y = Yamcs(os.environ.get("GROUND_MDB", XTCE), max_lifetime=300)
     y.start()
     print(f"\nYAMCS ready in {y.start_seconds:.1f} s, RSS {(y.rss_kib() or 0) // 1024} MiB, {y.url}")
     try:
@@ -44,9 +52,18 @@ def yamcs():
 
 @pytest.fixture(scope="module")
 def robot(yamcs):
-    r = FakeRobot(tm_port=yamcs.tm_port, tc_port=yamcs.tc_port)
+    r = RobotProcess(tm_port=yamcs.tm_port, tc_port=yamcs.tc_port)
+    assert r.ready.wait(STEP), "the robot did not start"
     yield r
     r.close()
+
+
+@pytest.fixture(scope="module")
+def inject(yamcs):
+    """Sends raw TM datagrams to YAMCS's TM link (127.0.0.1 only)."""
+    s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    yield lambda raw: s.sendto(raw, ("127.0.0.1", yamcs.tm_port))
+    s.close()
 
 
 @pytest.fixture(scope="module")
@@ -62,37 +79,45 @@ def show_yamcs_log_on_failure(request, yamcs):
         sys.stderr.write(yamcs.log_tail(80))
 
 
-class HkCollector:
-    """Parameter subscription; one record (name -> ParameterValue) per delivery."""
+@pytest.fixture(scope="module")
+def hk_expected(rust_fixtures):
+    return json.loads((rust_fixtures / "hk.json").read_text())
 
-    def __init__(self, processor):
+
+class HkCollector:
+    """Parameter subscription on every HK parameter and header field; one record per packet."""
+
+    def __init__(self, processor, names):
         self.records: "queue.Queue[dict]" = queue.Queue()
-        self.sub = processor.create_parameter_subscription(HK, on_data=self._on_data, send_from_cache=False)
+        self.names = ["/MMIC/" + n for n in names]
+        self.sub = processor.create_parameter_subscription(self.names, on_data=self._on_data,
+                                                           send_from_cache=False)
 
     def _on_data(self, data):
         rec = {}
         for pv in data.parameters:
-            if pv.name in rec:  # two packets in one delivery: split
+            name = pv.name.split("/")[-1]
+            if name in rec:  # two packets in one delivery: split
                 self.records.put(rec)
                 rec = {}
-            rec[pv.name] = pv
+            rec[name] = pv
         if rec:
             self.records.put(rec)
 
-    def next_hk(self, timeout=STEP):
-        """The next delivery that carries a battery voltage (i.e. came from a TM(3,25))."""
+    def next_hk(self, apid, timeout=STEP):
+        """The next delivery from a TM(3,25) of `apid`."""
         end = time.monotonic() + timeout
         while True:
             rec = self.records.get(timeout=max(0.01, end - time.monotonic()))
-            if "/MMIC/battery_voltage" in rec:
+            if "hk_sid" in rec and rec["ccsds_apid"].raw_value == apid:
                 return rec
 
-    def drain(self, seconds):
+    def drain(self, seconds, apid):
         time.sleep(seconds)
         out = []
         while not self.records.empty():
             rec = self.records.get_nowait()
-            if "/MMIC/battery_voltage" in rec:
+            if "hk_sid" in rec and rec["ccsds_apid"].raw_value == apid:
                 out.append(rec)
         return out
 
@@ -106,8 +131,8 @@ class HkCollector:
 
 
 @pytest.fixture(scope="module")
-def hk_subscription(processor):
-    c = HkCollector(processor)
+def hk_subscription(processor, hk_expected):
+    c = HkCollector(processor, HEADER + list(hk_expected[0]["parameters"]))
     time.sleep(0.5)  # let the subscription settle on the server
     yield c
     c.close()
@@ -119,179 +144,219 @@ def hk(hk_subscription):
     return hk_subscription
 
 
-def assert_hk_equal(rec, battery_mv, mode_label, mode_raw, faults, met):
-    got = {k.split("/")[-1]: (v.eng_value, v.raw_value) for k, v in rec.items()}
-    coarse, fine = int(met), round((met % 1) * 65536)
-    expected = {"hk_sid": (HK_SID, HK_SID), "battery_voltage": (battery_mv, battery_mv),
-                "mode": (mode_label, mode_raw), "fault_bitmap": (faults, faults),
-                "met_coarse": (coarse, coarse), "met_fine": (fine, fine)}
-    for name, value in expected.items():
-        assert got.get(name) == value, f"{name}: YAMCS has {got.get(name)}, the robot sent {value}"
+def as_robot2(decoded: dict, **changes) -> bytes:
+    """The packet our decoder described, re-encoded for APID 0x102 (same source data)."""
+    d = {k: decoded[k] for k in ("seq_count", "counter", "destination_id", "time", "service", "subservice",
+                                 "source_data")}
+    d.update(apid=ROBOT2, **changes)
+    return encode_tm(d)
+
+
+def assert_hk_equal(rec, expected):
+    """Every parameter of a YAMCS delivery equals what the packet carried (raw values; the CUC time
+    and counters too)."""
+    got = {k: v.raw_value for k, v in rec.items()}
+    want = dict(expected["parameters"], hk_sid=1, met_coarse=expected["time"]["coarse"],
+                met_fine=expected["time"]["fine"], msg_type_counter=expected["counter"],
+                ccsds_seq_count=expected["seq_count"], ccsds_apid=expected["apid"])
+    diff = {k: (got.get(k), v) for k, v in want.items() if got.get(k) != v}
+    assert not diff, f"YAMCS has / the robot sent: {diff}"
 
 
 # -- (a) telemetry ---------------------------------------------------------------------------------
 
-MODES = {0: "OFF", 1: "STANDBY", 2: "OPERATIONAL", 3: "SAFE"}
-HK_CASES = [  # battery mV, mode, fault bitmap, MET seconds: edges of every field
-    (3700, 2, 0x00000000, 1.5),
-    (0, 0, 0x00000001, 2.25),
-    (65535, 3, 0xFFFFFFFF, 3.0),
-    (4123, 1, 0x80000000, 4294967295 + 65535 / 65536),
-    (3321, 2, 0x00A5005A, 10.0078125),
-]
+def test_hk_values_equal_what_the_gateway_sent(inject, hk, hk_expected):
+    assert len(hk_expected) >= 4
+    for e in hk_expected:
+        inject(as_robot2(e))
+        rec = hk.next_hk(ROBOT2)
+        assert_hk_equal(rec, dict(e, apid=ROBOT2))
+        # engineering values: the labels of the enumerations, from the library's names
+        assert rec["mode"].eng_value == e["housekeeping"]["mode"].upper()
+        state = e["housekeeping"]["target_state"]
+        assert rec["target_state"].eng_value == (state if state else "NONE")
 
 
-def test_hk_values_equal_what_the_robot_sent(robot, hk):
-    for mv, mode, faults, met in HK_CASES:
-        robot.send_hk(mv, mode, faults, met)
-        assert_hk_equal(hk.next_hk(), mv, MODES[mode], mode, faults, met)
+def test_a_wrong_value_would_be_noticed(inject, hk, hk_expected):
+    e = hk_expected[1]
+    inject(as_robot2(e))
+    rec = hk.next_hk(ROBOT2)
+    for name in ("v_bat_a", "arm_b_now", "faults"):
+        wrong = dict(e, apid=ROBOT2, parameters=dict(e["parameters"], **{name: e["parameters"][name] + 1}))
+        with pytest.raises(AssertionError, match=name):
+            assert_hk_equal(rec, wrong)
 
 
-def test_a_wrong_value_would_be_noticed(robot, hk):
-    robot.send_hk(3700, 2, 0, 1.0)
-    rec = hk.next_hk()
-    with pytest.raises(AssertionError, match="battery_voltage"):
-        assert_hk_equal(rec, 3701, "OPERATIONAL", 2, 0, 1.0)
-    with pytest.raises(AssertionError, match="mode"):
-        assert_hk_equal(rec, 3700, "SAFE", 2, 0, 1.0)
-
-
-def test_bad_crc_and_other_apid_are_not_taken(yamcs, robot, hk):
-    bad = bytearray(robot.tm(3, 25, bytes.fromhex("0001" "0457" "02" "00000000"), 5.0))  # 1111 mV
+def test_bad_crc_and_foreign_apids_are_not_taken(yamcs, inject, hk, hk_expected):
+    e = hk_expected[2]
+    bad = bytearray(as_robot2(e, seq_count=100))
     bad[-1] ^= 0x01  # CRC wrong
-    robot.send(bytes(bad))
-    robot.send(robot.tm(3, 25, bytes.fromhex("0001" "08ae" "02" "00000000"), 5.0, apid=APID + 1))  # 2222 mV
-    robot.send_hk(3333, 2, 0, 6.0)
-    got = [r["/MMIC/battery_voltage"].eng_value for r in hk.drain(2.0)]
-    assert got == [3333], f"YAMCS delivered {got}: the CRC check or the APID restriction does not hold"
-    # The PusPacketPreprocessor said why it dropped the first one (an event, archived).
+    inject(bytes(bad))
+    for apid in (0x100, 0x200):  # just outside the robots' APIDs 0x101..=0x1FF
+        d = {k: e[k] for k in ("time", "source_data")}
+        inject(encode_tm(dict(d, apid=apid, service=3, subservice=25)))
+    inject(as_robot2(e, seq_count=101))
+    got = [r["ccsds_seq_count"].raw_value for r in hk.drain(2.0, ROBOT2)]
+    assert got == [101], f"YAMCS delivered {got}: the CRC check or the APID restriction does not hold"
+    assert not [r for r in hk.drain(0.1, 0x100) + hk.drain(0.1, 0x200)]
     end = time.monotonic() + STEP
     while not (msgs := [e.message for e in yamcs.client.get_archive(INSTANCE).list_events()
                         if e.message.startswith("Corrupted packet received")]):
         assert time.monotonic() < end, "no 'Corrupted packet received' event"
         time.sleep(0.3)
     crc = int.from_bytes(bad[-2:], "big")
-    assert msgs == [f"Corrupted packet received, computed checkword: {crc ^ 1}; packet checkword: {crc}"]
+    assert f"Corrupted packet received, computed checkword: {crc ^ 1}; packet checkword: {crc}" in msgs
 
 
-def test_battery_voltage_has_its_unit(yamcs):
-    p = yamcs.client.get_mdb(INSTANCE).get_parameter("/MMIC/battery_voltage")
-    units = [u.unit for u in p._proto.type.unitSet]
-    assert units == ["mV"], units
+def test_parameters_have_their_units(yamcs):
+    mdb = yamcs.client.get_mdb(INSTANCE)
+    for name, unit in [("v_bat_a", "mV"), ("i_bo_b", "mA"), ("arm_a_now", "us"), ("hip_target", "0.01 deg")]:
+        units = [u.unit for u in mdb.get_parameter(f"/MMIC/{name}")._proto.type.unitSet]
+        assert units == [unit], (name, units)
 
 
-def test_mission_elapsed_time_is_correlated_to_utc(yamcs, robot, hk):
-    # No coefficients yet: YAMCS stamps the packet with its reception time, whatever the MET says.
-    before = dt.datetime.now(dt.timezone.utc)
-    robot.send_hk(3700, 2, 0, 1000.0)
-    t = hk.next_hk()["/MMIC/battery_voltage"].generation_time
-    assert abs((t - before).total_seconds()) < 5, f"uncorrelated generation time {t} vs now {before}"
-    # Power-on at a known UTC: obt 0 <-> power_on, one obt unit = 2^-16 s.
+def test_mission_elapsed_time_is_correlated_to_utc(yamcs, inject, hk, hk_expected):
+    e = hk_expected[0]
     power_on = dt.datetime(2026, 11, 23, 12, 0, 0, tzinfo=dt.timezone.utc)
     yamcs.client.get_tco_client(INSTANCE, "tco0").override_coefficients(power_on, 0, 2.0 ** -16, 0)
-    robot.send_hk(3700, 2, 0, 100.5)
-    t = hk.next_hk()["/MMIC/battery_voltage"].generation_time
+    inject(as_robot2(e, seq_count=200, time={"coarse": 100, "fine": 32768}))
+    t = hk.next_hk(ROBOT2)["v_bat_a"].generation_time
     assert t == power_on + dt.timedelta(seconds=100.5), t
 
 
 # -- (b) telecommands --------------------------------------------------------------------------------
-
-def get_tc(robot, timeout=STEP):
-    rx = robot.tcs.get(timeout=timeout)
-    assert not robot.errors, robot.errors
-    return rx
-
 
 @pytest.fixture(scope="module")
 def commands(processor):
     return processor.create_command_connection()
 
 
-def ack_status(cmd, name):
+def ack(cmd, name):
     a = cmd.acknowledgments.get(name)
     return a.status if a else None
 
 
-def test_tc_is_accepted_and_completed_through_st1(yamcs, robot, commands):
-    robot.answer = "complete"
-    cmd = commands.issue(CMD, args={"function_id": "SET_MODE", "value": 2})
-    rx = get_tc(robot)
-    assert (rx.tc.service, rx.tc.message_subtype, rx.tc.app_data) == (8, 1, bytes([1, 2]))
-    assert rx.tc.sp_header.apid == APID and rx.tc.pus_tc_sec_header.ack_flags == 9
+def issue(robot, commands, name, args=None):
+    """Issues a command; returns it and the TC line the robot logged for it (bytes = YAMCS's)."""
+    cmd = commands.issue(f"/MMIC/{name}", args=args or {})
+    rx = robot.next_tc(STEP)
+    assert rx["refused"] is None, rx
+    return cmd, bytes.fromhex(rx["hex"])
+
+
+def complete(cmd):
     cmd.await_complete(timeout=STEP)
     assert cmd.is_success(), f"{cmd.error} {cmd.acknowledgments}"
-    assert ack_status(cmd, "Verifier_Accepted") == "OK"
-    assert ack_status(cmd, "Verifier_Complete") == "OK"
-    # The robot got exactly what YAMCS recorded (postprocessor: length, sequence count, CRC).
-    # (cmd.binary is the MDB encoding before postprocessing: sequence count 0, no CRC.)
-    assert cmd.attributes["binary"] == rx.raw
-    assert cmd.binary == rx.raw[:2] + b"\xc0\x00\x00\x00" + rx.raw[6:-2]
-    assert cmd.attributes["ccsds-seqcount"] == rx.tc.sp_header.seq_count
-    # The archived command history says the same.
+    for stage in ("Verifier_Accepted", "Verifier_Started", "Verifier_Complete"):
+        assert ack(cmd, stage) == "OK", (stage, cmd.acknowledgments)
+
+
+def test_are_you_alive_completes_and_reaches_the_robot_as_recorded(robot, commands):
+    cmd, raw = issue(robot, commands, "are_you_alive")
+    complete(cmd)
+    assert cmd.attributes["binary"] == raw
+    assert cmd.attributes["ccsds-seqcount"] == int.from_bytes(raw[2:4], "big") & 0x3FFF
+    assert raw[7:9] == bytes([17, 1])
+
+
+def test_reconfiguration_in_standby_fails_with_the_refusal_code(robot, commands):
+    cmd, raw = issue(robot, commands, "reconfiguration", {"initial": "a", "target": "m"})
+    assert raw[11:14] == bytes([9]) + b"am"
+    cmd.await_complete(timeout=STEP)
+    assert cmd.is_failure(), cmd.acknowledgments
+    assert ack(cmd, "Verifier_Accepted") == "OK" and ack(cmd, "Verifier_Failed") == "OK"
+    assert cmd.error == "Verifier Failed return: REFUSED_NOT_ALLOWED_IN_MODE"
+    assert ack(cmd, "Verifier_Complete") != "OK"
+
+
+def test_mode_operational_then_a_reconfiguration_complete(robot, commands, hk):
+    cmd, raw = issue(robot, commands, "mode", {"mode": 2})
+    assert raw[11:13] == bytes([10, 2])
+    complete(cmd)
+    cmd, _ = issue(robot, commands, "reconfiguration", {"initial": "a", "target": "m"})
+    complete(cmd)
+    # The robot's own HK now says so, and every value YAMCS shows is what the robot sent.
+    sent = {}
     end = time.monotonic() + STEP
     while True:
-        # (yamcs-client 2.1's list_command_history(CMD) asks /commands/MMIC/...: 404 on 5.12.8)
-        entries = [e for e in yamcs.client.get_archive(INSTANCE).list_command_history()
-                   if e.id == cmd.id]
-        if entries and entries[0].is_complete() or time.monotonic() > end:
+        rec = hk.next_hk(0x101)
+        while not robot.lines.empty():
+            line = robot.lines.get_nowait()
+            if line.get("dir") == "tm":
+                d = decode_tm(bytes.fromhex(line["hex"]))
+                if d["service"] == 3:
+                    sent[d["seq_count"]] = d
+        d = sent.get(rec["ccsds_seq_count"].raw_value)
+        if d and d["housekeeping"]["target_state"] == "m":
             break
-        time.sleep(0.3)
-    assert entries and entries[0].is_success(), entries
-    assert entries[0].acknowledgments["Verifier_Complete"].status == "OK"
-    assert entries[0].binary == rx.raw
+        assert time.monotonic() < end, "no HK with target state m"
+    assert_hk_equal(rec, d)
+    assert (rec["mode"].eng_value, rec["target_state"].eng_value) == ("OPERATIONAL", "m")
 
 
-def test_tc_answered_with_acceptance_failure_fails(robot, commands):
-    robot.answer, robot.failure_code = "fail-acceptance", 3
-    cmd = commands.issue(CMD, args={"function_id": "RECONFIGURE", "value": 1})
-    rx = get_tc(robot)
-    assert rx.tc.app_data == bytes([2, 1])
+def test_a_reconfiguration_to_a_stretch_state_fails_at_acceptance(robot, commands):
+    cmd, _ = issue(robot, commands, "reconfiguration", {"initial": "a", "target": "d"})
     cmd.await_complete(timeout=STEP)
-    assert cmd.is_failure(), cmd.acknowledgments
-    assert ack_status(cmd, "Verifier_Failed") == "OK"  # the FailedVerifier matched TM(1,2)
-    assert cmd.error == "Verifier Failed return: REFUSED_IN_MODE"  # ReturnParmRef: the failure code
-    assert ack_status(cmd, "Verifier_Complete") != "OK"
+    assert cmd.is_failure() and ack(cmd, "Verifier_Accepted") != "OK", cmd.acknowledgments
+    assert cmd.error == "Verifier Failed return: NO_SUCH_COMMAND"
 
 
-def test_tc_answered_with_completion_failure_fails(robot, commands):
-    robot.answer, robot.failure_code = "fail-completion", 4
-    cmd = commands.issue(CMD, args={"function_id": "STOP", "value": 0})
-    get_tc(robot)
-    cmd.await_complete(timeout=STEP)
-    assert cmd.is_failure(), cmd.acknowledgments
-    assert ack_status(cmd, "Verifier_Accepted") == "OK"
-    assert ack_status(cmd, "Verifier_Complete") != "OK"  # PENDING, then CANCELLED
-    assert cmd.error == "Verifier Failed return: EXECUTION_FAULT"
+def test_housekeeping_off_and_on_by_tc(robot, commands, hk):
+    cmd, _ = issue(robot, commands, "disable_housekeeping")
+    complete(cmd)
+    hk.clear()
+    assert hk.drain(2.5, 0x101) == []
+    cmd, _ = issue(robot, commands, "modify_collection_interval", {"interval_ms": 200})
+    complete(cmd)
+    cmd, _ = issue(robot, commands, "enable_housekeeping")
+    complete(cmd)
+    n = len(hk.drain(2.0, 0x101))
+    assert 5 <= n <= 15, f"{n} HK reports in 2 s at 200 ms"
+    cmd, _ = issue(robot, commands, "modify_collection_interval", {"interval_ms": 1000})
+    complete(cmd)
 
 
-def test_reports_with_another_request_id_do_not_complete_the_tc(robot, commands):
-    robot.answer = "silent"
-    cmd = commands.issue(CMD, args={"function_id": "SET_MODE", "value": 1})
-    rx = get_tc(robot)
-    seq = rx.tc.sp_header.seq_count
-    other = rx.raw[:2] + ((0xC000 | ((seq + 1) & 0x3FFF)).to_bytes(2, "big"))  # next sequence count
-    robot.report(1, other)
-    robot.report(7, other)
+def test_reports_with_another_request_id_do_nothing_and_silence_times_out(robot, inject, commands):
+    # Robot 2 is not served by this gateway: its TCs are refused by the CCSDS layer, unanswered.
+    silent = commands.issue("/MMIC/stop", args={"apid": ROBOT2 + 1})
+    cmd = commands.issue("/MMIC/stop", args={"apid": ROBOT2})
+    for _ in range(2):
+        assert robot.next_tc(STEP)["refused"] == "apid"
+    seq = cmd.attributes.get("ccsds-seqcount")
+    end = time.monotonic() + STEP
+    while seq is None and time.monotonic() < end:
+        time.sleep(0.05)
+        seq = cmd.attributes.get("ccsds-seqcount")
+
+    def report(sub, seq_count, n):
+        return encode_tm({"apid": ROBOT2, "seq_count": 300 + n, "service": 1, "subservice": sub,
+                          "report": {"stage": {1: "acceptance", 3: "start", 7: "completion"}[sub],
+                                     "request": {"apid": ROBOT2, "seq_count": seq_count}}})
+    for n, sub in enumerate((1, 3, 7)):
+        inject(report(sub, (seq + 1) & 0x3FFF, n))
     time.sleep(2.0)
     assert not cmd.is_complete(), f"completed by reports for another TC: {cmd.acknowledgments}"
-    robot.report(1, rx.request_id)
-    robot.report(7, rx.request_id)
-    cmd.await_complete(timeout=STEP)
-    assert cmd.is_success(), cmd.acknowledgments
+    for n, sub in enumerate((1, 3, 7)):
+        inject(report(sub, seq, 3 + n))
+    complete(cmd)
+    # The other one heard nothing: its acceptance window (10 s) ends and fails it (onTimeout FAIL).
+    silent.await_complete(timeout=15)
+    assert silent.is_failure(), silent.acknowledgments
+    assert ack(silent, "Verifier_Accepted") == "TIMEOUT"
 
 
 def test_out_of_range_argument_is_refused_by_yamcs(robot, commands):
-    robot.answer = "complete"
     from yamcs.client import YamcsError
 
-    with pytest.raises(YamcsError, match=r"Value 4 is not in the range \[0,3\]"):
-        commands.issue(CMD, args={"function_id": "SET_MODE", "value": 4})
+    with pytest.raises(YamcsError, match=r"Value 2501 is not in the range \[500,2500\]"):
+        commands.issue("/MMIC/arm", args={"side": 0, "target": 2, "pulse": 2501})
+    with pytest.raises(YamcsError, match=r"not in the range \[1,3\]"):
+        commands.issue("/MMIC/mode", args={"mode": 4})
     with pytest.raises(YamcsError, match="cannot be found in enumeration list"):
-        commands.issue(CMD, args={"function_id": "NO_SUCH_FUNCTION", "value": 0})
+        commands.issue("/MMIC/reconfiguration", args={"initial": "a", "target": "z"})
     with pytest.raises(queue.Empty):
-        robot.tcs.get(timeout=1.0)
-    assert not robot.errors, robot.errors
+        robot.next_tc(1.0)
 
 
-def test_no_invalid_tc_reached_the_robot(robot):
-    assert not robot.errors, robot.errors
+def test_no_tc_was_refused_by_the_robot_but_robot_2s(robot):
+    assert robot.proc.poll() is None, robot.proc.stderr.read()

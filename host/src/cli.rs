@@ -8,7 +8,7 @@
 //! own code); [`EXIT_IO`] 3 when a page cannot be written or stdout is closed.
 
 use crate::codec;
-use crate::{motion, pages};
+use crate::{ground, motion, pages, pus, xtce};
 use clap::{Parser, Subcommand};
 use mmic::motion::State;
 use mmic::wire::PacketKind;
@@ -26,13 +26,17 @@ voltages in mV, currents in mA. JSON field names are the `name` column of the fi
 Exit codes:
   0  success
   1  the bytes are not a valid packet; stderr names the failed check
-     (length, header, checksum, field or command) with expected and found values
+     (length, header, checksum, field or command; for pus-tc/pus-tm the check's name of
+     spec/ccsds/bad-inputs.toml, e.g. `checksum`, `unknown-function`) with the numbers
   2  bad input: unknown kind, invalid or out-of-range JSON, malformed hex, usage error
   3  a file could not be written (spec --write), or stdout is closed
 
 Examples:
   mmic encode command '{\"board\":1,\"command\":\"stop\"}'
   mmic decode command 4d49434d0102000000000000ad97
+  mmic encode pus-tc '{\"apid\":257,\"seq_count\":1,\"function\":\"reconfiguration\",\"args\":{\"initial\":\"a\",\"target\":\"m\"}}'
+  mmic decode pus-tc 1901c00100082f08010000096164....
+  mmic xtce > spec/ccsds/mmic.xtce.xml
   mmic spec --write spec/pages";
 
 const ENCODE_HELP: &str = "\
@@ -99,21 +103,37 @@ pub enum Cmd {
     /// Encode a packet from JSON; prints lowercase hex.
     #[command(long_about = ENCODE_HELP, after_help = ENCODE_AFTER)]
     Encode {
-        /// Packet kind: command | heartbeat | internal-heartbeat | b-command.
-        #[arg(value_parser = parse_kind)]
-        kind: PacketKind,
+        /// Packet kind: command | heartbeat | internal-heartbeat | b-command | pus-tc | pus-tm.
+        #[arg(value_parser = parse_any_kind)]
+        kind: AnyKind,
         /// The packet as JSON (as `mmic decode` prints it).
         json: String,
     },
     /// Decode a packet from hex; prints JSON with every field.
     #[command(long_about = DECODE_HELP, after_help = DECODE_AFTER)]
     Decode {
-        /// Packet kind: command | heartbeat | internal-heartbeat | b-command.
-        #[arg(value_parser = parse_kind)]
-        kind: PacketKind,
+        /// Packet kind: command | heartbeat | internal-heartbeat | b-command | pus-tc | pus-tm.
+        #[arg(value_parser = parse_any_kind)]
+        kind: AnyKind,
         /// The packet bytes in hex.
         hex: String,
+        /// pus-tc, pus-tm: an APID to accept (repeatable; decimal or 0x hex). Default: every
+        /// robot's, 0x101..=0x1FF.
+        #[arg(long = "apid", value_parser = pus::parse_apid)]
+        apids: Vec<u16>,
     },
+    /// The XTCE mission database of the PUS-C packets, generated from the library and spec/
+    /// (spec/ccsds/mmic.xtce.xml is this output); or the ccsdspy field list of TM(3,25).
+    #[command(after_help = XTCE_AFTER)]
+    Xtce {
+        /// Print the ccsdspy field list of TM(3,25) (CSV) instead.
+        #[arg(long)]
+        ccsdspy: bool,
+    },
+    /// Tools for the ground interop tests (ground/): fixtures made by the real PUS gateway, and
+    /// a UDP stand-in robot (the gateway and a trivial board A) for the YAMCS loop.
+    #[command(subcommand)]
+    Ground(GroundCmd),
     /// The shortest primitive sequence between two states (Table 5 letters a..o).
     #[command(
         after_help = "Example: mmic plan a m --json\n  {\"from\":\"a\",\"to\":\"m\",\"primitives\":[4,1]}"
@@ -163,6 +183,62 @@ pub enum Cmd {
     },
 }
 
+const XTCE_AFTER: &str = "\
+Regenerate the committed files (tests fail when they are stale):
+  cargo run -q -p mmic-host -- xtce > spec/ccsds/mmic.xtce.xml
+  cargo run -q -p mmic-host -- xtce --ccsdspy > spec/ccsds/hk-3-25.ccsdspy.csv";
+
+/// `mmic ground ...`.
+#[derive(Debug, Subcommand)]
+pub enum GroundCmd {
+    /// Write the interop fixtures: tm.jsonl, tc.jsonl (every TM type the gateway emits, the TCs
+    /// that made them, with their decoded JSON), hk.bin + hk.json (a TM(3,25) stream).
+    Fixtures {
+        /// Directory to write into (created).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
+    /// The stand-in robot: TCs on UDP 127.0.0.1:TC_PORT, TM to 127.0.0.1:TM_PORT; one JSON line
+    /// per packet on stdout (first {"ready":true,"tc_port":N}).
+    Robot {
+        /// Where TM goes (YAMCS's UDP TM link).
+        #[arg(long)]
+        tm_port: u16,
+        /// Where TCs arrive (0: a free port, printed first).
+        #[arg(long, default_value_t = 0)]
+        tc_port: u16,
+        /// Stop after this many seconds.
+        #[arg(long, default_value_t = 60.0)]
+        seconds: f64,
+        /// Housekeeping collection interval, ms.
+        #[arg(long, default_value_t = 1000)]
+        hk_ms: u32,
+        /// How long the stand-in's motions take, ms.
+        #[arg(long, default_value_t = 500)]
+        motion_ms: u32,
+    },
+}
+
+/// A packet kind of `mmic encode|decode`: a legacy packet, or a PUS-C TC or TM.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AnyKind {
+    /// One of the paper's packets.
+    Legacy(PacketKind),
+    /// A PUS-C telecommand.
+    PusTc,
+    /// A PUS-C telemetry packet.
+    PusTm,
+}
+
+/// A packet kind from its name: the legacy names, `pus-tc`, `pus-tm`.
+pub fn parse_any_kind(name: &str) -> Result<AnyKind, CliError> {
+    match name {
+        "pus-tc" => Ok(AnyKind::PusTc),
+        "pus-tm" => Ok(AnyKind::PusTm),
+        _ => parse_kind(name).map(AnyKind::Legacy),
+    }
+}
+
 /// The command line, with the help texts computed from the library (the map's legend).
 pub fn command() -> clap::Command {
     <Cli as clap::CommandFactory>::command()
@@ -193,13 +269,52 @@ pub fn parse_kind(name: &str) -> Result<PacketKind, CliError> {
 pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), CliError> {
     match cli.cmd {
         Cmd::Encode { kind, json } => {
-            let bytes = codec::encode(kind, &json)?;
+            let bytes = match kind {
+                AnyKind::Legacy(k) => codec::encode(k, &json)?,
+                AnyKind::PusTc => pus::encode_tc(&json)?,
+                AnyKind::PusTm => pus::encode_tm(&json)?,
+            };
             writeln!(out, "{}", codec::to_hex(&bytes)).map_err(CliError::Output)?;
         }
-        Cmd::Decode { kind, hex } => {
-            let json = codec::decode(kind, &codec::from_hex(&hex)?)?;
+        Cmd::Decode { kind, hex, apids } => {
+            let bytes = codec::from_hex(&hex)?;
+            let apids = if apids.is_empty() {
+                pus::robot_apids()
+            } else {
+                apids
+            };
+            let json = match kind {
+                AnyKind::Legacy(k) => codec::decode(k, &bytes)?,
+                AnyKind::PusTc => pus::decode_tc(&bytes, &apids)?.to_string(),
+                AnyKind::PusTm => pus::decode_tm(&bytes, &apids)?.to_string(),
+            };
             writeln!(out, "{json}").map_err(CliError::Output)?;
         }
+        Cmd::Xtce { ccsdspy } => {
+            let text = if ccsdspy {
+                xtce::ccsdspy_csv()
+            } else {
+                xtce::generate().map_err(CliError::Spec)?
+            };
+            write!(out, "{text}").map_err(CliError::Output)?;
+        }
+        Cmd::Ground(GroundCmd::Fixtures { out: dir }) => {
+            let files = ground::write_fixtures(&dir).map_err(|source| CliError::Write {
+                path: dir.clone(),
+                source,
+            })?;
+            for f in files {
+                writeln!(log, "wrote {}", f.display()).map_err(CliError::Output)?;
+            }
+        }
+        Cmd::Ground(GroundCmd::Robot {
+            tm_port,
+            tc_port,
+            seconds,
+            hk_ms,
+            motion_ms,
+        }) => ground::robot(tm_port, tc_port, seconds, hk_ms, motion_ms, out)
+            .map_err(CliError::Sim)?,
         Cmd::Plan { from, to, json } => {
             let text = if json {
                 motion::plan_json(from, to)

@@ -24,6 +24,12 @@ pub enum CliError {
     /// Encoding or decoding failed.
     #[error(transparent)]
     Codec(#[from] CodecError),
+    /// A PUS-C packet was refused, or its JSON is bad.
+    #[error(transparent)]
+    Pus(#[from] crate::pus::PusCodecError),
+    /// A table of spec/ could not be turned into the XTCE (a row without a name).
+    #[error("spec/: {0}")]
+    Spec(String),
     /// A page could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Write {
@@ -78,6 +84,8 @@ impl CliError {
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Codec(e) => e.exit_code(),
+            CliError::Pus(e) => e.exit_code(),
+            CliError::Spec(_) => EXIT_INPUT,
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
             CliError::Plan { .. } | CliError::Inject(_) => EXIT_INPUT,
             CliError::Incomplete(_) => 1,

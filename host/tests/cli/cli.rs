@@ -8,14 +8,14 @@ use mmic::wire::command::CommandRepr;
 use serde_json::{json, Value};
 use std::process::{Command as Proc, Output};
 
-fn mmic(args: &[&str]) -> Output {
+pub(crate) fn mmic(args: &[&str]) -> Output {
     Proc::new(env!("CARGO_BIN_EXE_mmic"))
         .args(args)
         .output()
         .expect("run mmic")
 }
 
-fn ok(args: &[&str]) -> String {
+pub(crate) fn ok(args: &[&str]) -> String {
     let o = mmic(args);
     assert!(
         o.status.success(),
@@ -25,7 +25,7 @@ fn ok(args: &[&str]) -> String {
     String::from_utf8(o.stdout).unwrap().trim().to_string()
 }
 
-fn fails(args: &[&str], code: i32, needle: &str) {
+pub(crate) fn fails(args: &[&str], code: i32, needle: &str) {
     let o = mmic(args);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(code), "{args:?}: {err}");

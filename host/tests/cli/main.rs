@@ -7,3 +7,4 @@ mod json_shape;
 mod pages;
 mod plan;
 mod plot;
+mod pus;

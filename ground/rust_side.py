@@ -1,0 +1,118 @@
+"""The Rust side of the ground tests: the `mmic` binary (its path from $MMIC_BIN, which
+ground/run-tests sets after building it) and what it makes.
+
+- `mmic(*args)` runs it and returns the CompletedProcess;
+- `fixtures(dir)` writes the interop fixtures (`mmic ground fixtures`): tm.jsonl / tc.jsonl (every TM
+  type the real PUS gateway emits and the TCs that made them, with the decoded JSON), hk.bin +
+  hk.json (a TM(3,25) stream and what each packet carries);
+- `RobotProcess` is the robot the YAMCS loop talks to over UDP. By default the stand-in
+  `mmic ground robot` (the real gateway + a trivial board A); $GROUND_ROBOT replaces the command
+  line (a format string with {mmic}, {tm_port}, {tc_port}, {seconds}), e.g. for
+  `mmic sim --protocol pus` (ground/README.md, "Plugging in the simulator").
+"""
+from __future__ import annotations
+
+import json
+import os
+import queue
+import shlex
+import signal
+import subprocess
+import threading
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+XTCE = REPO / "spec" / "ccsds" / "mmic.xtce.xml"
+CCSDSPY_CSV = REPO / "spec" / "ccsds" / "hk-3-25.ccsdspy.csv"
+ROBOT_APID = 0x101  # robot 1 (spec/ccsds/services.toml: 0x100 + n)
+
+
+def crc16_ccitt_false(data: bytes) -> int:
+    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection, no final XOR), as PUS requires;
+    written here independently of both Rust and spacepackets."""
+    crc = 0xFFFF
+    for b in data:
+        crc ^= b << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ 0x1021) & 0xFFFF if crc & 0x8000 else (crc << 1) & 0xFFFF
+    return crc
+
+
+def mmic_bin() -> str:
+    b = os.environ.get("MMIC_BIN")
+    if not b:
+        target = os.environ.get("CARGO_TARGET_DIR", str(REPO / "target"))
+        b = str(Path(target) / "debug" / "mmic")
+    if not Path(b).is_file():
+        raise FileNotFoundError(f"no mmic binary at {b}: run ground/run-tests (it builds it) or set MMIC_BIN")
+    return b
+
+
+def mmic(*args: str, check: bool = True) -> subprocess.CompletedProcess:
+    return subprocess.run([mmic_bin(), *args], capture_output=True, text=True, check=check, timeout=60)
+
+
+def decode_tm(raw: bytes) -> dict:
+    return json.loads(mmic("decode", "pus-tm", raw.hex()).stdout)
+
+
+def decode_tc(raw: bytes) -> dict:
+    return json.loads(mmic("decode", "pus-tc", raw.hex()).stdout)
+
+
+def encode_tm(obj: dict) -> bytes:
+    return bytes.fromhex(mmic("encode", "pus-tm", json.dumps(obj)).stdout.strip())
+
+
+def encode_tc(obj: dict) -> bytes:
+    return bytes.fromhex(mmic("encode", "pus-tc", json.dumps(obj)).stdout.strip())
+
+
+def fixtures(out: Path) -> Path:
+    mmic("ground", "fixtures", "--out", str(out))
+    return out
+
+
+def jsonl(path: Path) -> list[dict]:
+    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+class RobotProcess:
+    """The robot on UDP: TCs on 127.0.0.1:tc_port, TM to 127.0.0.1:tm_port. Its JSON lines
+    ({"dir":"tc"|"tm","hex":..}) arrive on `self.lines`; `tcs()` gets the next TC it received."""
+
+    def __init__(self, tm_port: int, tc_port: int, seconds: int = 240):
+        template = os.environ.get(
+            "GROUND_ROBOT",
+            "{mmic} ground robot --tm-port {tm_port} --tc-port {tc_port} --seconds {seconds}")
+        cmd = template.format(mmic=mmic_bin(), tm_port=tm_port, tc_port=tc_port, seconds=seconds)
+        self.proc = subprocess.Popen(shlex.split(cmd), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True, start_new_session=True)
+        self.lines: "queue.Queue[dict]" = queue.Queue()
+        self.tc_lines: "queue.Queue[dict]" = queue.Queue()
+        self.ready = threading.Event()
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self):
+        for line in self.proc.stdout:
+            try:
+                d = json.loads(line)
+            except ValueError:
+                continue
+            if d.get("ready"):
+                self.ready.set()
+            elif d.get("dir") == "tc":
+                self.tc_lines.put(d)
+            self.lines.put(d)
+
+    def next_tc(self, timeout: float) -> dict:
+        return self.tc_lines.get(timeout=timeout)
+
+    def close(self):
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGTERM)
+            try:
+                self.proc.wait(5)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait()

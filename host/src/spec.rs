@@ -1,0 +1,290 @@
+//! The reviewable tables of spec/ that the PUS tools read: the ST\[8\] argument table
+//! (spec/ccsds/functions.toml), the services, failure codes and events
+//! (spec/ccsds/services.toml) and the fault names (spec/faults.toml). They are compiled in
+//! (`include_str!`) and parsed once, so the XTCE generator and the PUS codec have no second
+//! copy of any of them; tests/pus/spec.rs holds the library to the same files.
+
+use mmic::faults::Fault;
+use mmic::pus::function::FunctionId;
+use mmic::pus::request::RequestError;
+use mmic::pus::verification::{ABANDONED, KEY_REUSED, QUEUE_FULL, UNACKNOWLEDGED};
+use mmic::refusal::Refusal;
+use serde::Deserialize;
+use std::sync::OnceLock;
+
+/// spec/ccsds/functions.toml.
+pub const FUNCTIONS_TOML: &str = include_str!("../../spec/ccsds/functions.toml");
+/// spec/ccsds/services.toml.
+pub const SERVICES_TOML: &str = include_str!("../../spec/ccsds/services.toml");
+/// spec/faults.toml.
+pub const FAULTS_TOML: &str = include_str!("../../spec/faults.toml");
+
+/// One argument of an ST\[8\] function.
+#[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
+pub struct Arg {
+    /// Its name.
+    pub name: String,
+    /// `u8` or `u16`.
+    #[serde(rename = "type")]
+    pub ty: String,
+    /// Inclusive range.
+    pub range: [u32; 2],
+    /// Unit, if any.
+    #[serde(default)]
+    pub unit: Option<String>,
+    /// What it means.
+    pub meaning: String,
+}
+
+impl Arg {
+    /// Size in bits (8 or 16).
+    pub fn bits(&self) -> u32 {
+        match self.ty.as_str() {
+            "u16" => 16,
+            _ => 8,
+        }
+    }
+
+    /// A motion state 'a'..='o' (Table 5), sent as its ASCII letter.
+    pub fn is_state(&self) -> bool {
+        self.range == [u32::from(b'a'), u32::from(b'o')]
+    }
+}
+
+/// One ST\[8\] function.
+#[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
+pub struct Function {
+    /// Function ID.
+    pub id: u8,
+    /// Name (`FunctionId::name`).
+    pub name: String,
+    /// Arguments in order.
+    pub args: Vec<Arg>,
+}
+
+#[derive(Deserialize)]
+struct FunctionsFile {
+    function: Vec<Function>,
+}
+
+/// One telecommand the robot serves.
+#[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
+pub struct TcRow {
+    /// Service type.
+    pub service: u8,
+    /// Subservice type.
+    pub subservice: u8,
+    /// Name.
+    pub name: String,
+    /// Application data, in words.
+    pub app_data: String,
+    /// The reports it gets.
+    pub reports: String,
+}
+
+/// One telemetry packet type the robot sends.
+#[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
+pub struct TmRow {
+    /// Service type.
+    pub service: u8,
+    /// Its subservices.
+    pub subservices: Vec<u8>,
+    /// Name.
+    pub name: String,
+    /// Source data, in words.
+    pub source_data: String,
+}
+
+/// One row of the ST\[1\] failure code table.
+#[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
+pub struct FailureRow {
+    /// A code (`0x0200`) or a family (`1..=255`, `0x0100 + n`).
+    pub code: String,
+    /// What it means.
+    pub meaning: String,
+    /// What its data word carries.
+    pub data: String,
+}
+
+/// One ST\[5\] event definition.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+pub struct EventRow {
+    /// Its ID (`0x0001`) or family (`0x0100 + n`).
+    pub id: String,
+    /// Name.
+    pub name: String,
+    /// Severity: a number or a sentence.
+    pub severity: toml::Value,
+    /// Its auxiliary data.
+    pub aux: String,
+}
+
+/// spec/ccsds/services.toml.
+#[derive(Debug, Clone, Deserialize)]
+pub struct Services {
+    /// Telecommands.
+    pub tc: Vec<TcRow>,
+    /// Telemetry.
+    pub tm: Vec<TmRow>,
+    /// Failure codes.
+    pub failure: Vec<FailureRow>,
+    /// Events.
+    pub event: Vec<EventRow>,
+}
+
+/// One fault of spec/faults.toml.
+#[derive(Debug, Clone, Deserialize)]
+pub struct FaultRow {
+    /// Its bit.
+    pub bit: u8,
+    /// Its name.
+    pub name: String,
+}
+
+#[derive(Deserialize)]
+struct FaultsFile {
+    fault: Vec<FaultRow>,
+}
+
+/// The functions of spec/ccsds/functions.toml, in file order.
+pub fn functions() -> &'static [Function] {
+    static F: OnceLock<Vec<Function>> = OnceLock::new();
+    F.get_or_init(|| {
+        toml::from_str::<FunctionsFile>(FUNCTIONS_TOML)
+            .map(|f| f.function)
+            .unwrap_or_default()
+    })
+}
+
+/// The function named `name` (or with that ID).
+pub fn function(id: FunctionId) -> Option<&'static Function> {
+    functions().iter().find(|f| f.id == id.id())
+}
+
+/// spec/ccsds/services.toml.
+pub fn services() -> &'static Services {
+    static S: OnceLock<Services> = OnceLock::new();
+    S.get_or_init(|| {
+        toml::from_str(SERVICES_TOML).unwrap_or(Services {
+            tc: Vec::new(),
+            tm: Vec::new(),
+            failure: Vec::new(),
+            event: Vec::new(),
+        })
+    })
+}
+
+/// The faults of spec/faults.toml, in file order.
+pub fn faults() -> &'static [FaultRow] {
+    static F: OnceLock<Vec<FaultRow>> = OnceLock::new();
+    F.get_or_init(|| {
+        toml::from_str::<FaultsFile>(FAULTS_TOML)
+            .map(|f| f.fault)
+            .unwrap_or_default()
+    })
+}
+
+/// The name of the telecommand (service, subservice), from services.toml.
+pub fn tc_name(service: u8, subservice: u8) -> Option<&'static str> {
+    services()
+        .tc
+        .iter()
+        .find(|t| t.service == service && t.subservice == subservice)
+        .map(|t| t.name.as_str())
+}
+
+/// An upper-case label for XTCE enumerations (`not_allowed_in_mode` → `NOT_ALLOWED_IN_MODE`).
+pub fn label(name: &str) -> String {
+    name.to_ascii_uppercase().replace(['-', ' '], "_")
+}
+
+fn parse_code(text: &str) -> Option<u16> {
+    match text.strip_prefix("0x") {
+        Some(h) => u16::from_str_radix(h, 16).ok(),
+        None => text.parse().ok(),
+    }
+}
+
+/// Every ST\[1\] failure code with its label, ascending: each row of services.toml's failure
+/// table expanded (refusal codes with the library's refusal names, fault codes with the fault
+/// names of spec/faults.toml, the single codes with the library's constants' names).
+/// A row the generator cannot name is an error (services.toml grew a code: name it here).
+pub fn failure_codes() -> Result<Vec<(u16, String)>, String> {
+    let mut out = Vec::new();
+    for row in &services().failure {
+        match row.code.as_str() {
+            "1..=255" => {
+                for r in Refusal::ALL {
+                    out.push((
+                        u16::from(r.to_wire()),
+                        format!("REFUSED_{}", label(r.name())),
+                    ));
+                }
+            }
+            "0x0100 + n" => {
+                for f in faults() {
+                    out.push((
+                        0x0100 + u16::from(f.bit),
+                        format!("FAULT_{}", label(&f.name)),
+                    ));
+                }
+            }
+            text => {
+                let code = parse_code(text).ok_or(format!("failure code {text:?}"))?;
+                let name = match code {
+                    UNACKNOWLEDGED => "UNACKNOWLEDGED".to_string(),
+                    ABANDONED => "ABANDONED".to_string(),
+                    QUEUE_FULL => "QUEUE_FULL".to_string(),
+                    KEY_REUSED => "KEY_REUSED".to_string(),
+                    0x0301..=0x0306 => RequestError::NAMES
+                        .get(usize::from(code - 0x0301))
+                        .map(|n| label(n))
+                        .unwrap_or_default(),
+                    _ => {
+                        return Err(format!(
+                            "failure code {text} has no name in host/src/spec.rs"
+                        ))
+                    }
+                };
+                out.push((code, name));
+            }
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// The label of a failure code, if it has one.
+pub fn failure_label(code: u16) -> Option<String> {
+    failure_codes()
+        .ok()?
+        .into_iter()
+        .find(|(c, _)| *c == code)
+        .map(|(_, l)| l)
+}
+
+/// Every event definition ID with its name, ascending: the single events of services.toml and
+/// one `fault_<name>` per fault of spec/faults.toml for the `0x0100 + n` family.
+pub fn event_ids() -> Result<Vec<(u16, String)>, String> {
+    let mut out = Vec::new();
+    for row in &services().event {
+        if row.id == "0x0100 + n" {
+            for f in faults() {
+                out.push((
+                    0x0100 + u16::from(f.bit),
+                    format!("{}_{}", row.name, f.name),
+                ));
+            }
+        } else {
+            let id = parse_code(&row.id).ok_or(format!("event ID {:?}", row.id))?;
+            out.push((id, row.name.clone()));
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
+/// The fault of a bit, by the library.
+pub fn fault_of_bit(bit: u8) -> Option<Fault> {
+    Fault::ALL.into_iter().find(|f| f.bit() == bit)
+}
