@@ -597,7 +597,8 @@ const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + gateway::MAX_TM_DATA;
 /// ground's UDP socket into [`Gateway::tc_packet`], the legacy commands of
 /// [`Gateway::tick`] to board A over the same visits as [`ServerTask`]'s (connect, send, wait
 /// for the heartbeat, disconnect), the heartbeat into [`Gateway::heartbeat`], and every
-/// report written by [`Gateway::encode`] to the ground over UDP.
+/// report written by [`Gateway::encode`] to the ground over UDP. It takes telecommands only
+/// once board A's first heartbeat came, so every change after power-up is an event.
 pub struct GatewayTask {
     /// Where the ground's telecommands arrive (non-blocking).
     pub from_ground: UdpSocket,
@@ -621,7 +622,15 @@ impl GatewayTask {
         while node.running() {
             let now = node.poll();
             let mut busy = false;
-            while let Ok(n) = self.from_ground.recv(&mut buf) {
+            // Telecommands are taken once board A's first heartbeat came (the gateway polls
+            // at once): ST[5] events are what changed between two heartbeats, so a command
+            // answered by the very first one (entering Operational, a fault raised on the
+            // way) would otherwise change nothing the gateway could report. Meanwhile they
+            // wait in the socket.
+            while g.latest(self.robot.0).is_some() {
+                let Ok(n) = self.from_ground.recv(&mut buf) else {
+                    break;
+                };
                 busy = true;
                 let bytes = buf.get(..n).unwrap_or(&[]);
                 match g.tc_packet(bytes) {
