@@ -527,31 +527,40 @@ impl ServerTask {
     }
 
     /// Waits up to `visit_ms` for the robot's heartbeat and forwards it; then disconnects (one
-    /// robot per loop). Polled without blocking: a socket read timeout is rounded up to the
-    /// kernel's tick (4–8 ms here), and a blocked server would hold the paced clock back.
-    fn await_heartbeat(&mut self, node: &Node<'_>, mut sock: TcpStream) {
-        let _ = sock.set_nonblocking(true);
-        let until = node.clock.now_ms().saturating_add(self.visit_ms);
-        let mut d = Deframer::<256>::new();
-        let mut buf = [0u8; 256];
-        while node.running() && node.poll() < until {
-            match sock.read(&mut buf) {
-                Ok(0) => return,
-                Ok(n) => {
-                    for f in frames(&mut d, &buf[..n]) {
-                        if f.kind() == PacketKind::Heartbeat {
-                            self.to_ground.send(node.clock.now_ms(), f.as_bytes());
-                            return;
-                        }
-                    }
-                }
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
-                    std::thread::sleep(Duration::from_micros(200));
-                }
-                Err(_) => return,
-            }
+    /// robot per loop).
+    fn await_heartbeat(&mut self, node: &Node<'_>, sock: TcpStream) {
+        if let Some(hb) = await_heartbeat(node, sock, self.visit_ms) {
+            self.to_ground.send(node.clock.now_ms(), &hb);
         }
     }
+}
+
+/// Waits up to `wait_ms` on a visit's connection for board A's heartbeat. Polled without
+/// blocking: a socket read timeout is rounded up to the kernel's tick (4–8 ms here), and a
+/// blocked server would hold the paced clock back.
+fn await_heartbeat(node: &Node<'_>, mut sock: TcpStream, wait_ms: u32) -> Option<Vec<u8>> {
+    let _ = sock.set_nonblocking(true);
+    let until = node.clock.now_ms().saturating_add(wait_ms);
+    let mut d = Deframer::<256>::new();
+    let mut buf = [0u8; 256];
+    while node.running() && node.poll() < until {
+        match sock.read(&mut buf) {
+            Ok(0) => return None,
+            Ok(n) => {
+                if let Some(f) = frames(&mut d, &buf[..n])
+                    .into_iter()
+                    .find(|f| f.kind() == PacketKind::Heartbeat)
+                {
+                    return Some(f.as_bytes().to_vec());
+                }
+            }
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+                std::thread::sleep(Duration::from_micros(200));
+            }
+            Err(_) => return None,
+        }
+    }
+    None
 }
 
 /// One end of a UDP link as a packet writer: each write is one datagram to `peer`.
@@ -689,33 +698,12 @@ impl GatewayTask {
         if sock.write_all(&packet).is_err() {
             return;
         }
-        let _ = sock.set_nonblocking(true);
-        let until = node
-            .clock
-            .now_ms()
-            .saturating_add(self.config.uplink.timeout_ms);
-        let mut d = Deframer::<256>::new();
-        let mut buf = [0u8; 256];
-        while node.running() && node.poll() < until {
-            match sock.read(&mut buf) {
-                Ok(0) => return,
-                Ok(n) => {
-                    for f in frames(&mut d, &buf[..n]) {
-                        if f.kind() != PacketKind::Heartbeat {
-                            continue;
-                        }
-                        if let Ok(hb) = mmic::wire::heartbeat::HeartbeatRepr::parse(f.as_bytes()) {
-                            let out = g.heartbeat(node.clock.now_ms(), &hb);
-                            self.reports(node, g, out);
-                        }
-                        return;
-                    }
-                }
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
-                    std::thread::sleep(Duration::from_micros(200));
-                }
-                Err(_) => return,
-            }
+        let wait = self.config.uplink.timeout_ms;
+        let hb = await_heartbeat(node, sock, wait)
+            .and_then(|b| mmic::wire::heartbeat::HeartbeatRepr::parse(&b).ok());
+        if let Some(hb) = hb {
+            let out = g.heartbeat(node.clock.now_ms(), &hb);
+            self.reports(node, g, out);
         }
     }
 }
