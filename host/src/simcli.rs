@@ -24,6 +24,13 @@ Live progress goes to stderr; at the end a summary is printed, the JSON-lines lo
 packet and event is written (OUT/sim.jsonl), and two SVG plots: OUT/wifi-efficiency.svg
 (Figure 11 analogue) and OUT/bolting-attempts.svg (Figure 10 analogue).
 
+--protocol pus runs the same plan over CCSDS space packets with PUS-C services: the ground
+sends each step as a TC(8,1) function over UDP on loopback to the server board, which runs the
+PUS gateway (legacy commands to board A as before) and answers with ST[1] verification
+reports, periodic ST[3] housekeeping and ST[5] events; a step is done at its ST[1] completion.
+Every packet (TC, TM, legacy) is logged with its hex and kind. --serial-loss applies to the
+UDP link; every injection works as in the legacy run. The default is --protocol legacy.
+
 The clock is paced: simulated time never runs more than 20 ms ahead of the slowest node, so a
 busy host slows the run down instead of making the firmware's timeouts fire. Before anything
 is sent, the plan is checked against the robot's state, from its `start` line (`a` if none).";
@@ -91,6 +98,7 @@ Examples:
   mmic sim --inject low-battery@25 --summary-json out.json   the battery sags mid-reconfiguration
   mmic sim --inject hip-mismatch@0           the hip encoder reads off from power-up
   mmic sim --inject stop@28 --inject reset@31   the operator stops the motion and resumes it
+  mmic sim --protocol pus                    the demo over PUS: telecommands and telemetry over UDP
 
 Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
 2 bad arguments or a malformed plan file, or a step that does not fit the robot's state
@@ -104,6 +112,10 @@ pub struct SimArgs {
     /// Plan file (format: see host/plans/demo.plan); the built-in demo without it.
     #[arg(long, value_name = "FILE")]
     pub plan: Option<PathBuf>,
+    /// Between the ground and the server board: legacy (the paper's packets over the serial
+    /// line) or pus (PUS-C telecommands and telemetry over UDP, the server board as gateway).
+    #[arg(long, default_value = "legacy", value_parser = protocol)]
+    pub protocol: sim::Protocol,
     /// Simulated seconds per wall second.
     #[arg(long, default_value_t = 10.0)]
     pub scale: f64,
@@ -113,7 +125,7 @@ pub struct SimArgs {
     /// WiFi packet loss, each direction, 0..1.
     #[arg(long, default_value_t = 0.0, value_parser = probability)]
     pub wifi_loss: f64,
-    /// opsUI <-> server serial packet loss, 0..1.
+    /// opsUI <-> server serial packet loss (the UDP link's with --protocol pus), 0..1.
     #[arg(long, default_value_t = 0.0, value_parser = probability)]
     pub serial_loss: f64,
     /// Board A <-> board B serial packet loss, 0..1.
@@ -171,6 +183,10 @@ fn injections(a: &SimArgs) -> Result<Vec<Scheduled>, InjectError> {
         }
     }
     Ok(all)
+}
+
+fn protocol(s: &str) -> Result<sim::Protocol, String> {
+    s.parse()
 }
 
 fn probability(s: &str) -> Result<f64, String> {
@@ -238,6 +254,7 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     })?;
     let mut cfg = SimConfig::with_steps(steps);
     cfg.start_state = start;
+    cfg.protocol = a.protocol;
     cfg.scale = a.scale;
     cfg.seed = a.seed;
     cfg.wifi_loss = a.wifi_loss;

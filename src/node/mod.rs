@@ -40,4 +40,5 @@ pub mod ground;
 ))]
 pub mod handoff;
 pub mod plan_runner;
+pub mod pus_ground;
 pub mod server;

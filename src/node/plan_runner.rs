@@ -41,6 +41,7 @@
 //! ```
 
 use super::ground::{self, Done, Outcome, Uplink};
+use super::pus_ground::{self, TcLink, TcOut};
 use crate::command::Reconfiguration;
 use crate::command::{Command, CommandKind};
 use crate::faults::Faults;
@@ -97,14 +98,106 @@ pub enum PlanEnd {
         /// Its latched faults.
         faults: Faults,
     },
+    /// Step `step`'s telecommand (or an out-of-band one during it) was refused by the PUS
+    /// gateway itself, not by board A (a failure code of spec/ccsds/services.toml that is no
+    /// refusal: the request did not read, the queue was full, the key was reused).
+    Rejected {
+        /// The step.
+        step: usize,
+        /// The ST\[1\] failure code.
+        code: u16,
+    },
+}
+
+/// How a started motion ended, as a link that reports it says ([`Link::POLLS`] false: the
+/// PUS link's ST\[1\] completion report).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum MotionEnd {
+    /// It completed.
+    Completed,
+    /// A fault, or a mode change, cut it short.
+    Interrupted {
+        /// The mode the robot reported.
+        mode: Mode,
+        /// Its latched faults.
+        faults: Faults,
+    },
+    /// Its end was never heard (the link is gone).
+    Unacknowledged,
+}
+
+/// What one call of a [`Link`] asks for or reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LinkTick<P> {
+    /// Transmit this packet now.
+    pub send: Option<P>,
+    /// An attempt closed: answered in time or not (Figure 11).
+    pub attempt: Option<bool>,
+    /// A command finished (started, refused, or unacknowledged).
+    pub done: Option<Done>,
+    /// A started motion ended (only a link that reports it).
+    pub ended: Option<(u16, MotionEnd)>,
+}
+
+impl<P> Default for LinkTick<P> {
+    fn default() -> Self {
+        LinkTick {
+            send: None,
+            attempt: None,
+            done: None,
+            ended: None,
+        }
+    }
+}
+
+/// What the plan runner sends its commands through: one command outstanding at a time,
+/// numbered, resent until answered. The legacy [`Uplink`] (14-byte commands, heartbeats back)
+/// and the PUS [`TcLink`] (telecommands to the gateway, ST\[1\]/ST\[3\]/ST\[5\] back).
+pub trait Link {
+    /// What goes out for one command.
+    type Packet: Copy;
+    /// The runner polls with heartbeat requests to see a motion settle (legacy); false: the
+    /// link reports each motion's end itself ([`LinkTick::ended`]) and the robot's status.
+    const POLLS: bool;
+    /// No command is outstanding: one may be submitted.
+    fn is_idle(&self) -> bool;
+    /// Takes `command` and numbers it; none when one is outstanding.
+    fn submit(&mut self, command: Command) -> Option<u16>;
+    /// Advances to `now`: what to send, attempts closed, commands finished.
+    fn tick(&mut self, now: u32) -> LinkTick<Self::Packet>;
+}
+
+impl Link for Uplink {
+    type Packet = CommandRepr;
+    const POLLS: bool = true;
+
+    fn is_idle(&self) -> bool {
+        Uplink::is_idle(self)
+    }
+
+    fn submit(&mut self, command: Command) -> Option<u16> {
+        Uplink::submit(self, command).ok()
+    }
+
+    fn tick(&mut self, now: u32) -> LinkTick<CommandRepr> {
+        let t = Uplink::tick(self, now);
+        LinkTick {
+            send: t.send,
+            attempt: t.attempt,
+            done: t.done,
+            ended: None,
+        }
+    }
 }
 
 /// What one call asks for or reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct PlanTick {
+pub struct PlanTick<P = CommandRepr> {
     /// Transmit this packet now.
-    pub send: Option<CommandRepr>,
+    pub send: Option<P>,
     /// An attempt closed: answered in time or not (Figure 11).
     pub attempt: Option<bool>,
     /// A command finished.
@@ -113,6 +206,18 @@ pub struct PlanTick {
     pub started: Option<usize>,
     /// The plan ended.
     pub end: Option<PlanEnd>,
+}
+
+impl<P> Default for PlanTick<P> {
+    fn default() -> Self {
+        PlanTick {
+            send: None,
+            attempt: None,
+            done: None,
+            started: None,
+            end: None,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -124,10 +229,14 @@ enum Phase {
     Sending,
     /// Step `next`'s motion is running; polling. A settled answer counts once `polls`
     /// reaches `need` (a bolting job may start a tick late, after board B reports idle).
+    /// Over a link that reports motions' ends: `ended` once its end came (a mode step's at
+    /// once), and the step is done then (a mode step: at the first settled status after it),
+    /// unless a Stop holds the plan.
     Settling {
         polls: u16,
         need: u16,
         mode_step: bool,
+        ended: bool,
     },
     /// Step `next` is a wait until this time.
     Waiting { until: u32 },
@@ -173,12 +282,14 @@ pub enum InterjectError {
     },
 }
 
-/// The runner.
+/// The runner, over the legacy [`Uplink`] or another [`Link`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct PlanRunner {
-    up: Uplink,
+pub struct PlanRunner<L = Uplink> {
+    up: L,
     next: usize,
+    /// The number of the current step's command, once submitted.
+    step_seq: Option<u16>,
     phase: Phase,
     /// What the outstanding command is.
     sent: Sent,
@@ -233,11 +344,96 @@ pub fn settled(hb: &HeartbeatRepr) -> bool {
 }
 
 impl PlanRunner {
-    /// At the first step.
+    /// At the first step, over the legacy uplink.
     pub const fn new(cfg: ground::Config, board: BoardNumber) -> PlanRunner {
+        PlanRunner::over(Uplink::new(cfg, board))
+    }
+
+    /// A heartbeat arrived at `now`.
+    pub fn heartbeat(&mut self, steps: &[PlanStep], now: u32, hb: &HeartbeatRepr) -> PlanTick {
+        let _ = steps;
+        let mut t = PlanTick::default();
+        let u = self.up.heartbeat(now, hb);
+        t.attempt = u.attempt;
+        if let Some(d) = u.done {
+            t.done = Some(d);
+            self.finished(d, Some(hb));
+        }
+        t.end = self.end();
+        t
+    }
+}
+
+impl PlanRunner<TcLink> {
+    /// At the first step, over PUS: telecommands to robot `board`'s APID through the gateway.
+    pub fn pus(cfg: pus_ground::Config, board: BoardNumber) -> PlanRunner<TcLink> {
+        PlanRunner::over(TcLink::new(cfg, board))
+    }
+
+    /// A telemetry packet arrived at `now` (its CCSDS headers checked by the caller): its
+    /// service, subservice and source data. ST\[1\] reports start and end the plan's commands
+    /// ([`TcLink::telemetry`]); a housekeeping report settles a mode step.
+    pub fn telemetry(
+        &mut self,
+        steps: &[PlanStep],
+        now: u32,
+        service: u8,
+        subservice: u8,
+        data: &[u8],
+    ) -> PlanTick<TcOut> {
+        let _ = (steps, now);
+        let mut t = PlanTick::default();
+        let h = self.up.telemetry(service, subservice, data);
+        t.attempt = h.attempt;
+        let status = self.up.status();
+        if let Some(d) = h.done {
+            t.done = Some(d);
+            self.finished(d, status.as_ref());
+        }
+        if let Some((seq, _)) = h.rejected {
+            if self.end().is_none() && self.up.is_idle() && self.is_ours(seq) {
+                self.sent = Sent::Step;
+                self.phase = Phase::Ended(PlanEnd::Rejected {
+                    step: self.next,
+                    code: h.rejected.map_or(0, |(_, f)| f.code),
+                });
+            }
+        }
+        if let Some((seq, e)) = h.ended {
+            self.motion_ended(seq, e);
+        }
+        if let (
+            Some(hb),
+            Phase::Settling {
+                mode_step: true,
+                ended: true,
+                ..
+            },
+        ) = (h.status, self.phase)
+        {
+            if !self.held && settled(&hb) {
+                self.next += 1;
+                self.phase = Phase::Ready;
+            }
+        }
+        t.end = self.end();
+        t
+    }
+
+    /// Whether the telecommand numbered `seq` is one the runner sent last (its step's or an
+    /// interjection's).
+    fn is_ours(&self, seq: u16) -> bool {
+        self.step_seq == Some(seq) || self.sent == Sent::Interjection
+    }
+}
+
+impl<L: Link> PlanRunner<L> {
+    /// At the first step, over `link`.
+    pub const fn over(link: L) -> PlanRunner<L> {
         PlanRunner {
-            up: Uplink::new(cfg, board),
+            up: link,
             next: 0,
+            step_seq: None,
             phase: Phase::Ready,
             sent: Sent::Step,
             pending: [None; INTERJECTIONS],
@@ -246,8 +442,8 @@ impl PlanRunner {
         }
     }
 
-    /// The uplink (efficiency, outstanding command).
-    pub const fn uplink(&self) -> &Uplink {
+    /// The link (efficiency, outstanding command).
+    pub const fn uplink(&self) -> &L {
         &self.up
     }
 
@@ -308,9 +504,45 @@ impl PlanRunner {
 
     fn submit(&mut self, c: Command, sent: Sent) {
         // Only called when the uplink is idle.
-        if self.up.submit(c).is_ok() {
+        if let Some(seq) = self.up.submit(c) {
             self.sent = sent;
+            if sent == Sent::Step {
+                self.step_seq = Some(seq);
+            }
         }
+    }
+
+    /// A motion the link reports ended: the step's settles, or the plan is interrupted.
+    fn motion_ended(&mut self, seq: u16, e: MotionEnd) {
+        let Phase::Settling {
+            polls,
+            need,
+            mode_step,
+            ..
+        } = self.phase
+        else {
+            return;
+        };
+        if self.step_seq != Some(seq) {
+            return;
+        }
+        let step = self.next;
+        self.phase = match e {
+            MotionEnd::Completed if !self.held && !mode_step => {
+                self.next += 1;
+                Phase::Ready
+            }
+            MotionEnd::Completed => Phase::Settling {
+                polls,
+                need,
+                mode_step,
+                ended: true,
+            },
+            MotionEnd::Interrupted { mode, faults } => {
+                Phase::Ended(PlanEnd::Interrupted { step, mode, faults })
+            }
+            MotionEnd::Unacknowledged => Phase::Ended(PlanEnd::Unacknowledged { step }),
+        };
     }
 
     /// The oldest waiting interjection, taken out of the queue.
@@ -333,7 +565,7 @@ impl PlanRunner {
     }
 
     /// Advances to `now`.
-    pub fn tick(&mut self, steps: &[PlanStep], now: u32) -> PlanTick {
+    pub fn tick(&mut self, steps: &[PlanStep], now: u32) -> PlanTick<L::Packet> {
         let mut t = PlanTick::default();
         if self.up.is_idle() && self.end().is_none() {
             if let Some(c) = self.take_interjection() {
@@ -345,7 +577,11 @@ impl PlanRunner {
                 Phase::Ready => match steps.get(self.next) {
                     None => self.phase = Phase::Ended(PlanEnd::Completed),
                     // Stopped by the operator: keep polling, start nothing.
-                    Some(_) if self.held => self.submit(Command::Heartbeat, Sent::Poll),
+                    Some(_) if self.held => {
+                        if L::POLLS {
+                            self.submit(Command::Heartbeat, Sent::Poll)
+                        }
+                    }
                     Some(PlanStep::Command(c)) => {
                         t.started = Some(self.next);
                         let c = self.as_sent(*c);
@@ -370,8 +606,21 @@ impl PlanRunner {
                     self.phase = Phase::Ready;
                     return self.tick(steps, now);
                 }
+                // A link that reports motions' ends: a step whose end came while a Stop
+                // held the plan is done once the Reset is accepted.
+                Phase::Settling {
+                    ended: true,
+                    mode_step: false,
+                    ..
+                } if !L::POLLS && !self.held => {
+                    self.next += 1;
+                    self.phase = Phase::Ready;
+                    return self.tick(steps, now);
+                }
                 Phase::Waiting { .. } | Phase::Settling { .. } => {
-                    self.submit(Command::Heartbeat, Sent::Poll);
+                    if L::POLLS {
+                        self.submit(Command::Heartbeat, Sent::Poll);
+                    }
                 }
                 Phase::Sending | Phase::Ended(_) => {}
             }
@@ -383,19 +632,8 @@ impl PlanRunner {
             t.done = Some(d);
             self.finished(d, None);
         }
-        t.end = self.end();
-        t
-    }
-
-    /// A heartbeat arrived at `now`.
-    pub fn heartbeat(&mut self, steps: &[PlanStep], now: u32, hb: &HeartbeatRepr) -> PlanTick {
-        let _ = steps;
-        let mut t = PlanTick::default();
-        let u = self.up.heartbeat(now, hb);
-        t.attempt = u.attempt;
-        if let Some(d) = u.done {
-            t.done = Some(d);
-            self.finished(d, Some(hb));
+        if let Some((seq, e)) = u.ended {
+            self.motion_ended(seq, e);
         }
         t.end = self.end();
         t
@@ -435,6 +673,9 @@ impl PlanRunner {
                         polls: 0,
                         need,
                         mode_step,
+                        // A mode change is not a motion: over a link that reports motions'
+                        // ends, it waits only for a settled status.
+                        ended: !L::POLLS && mode_step,
                     };
                 } else {
                     self.next += 1;
@@ -446,6 +687,7 @@ impl PlanRunner {
                     polls,
                     need,
                     mode_step,
+                    ended,
                 },
                 _,
             ) => {
@@ -463,6 +705,7 @@ impl PlanRunner {
                         polls: polls.saturating_add(1),
                         need,
                         mode_step,
+                        ended,
                     };
                 }
             }

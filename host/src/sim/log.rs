@@ -3,8 +3,11 @@
 //! Every record has `t_ms` (simulated time) and `kind`. Packets: `{"kind":"packet","link":
 //! "wifi","from":"server","to":"robot","fate":"delivered","hex":"4d49..","packet":{..}}`,
 //! with `fate` one of `delivered`, `lost` (injected loss), `cut` (board B cut off) or
-//! `unconnected` (a heartbeat with no server connection to carry it). Events come from the
-//! nodes: `{"kind":"event","node":"board_a","event":{..}}`.
+//! `unconnected` (a heartbeat with no server connection to carry it), and `packet_kind` one of
+//! the legacy kinds (`command`, `heartbeat`, `internal_heartbeat`, `b_command`) or, with
+//! `--protocol pus`, `tc` or `tm` (`packet` then holds the headers and what the service data
+//! reads as: the function or request, the ST\[1\] report, the event, the housekeeping
+//! heartbeat). Events come from the nodes: `{"kind":"event","node":"board_a","event":{..}}`.
 
 use serde_json::{json, Value};
 use std::io::Write;
@@ -28,12 +31,10 @@ impl Log {
 
     /// Logs a packet on a link.
     pub fn packet(&self, t_ms: u32, link: &str, from: &str, to: &str, fate: &str, bytes: &[u8]) {
-        let decoded = crate::codec::decode_any(bytes)
-            .and_then(|s| serde_json::from_str::<Value>(&s).ok())
-            .unwrap_or(Value::Null);
+        let (kind, decoded) = decode(bytes);
         self.send(json!({
             "t_ms": t_ms, "kind": "packet", "link": link, "from": from, "to": to,
-            "fate": fate, "hex": hex(bytes), "packet": decoded,
+            "fate": fate, "packet_kind": kind, "hex": hex(bytes), "packet": decoded,
         }));
     }
 
@@ -47,6 +48,90 @@ impl Log {
         // The writer outlives every node; a send after it stopped has nowhere to go.
         let _ = self.tx.send(r);
     }
+}
+
+/// A packet's kind and its JSON form: a legacy packet by its header, else a PUS telecommand
+/// or telemetry packet of a robot's APID; `unknown` and null for anything else.
+pub fn decode(bytes: &[u8]) -> (&'static str, Value) {
+    use mmic::wire::PacketKind;
+    let legacy = bytes
+        .get(..mmic::wire::HEADER_LEN)
+        .and_then(PacketKind::from_header);
+    if let Some(k) = legacy {
+        let name = match k {
+            PacketKind::Command => "command",
+            PacketKind::Heartbeat => "heartbeat",
+            PacketKind::InternalHeartbeat => "internal_heartbeat",
+            PacketKind::BCommand => "b_command",
+        };
+        let v = crate::codec::decode_any(bytes)
+            .and_then(|s| serde_json::from_str::<Value>(&s).ok())
+            .unwrap_or(Value::Null);
+        return (name, v);
+    }
+    pus(bytes).unwrap_or(("unknown", Value::Null))
+}
+
+/// Every robot's APID.
+fn robot_apids() -> Vec<u16> {
+    (1..=255u8)
+        .filter_map(|n| mmic::units::BoardNumber::new(n).ok())
+        .map(mmic::pus::robot_apid)
+        .collect()
+}
+
+/// A PUS packet as JSON.
+fn pus(bytes: &[u8]) -> Option<(&'static str, Value)> {
+    use mmic::ccsds::tc::TcRepr;
+    use mmic::ccsds::tm::TmRepr;
+    use mmic::pus::request::Request;
+    let apids = robot_apids();
+    if let Ok(tc) = TcRepr::parse(bytes, &apids) {
+        let h = tc.header;
+        let request = match Request::parse(h.service, h.subservice, tc.app_data) {
+            Ok(Request::Function(c)) => json!({"function": c}),
+            Ok(q) => json!(format!("{q:?}")),
+            Err(e) => json!({"refused": e.to_string()}),
+        };
+        return Some((
+            "tc",
+            json!({
+                "apid": tc.apid.get(), "seq_count": tc.seq_count.get(),
+                "service": h.service, "subservice": h.subservice, "source_id": h.source_id,
+                "ack": h.ack.bits(), "request": request,
+            }),
+        ));
+    }
+    let tm = TmRepr::parse(bytes, &apids).ok()?;
+    let h = tm.header;
+    let data = tm.source_data;
+    let content = match h.service {
+        1 => match mmic::pus::verification::Report::parse(h.subservice, data) {
+            Ok(r) => json!({
+                "stage": format!("{:?}", r.stage).to_lowercase(),
+                "seq_count": r.request.seq_count,
+                "failure": r.failure.map(|f| json!({"code": f.code, "data": f.data})),
+            }),
+            Err(e) => json!({"unreadable": e.to_string()}),
+        },
+        3 => match mmic::pus::housekeeping::parse(data) {
+            Ok(hb) => json!({"housekeeping": hb}),
+            Err(e) => json!({"unreadable": e.to_string()}),
+        },
+        5 => json!({
+            "event_id": data.get(..2).map(|b| u16::from_be_bytes([b[0], b[1]])),
+            "aux": hex(data.get(2..).unwrap_or(&[])),
+        }),
+        _ => json!({"data": hex(data)}),
+    };
+    Some((
+        "tm",
+        json!({
+            "apid": tm.apid.get(), "seq_count": tm.seq_count.get(),
+            "service": h.service, "subservice": h.subservice, "counter": h.counter,
+            "destination_id": h.destination_id, "report": content,
+        }),
+    ))
 }
 
 /// Lowercase hex.

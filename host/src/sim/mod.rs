@@ -17,6 +17,12 @@
 //! in the plant ([`PlantConfig`]: a jammed fastener, a dead switch, an obstacle, an offset or
 //! silent encoder, a silent ADC, a sagging battery), on the A–B line (cut, both directions) or from the ground (a misstated
 //! reconfiguration, out-of-band commands).
+//!
+//! [`Protocol::Pus`] runs the same plans over CCSDS/PUS: the ground's plan runner sends PUS-C
+//! telecommands ([`mmic::node::pus_ground`]) over UDP on loopback to the server board, which
+//! runs the PUS gateway ([`mmic::node::gateway`]) instead of the legacy relay and sends its
+//! ST\[1\], ST\[3\], ST\[5\] and ST\[17\] telemetry back over UDP; the server board and board A talk
+//! as before.
 
 pub mod bench;
 pub mod clock;
@@ -33,25 +39,68 @@ use clock::Clock;
 use mmic::motion::State;
 use mmic::node::board_a::{self, BoardA};
 use mmic::node::board_b::{self, BoardB};
-use mmic::node::ground;
+use mmic::node::gateway;
+use mmic::node::ground::{self, Efficiency};
 use mmic::node::handoff::PacketQueue;
-use mmic::node::plan_runner::{PlanEnd, PlanRunner, PlanStep};
+use mmic::node::plan_runner::{Link, PlanEnd, PlanRunner, PlanStep, PlanTick};
+use mmic::node::pus_ground::{self, TcLink, TcOut};
 use mmic::units::BoardNumber;
+use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
 use nodes::Lossy;
 pub use plant::PlantConfig;
 use serde_json::{json, Value};
 use std::io::Write;
-use std::net::TcpListener;
+use std::net::{TcpListener, UdpSocket};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 pub use steps::{demo_steps, steps_of, SimStep, DEMO_PLAN};
 
+/// How the ground and the server board talk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Protocol {
+    /// The paper's: 14-byte commands and 66-byte heartbeats over the serial line (an OS
+    /// pipe), the server board relaying them.
+    #[default]
+    Legacy,
+    /// CCSDS space packets with PUS-C services over UDP on loopback, the server board as the
+    /// PUS gateway.
+    Pus,
+}
+
+impl Protocol {
+    /// Its name on the command line and in the summary.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Protocol::Legacy => "legacy",
+            Protocol::Pus => "pus",
+        }
+    }
+}
+
+impl std::str::FromStr for Protocol {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Protocol, String> {
+        match s {
+            "legacy" => Ok(Protocol::Legacy),
+            "pus" => Ok(Protocol::Pus),
+            _ => Err(format!("{s:?} is no protocol: legacy or pus")),
+        }
+    }
+}
+
 /// What to simulate.
 #[derive(Debug, Clone)]
 pub struct SimConfig {
+    /// How the ground and the server board talk.
+    pub protocol: Protocol,
+    /// The ground's telecommand link with [`Protocol::Pus`].
+    pub pus: pus_ground::Config,
+    /// The server board's gateway with [`Protocol::Pus`] (its uplink to board A, polls,
+    /// housekeeping interval).
+    pub gateway: gateway::Config,
     /// The plan every robot runs.
     pub steps: Vec<SimStep>,
     /// Robots (each with its own server board and serial line to the one ground process).
@@ -111,6 +160,9 @@ impl SimConfig {
     /// Default settings for these steps.
     pub fn with_steps(steps: Vec<SimStep>) -> SimConfig {
         SimConfig {
+            protocol: Protocol::Legacy,
+            pus: pus_ground::Config::default(),
+            gateway: gateway::Config::default(),
             steps,
             robots: 1,
             scale: 10.0,
@@ -142,6 +194,8 @@ impl SimConfig {
 /// What a run produced.
 #[derive(Debug, Clone)]
 pub struct Summary {
+    /// The protocol between the ground and the server board.
+    pub protocol: Protocol,
     /// How each robot's plan ended (none: the time limit came first).
     pub ends: Vec<Option<PlanEnd>>,
     /// The plan's steps (their number is the plan's length), for reports that quote the step
@@ -242,16 +296,16 @@ impl<'a> RunEnv<'a> {
     /// A lossy writer for one direction of a link; its loss draws are seeded from the robot's
     /// seed and `k`, so each direction draws its own sequence.
     #[allow(clippy::too_many_arguments)]
-    fn lossy(
+    fn lossy<W: Write>(
         &self,
-        out: std::io::PipeWriter,
+        out: W,
         link: &'static str,
         (from, to): (&str, &str),
         loss: f64,
         cut_at: Option<u32>,
         seed: u64,
         k: u64,
-    ) -> Lossy<std::io::PipeWriter> {
+    ) -> Lossy<W> {
         Lossy {
             out,
             link,
@@ -299,7 +353,6 @@ fn spawn_robot<'scope, 'env>(
         cfg.start_state,
     )));
     let (a_to_b, b_to_a) = (serial(scope)?, serial(scope)?);
-    let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
     let (cmd_queue, hb_queue) = (&mut queues.0, &mut queues.1);
     let (cmd_p, cmd_c) = cmd_queue.split();
     let (hb_p, hb_c) = hb_queue.split();
@@ -347,20 +400,6 @@ fn spawn_robot<'scope, 'env>(
         ),
         plant,
     };
-    let server = nodes::ServerTask {
-        from_ground: ground_to_server.read,
-        to_ground: env.lossy(
-            server_to_ground.write,
-            "serial_ground",
-            (&name_s, "ground"),
-            cfg.serial_loss,
-            None,
-            seed,
-            3,
-        ),
-        robots: vec![(board, robot.addr)],
-        visit_ms: cfg.visit_ms,
-    };
     // The WiFi task logs its packets (the packet log) and the hand-off events with them.
     let nodes = (
         env.node(&name_a, &env.packet_log),
@@ -371,17 +410,79 @@ fn spawn_robot<'scope, 'env>(
     scope.spawn(move || wifi.run(nodes.0));
     scope.spawn(move || control.run(nodes.1));
     scope.spawn(move || b.run(nodes.2));
-    scope.spawn(move || server.run(nodes.3));
-    let to_server = env.lossy(
-        ground_to_server.write,
-        "serial_ground",
-        ("ground", &name_s),
-        cfg.serial_loss,
-        None,
-        seed,
-        4,
-    );
-    Ok((to_server, server_to_ground.read, board))
+    match cfg.protocol {
+        Protocol::Legacy => {
+            let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
+            let server = nodes::ServerTask {
+                from_ground: ground_to_server.read,
+                to_ground: env.lossy(
+                    server_to_ground.write,
+                    "serial_ground",
+                    (&name_s, "ground"),
+                    cfg.serial_loss,
+                    None,
+                    seed,
+                    3,
+                ),
+                robots: vec![(board, robot.addr)],
+                visit_ms: cfg.visit_ms,
+            };
+            scope.spawn(move || server.run(nodes.3));
+            let to_server = env.lossy(
+                ground_to_server.write,
+                "serial_ground",
+                ("ground", &name_s),
+                cfg.serial_loss,
+                None,
+                seed,
+                4,
+            );
+            Ok((to_server.boxed(), server_to_ground.read, board))
+        }
+        Protocol::Pus => {
+            // UDP on loopback: one socket at the ground, one at the server board.
+            let ground = UdpSocket::bind("127.0.0.1:0")?;
+            let server = UdpSocket::bind("127.0.0.1:0")?;
+            let (ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
+            server.set_nonblocking(true)?;
+            let to_ground = nodes::UdpOut {
+                sock: server.try_clone()?,
+                peer: ground_addr,
+            };
+            let to_server = nodes::UdpOut {
+                sock: ground.try_clone()?,
+                peer: server_addr,
+            };
+            let gw = nodes::GatewayTask {
+                from_ground: server,
+                to_ground: env.lossy(
+                    to_ground,
+                    "udp_ground",
+                    (&name_s, "ground"),
+                    cfg.serial_loss,
+                    None,
+                    seed,
+                    3,
+                ),
+                robot: (board, robot.addr),
+                config: cfg.gateway,
+            };
+            scope.spawn(move || gw.run(nodes.3));
+            let (tx, rx) = std::sync::mpsc::channel();
+            let stop = env.stop;
+            scope.spawn(move || nodes::udp_reader(ground, tx, stop));
+            let to_server = env.lossy(
+                to_server,
+                "udp_ground",
+                ("ground", &name_s),
+                cfg.serial_loss,
+                None,
+                seed,
+                4,
+            );
+            Ok((to_server.boxed(), rx, board))
+        }
+    }
 }
 
 /// Runs the simulation to the end of every robot's plan (or the time limit).
@@ -438,11 +539,15 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         .map_err(|_| std::io::Error::other("log writer panicked"))??;
     let status = statuses[0].lock().map(|s| s.clone()).unwrap_or(Value::Null);
     Ok(Summary {
+        protocol: cfg.protocol,
         ends,
         plan: cfg.steps.clone(),
         start_state: cfg.start_state,
         wifi_loss: cfg.wifi_loss,
-        visit_ms: cfg.visit_ms,
+        visit_ms: match cfg.protocol {
+            Protocol::Legacy => cfg.visit_ms,
+            Protocol::Pus => cfg.gateway.uplink.timeout_ms,
+        },
         sim_ms: stats.sim_ms,
         wall: clock.wall_elapsed(),
         records,
@@ -481,7 +586,7 @@ struct GroundStats {
 }
 
 type GroundLink = (
-    Lossy<std::io::PipeWriter>,
+    Lossy<Box<dyn Write + Send>>,
     std::sync::mpsc::Receiver<Vec<u8>>,
     BoardNumber,
 );
@@ -489,7 +594,10 @@ type GroundLink = (
 /// The ground's part of an injection: an out-of-band command handed to the plan runner, or
 /// the next reconfiguration misstated; nothing for the plant's and the line's. Returns why
 /// the runner did not take the command, if it did not.
-fn ground_injection(run: &mut PlanRunner, injection: inject::Injection) -> Option<String> {
+fn ground_injection<L: Link>(
+    run: &mut PlanRunner<L>,
+    injection: inject::Injection,
+) -> Option<String> {
     if let Some(c) = injection.command() {
         return run.interject(c).err().map(|e| e.to_string());
     }
@@ -499,21 +607,151 @@ fn ground_injection(run: &mut PlanRunner, injection: inject::Injection) -> Optio
     None
 }
 
-/// The opsUI: one plan runner per robot, in one thread (one ground process).
+/// The ground's plan runner over one protocol, as the ground loop drives it: ticks, packets
+/// from the server board in, packets to it out.
+trait Ground {
+    /// What the runner sends.
+    type Packet: Copy;
+    /// Advances to `now`.
+    fn tick(&mut self, steps: &[PlanStep], now: u32) -> PlanTick<Self::Packet>;
+    /// A packet from the server board: what the runner made of it, and whether it answered
+    /// the command outstanding (for the latency); none if it is no packet of the protocol.
+    fn receive(
+        &mut self,
+        steps: &[PlanStep],
+        now: u32,
+        bytes: &[u8],
+    ) -> Option<(PlanTick<Self::Packet>, bool)>;
+    /// A packet's bytes.
+    fn bytes(p: &Self::Packet) -> Vec<u8>;
+    /// The robot's status as last reported (a heartbeat, or a housekeeping report).
+    fn status(&self) -> Option<HeartbeatRepr>;
+    /// The attempts answered, Figure 11.
+    fn efficiency(&self) -> Efficiency;
+    /// An injection's ground part ([`ground_injection`]).
+    fn inject(&mut self, injection: inject::Injection) -> Option<String>;
+}
+
+/// The legacy ground: the plan runner over the uplink, and the last heartbeat.
+struct LegacyGround {
+    run: PlanRunner,
+    last: Option<HeartbeatRepr>,
+}
+
+impl Ground for LegacyGround {
+    type Packet = CommandRepr;
+
+    fn tick(&mut self, steps: &[PlanStep], now: u32) -> PlanTick {
+        self.run.tick(steps, now)
+    }
+
+    fn receive(&mut self, steps: &[PlanStep], now: u32, bytes: &[u8]) -> Option<(PlanTick, bool)> {
+        let hb = HeartbeatRepr::parse(bytes).ok()?;
+        let answers = hb.last_seq == self.run.uplink().outstanding().unwrap_or(0);
+        self.last = Some(hb);
+        Some((self.run.heartbeat(steps, now, &hb), answers))
+    }
+
+    fn bytes(p: &CommandRepr) -> Vec<u8> {
+        p.to_bytes().to_vec()
+    }
+
+    fn status(&self) -> Option<HeartbeatRepr> {
+        self.last
+    }
+
+    fn efficiency(&self) -> Efficiency {
+        self.run.uplink().efficiency()
+    }
+
+    fn inject(&mut self, injection: inject::Injection) -> Option<String> {
+        ground_injection(&mut self.run, injection)
+    }
+}
+
+impl Ground for PlanRunner<TcLink> {
+    type Packet = TcOut;
+
+    fn tick(&mut self, steps: &[PlanStep], now: u32) -> PlanTick<TcOut> {
+        PlanRunner::tick(self, steps, now)
+    }
+
+    fn receive(
+        &mut self,
+        steps: &[PlanStep],
+        now: u32,
+        bytes: &[u8],
+    ) -> Option<(PlanTick<TcOut>, bool)> {
+        let tm = mmic::ccsds::tm::TmRepr::parse(bytes, &[self.uplink().apid()]).ok()?;
+        let h = tm.header;
+        let answers = h.service == mmic::pus::request::ST_VERIFICATION
+            && mmic::pus::verification::Report::parse(h.subservice, tm.source_data)
+                .is_ok_and(|r| Some(r.request.seq_count) == self.uplink().outstanding());
+        let t = self.telemetry(steps, now, h.service, h.subservice, tm.source_data);
+        Some((t, answers))
+    }
+
+    fn bytes(p: &TcOut) -> Vec<u8> {
+        let mut b = [0u8; pus_ground::MAX_TC_LEN];
+        match p.emit(&mut b) {
+            Ok(n) => b.get(..n).unwrap_or(&[]).to_vec(),
+            Err(_) => Vec::new(),
+        }
+    }
+
+    fn status(&self) -> Option<HeartbeatRepr> {
+        self.uplink().status()
+    }
+
+    fn efficiency(&self) -> Efficiency {
+        self.uplink().efficiency()
+    }
+
+    fn inject(&mut self, injection: inject::Injection) -> Option<String> {
+        ground_injection(self, injection)
+    }
+}
+
+/// The opsUI over the configured protocol.
 fn ground_loop(
     cfg: &SimConfig,
     steps: &[PlanStep],
-    mut links: Vec<GroundLink>,
+    links: Vec<GroundLink>,
     clock: clock::NodeClock<'_>,
     log: Option<log::Log>,
 ) -> (Vec<Option<PlanEnd>>, GroundStats) {
-    let mut runners: Vec<PlanRunner> = links
-        .iter()
-        .map(|(_, _, b)| PlanRunner::new(cfg.ground, *b))
-        .collect();
+    match cfg.protocol {
+        Protocol::Legacy => {
+            let runners = links
+                .iter()
+                .map(|(_, _, b)| LegacyGround {
+                    run: PlanRunner::new(cfg.ground, *b),
+                    last: None,
+                })
+                .collect();
+            run_ground(cfg, steps, links, runners, clock, log)
+        }
+        Protocol::Pus => {
+            let runners = links
+                .iter()
+                .map(|(_, _, b)| PlanRunner::pus(cfg.pus, *b))
+                .collect();
+            run_ground(cfg, steps, links, runners, clock, log)
+        }
+    }
+}
+
+/// The opsUI: one plan runner per robot, in one thread (one ground process).
+fn run_ground<G: Ground>(
+    cfg: &SimConfig,
+    steps: &[PlanStep],
+    mut links: Vec<GroundLink>,
+    mut runners: Vec<G>,
+    clock: clock::NodeClock<'_>,
+    log: Option<log::Log>,
+) -> (Vec<Option<PlanEnd>>, GroundStats) {
     let mut ends: Vec<Option<PlanEnd>> = vec![None; runners.len()];
     let mut sent_at: Vec<Option<u32>> = vec![None; runners.len()];
-    let mut last_hb: Vec<Option<HeartbeatRepr>> = vec![None; runners.len()];
     let mut stats = GroundStats {
         sim_ms: 0,
         efficiency: Vec::new(),
@@ -541,7 +779,7 @@ fn ground_loop(
                 .filter(|s| s.at_ms <= now)
             {
                 next_injection[i] += 1;
-                let refused = ground_injection(run, inj.injection);
+                let refused = run.inject(inj.injection);
                 if i == 0 {
                     progress.inject(now, inj.injection);
                 }
@@ -556,27 +794,24 @@ fn ground_loop(
             }
             let mut ticks = vec![run.tick(steps, now)];
             while let Ok(bytes) = rx.try_recv() {
-                if let Ok(hb) = HeartbeatRepr::parse(&bytes) {
-                    let t = clock.now_ms();
-                    if let Some(s) = sent_at[i] {
-                        if hb.last_seq == run.uplink().outstanding().unwrap_or(0) {
-                            stats.max_latency_ms = stats.max_latency_ms.max(t.saturating_sub(s));
-                        }
+                let t = clock.now_ms();
+                if let Some((tick, answers)) = run.receive(steps, t, &bytes) {
+                    if let (Some(s), true) = (sent_at[i], answers) {
+                        stats.max_latency_ms = stats.max_latency_ms.max(t.saturating_sub(s));
                     }
-                    ticks.push(run.heartbeat(steps, t, &hb));
-                    last_hb[i] = Some(hb);
+                    ticks.push(tick);
                 }
             }
             for t in ticks {
                 if let Some(p) = t.send {
                     sent_at[i] = Some(now);
-                    writer.send(now, &p.to_bytes());
+                    writer.send(now, &G::bytes(&p));
                 }
                 if let Some(ok) = t.attempt {
                     stats.attempts.1 += 1;
                     stats.attempts.0 += ok as u64;
                     if i == 0 {
-                        let e = run.uplink().efficiency().percent().unwrap_or(0);
+                        let e = run.efficiency().percent().unwrap_or(0);
                         stats.efficiency.push((now as f64 / 1000.0, e as f64));
                     }
                     if let Some(l) = &log {
@@ -622,14 +857,15 @@ fn ground_loop(
                 }
             }
         }
-        if let Some(hb) = &last_hb[0] {
-            let eff = runners[0].uplink().efficiency();
-            progress.status(now, hb, eff);
+        if let Some(r) = runners.first() {
+            if let Some(hb) = r.status() {
+                progress.status(now, &hb, r.efficiency());
+            }
         }
         std::thread::sleep(Duration::from_micros(500));
     }
     progress.finish();
     let _ = std::io::stderr().flush();
-    stats.last_heartbeat = last_hb.first().copied().flatten();
+    stats.last_heartbeat = runners.first().and_then(Ground::status);
     (ends, stats)
 }

@@ -1,12 +1,15 @@
 //! The shells: each node's thread moves bytes between its transport and the library's pure
 //! node, and does nothing else. Board A runs two threads, as on the ESP32's two cores: the
-//! WiFi task (TCP) and the control loop, joined by the library's SPSC hand-off queues.
+//! WiFi task (TCP) and the control loop, joined by the library's SPSC hand-off queues. The
+//! server board runs the legacy relay ([`ServerTask`]) or, with `--protocol pus`, the PUS
+//! gateway ([`GatewayTask`]: telecommands in and telemetry out over UDP).
 
 use super::clock::{Clock, NodeClock};
 use super::log::Log;
 use super::plant::{Drives, Plant};
 use mmic::node::board_a::{self, BoardA, Event};
 use mmic::node::board_b::{self, BoardB};
+use mmic::node::gateway::{self, Gateway, Out};
 use mmic::node::handoff::{Consumer, Producer};
 use mmic::node::server::{Accepted, Server};
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
@@ -17,7 +20,7 @@ use mmic::wire::heartbeat::HEARTBEAT_LEN;
 use mmic::wire::PacketKind;
 use serde_json::{json, Value};
 use std::io::{ErrorKind, Read, Write};
-use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::net::{SocketAddr, TcpListener, TcpStream, UdpSocket};
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, Sender};
 use std::sync::{Arc, Mutex};
@@ -60,6 +63,22 @@ impl<W: Write> Lossy<W> {
             l.packet(now, self.link, &self.from, &self.to, fate, bytes);
         }
         fate == "delivered"
+    }
+}
+
+impl<W: Write + Send + 'static> Lossy<W> {
+    /// The same writer behind a box, for links of either kind.
+    pub fn boxed(self) -> Lossy<Box<dyn Write + Send>> {
+        Lossy {
+            out: Box::new(self.out),
+            link: self.link,
+            from: self.from,
+            to: self.to,
+            loss: self.loss,
+            cut_at: self.cut_at,
+            rng: self.rng,
+            log: self.log,
+        }
     }
 }
 
@@ -508,29 +527,183 @@ impl ServerTask {
     }
 
     /// Waits up to `visit_ms` for the robot's heartbeat and forwards it; then disconnects (one
-    /// robot per loop). Polled without blocking: a socket read timeout is rounded up to the
-    /// kernel's tick (4–8 ms here), and a blocked server would hold the paced clock back.
-    fn await_heartbeat(&mut self, node: &Node<'_>, mut sock: TcpStream) {
-        let _ = sock.set_nonblocking(true);
-        let until = node.clock.now_ms().saturating_add(self.visit_ms);
-        let mut d = Deframer::<256>::new();
-        let mut buf = [0u8; 256];
-        while node.running() && node.poll() < until {
-            match sock.read(&mut buf) {
-                Ok(0) => return,
-                Ok(n) => {
-                    for f in frames(&mut d, &buf[..n]) {
-                        if f.kind() == PacketKind::Heartbeat {
-                            self.to_ground.send(node.clock.now_ms(), f.as_bytes());
-                            return;
-                        }
-                    }
+    /// robot per loop).
+    fn await_heartbeat(&mut self, node: &Node<'_>, sock: TcpStream) {
+        if let Some(hb) = await_heartbeat(node, sock, self.visit_ms) {
+            self.to_ground.send(node.clock.now_ms(), &hb);
+        }
+    }
+}
+
+/// Waits up to `wait_ms` on a visit's connection for board A's heartbeat. Polled without
+/// blocking: a socket read timeout is rounded up to the kernel's tick (4–8 ms here), and a
+/// blocked server would hold the paced clock back.
+fn await_heartbeat(node: &Node<'_>, mut sock: TcpStream, wait_ms: u32) -> Option<Vec<u8>> {
+    let _ = sock.set_nonblocking(true);
+    let until = node.clock.now_ms().saturating_add(wait_ms);
+    let mut d = Deframer::<256>::new();
+    let mut buf = [0u8; 256];
+    while node.running() && node.poll() < until {
+        match sock.read(&mut buf) {
+            Ok(0) => return None,
+            Ok(n) => {
+                if let Some(f) = frames(&mut d, &buf[..n])
+                    .into_iter()
+                    .find(|f| f.kind() == PacketKind::Heartbeat)
+                {
+                    return Some(f.as_bytes().to_vec());
                 }
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
-                    std::thread::sleep(Duration::from_micros(200));
-                }
-                Err(_) => return,
             }
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
+                std::thread::sleep(Duration::from_micros(200));
+            }
+            Err(_) => return None,
+        }
+    }
+    None
+}
+
+/// One end of a UDP link as a packet writer: each write is one datagram to `peer`.
+pub struct UdpOut {
+    /// The socket sent from.
+    pub sock: UdpSocket,
+    /// Where to.
+    pub peer: SocketAddr,
+}
+
+impl Write for UdpOut {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.sock.send_to(buf, self.peer)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// Receives datagrams until the run stops and sends each to `tx` (the ground's end of the UDP
+/// link, read as the serial lines' readers are).
+pub fn udp_reader(sock: UdpSocket, tx: Sender<Vec<u8>>, stop: &AtomicBool) {
+    let _ = sock.set_read_timeout(Some(Duration::from_millis(5)));
+    let mut buf = [0u8; 2048];
+    while !stop.load(Ordering::Relaxed) {
+        match sock.recv(&mut buf) {
+            Ok(n) => {
+                if tx.send(buf[..n].to_vec()).is_err() {
+                    return;
+                }
+            }
+            Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
+            Err(_) => return,
+        }
+    }
+}
+
+/// The largest telemetry packet the gateway writes, bytes.
+const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + gateway::MAX_TM_DATA;
+
+/// The server board as the PUS gateway (`--protocol pus`): telecommand packets from the
+/// ground's UDP socket into [`Gateway::tc_packet`], the legacy commands of
+/// [`Gateway::tick`] to board A over the same visits as [`ServerTask`]'s (connect, send, wait
+/// for the heartbeat, disconnect), the heartbeat into [`Gateway::heartbeat`], and every
+/// report written by [`Gateway::encode`] to the ground over UDP. It takes telecommands only
+/// once board A's first heartbeat came, so every change after power-up is an event.
+pub struct GatewayTask {
+    /// Where the ground's telecommands arrive (non-blocking).
+    pub from_ground: UdpSocket,
+    /// The ground's UDP socket.
+    pub to_ground: Lossy<UdpOut>,
+    /// The robot's board A and where it listens.
+    pub robot: (BoardNumber, SocketAddr),
+    /// The gateway's timing: its uplink's timeout is how long a visit waits for the heartbeat.
+    pub config: gateway::Config,
+}
+
+/// One robot, eight waiting telecommands, 64 remembered keys.
+type SimGateway = Gateway<1, 8, 64>;
+
+impl GatewayTask {
+    /// Runs until the run stops.
+    pub fn run(mut self, node: Node<'_>) {
+        let mut g = SimGateway::new(self.config);
+        g.add(self.robot.0);
+        let mut buf = [0u8; 2048];
+        while node.running() {
+            let now = node.poll();
+            let mut busy = false;
+            // Telecommands are taken once board A's first heartbeat came (the gateway polls
+            // at once): ST[5] events are what changed between two heartbeats, so a command
+            // answered by the very first one (entering Operational, a fault raised on the
+            // way) would otherwise change nothing the gateway could report. Meanwhile they
+            // wait in the socket.
+            while g.latest(self.robot.0).is_some() {
+                let Ok(n) = self.from_ground.recv(&mut buf) else {
+                    break;
+                };
+                busy = true;
+                let bytes = buf.get(..n).unwrap_or(&[]);
+                match g.tc_packet(bytes) {
+                    Ok(out) => self.reports(&node, &mut g, out),
+                    Err(e) => node.event(
+                        now,
+                        json!({"type": "tc_refused", "error": e.to_string(),
+                               "hex": super::log::hex(bytes)}),
+                    ),
+                }
+            }
+            let out = g.tick(node.clock.now_ms());
+            let visits = out.to_robots.clone();
+            self.reports(&node, &mut g, out);
+            for (board, command) in visits {
+                busy = true;
+                if board == self.robot.0 {
+                    self.visit(&node, &mut g, command.to_bytes());
+                }
+            }
+            if !busy {
+                std::thread::sleep(Duration::from_micros(300));
+            }
+        }
+    }
+
+    /// Writes the reports of `out` to the ground.
+    fn reports<const M: usize>(&mut self, node: &Node<'_>, g: &mut SimGateway, out: Out<M>) {
+        if out.overflow > 0 {
+            node.event(
+                node.clock.now_ms(),
+                json!({"type": "overflow", "count": out.overflow}),
+            );
+        }
+        for tm in &out.reports {
+            let now = node.clock.now_ms();
+            let mut b = [0u8; MAX_TM_LEN];
+            match g.encode(tm, now, &mut b) {
+                Ok(n) => {
+                    self.to_ground.send(now, b.get(..n).unwrap_or(&[]));
+                }
+                Err(e) => node.event(now, json!({"type": "tm_unwritten", "error": e.to_string()})),
+            }
+        }
+    }
+
+    /// One visit of board A: connect, send the command, wait up to the gateway's uplink
+    /// timeout for the heartbeat and hand it to the gateway, disconnect.
+    fn visit(&mut self, node: &Node<'_>, g: &mut SimGateway, packet: [u8; COMMAND_LEN]) {
+        let Ok(mut sock) = TcpStream::connect_timeout(&self.robot.1, Duration::from_millis(200))
+        else {
+            std::thread::sleep(Duration::from_millis(1));
+            return;
+        };
+        let _ = sock.set_nodelay(true);
+        if sock.write_all(&packet).is_err() {
+            return;
+        }
+        let wait = self.config.uplink.timeout_ms;
+        let hb = await_heartbeat(node, sock, wait)
+            .and_then(|b| mmic::wire::heartbeat::HeartbeatRepr::parse(&b).ok());
+        if let Some(hb) = hb {
+            let out = g.heartbeat(node.clock.now_ms(), &hb);
+            self.reports(node, g, out);
         }
     }
 }

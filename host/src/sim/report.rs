@@ -151,6 +151,64 @@ pub fn wifi_crossings(s: &Summary) -> Option<WifiCrossings> {
     any.then_some(w)
 }
 
+/// The PUS packets between the ground and the server boards (`--protocol pus`), from the
+/// packet log: telecommands sent, telemetry per service, and how many the link lost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PusCounts {
+    /// Telecommand transmissions (first sends, resends and queries).
+    pub tc: u64,
+    /// ... of which the link lost.
+    pub tc_lost: u64,
+    /// Distinct telecommands (keys).
+    pub tc_keys: u64,
+    /// Telemetry packets the server boards sent.
+    pub tm: u64,
+    /// ... of which the link lost.
+    pub tm_lost: u64,
+    /// ST\[1\] reports, ST\[3\] housekeeping reports, ST\[5\] events, ST\[17\] answers among them.
+    pub st1: u64,
+    /// See `st1`.
+    pub st3: u64,
+    /// See `st1`.
+    pub st5: u64,
+    /// See `st1`.
+    pub st17: u64,
+}
+
+/// Counts the PUS packets in the log; none when packets were not logged or none was PUS.
+pub fn pus_counts(s: &Summary) -> Option<PusCounts> {
+    let mut c = PusCounts::default();
+    let mut keys = std::collections::BTreeSet::new();
+    for r in s.records.iter().filter(|r| r["kind"] == "packet") {
+        let lost = r["fate"] == "lost";
+        match r["packet_kind"].as_str() {
+            Some("tc") => {
+                c.tc += 1;
+                c.tc_lost += lost as u64;
+                keys.insert((
+                    r["packet"]["apid"].as_u64(),
+                    r["packet"]["source_id"].as_u64(),
+                    r["packet"]["seq_count"].as_u64(),
+                ));
+            }
+            Some("tm") => {
+                c.tm += 1;
+                c.tm_lost += lost as u64;
+                match r["packet"]["service"].as_u64() {
+                    Some(1) => c.st1 += 1,
+                    Some(3) => c.st3 += 1,
+                    Some(5) => c.st5 += 1,
+                    Some(17) => c.st17 += 1,
+                    _ => {}
+                }
+            }
+            _ => {}
+        }
+    }
+    c.tc_keys = keys.len() as u64;
+    (c.tc + c.tm > 0).then_some(c)
+}
+
 /// The share of attempts answered that independent losses of `loss` each way predict, and its
 /// standard deviation over `n` attempts: an attempt is answered only when its command and the
 /// heartbeat both cross, (1 − loss)².
@@ -210,6 +268,10 @@ pub fn plan_line(s: &Summary) -> String {
             "plan: stopped at {}: interrupted, robot in {mode} (faults: {})",
             step_ref(s, step),
             fault_list(&faults)
+        ),
+        Some(PlanEnd::Rejected { step, code }) => format!(
+            "plan: stopped at {}: the PUS gateway refused the telecommand (failure code {code:#06x})",
+            step_ref(s, step)
         ),
         None => "plan: time limit reached".to_string(),
     }
@@ -275,9 +337,29 @@ pub fn text(s: &Summary) -> String {
         s.sim_ms as f64 / 1000.0 / s.wall.as_secs_f64().max(1e-9)
     );
     let (ok, n) = s.attempts;
+    if s.protocol == super::Protocol::Pus {
+        let _ = writeln!(
+            t,
+            "protocol: pus -- PUS-C telecommands and telemetry over UDP on loopback between the \
+             ground and the server board (the PUS gateway); legacy commands to board A"
+        );
+        if let Some(c) = pus_counts(s) {
+            let _ = writeln!(
+                t,
+                "pus: {} TC sent ({} telecommands, the rest resends and queries; {} lost), \
+                 {} TM ({} lost): {} ST[1], {} ST[3] housekeeping, {} ST[5] events, {} ST[17]",
+                c.tc, c.tc_keys, c.tc_lost, c.tm, c.tm_lost, c.st1, c.st3, c.st5, c.st17
+            );
+        }
+    }
     let _ = writeln!(
         t,
-        "wifi: {ok}/{n} attempts answered within the timeout ({:.1}%), longest answer {} ms",
+        "{}: {ok}/{n} attempts answered within the timeout ({:.1}%), longest answer {} ms",
+        match s.protocol {
+            super::Protocol::Legacy => "wifi",
+            // The gateway resends to board A itself: the ground's attempts are its TCs.
+            super::Protocol::Pus => "udp (ground's TC transmissions)",
+        },
         if n == 0 {
             100.0
         } else {
@@ -285,7 +367,7 @@ pub fn text(s: &Summary) -> String {
         },
         s.max_latency_ms
     );
-    if s.wifi_loss > 0.0 {
+    if s.wifi_loss > 0.0 && s.protocol == super::Protocol::Legacy {
         let (p, sd) = expected_efficiency(s.wifi_loss, n);
         let _ = writeln!(
             t,

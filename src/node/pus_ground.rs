@@ -1,0 +1,502 @@
+//! The ground's telecommand link over PUS: the plan runner's commands as PUS-C telecommands
+//! to the server board acting as gateway ([`super::gateway`]), and its telemetry read back
+//! into what the runner waits for — the start of each command, the completion of each
+//! motion, the robot's status. The PUS counterpart of the legacy [`super::ground::Uplink`];
+//! [`super::plan_runner::PlanRunner`] drives either ([`super::plan_runner::Link`]).
+//!
+//! Each command becomes a TC(8,1) function (TC(17,1) are-you-alive for a heartbeat request)
+//! on the robot's APID ([`crate::pus::robot_apid`]), numbered in the APID's sequence count,
+//! with this ground's source ID and every acknowledgement flag. A command is *started* when
+//! its TM(1,3) arrives (TM(1,4) with a refusal code: refused; with `UNACKNOWLEDGED`: board A
+//! never answered the gateway), and a motion *completes* with its TM(1,7) (TM(1,8): a fault,
+//! or the robot left the mode, cut it short).
+//!
+//! Resends: the gateway resends to board A by itself; the link resends a telecommand (same
+//! key, same bytes) only when a transmission got no report at all within
+//! [`Config::timeout_ms`] (UDP can lose it or its answer), and, once the gateway accepted it,
+//! asks again every [`Config::query_ms`] for a start or completion report it may have lost.
+//! The gateway answers a copy with its latest report and never runs it twice
+//! (spec/decisions.toml, `pus-gateway`). After [`Config::max_attempts`] unanswered
+//! transmissions in a row the command is given up as unacknowledged.
+//!
+//! ```
+//! use mmic::command::Command;
+//! use mmic::node::ground::Outcome;
+//! use mmic::node::plan_runner::Link;
+//! use mmic::node::pus_ground::{Config, TcLink};
+//! use mmic::pus::verification::{Report, Stage};
+//! use mmic::units::BoardNumber;
+//!
+//! let mut link = TcLink::new(Config::default(), BoardNumber::ONE);
+//! let seq = link.submit(Command::Stop).unwrap();
+//! let tc = link.tick(0).send.unwrap();
+//! assert_eq!((tc.request.apid, tc.request.seq_count, tc.command), (0x101, seq, Command::Stop));
+//! let mut bytes = [0u8; mmic::node::pus_ground::MAX_TC_LEN];
+//! let n = tc.emit(&mut bytes).unwrap();
+//! assert_eq!(mmic::pus::read_tc(&bytes[..n], &[0x101]).unwrap().0.header.service, 8);
+//! let start = Report { stage: Stage::Start, request: tc.request, failure: None };
+//! let r = link.report(&start);
+//! assert_eq!(r.done.map(|d| d.outcome), Some(Outcome::Accepted));
+//! assert!(link.is_idle());
+//! ```
+
+use super::ground::{Done, Efficiency, Outcome};
+use super::plan_runner::{Link, LinkTick, MotionEnd};
+use crate::ccsds::primary::{Apid, SeqCount};
+use crate::ccsds::tc::{TcRepr, TC_MIN_LEN};
+use crate::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
+use crate::ccsds::EmitError;
+use crate::command::Command;
+use crate::faults::Faults;
+use crate::mode::Mode;
+use crate::pus::function::{self, FunctionError};
+use crate::pus::housekeeping;
+use crate::pus::request::{ST_EVENT, ST_FUNCTION, ST_HOUSEKEEPING, ST_TEST, ST_VERIFICATION};
+use crate::pus::robot_apid;
+use crate::pus::verification::{Failure, Report, RequestId, Stage, ABANDONED, UNACKNOWLEDGED};
+use crate::refusal::Refusal;
+use crate::units::{BoardNumber, Instant};
+use crate::wire::heartbeat::HeartbeatRepr;
+
+/// The longest telecommand the link sends, bytes: headers, the longest function, CRC.
+pub const MAX_TC_LEN: usize = TC_MIN_LEN + function::MAX_LEN;
+
+/// Timing and identity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Config {
+    /// The source ID in every telecommand's secondary header (the key is source ID and
+    /// sequence count).
+    pub source_id: u16,
+    /// A transmission with no report within this is unanswered, and the telecommand is sent
+    /// again, ms. Above the gateway's longest visit of board A (it reads no telecommand while
+    /// it waits for a heartbeat).
+    pub timeout_ms: u32,
+    /// Once accepted, the telecommand is sent again (a query: the gateway answers a copy with
+    /// its latest report) when no start report, or for a motion no completion report, came
+    /// within this, ms.
+    pub query_ms: u32,
+    /// Unanswered transmissions in a row before the command is given up (≥ 1).
+    pub max_attempts: u8,
+}
+
+impl Default for Config {
+    /// Source ID 1; a second to answer; ask again after five seconds; ten attempts.
+    fn default() -> Config {
+        Config {
+            source_id: 1,
+            timeout_ms: 1000,
+            query_ms: 5000,
+            max_attempts: 10,
+        }
+    }
+}
+
+/// A telecommand to send: its key and the command it carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TcOut {
+    /// APID and sequence count.
+    pub request: RequestId,
+    /// Source ID.
+    pub source_id: u16,
+    /// The command: a TC(8,1) function, or TC(17,1) for [`Command::Heartbeat`].
+    pub command: Command,
+}
+
+/// Why a telecommand could not be written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TcOutError {
+    /// The command is no function.
+    #[error("{0}")]
+    Function(FunctionError),
+    /// The buffer is too short.
+    #[error("{0}")]
+    Emit(EmitError),
+}
+
+impl TcOut {
+    /// Service and subservice: (8, 1), or (17, 1) for a heartbeat request.
+    pub const fn service(&self) -> (u8, u8) {
+        match self.command {
+            Command::Heartbeat => (ST_TEST, 1),
+            _ => (ST_FUNCTION, 1),
+        }
+    }
+
+    /// Writes the telecommand (every acknowledgement flag set); returns its length (at most
+    /// [`MAX_TC_LEN`]).
+    pub fn emit(&self, out: &mut [u8]) -> Result<usize, TcOutError> {
+        let mut data = [0u8; function::MAX_LEN];
+        let n = match self.command {
+            Command::Heartbeat => 0,
+            c => function::encode(&c, &mut data).map_err(TcOutError::Function)?,
+        };
+        let (service, subservice) = self.service();
+        TcRepr {
+            apid: Apid::new(self.request.apid).unwrap_or_default(),
+            seq_count: SeqCount::new(self.request.seq_count).unwrap_or_default(),
+            header: TcSecondaryHeader {
+                ack: AckFlags::ALL,
+                service,
+                subservice,
+                source_id: self.source_id,
+            },
+            app_data: data.get(..n).unwrap_or(&[]),
+        }
+        .emit(out)
+        .map_err(TcOutError::Emit)
+    }
+}
+
+/// What a report told the link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Heard {
+    /// A transmission was answered (Figure 11's attempt).
+    pub attempt: Option<bool>,
+    /// A command started, was refused, or went unacknowledged.
+    pub done: Option<Done>,
+    /// A started motion ended: its sequence count and how.
+    pub ended: Option<(u16, MotionEnd)>,
+    /// The gateway refused a telecommand at acceptance, or failed its start with a code that
+    /// is no refusal of board A's: its sequence count and the failure notice.
+    pub rejected: Option<(u16, Failure)>,
+    /// A housekeeping report: the robot's status now.
+    pub status: Option<HeartbeatRepr>,
+}
+
+/// A telecommand on its way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+struct Pending {
+    tc: TcOut,
+    /// When last transmitted (for a running motion: when its query timer started).
+    sent: Option<Instant>,
+    /// The last transmission awaits its first report.
+    open: bool,
+    /// Transmissions in a row with no report.
+    unanswered: u8,
+    /// Transmissions made.
+    attempts: u8,
+    /// The gateway accepted it (TM(1,1)).
+    accepted: bool,
+}
+
+/// What [`Pending::due`] decided.
+enum Due {
+    /// Nothing yet.
+    Wait,
+    /// Transmit (again); `failed`: the previous transmission went unanswered.
+    Send { failed: bool },
+    /// `max_attempts` transmissions in a row went unanswered.
+    GiveUp,
+}
+
+impl Pending {
+    const fn new(tc: TcOut) -> Pending {
+        Pending {
+            tc,
+            sent: None,
+            open: false,
+            unanswered: 0,
+            attempts: 0,
+            accepted: false,
+        }
+    }
+
+    /// Whether to transmit at `now`, when a transmission waits `limit` ms for an answer.
+    fn due(&mut self, now: Instant, limit: u32, max: u8) -> Due {
+        let Some(t) = self.sent else {
+            return Due::Send { failed: false };
+        };
+        if now.since(t).millis() < limit {
+            return Due::Wait;
+        }
+        let failed = self.open;
+        if failed {
+            self.open = false;
+            self.unanswered = self.unanswered.saturating_add(1);
+        }
+        if self.unanswered >= max.max(1) {
+            Due::GiveUp
+        } else {
+            Due::Send { failed }
+        }
+    }
+
+    fn transmit(&mut self, now: Instant) -> TcOut {
+        self.sent = Some(now);
+        self.open = true;
+        self.attempts = self.attempts.saturating_add(1);
+        self.tc
+    }
+
+    /// A report about it arrived: closes the open transmission (an answered attempt).
+    fn answered(&mut self) -> Option<bool> {
+        let was = self.open;
+        self.open = false;
+        self.unanswered = 0;
+        was.then_some(true)
+    }
+
+    const fn done(&self, outcome: Outcome) -> Done {
+        Done {
+            seq: self.tc.request.seq_count,
+            command: self.tc.command,
+            outcome,
+            attempts: self.attempts,
+        }
+    }
+}
+
+/// One robot's telecommand link at the ground.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TcLink {
+    cfg: Config,
+    apid: u16,
+    next: SeqCount,
+    /// The command submitted last, until its start report.
+    current: Option<Pending>,
+    /// A started motion, until its completion report.
+    running: Option<Pending>,
+    efficiency: Efficiency,
+    /// The latest housekeeping report.
+    status: Option<HeartbeatRepr>,
+    /// The mode last reported (housekeeping or event).
+    mode: Option<Mode>,
+}
+
+impl TcLink {
+    /// For robot `board` (its APID), numbering from sequence count 0.
+    pub fn new(cfg: Config, board: BoardNumber) -> TcLink {
+        TcLink {
+            cfg,
+            apid: robot_apid(board),
+            next: SeqCount::default(),
+            current: None,
+            running: None,
+            efficiency: Efficiency::default(),
+            status: None,
+            mode: None,
+        }
+    }
+
+    /// The APID of its telecommands.
+    pub const fn apid(&self) -> u16 {
+        self.apid
+    }
+
+    /// The transmissions answered over the last 100 (Figure 11).
+    pub const fn efficiency(&self) -> Efficiency {
+        self.efficiency
+    }
+
+    /// The sequence count of the command awaiting its start report, if any.
+    pub fn outstanding(&self) -> Option<u16> {
+        self.current.map(|p| p.tc.request.seq_count)
+    }
+
+    /// The robot's status as last reported: the latest housekeeping report, with the mode
+    /// of any mode-change or fault event since.
+    pub fn status(&self) -> Option<HeartbeatRepr> {
+        self.status.map(|s| HeartbeatRepr {
+            mode: self.mode.unwrap_or(s.mode),
+            ..s
+        })
+    }
+
+    /// A telemetry packet's service, subservice and source data (its CCSDS headers checked by
+    /// the caller): ST\[1\] reports ([`TcLink::report`]), ST\[3\] housekeeping (the status),
+    /// ST\[5\] events (the mode they name); anything else, or source data that does not read,
+    /// tells nothing.
+    pub fn telemetry(&mut self, service: u8, subservice: u8, data: &[u8]) -> Heard {
+        match service {
+            ST_VERIFICATION => match Report::parse(subservice, data) {
+                Ok(r) => self.report(&r),
+                Err(_) => Heard::default(),
+            },
+            ST_HOUSEKEEPING if subservice == 25 => match housekeeping::parse(data) {
+                Ok(hb) => {
+                    self.status = Some(hb);
+                    self.mode = Some(hb.mode);
+                    Heard {
+                        status: Some(hb),
+                        ..Heard::default()
+                    }
+                }
+                Err(_) => Heard::default(),
+            },
+            ST_EVENT => {
+                // Mode changes (ID 1: from, to) and faults (ID 0x01xx: the mode after it);
+                // spec/ccsds/services.toml.
+                let mode = match data {
+                    [0x00, 0x01, _, to, _, _] => Mode::from_wire(*to),
+                    [0x01, _, m, _, _, _] => Mode::from_wire(*m),
+                    _ => None,
+                };
+                self.mode = mode.or(self.mode);
+                Heard::default()
+            }
+            _ => Heard::default(),
+        }
+    }
+
+    /// How a motion ended, from its completion report.
+    fn motion_end(&self, failure: Option<Failure>) -> MotionEnd {
+        let Some(f) = failure else {
+            return MotionEnd::Completed;
+        };
+        let known = self.status();
+        let mode = self.mode.unwrap_or(Mode::Operational);
+        let faults = known.map_or(Faults::EMPTY, |s| s.faults);
+        match f.code {
+            c if (0x0100..0x0100 + 16).contains(&c) => MotionEnd::Interrupted {
+                mode,
+                faults: Faults::from_wire([f.data as u8, (f.data >> 8) as u8]).unwrap_or(faults),
+            },
+            ABANDONED => MotionEnd::Interrupted {
+                mode: Mode::from_wire(f.data as u8).unwrap_or(mode),
+                faults,
+            },
+            _ => MotionEnd::Unacknowledged,
+        }
+    }
+
+    /// An ST\[1\] report.
+    pub fn report(&mut self, r: &Report) -> Heard {
+        let mut heard = Heard::default();
+        if r.request.apid != self.apid {
+            return heard;
+        }
+        let seq = r.request.seq_count;
+        if let Some(mut p) = self.current.filter(|p| p.tc.request.seq_count == seq) {
+            heard.attempt = p.answered();
+            self.current = None;
+            match (r.stage, r.failure) {
+                (Stage::Acceptance, None) => {
+                    p.accepted = true;
+                    self.current = Some(p);
+                }
+                (Stage::Acceptance, Some(f)) => heard.rejected = Some((seq, f)),
+                (Stage::Start, None) => {
+                    heard.done = Some(p.done(Outcome::Accepted));
+                    if p.tc.command.kind().moves() {
+                        // Its completion is asked for from the next tick on.
+                        self.running = Some(Pending { sent: None, ..p });
+                    }
+                }
+                (Stage::Start, Some(f)) => {
+                    let refusal = u8::try_from(f.code).ok().and_then(Refusal::from_wire);
+                    match (f.code, refusal) {
+                        (_, Some(r)) => heard.done = Some(p.done(Outcome::Refused(r))),
+                        (UNACKNOWLEDGED, _) => heard.done = Some(p.done(Outcome::Unacknowledged)),
+                        _ => heard.rejected = Some((seq, f)),
+                    }
+                }
+                (Stage::Completion, failure) => {
+                    // Its start report was lost: started, and ended already.
+                    heard.done = Some(p.done(Outcome::Accepted));
+                    if p.tc.command.kind().moves() {
+                        heard.ended = Some((seq, self.motion_end(failure)));
+                    }
+                }
+            }
+        } else if let Some(mut p) = self.running.filter(|p| p.tc.request.seq_count == seq) {
+            heard.attempt = p.answered();
+            self.running = Some(p);
+            if r.stage == Stage::Completion {
+                self.running = None;
+                heard.ended = Some((seq, self.motion_end(r.failure)));
+            }
+        }
+        if let Some(ok) = heard.attempt {
+            self.efficiency.push(ok);
+        }
+        heard
+    }
+}
+
+impl Link for TcLink {
+    type Packet = TcOut;
+    const POLLS: bool = false;
+
+    fn is_idle(&self) -> bool {
+        self.current.is_none()
+    }
+
+    /// Numbers `command` with the next sequence count; none while another awaits its start.
+    fn submit(&mut self, command: Command) -> Option<u16> {
+        if self.current.is_some() {
+            return None;
+        }
+        let seq = self.next;
+        self.next = seq.wrapping_next();
+        self.current = Some(Pending::new(TcOut {
+            request: RequestId {
+                apid: self.apid,
+                seq_count: seq.get(),
+            },
+            source_id: self.cfg.source_id,
+            command,
+        }));
+        Some(seq.get())
+    }
+
+    /// The transmission due now, if any (the submitted command first, then a query for a
+    /// running motion's completion); a failed attempt; a command given up.
+    fn tick(&mut self, now: u32) -> LinkTick<TcOut> {
+        let t = Instant::from_millis(now);
+        let mut out = LinkTick::default();
+        let cfg = self.cfg;
+        if let Some(mut p) = self.current.take() {
+            let limit = if p.accepted {
+                cfg.query_ms
+            } else {
+                cfg.timeout_ms
+            };
+            match p.due(t, limit, cfg.max_attempts) {
+                Due::Wait => self.current = Some(p),
+                Due::Send { failed } => {
+                    out.attempt = failed.then_some(false);
+                    out.send = Some(p.transmit(t));
+                    self.current = Some(p);
+                }
+                Due::GiveUp => {
+                    out.attempt = Some(false);
+                    out.done = Some(p.done(Outcome::Unacknowledged));
+                }
+            }
+        }
+        if out.send.is_none() && out.done.is_none() {
+            if let Some(mut p) = self.running.take() {
+                match p.sent {
+                    // The query timer starts now.
+                    None => {
+                        p.sent = Some(t);
+                        p.open = false;
+                        self.running = Some(p);
+                    }
+                    Some(_) => match p.due(t, cfg.query_ms, cfg.max_attempts) {
+                        Due::Wait => self.running = Some(p),
+                        Due::Send { failed } => {
+                            out.attempt = failed.then_some(false);
+                            out.send = Some(p.transmit(t));
+                            self.running = Some(p);
+                        }
+                        Due::GiveUp => {
+                            out.attempt = Some(false);
+                            out.ended = Some((p.tc.request.seq_count, MotionEnd::Unacknowledged));
+                        }
+                    },
+                }
+            }
+        }
+        if let Some(ok) = out.attempt {
+            self.efficiency.push(ok);
+        }
+        out
+    }
+}
