@@ -294,8 +294,8 @@ pub struct BoardA {
     tracked: Option<State>,
     target_state: Option<State>,
     complete: bool,
-    /// A single-module motion (arm, gripper, hip, bolter) runs: when it ends with no fault
-    /// raised and no stop, the heartbeat's "command complete" (byte 54) is set, as a
+    /// A single-module motion (arm, gripper, hip, bolter) runs: when it ends (not stopped
+    /// by a Stop or a mode change), the heartbeat's "command complete" (byte 54) is set, as a
     /// reconfiguration's is (spec/decisions.toml, `command-complete`).
     single: bool,
     coord: Coordinator,
@@ -818,8 +818,8 @@ impl BoardA {
         }
         let new_faults = Faults::from_iter(s.faults.iter().filter(|f| !before.1.contains(*f)));
         if !new_faults.is_empty() {
-            // A motion that raised a fault does not complete.
-            self.single = false;
+            // A fault that stops the motion (a mode change: `stop_all`) leaves it incomplete;
+            // one deferred to the motion's end lets it complete first, as Table 8 says.
             out.push(Event::Faults(new_faults));
         }
         s

@@ -638,7 +638,12 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
             return;
         }
         let raised = Faults::from_iter(hb.faults.iter().filter(|f| !prev.faults.contains(*f)));
-        let failure = match raised.iter().next() {
+        // A fault deferred to the motion's end (Table 8: low battery, assembly system) lets
+        // the motion complete; its ST[5] event reports it. Any other fails the motion.
+        let stopping = raised
+            .iter()
+            .find(|f| !crate::safety::policy::fault_action(*f).deferred);
+        let failure = match stopping {
             Some(f) => Some(Failure::fault(f, hb.faults)),
             None if hb.mode != prev.mode => Some(Failure {
                 code: ABANDONED,

@@ -391,3 +391,42 @@ fn motions_run_together_complete_together_and_stale_answers_say_nothing() {
         [(Stage::Completion, None, 1), (Stage::Completion, None, 2)]
     );
 }
+
+/// A fault Table 8 defers to the motion's end (low battery) lets the motion complete: ST[1]
+/// completes it, ST[5] reports the fault; an immediate one (above) fails it.
+#[test]
+fn a_deferred_fault_lets_the_motion_complete() {
+    let mut g = gateway();
+    g.tc(&tc(
+        1,
+        Request::Function(Command::Hip(mmic::command::HipTarget::RightAngleCw)),
+    ));
+    let c = sent(&mut g, 0);
+    g.heartbeat(10, &answer(c.seq));
+    let p = sent(&mut g, 300);
+    let low = HeartbeatRepr {
+        faults: Faults::EMPTY.with(Fault::LowBattery),
+        ..answer(p.seq)
+    };
+    let out = g.heartbeat(310, &low);
+    assert!(reports(&out).is_empty(), "not failed: the motion goes on");
+    assert!(
+        out.reports
+            .iter()
+            .any(|t| (t.service, t.subservice) == (5, 3)),
+        "the fault's event"
+    );
+    let p = sent(&mut g, 600);
+    let done = HeartbeatRepr {
+        command_complete: true,
+        ..low
+    };
+    let done = HeartbeatRepr {
+        last_seq: p.seq,
+        ..done
+    };
+    assert_eq!(
+        reports(&g.heartbeat(610, &done)),
+        [(Stage::Completion, None, 1)]
+    );
+}
