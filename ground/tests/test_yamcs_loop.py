@@ -33,6 +33,9 @@ from yamcs_harness import INSTANCE, Yamcs
 
 ROBOT2 = 0x102
 STEP = 10.0  # seconds any single wait may take
+# A motion's wait: the stand-in completes one in 0.5 s, the simulated robot (GROUND_ROBOT =
+# `mmic sim ... --ground-tm-to`) needs its real duration at scale 1 (a -> m: about 20 s).
+MOTION = 90.0
 HEADER = ["ccsds_apid", "ccsds_seq_count", "met_coarse", "met_fine", "msg_type_counter", "hk_sid"]
 
 
@@ -244,8 +247,8 @@ def issue(robot, commands, name, args=None):
     return cmd, bytes.fromhex(rx["hex"])
 
 
-def complete(cmd):
-    cmd.await_complete(timeout=STEP)
+def complete(cmd, timeout=STEP):
+    cmd.await_complete(timeout=timeout)
     assert cmd.is_success(), f"{cmd.error} {cmd.acknowledgments}"
     for stage in ("Verifier_Accepted", "Verifier_Started", "Verifier_Complete"):
         assert ack(cmd, stage) == "OK", (stage, cmd.acknowledgments)
@@ -274,7 +277,7 @@ def test_mode_operational_then_a_reconfiguration_complete(robot, commands, hk):
     assert raw[11:13] == bytes([10, 2])
     complete(cmd)
     cmd, _ = issue(robot, commands, "reconfiguration", {"initial": "a", "target": "m"})
-    complete(cmd)
+    complete(cmd, MOTION)
     # The robot's own HK now says so, and every value YAMCS shows is what the robot sent.
     sent = {}
     end = time.monotonic() + STEP

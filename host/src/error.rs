@@ -74,6 +74,9 @@ pub enum CliError {
         /// The latest tick, simulated ms.
         late_ms: u32,
     },
+    /// Options that do not go together.
+    #[error("{0}")]
+    Usage(String),
     /// Standard output or error is closed.
     #[error("cannot write output: {0}")]
     Output(#[source] std::io::Error),
@@ -85,7 +88,7 @@ impl CliError {
         match self {
             CliError::Codec(e) => e.exit_code(),
             CliError::Pus(e) => e.exit_code(),
-            CliError::Spec(_) => EXIT_INPUT,
+            CliError::Spec(_) | CliError::Usage(_) => EXIT_INPUT,
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
             CliError::Plan { .. } | CliError::Inject(_) => EXIT_INPUT,
             CliError::Incomplete(_) => 1,

@@ -29,9 +29,7 @@ use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::ccsds::tm::TmRepr;
 use mmic::ccsds::tm_header::{TimeRefStatus, TmSecondaryHeader};
 use mmic::ccsds::{PusError, MAX_PACKET_LEN};
-use mmic::faults::Faults;
-use mmic::mode::Mode;
-use mmic::pus::event::{AttemptResult, Event, EVENT_LEN};
+use mmic::pus::event::{AttemptResult, Event};
 use mmic::pus::function::FunctionId;
 use mmic::pus::housekeeping;
 use mmic::pus::request::Request;
@@ -218,19 +216,26 @@ fn function_data(name: &str, args: Option<&Value>) -> Result<Vec<u8>, PusCodecEr
     Ok(data)
 }
 
+/// The JSON object of `json`, every key one of `keys`.
+fn object(
+    json: &str,
+    keys: &[&str],
+    err: fn(String) -> PusCodecError,
+) -> Result<serde_json::Map<String, Value>, PusCodecError> {
+    let v: Value = serde_json::from_str(json).map_err(|e| err(e.to_string()))?;
+    let Value::Object(m) = v else {
+        return Err(err("expected a JSON object".into()));
+    };
+    if let Some(k) = m.keys().find(|k| !keys.contains(&k.as_str())) {
+        return Err(err(format!("unknown key {k:?}; keys: {}", keys.join(", "))));
+    }
+    Ok(m)
+}
+
 /// Encodes a telecommand from its JSON form; a packet the robot would refuse is refused here
 /// too, by the same check.
 pub fn encode_tc(json: &str) -> Result<Vec<u8>, PusCodecError> {
-    let v: Value = serde_json::from_str(json).map_err(|e| tc_input(e.to_string()))?;
-    let m = v
-        .as_object()
-        .ok_or_else(|| tc_input("expected a JSON object"))?;
-    if let Some(k) = m.keys().find(|k| !TC_KEYS.contains(&k.as_str())) {
-        return Err(tc_input(format!(
-            "unknown key {k:?}; keys: {}",
-            TC_KEYS.join(", ")
-        )));
-    }
+    let m = &object(json, &TC_KEYS, tc_input)?;
     let get = |k: &str, default: u64, max: u64| -> Result<u64, PusCodecError> {
         m.get(k).map_or(Ok(default), |v| uint(v, k, max, tc_input))
     };
@@ -482,78 +487,23 @@ fn report_of(v: &Value) -> Result<(u8, Vec<u8>), PusCodecError> {
     Ok((r.subservice(), b.get(..n).unwrap_or(&[]).to_vec()))
 }
 
-fn mode_name(b: u8) -> Value {
-    Mode::from_wire(b).map_or(json!(b), |m| json!(m.name()))
-}
-
-/// The event of TM(5,`subservice`) source data, checked whole: the event the bytes name must
-/// give back exactly these bytes and this severity (the layout is `Event::to_bytes`).
+/// The event of TM(5,`subservice`) source data, read by the library (`Event::parse`: the
+/// bytes `Event::to_bytes` writes, in the event's severity).
 fn event_json(subservice: u8, data: &[u8]) -> Result<Value, PusCodecError> {
-    let bad = |why: String| tm_refused("source-data", format!("TM(5,{subservice}): {why}"));
-    if data.len() != EVENT_LEN {
-        return Err(bad(format!("{} octets, expected {EVENT_LEN}", data.len())));
-    }
-    let id = u16::from_be_bytes([data[0], data[1]]);
-    let aux = [data[2], data[3], data[4], data[5]];
-    let mode = |b: u8| Mode::from_wire(b).ok_or_else(|| bad(format!("mode {b}")));
-    let (event, extra) = match id {
-        1 => (
-            Event::ModeChanged {
-                from: mode(aux[0])?,
-                to: mode(aux[1])?,
-            },
-            json!({"from": mode_name(aux[0]), "to": mode_name(aux[1])}),
-        ),
-        2 => {
-            let pair = mmic::bolter::BolterPair::from_number(aux[0])
-                .ok_or_else(|| bad(format!("bolter pair {}", aux[0])))?;
-            let (result, rname) = ATTEMPT_RESULTS
-                .iter()
-                .find(|(r, _)| *r as u8 == aux[2])
-                .copied()
-                .ok_or_else(|| bad(format!("attempt result {}", aux[2])))?;
-            (
-                Event::Attempt {
-                    pair,
-                    attempt: aux[1],
-                    result,
-                },
-                json!({"pair": aux[0], "attempt": aux[1], "result": rname}),
-            )
-        }
-        3 => {
-            let bits = u32::from_be_bytes(aux);
-            let f = u16::try_from(bits)
-                .ok()
-                .and_then(|b| Faults::from_wire(b.to_le_bytes()).ok())
-                .ok_or_else(|| bad(format!("fault map {bits:#x}")))?;
-            let names: Vec<&str> = f.iter().map(|x| x.name()).collect();
-            (Event::Cleared(f), json!({"faults": names}))
-        }
-        0x0100..=0x01FF => {
-            let fault = spec::fault_of_bit((id - 0x0100) as u8)
-                .ok_or_else(|| bad(format!("event ID {id:#06x}: no such fault")))?;
-            (
-                Event::Fault {
-                    fault,
-                    mode: mode(aux[0])?,
-                },
-                json!({"fault": fault.name(), "mode": mode_name(aux[0])}),
-            )
-        }
-        _ => return Err(bad(format!("unknown event ID {id:#06x}"))),
+    let event = Event::parse(subservice, data)
+        .map_err(|e| tm_refused("source-data", format!("TM(5,{subservice}): {e}")))?;
+    let id = event.id();
+    let extra = match event {
+        Event::ModeChanged { from, to } => json!({"from": from.name(), "to": to.name()}),
+        Event::Attempt {
+            pair,
+            attempt,
+            result,
+        } => json!({"pair": pair.number(), "attempt": attempt,
+                    "result": ATTEMPT_RESULTS.iter().find(|(r, _)| *r == result).map(|(_, n)| *n)}),
+        Event::Cleared(f) => json!({"faults": f.iter().map(|x| x.name()).collect::<Vec<_>>()}),
+        Event::Fault { fault, mode } => json!({"fault": fault.name(), "mode": mode.name()}),
     };
-    if event.to_bytes().as_slice() != data {
-        return Err(bad(format!(
-            "not the bytes of event {id:#06x} (padding not zero?)"
-        )));
-    }
-    if event.severity() != subservice && !matches!(event, Event::Attempt { .. }) {
-        return Err(bad(format!(
-            "event {id:#06x} has severity {}, sent as {subservice}",
-            event.severity()
-        )));
-    }
     let name = spec::event_ids()
         .ok()
         .and_then(|ids| ids.into_iter().find(|(i, _)| *i == id).map(|(_, n)| n));
@@ -649,16 +599,7 @@ pub fn decode_tm(bytes: &[u8], apids: &[u16]) -> Result<Value, PusCodecError> {
 /// decode (the robot's TM only), and every other key given must agree with it (so `decode
 /// pus-tm`'s output encodes back to the same bytes).
 pub fn encode_tm(json: &str) -> Result<Vec<u8>, PusCodecError> {
-    let v: Value = serde_json::from_str(json).map_err(|e| tm_input(e.to_string()))?;
-    let m = v
-        .as_object()
-        .ok_or_else(|| tm_input("expected a JSON object"))?;
-    if let Some(k) = m.keys().find(|k| !TM_KEYS.contains(&k.as_str())) {
-        return Err(tm_input(format!(
-            "unknown key {k:?}; keys: {}",
-            TM_KEYS.join(", ")
-        )));
-    }
+    let m = &object(json, &TM_KEYS, tm_input)?;
     let get = |k: &str, default: u64, max: u64| -> Result<u64, PusCodecError> {
         m.get(k).map_or(Ok(default), |v| uint(v, k, max, tm_input))
     };

@@ -158,6 +158,17 @@ pub struct SimArgs {
     /// No live progress.
     #[arg(long)]
     pub quiet: bool,
+    /// With --protocol pus: an external ground (YAMCS) instead of the plan runner. The
+    /// server board sends its telemetry to this UDP address (e.g. 127.0.0.1:18015) and takes
+    /// telecommands on --ground-tc-port; no plan runs, the scale is 1 (the ground's timeouts
+    /// are wall time) and the run ends after --max-seconds or when killed. Prints one JSON line
+    /// per packet on stdout (ground/README.md).
+    #[arg(long, value_name = "ADDR", requires = "ground_tc_port")]
+    pub ground_tm_to: Option<std::net::SocketAddr>,
+    /// The UDP port on 127.0.0.1 where the external ground's telecommands arrive (0: a free
+    /// one, printed in the first line).
+    #[arg(long, value_name = "PORT", requires = "ground_tm_to")]
+    pub ground_tc_port: Option<u16>,
     /// Parse the plan and follow the robot's state through it, then exit without running:
     /// a step that does not fit the state is reported with its line and column.
     #[arg(long)]
@@ -266,6 +277,9 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     cfg.max_sim_ms = ms(Some(a.max_seconds)).unwrap_or(u32::MAX);
     cfg.log_path = Some(a.out.join("sim.jsonl"));
     cfg.progress = !a.quiet;
+    if let (Some(tm_to), Some(tc_port)) = (a.ground_tm_to, a.ground_tc_port) {
+        return external(cfg, tm_to, tc_port, out);
+    }
     let summary = sim::run(&cfg).map_err(CliError::Sim)?;
     let plots = report::plots(&summary, &a.out).map_err(|source| CliError::Write {
         path: a.out.clone(),
@@ -287,6 +301,65 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
         })?;
     }
     verdict
+}
+
+/// `mmic sim --ground-tm-to`: the robot and its server board, commanded by an external ground
+/// over UDP for --max-seconds of wall time; the packet lines go to `out`.
+fn external(
+    mut cfg: SimConfig,
+    tm_to: std::net::SocketAddr,
+    tc_port: u16,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    if cfg.protocol != sim::Protocol::Pus {
+        return Err(CliError::Usage(
+            "--ground-tm-to and --ground-tc-port need --protocol pus".into(),
+        ));
+    }
+    cfg.scale = 1.0;
+    cfg.paced = false;
+    cfg.progress = false;
+    // The node threads send their packet lines here; this thread writes them to `out`
+    // (which may hold the stdout lock) until the run ends.
+    let (tx, rx) = std::sync::mpsc::channel::<Vec<u8>>();
+    cfg.external = Some(sim::External {
+        tm_to,
+        tc_port,
+        wire: sim::nodes::WireLog(std::sync::Arc::new(std::sync::Mutex::new(Box::new(Lines(
+            tx,
+        ))))),
+    });
+    let summary = std::thread::scope(|s| -> Result<sim::Summary, CliError> {
+        let run = s.spawn(move || sim::run(&cfg));
+        for line in rx {
+            out.write_all(&line)
+                .and_then(|_| out.flush())
+                .map_err(CliError::Output)?;
+        }
+        run.join()
+            .map_err(|_| CliError::Sim(std::io::Error::other("the simulation panicked")))?
+            .map_err(CliError::Sim)
+    })?;
+    let done =
+        serde_json::json!({"done": true, "sim_ms": summary.sim_ms, "status": summary.status});
+    writeln!(out, "{done}").map_err(CliError::Output)?;
+    Ok(())
+}
+
+/// A writer that hands what it is given to another thread.
+struct Lines(std::sync::mpsc::Sender<Vec<u8>>);
+
+impl Write for Lines {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.0
+            .send(buf.to_vec())
+            .map_err(|_| std::io::Error::other("output closed"))?;
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
 }
 
 /// The exit code `mmic sim` returns for this run: 0 completed, 1 incomplete, 4 the host fell

@@ -274,6 +274,58 @@ fn a_fault_mid_motion_fails_the_tc_with_the_faults_code_and_an_event() {
     );
 }
 
+#[test]
+fn a_deferred_fault_mid_motion_lets_the_tc_complete_then_standby() {
+    // Table 8: low battery is deferred to the motion's end. The reconfiguration completes
+    // (TM(1,7) when the robot reached its target), the fault is a medium-severity event
+    // (TM(5,3)), and the robot is in Standby only after the motion completed.
+    let mut l = Loop::operational(State::A);
+    l.tc(1, reconfigure(State::A, State::M));
+    l.report(2_000, 1, Stage::Start).expect("started");
+    for _ in 0..100 {
+        l.step();
+    }
+    assert!(l.r.a.in_motion());
+    let sag = l.r.now;
+    l.r.plant.config_mut().low_battery_at = Some(sag);
+    let (done_at, r) = l.report(60_000, 1, Stage::Completion).expect("ended");
+    assert_eq!(
+        r.failure, None,
+        "the motion completes despite the deferred fault"
+    );
+    let reached = l.reached(State::M).expect("reached its target");
+    assert!(reached <= done_at);
+    // Let the gateway see the Standby heartbeat after the completion.
+    for _ in 0..100 {
+        l.step();
+    }
+    let events: Vec<(u32, u8, u16, Vec<u8>)> =
+        l.tm.iter()
+            .filter(|t| t.service == 5)
+            .map(|t| {
+                (
+                    t.at,
+                    t.subservice,
+                    u16::from_be_bytes([t.data[0], t.data[1]]),
+                    t.data[2..].to_vec(),
+                )
+            })
+            .collect();
+    let bit = u16::from(Fault::LowBattery.bit());
+    let fault = events
+        .iter()
+        .find(|e| e.2 == 0x0100 + bit)
+        .unwrap_or_else(|| panic!("no low-battery event: {events:?}"));
+    assert_eq!(fault.1, 3, "deferred: medium severity, TM(5,3)");
+    assert!(fault.0 >= sag);
+    let standby = events
+        .iter()
+        .find(|e| e.2 == 1 && e.3[1] == Mode::Standby.to_wire())
+        .unwrap_or_else(|| panic!("no mode change to Standby: {events:?}"));
+    assert!(standby.0 >= done_at, "Standby only after the completion");
+    assert_eq!(l.r.a.mode(), Mode::Standby);
+}
+
 /// The ground's PUS plan runner against the gateway and the lock-step robot: every packet
 /// crosses as bytes; `lose(k)` drops the k-th packet on the ground link (either way).
 fn run_plan(

@@ -28,7 +28,11 @@
 //!               request_of: Ok(Request::Function(Command::Stop)) };
 //! let out = g.tc(&tc);
 //! assert_eq!(out.reports[0].stage(), Some((Stage::Acceptance, true)));
-//! let out = g.tick(0);
+//! // Until board A was heard from, the gateway polls and holds the telecommand back.
+//! let poll = g.tick(0).to_robots[0].1;
+//! assert_eq!(poll.command, Command::Heartbeat);
+//! g.heartbeat(3, &HeartbeatRepr { last_seq: poll.seq, ..HeartbeatRepr::default() });
+//! let out = g.tick(10);
 //! let sent = out.to_robots[0].1;
 //! assert_eq!(sent.command, Command::Stop);
 //! // Board A answers: accepted, so started and (Stop being instantaneous) completed.
@@ -558,9 +562,19 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
         }
     }
 
-    /// The uplink is idle: the next telecommand, else a poll when one is due.
+    /// The uplink is idle: the next telecommand, else a poll when one is due. Until board A's
+    /// first heartbeat came, telecommands wait in the queue and the gateway polls: ST\[5\]
+    /// events are what changed between two heartbeats, so a command answered by the very
+    /// first one (entering Operational, a fault raised on the way) would change nothing the
+    /// gateway could report (spec/decisions.toml, `pus-gateway`).
     fn submit_next(&mut self, now: u32, cfg: &Config) {
         let t = Instant::from_millis(now);
+        if self.last.is_none() && !self.queue.is_empty() {
+            if self.uplink.submit(Command::Heartbeat).is_ok() {
+                self.next_poll = Some(Instant::from_millis(now.wrapping_add(cfg.poll_ms)));
+            }
+            return;
+        }
         if !self.queue.is_empty() {
             let job = self.queue.remove(0);
             if let Ok(seq) = self.uplink.submit(job.command) {
@@ -643,13 +657,15 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
         let stopping = raised
             .iter()
             .find(|f| !crate::safety::policy::fault_action(*f).deferred);
+        // "Command complete" before the mode: a deferred fault takes the robot to its mode in
+        // the very tick the motion completes, so the completing heartbeat shows both.
         let failure = match stopping {
             Some(f) => Some(Failure::fault(f, hb.faults)),
+            None if hb.command_complete => None,
             None if hb.mode != prev.mode => Some(Failure {
                 code: ABANDONED,
                 data: u32::from(hb.mode.to_wire()),
             }),
-            None if hb.command_complete => None,
             None => return,
         };
         for (_, job) in core::mem::take(&mut self.running) {

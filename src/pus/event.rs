@@ -35,6 +35,52 @@ use crate::mode::Mode;
 use crate::safety::policy::fault_action;
 use crate::wire::heartbeat::HeartbeatRepr;
 
+/// Why TM(5,x) source data is not an event of ours (checked in this order).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum EventError {
+    /// Not a subservice of ST\[5\] (1..=4).
+    #[error("TM(5,{0}) is no event report (subservices 1..=4)")]
+    Subservice(u8),
+    /// Not the length of an event's source data.
+    #[error("event source data of {found} octets, expected {expected}")]
+    Length {
+        /// Octets expected ([`EVENT_LEN`]).
+        expected: usize,
+        /// Octets found.
+        found: usize,
+    },
+    /// No event has this ID (or a fault event names a bit no fault has).
+    #[error("unknown event ID {0:#06x}")]
+    UnknownId(u16),
+    /// A byte of the auxiliary data is out of its range.
+    #[error("event {id:#06x}: {field} {found:#x} is out of range")]
+    Field {
+        /// Event ID.
+        id: u16,
+        /// The field (`mode`, `from`, `to`, `pair`, `attempt`, `result`, `faults`).
+        field: &'static str,
+        /// Its value.
+        found: u32,
+    },
+    /// Octets the event does not use are not zero.
+    #[error("event {id:#06x}: unused octets not zero")]
+    Padding {
+        /// Event ID.
+        id: u16,
+    },
+    /// The subservice is not the event's severity.
+    #[error("event {id:#06x} has severity {expected}, sent as TM(5,{found})")]
+    Severity {
+        /// Event ID.
+        id: u16,
+        /// Its severity ([`Event::severity`]).
+        expected: u8,
+        /// The subservice it came in.
+        found: u8,
+    },
+}
+
 /// How a bolting attempt ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -129,6 +175,81 @@ impl Event {
         };
         let [i0, i1] = self.id().to_be_bytes();
         [i0, i1, aux[0], aux[1], aux[2], aux[3]]
+    }
+}
+
+impl Event {
+    /// Reads TM(5,`subservice`) source data: exactly the bytes [`Event::to_bytes`] writes, sent
+    /// in the event's severity. Ground tools use it; the gateway only emits.
+    ///
+    /// ```
+    /// use mmic::mode::Mode;
+    /// use mmic::pus::event::{Event, EventError};
+    /// let e = Event::ModeChanged { from: Mode::Standby, to: Mode::Operational };
+    /// assert_eq!(Event::parse(1, &e.to_bytes()), Ok(e));
+    /// assert_eq!(
+    ///     Event::parse(4, &e.to_bytes()),
+    ///     Err(EventError::Severity { id: 1, expected: 1, found: 4 })
+    /// );
+    /// ```
+    pub fn parse(subservice: u8, data: &[u8]) -> Result<Event, EventError> {
+        if !(1..=4).contains(&subservice) {
+            return Err(EventError::Subservice(subservice));
+        }
+        let b: [u8; EVENT_LEN] = data.try_into().map_err(|_| EventError::Length {
+            expected: EVENT_LEN,
+            found: data.len(),
+        })?;
+        let id = u16::from_be_bytes([b[0], b[1]]);
+        let field = |field, found: u32| EventError::Field { id, field, found };
+        let mode = |name, x: u8| Mode::from_wire(x).ok_or(field(name, u32::from(x)));
+        let event = match id {
+            1 => Event::ModeChanged {
+                from: mode("from", b[2])?,
+                to: mode("to", b[3])?,
+            },
+            2 => Event::Attempt {
+                pair: BolterPair::from_number(b[2]).ok_or(field("pair", u32::from(b[2])))?,
+                attempt: match b[3] {
+                    1..=3 => b[3],
+                    x => return Err(field("attempt", u32::from(x))),
+                },
+                result: match b[4] {
+                    0 => AttemptResult::Done,
+                    1 => AttemptResult::Failed,
+                    2 => AttemptResult::GaveUp,
+                    3 => AttemptResult::Interrupted,
+                    x => return Err(field("result", u32::from(x))),
+                },
+            },
+            3 => {
+                let bits = u32::from_be_bytes([b[2], b[3], b[4], b[5]]);
+                let wire = u16::try_from(bits).map(u16::to_le_bytes);
+                match wire.map(Faults::from_wire) {
+                    Ok(Ok(f)) if !f.is_empty() => Event::Cleared(f),
+                    _ => return Err(field("faults", bits)),
+                }
+            }
+            0x0100..=0x01FF => Event::Fault {
+                fault: Fault::ALL
+                    .into_iter()
+                    .find(|f| 0x0100 + u16::from(f.bit()) == id)
+                    .ok_or(EventError::UnknownId(id))?,
+                mode: mode("mode", b[2])?,
+            },
+            _ => return Err(EventError::UnknownId(id)),
+        };
+        if event.to_bytes() != b {
+            return Err(EventError::Padding { id });
+        }
+        if event.severity() != subservice {
+            return Err(EventError::Severity {
+                id,
+                expected: event.severity(),
+                found: subservice,
+            });
+        }
+        Ok(event)
     }
 }
 

@@ -23,6 +23,8 @@ fn gateway() -> G {
     });
     assert!(g.add(BoardNumber::ONE));
     assert!(!g.add(BoardNumber::ONE), "a robot is served once");
+    // Board A was heard from (the gateway holds telecommands back until then).
+    g.heartbeat(0, &answer(0));
     g
 }
 
@@ -62,6 +64,33 @@ fn answer(seq: u16) -> HeartbeatRepr {
         mode: Mode::Operational,
         ..HeartbeatRepr::default()
     }
+}
+
+#[test]
+fn telecommands_wait_for_board_as_first_heartbeat() {
+    let mut g = G::new(Config {
+        hk_enabled: false,
+        ..Config::default()
+    });
+    assert!(g.add(BoardNumber::ONE));
+    let r = Command::Mode(Mode::Operational);
+    assert_eq!(
+        reports(&g.tc(&tc(1, Request::Function(r)))),
+        [(Stage::Acceptance, None, 1)]
+    );
+    // Polls, resent until answered; the telecommand waits.
+    let mut polls = vec![];
+    for t in (0..1_000).step_by(10) {
+        polls.extend(g.tick(t).to_robots.iter().map(|(_, c)| (c.command, c.seq)));
+    }
+    assert!(polls.len() >= 2, "{polls:?}");
+    assert!(
+        polls.iter().all(|p| *p == (Command::Heartbeat, polls[0].1)),
+        "{polls:?}"
+    );
+    g.heartbeat(1_005, &answer(polls[0].1));
+    let c = sent(&mut g, 1_010);
+    assert_eq!(c.command, r);
 }
 
 #[test]
@@ -212,9 +241,11 @@ fn housekeeping_comes_every_interval_and_can_be_switched_off() {
             .count()
     };
     g.tc(&tc(1, Request::HkEnable));
-    let c = sent(&mut g, 0);
-    g.heartbeat(10, &answer(c.seq));
-    let mut times = vec![];
+    // Board A was heard from at 0: the first report comes with the first tick.
+    let out = g.tick(0);
+    assert_eq!(hk(&out), 1);
+    g.heartbeat(10, &answer(out.to_robots[0].1.seq));
+    let mut times = vec![0];
     for t in (20..5_000).step_by(10) {
         let out = g.tick(t);
         if hk(&out) > 0 {
@@ -224,7 +255,7 @@ fn housekeeping_comes_every_interval_and_can_be_switched_off() {
             g.heartbeat(t + 5, &answer(c.seq));
         }
     }
-    assert_eq!(times, [20, 1020, 2020, 3020, 4020]);
+    assert_eq!(times, [0, 1000, 2000, 3000, 4000]);
     g.tc(&tc(2, Request::HkInterval { ms: 500 }));
     let mut n = 0;
     for t in (5_000..7_000).step_by(10) {

@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod event;
 mod function;
 mod gateway;
 mod housekeeping;

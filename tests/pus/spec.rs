@@ -300,3 +300,36 @@ fn housekeeping_toml_is_the_report_layout() {
         (1, REPORT_LEN, FIELDS.len())
     );
 }
+
+#[derive(Deserialize)]
+struct TimingDoc {
+    pus_timing: PusTiming,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PusTiming {
+    tc_timeout_ms: u32,
+    tc_query_ms: u32,
+    tc_max_attempts: u8,
+    gateway_poll_ms: u32,
+    gateway_visit_timeout_ms: u32,
+}
+
+#[test]
+fn pus_timing_is_the_decision() {
+    let t: TimingDoc = load("decisions.toml");
+    let t = t.pus_timing;
+    let g = mmic::node::pus_ground::Config::default();
+    assert_eq!(
+        (g.timeout_ms, g.query_ms, g.max_attempts),
+        (t.tc_timeout_ms, t.tc_query_ms, t.tc_max_attempts)
+    );
+    let w = mmic::node::gateway::Config::default();
+    assert_eq!(
+        (w.poll_ms, w.uplink.timeout_ms),
+        (t.gateway_poll_ms, t.gateway_visit_timeout_ms)
+    );
+    // A resend means a loss: the ground waits longer than one visit and one poll period.
+    assert!(t.tc_timeout_ms > t.gateway_visit_timeout_ms + t.gateway_poll_ms);
+}

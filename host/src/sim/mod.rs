@@ -141,6 +141,32 @@ pub struct SimConfig {
     /// the run instead of stretching the firmware's timeouts. The scale benchmark, which
     /// measures what the host can do in real time, runs unpaced.
     pub paced: bool,
+    /// An external ground (YAMCS) instead of the plan runner, with [`Protocol::Pus`].
+    pub external: Option<External>,
+}
+
+/// An external ground on UDP (`mmic sim --protocol pus --ground-tm-to ADDR --ground-tc-port
+/// P`): the server board's gateway takes telecommands on 127.0.0.1:`tc_port` and sends its
+/// telemetry to `tm_to`; no plan runs; the run ends after [`SimConfig::max_sim_ms`] of wall
+/// time (the scale is 1, since the ground's timeouts run on the wall clock) or when killed.
+/// One JSON line per packet on `wire` ([`nodes::WireLog`]), after `{"ready":true,"tc_port":P}`.
+#[derive(Clone)]
+pub struct External {
+    /// Where telemetry goes (YAMCS's UDP TM link).
+    pub tm_to: std::net::SocketAddr,
+    /// The port telecommands arrive on (YAMCS's UDP TC link sends there); 0: any free one.
+    pub tc_port: u16,
+    /// Where the packet lines go (stdout in the CLI).
+    pub wire: nodes::WireLog,
+}
+
+impl std::fmt::Debug for External {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("External")
+            .field("tm_to", &self.tm_to)
+            .field("tc_port", &self.tc_port)
+            .finish_non_exhaustive()
+    }
 }
 
 /// How far simulated time may run ahead of the slowest node of a paced run, ms: two of the
@@ -187,6 +213,7 @@ impl SimConfig {
             log_packets: true,
             progress: false,
             paced: true,
+            external: None,
         }
     }
 }
@@ -442,8 +469,14 @@ fn spawn_robot<'scope, 'env>(
         Protocol::Pus => {
             // UDP on loopback: one socket at the ground, one at the server board.
             let ground = UdpSocket::bind("127.0.0.1:0")?;
-            let server = UdpSocket::bind("127.0.0.1:0")?;
-            let (ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
+            let server =
+                UdpSocket::bind(("127.0.0.1", cfg.external.as_ref().map_or(0, |x| x.tc_port)))?;
+            let (mut ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
+            if let Some(x) = &cfg.external {
+                ground_addr = x.tm_to;
+                x.wire
+                    .line(json!({"ready": true, "tc_port": server_addr.port()}));
+            }
             server.set_nonblocking(true)?;
             let to_ground = nodes::UdpOut {
                 sock: server.try_clone()?,
@@ -466,6 +499,7 @@ fn spawn_robot<'scope, 'env>(
                 ),
                 robot: (board, robot.addr),
                 config: cfg.gateway,
+                wire: cfg.external.as_ref().map(|x| x.wire.clone()),
             };
             scope.spawn(move || gw.run(nodes.3));
             let (tx, rx) = std::sync::mpsc::channel();
@@ -528,7 +562,10 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         for (i, (robot, q)) in robots.into_iter().zip(queues.iter_mut()).enumerate() {
             ground_links.push(spawn_robot(scope, &env, i, robot, q, statuses[i].clone())?);
         }
-        let out = ground_loop(cfg, &steps, ground_links, clock.node(), env.log.clone());
+        let out = match &cfg.external {
+            None => ground_loop(cfg, &steps, ground_links, clock.node(), env.log.clone()),
+            Some(_) => external_ground(cfg, &clock),
+        };
         stop.store(true, Ordering::Relaxed);
         Ok(out)
     });
@@ -710,6 +747,21 @@ impl Ground for PlanRunner<TcLink> {
     fn inject(&mut self, injection: inject::Injection) -> Option<String> {
         ground_injection(self, injection)
     }
+}
+
+/// An external ground does the commanding: wait out the run's time.
+fn external_ground(cfg: &SimConfig, clock: &Clock) -> (Vec<Option<PlanEnd>>, GroundStats) {
+    while clock.now_ms() < cfg.max_sim_ms {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let stats = GroundStats {
+        sim_ms: clock.now_ms(),
+        efficiency: Vec::new(),
+        attempts: (0, 0),
+        max_latency_ms: 0,
+        last_heartbeat: None,
+    };
+    (vec![None; cfg.robots.max(1) as usize], stats)
 }
 
 /// The opsUI over the configured protocol.

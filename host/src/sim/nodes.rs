@@ -606,8 +606,7 @@ const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + gateway::MAX_TM_DATA;
 /// ground's UDP socket into [`Gateway::tc_packet`], the legacy commands of
 /// [`Gateway::tick`] to board A over the same visits as [`ServerTask`]'s (connect, send, wait
 /// for the heartbeat, disconnect), the heartbeat into [`Gateway::heartbeat`], and every
-/// report written by [`Gateway::encode`] to the ground over UDP. It takes telecommands only
-/// once board A's first heartbeat came, so every change after power-up is an event.
+/// report written by [`Gateway::encode`] to the ground over UDP.
 pub struct GatewayTask {
     /// Where the ground's telecommands arrive (non-blocking).
     pub from_ground: UdpSocket,
@@ -617,6 +616,24 @@ pub struct GatewayTask {
     pub robot: (BoardNumber, SocketAddr),
     /// The gateway's timing: its uplink's timeout is how long a visit waits for the heartbeat.
     pub config: gateway::Config,
+    /// With an external ground (`mmic sim --ground-tm-to`): one JSON line per packet
+    /// crossing the ground link.
+    pub wire: Option<WireLog>,
+}
+
+/// The packets between an external ground and the gateway, one JSON line each, as
+/// `mmic ground robot` prints them (ground/README.md): `{"dir":"tc","hex":..,"refused":null|check}`
+/// per telecommand datagram, `{"dir":"tm","hex":..}` per telemetry packet sent.
+#[derive(Clone)]
+pub struct WireLog(pub Arc<Mutex<Box<dyn Write + Send>>>);
+
+impl WireLog {
+    /// Writes one line and flushes it (the reader waits on it).
+    pub fn line(&self, v: Value) {
+        if let Ok(mut w) = self.0.lock() {
+            let _ = writeln!(w, "{v}").and_then(|_| w.flush());
+        }
+    }
 }
 
 /// One robot, eight waiting telecommands, 64 remembered keys.
@@ -631,18 +648,16 @@ impl GatewayTask {
         while node.running() {
             let now = node.poll();
             let mut busy = false;
-            // Telecommands are taken once board A's first heartbeat came (the gateway polls
-            // at once): ST[5] events are what changed between two heartbeats, so a command
-            // answered by the very first one (entering Operational, a fault raised on the
-            // way) would otherwise change nothing the gateway could report. Meanwhile they
-            // wait in the socket.
-            while g.latest(self.robot.0).is_some() {
-                let Ok(n) = self.from_ground.recv(&mut buf) else {
-                    break;
-                };
+            // Until board A's first heartbeat the gateway holds telecommands back itself.
+            while let Ok(n) = self.from_ground.recv(&mut buf) {
                 busy = true;
                 let bytes = buf.get(..n).unwrap_or(&[]);
-                match g.tc_packet(bytes) {
+                let refused = g.tc_packet(bytes);
+                if let Some(w) = &self.wire {
+                    w.line(json!({"dir": "tc", "hex": super::log::hex(bytes),
+                                  "refused": refused.as_ref().err().map(|e| e.name())}));
+                }
+                match refused {
                     Ok(out) => self.reports(&node, &mut g, out),
                     Err(e) => node.event(
                         now,
@@ -679,7 +694,11 @@ impl GatewayTask {
             let mut b = [0u8; MAX_TM_LEN];
             match g.encode(tm, now, &mut b) {
                 Ok(n) => {
-                    self.to_ground.send(now, b.get(..n).unwrap_or(&[]));
+                    let p = b.get(..n).unwrap_or(&[]);
+                    self.to_ground.send(now, p);
+                    if let Some(w) = &self.wire {
+                        w.line(json!({"dir": "tm", "hex": super::log::hex(p)}));
+                    }
                 }
                 Err(e) => node.event(now, json!({"type": "tm_unwritten", "error": e.to_string()})),
             }

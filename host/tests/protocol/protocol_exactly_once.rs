@@ -19,7 +19,7 @@
 
 use mmic::command::Command;
 use mmic::mode::Mode;
-use mmic::node::board_a::{self, BoardA, Event};
+use mmic::node::board_a::{self, BoardA};
 use mmic::node::board_b::{self, BoardB};
 use mmic::node::ground::{self, Outcome, Uplink};
 use mmic::node::server::{Accepted, Server};
@@ -198,22 +198,13 @@ impl Model for GroundModel {
                 n.wifi.remove(i);
                 match p {
                     Packet::Command(bytes) => {
-                        n.a_now += 10;
-                        let out = n.a.tick(
-                            n.a_now,
-                            &board_a::Inputs {
-                                command: Some(bytes),
-                                ..board_a::Inputs::at_home()
-                            },
-                        );
-                        for e in &out.events {
-                            if let Event::Executed { seq, .. } = e {
-                                if let Some(i) = index_of(*seq) {
-                                    n.executed[i] = n.executed[i].saturating_add(1);
-                                }
+                        let executed = &mut n.executed;
+                        let hb = super::board_a_takes(&mut n.a, &mut n.a_now, bytes, |seq| {
+                            if let Some(i) = index_of(seq) {
+                                executed[i] = executed[i].saturating_add(1);
                             }
-                        }
-                        if let Some(hb) = out.heartbeat {
+                        });
+                        if let Some(hb) = hb {
                             if n.wifi.len() < MAX_IN_FLIGHT {
                                 put(&mut n.wifi, Packet::Heartbeat(hb));
                             }

@@ -13,7 +13,7 @@
 
 use mmic::command::Command;
 use mmic::mode::Mode;
-use mmic::node::board_a::{self, BoardA, Event};
+use mmic::node::board_a::{self, BoardA};
 use mmic::node::gateway::{Config, Gateway, Tc};
 use mmic::node::ground;
 use mmic::pus::request::Request;
@@ -164,6 +164,17 @@ impl Model for PusModel {
         };
         let mut g = Gateway::new(cfg);
         g.add(BoardNumber::ONE);
+        // The model starts once board A's first heartbeat reached the gateway (power-up: Standby,
+        // nothing run), which the gateway waits for before it forwards a telecommand (that hold
+        // is tests/pus/gateway.rs, `telecommands_wait_for_board_as_first_heartbeat`).
+        g.heartbeat(
+            0,
+            &HeartbeatRepr {
+                board: BoardNumber::ONE,
+                mode: Mode::Standby,
+                ..HeartbeatRepr::default()
+            },
+        );
         vec![State {
             g,
             now: 0,
@@ -246,23 +257,13 @@ impl Model for PusModel {
                             n.got[i] = Some(f);
                         }
                         Packet::Command(bytes) => {
-                            n.a_now += 10;
-                            let out = n.a.tick(
-                                n.a_now,
-                                &board_a::Inputs {
-                                    command: Some(bytes),
-                                    ..board_a::Inputs::at_home()
-                                },
-                            );
-                            for e in &out.events {
-                                if let Event::Executed { seq, .. } = e {
-                                    if let Some(i) = n.seq_of.iter().position(|s| *s == Some(*seq))
-                                    {
-                                        n.executed[i] = n.executed[i].saturating_add(1);
-                                    }
+                            let (executed, seq_of) = (&mut n.executed, &n.seq_of);
+                            let hb = super::board_a_takes(&mut n.a, &mut n.a_now, bytes, |seq| {
+                                if let Some(i) = seq_of.iter().position(|s| *s == Some(seq)) {
+                                    executed[i] = executed[i].saturating_add(1);
                                 }
-                            }
-                            if let Some(hb) = out.heartbeat {
+                            });
+                            if let Some(hb) = hb {
                                 if n.wifi.len() < MAX_IN_FLIGHT {
                                     put(&mut n.wifi, Packet::Heartbeat(hb));
                                 }
