@@ -409,3 +409,75 @@ fn xtce_structure_is_the_librarys_tables() {
         }
     }
 }
+
+/// `mmic sim --protocol pus --ground-tm-to`: the simulated robot serves an external ground
+/// over UDP. A TC sent to the port of its first line reaches board A through the gateway:
+/// `mode` operational is accepted, started and completed (TM(1,1), (1,3), (1,7)), and the
+/// gateway's housekeeping then says Operational; the packet lines are the ones it sent.
+#[test]
+fn the_simulator_takes_telecommands_from_an_external_ground() {
+    use std::io::{BufRead, BufReader};
+    use std::net::UdpSocket;
+    use std::time::{Duration, Instant};
+    let ground = UdpSocket::bind("127.0.0.1:0").unwrap();
+    ground
+        .set_read_timeout(Some(Duration::from_millis(200)))
+        .unwrap();
+    let tm_to = ground.local_addr().unwrap().to_string();
+    let out = std::env::temp_dir().join(format!("mmic-ext-{}", std::process::id()));
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mmic"))
+        .args(["sim", "--protocol", "pus", "--ground-tm-to", &tm_to])
+        .args(["--ground-tc-port", "0", "--max-seconds", "20", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let ready: Value = serde_json::from_str(&lines.next().unwrap().unwrap()).unwrap();
+    assert_eq!(ready["ready"], true);
+    let port = ready["tc_port"].as_u64().unwrap() as u16;
+    let tc = ok(&[
+        "encode",
+        "pus-tc",
+        r#"{"apid":257,"seq_count":5,"source_id":3,"function":"mode","args":{"mode":2}}"#,
+    ]);
+    ground
+        .send_to(
+            &mmic_host::codec::from_hex(&tc).unwrap(),
+            ("127.0.0.1", port),
+        )
+        .unwrap();
+    let (mut stages, mut operational) = (Vec::new(), false);
+    let mut received = Vec::new();
+    let end = Instant::now() + Duration::from_secs(15);
+    while Instant::now() < end && !(stages.len() == 3 && operational) {
+        let mut b = [0u8; 512];
+        let Ok(n) = ground.recv(&mut b) else { continue };
+        let hex: String = b[..n].iter().map(|x| format!("{x:02x}")).collect();
+        let d: Value = serde_json::from_str(&ok(&["decode", "pus-tm", &hex])).unwrap();
+        received.push(hex);
+        match (d["service"].as_u64(), d["subservice"].as_u64()) {
+            (Some(1), Some(s)) if d["report"]["request"]["seq_count"] == 5 => stages.push(s),
+            (Some(3), Some(25)) => operational |= d["housekeeping"]["mode"] == "operational",
+            _ => {}
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(stages, [1, 3, 7]);
+    assert!(operational, "no HK in Operational");
+    // The robot's own lines: the TC it took, and every TM it sent.
+    let logged: Vec<Value> = lines
+        .map_while(Result::ok)
+        .filter_map(|l| serde_json::from_str(&l).ok())
+        .collect();
+    assert!(logged
+        .iter()
+        .any(|l| l["dir"] == "tc" && l["hex"] == tc.as_str() && l["refused"].is_null()));
+    for hex in &received {
+        assert!(logged
+            .iter()
+            .any(|l| l["dir"] == "tm" && l["hex"] == hex.as_str()));
+    }
+    let _ = std::fs::remove_dir_all(out);
+}
