@@ -32,12 +32,12 @@
 //! let poll = g.tick(0).to_robots[0].1;
 //! assert_eq!(poll.command, Command::Heartbeat);
 //! g.heartbeat(3, &HeartbeatRepr { last_seq: poll.seq, ..HeartbeatRepr::default() });
-//! let out = g.tick(10);
+//! let out = g.tick(250); // the uplink's period: one command per 250 ms
 //! let sent = out.to_robots[0].1;
 //! assert_eq!(sent.command, Command::Stop);
 //! // Board A answers: accepted, so started and (Stop being instantaneous) completed.
 //! let hb = HeartbeatRepr { last_seq: sent.seq, ..HeartbeatRepr::default() };
-//! let out = g.heartbeat(5, &hb);
+//! let out = g.heartbeat(255, &hb);
 //! let stages: Vec<_> = out.reports.iter().filter_map(|r| r.stage()).collect();
 //! assert_eq!(stages, [(Stage::Completion, true)]); // start success not asked (ack 0b1001)
 //! ```
