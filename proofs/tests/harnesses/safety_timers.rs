@@ -14,35 +14,67 @@ const COMM_EVENTS: usize = 12;
 
 /// Low battery fires at a sample iff the voltage has been below 10.0 V at every sample of a run
 /// ending there whose span is more than 500 ms; the clock may start anywhere, wrap included.
+///
+/// Under `cargo test` (see proofs/README.md, the ledger): exhaustively, every run of 4 samples
+/// whose steps are 0, 1, 250, 499, 500 or 501 ms and whose voltages are each of the four
+/// below/not-below pairs, from 4 clock starts (0, and 499, 250 and 0 ms before the u32 wrap):
+/// the spans those steps add up to include 499, 500 and 501 ms (the threshold ±1) inside one
+/// run, across the wrap, and a run broken at every position; then sampled inputs of the full
+/// type.
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn low_battery_fires_exactly_after_half_a_second() {
+    #[cfg(not(any(kani, fuzzing)))]
+    {
+        const DT: [u16; 6] = [0, 1, 250, 499, 500, 501];
+        const LOW: [(bool, bool); 4] = [(false, false), (true, false), (false, true), (true, true)];
+        const START: [u32; 4] = [0, u32::MAX - 499, u32::MAX - 250, u32::MAX];
+        crate::ledger::exhaustive(
+            "low_battery_fires_exactly_after_half_a_second",
+            4 * 24u64.pow(4),
+            (0usize..4, crate::ledger::seq::<_, 4>((0usize..6, 0usize..4))),
+            |(start, run)| {
+                let samples = run.map(|(dt, low)| (DT[dt], LOW[low].0, LOW[low].1));
+                low_battery(START[*start], &samples);
+            },
+        );
+        crate::ledger::sampled::<(u32, [(u16, bool, bool); SAMPLES])>(
+            "low_battery_fires_exactly_after_half_a_second",
+            200_000,
+            |(start, samples)| low_battery(*start, samples),
+        );
+        return;
+    }
+    #[allow(unreachable_code)]
     bolero::check!()
         .with_type::<(u32, [(u16, bool, bool); SAMPLES])>()
-        .for_each(|(start, samples)| {
-            let cfg = Config::default();
-            let mut lb = LowBattery::default();
-            let mut abs: u64 = *start as u64;
-            let mut run_start: Option<u64> = None;
-            for (i, &(dt, low_a, low_b)) in samples.iter().enumerate() {
-                if i > 0 {
-                    abs += dt as u64;
-                }
-                let now = abs as u32; // the wrapping clock the robot sees
-                let (va, vb) = (
-                    if low_a { 9_999 } else { 10_000 },
-                    if low_b { 9_999 } else { 12_600 },
-                );
-                let below = low_a || low_b;
-                run_start = if below {
-                    Some(run_start.unwrap_or(abs))
-                } else {
-                    None
-                };
-                let expected = run_start.is_some_and(|s| abs - s > 500);
-                assert_eq!(lb.update(&cfg, now, va, vb), expected, "sample {i}");
-            }
-        });
+        .for_each(|(start, samples)| low_battery(*start, samples));
+}
+
+/// The property of [`low_battery_fires_exactly_after_half_a_second`] for one run.
+fn low_battery(start: u32, samples: &[(u16, bool, bool)]) {
+    let cfg = Config::default();
+    let mut lb = LowBattery::default();
+    let mut abs: u64 = start as u64;
+    let mut run_start: Option<u64> = None;
+    for (i, &(dt, low_a, low_b)) in samples.iter().enumerate() {
+        if i > 0 {
+            abs += dt as u64;
+        }
+        let now = abs as u32; // the wrapping clock the robot sees
+        let (va, vb) = (
+            if low_a { 9_999 } else { 10_000 },
+            if low_b { 9_999 } else { 12_600 },
+        );
+        let below = low_a || low_b;
+        run_start = if below {
+            Some(run_start.unwrap_or(abs))
+        } else {
+            None
+        };
+        let expected = run_start.is_some_and(|s| abs - s > 500);
+        assert_eq!(lb.update(&cfg, now, va, vb), expected, "sample {i}");
+    }
 }
 
 /// Comm loss fires iff B has been silent for more than the timeout (counting from the first
