@@ -62,7 +62,12 @@ fn parse_exhaustive(name: &str, kind: PacketType) {
     crate::ledger::exhaustive(
         &format!("{name} (substitutions)"),
         4 * 32 * 256 * 2,
-        (0usize..4, 0usize..32, bolero::produce::<u8>(), bolero::produce::<bool>()),
+        (
+            0usize..4,
+            0usize..32,
+            bolero::produce::<u8>(),
+            bolero::produce::<bool>(),
+        ),
         |&(k, at, v, reseal_it)| {
             let mut out = [0u8; MAX_LEN];
             let n = base(kind, k, &mut out);
@@ -218,7 +223,12 @@ fn near_valid_exhaustive(name: &str, kind: PacketType) {
     crate::ledger::exhaustive(
         name,
         4 * 64 * 256 * 2,
-        (0u8..4, 0u8..64, bolero::produce::<u8>(), bolero::produce::<bool>()),
+        (
+            0u8..4,
+            0u8..64,
+            bolero::produce::<u8>(),
+            bolero::produce::<bool>(),
+        ),
         |&(k, at, v, reseal_it)| {
             let seed: [u8; SEED] = core::array::from_fn(|i| match k {
                 0 => 0,

@@ -35,7 +35,14 @@ const PLAN: usize = 4;
 /// Chunk plans of the exhaustive parts: the whole stream at once, then chunks of 1, 2, 13, 66
 /// (the smallest legal buffer) and 70 bytes (more than the buffer: `push` takes part).
 #[cfg(not(any(kani, fuzzing)))]
-const PLANS: [&[u8]; 6] = [&[], &[0; PLAN], &[1; PLAN], &[12; PLAN], &[65; PLAN], &[69; PLAN]];
+const PLANS: [&[u8]; 6] = [
+    &[],
+    &[0; PLAN],
+    &[1; PLAN],
+    &[12; PLAN],
+    &[65; PLAN],
+    &[69; PLAN],
+];
 
 /// Token `t` of the exhaustive streams, appended to `out`: 0–3 a packet of kind `ALL[t]` with
 /// sound framing (zero body), 4–7 that kind's header alone, 8–11 the packet with its last

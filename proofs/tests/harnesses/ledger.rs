@@ -66,8 +66,12 @@ pub fn sample_bytes(seed: u64, i: u64, max_len: usize) -> Vec<u8> {
 
 /// Runs `property` on every value `generator` produces, with bolero's exhaustive engine, and
 /// asserts that there were exactly `domain` of them (the size the ledger states).
-pub fn exhaustive<G>(name: &str, domain: u64, generator: G, property: impl Fn(&G::Output) + RefUnwindSafe)
-where
+pub fn exhaustive<G>(
+    name: &str,
+    domain: u64,
+    generator: G,
+    property: impl Fn(&G::Output) + RefUnwindSafe,
+) where
     G: ValueGenerator,
     G::Output: Debug,
 {
@@ -82,7 +86,10 @@ where
         });
     let n = n.into_inner();
     println!("{name}: exhaustive, {n} cases in {:.2?}", t.elapsed());
-    assert_eq!(n, domain, "{name}: the exhaustive part walked {n} cases, the ledger says {domain}");
+    assert_eq!(
+        n, domain,
+        "{name}: the exhaustive part walked {n} cases, the ledger says {domain}"
+    );
 }
 
 /// Runs `property` on the sampled values `0..count` of `T` for [`seed_of`]`(name)` (see

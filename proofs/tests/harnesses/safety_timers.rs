@@ -32,7 +32,10 @@ fn low_battery_fires_exactly_after_half_a_second() {
         crate::ledger::exhaustive(
             "low_battery_fires_exactly_after_half_a_second",
             4 * 24u64.pow(4),
-            (0usize..4, crate::ledger::seq::<_, 4>((0usize..6, 0usize..4))),
+            (
+                0usize..4,
+                crate::ledger::seq::<_, 4>((0usize..6, 0usize..4)),
+            ),
             |(start, run)| {
                 let samples = run.map(|(dt, low)| (DT[dt], LOW[low].0, LOW[low].1));
                 low_battery(START[*start], &samples);
