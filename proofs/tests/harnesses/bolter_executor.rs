@@ -115,6 +115,7 @@ fn bolter_side_reports_what_it_runs() {
 }
 
 /// The property of [`bolter_side_reports_what_it_runs`].
+#[allow(clippy::type_complexity)]
 fn bolter_side(t0: u32, events: &[(bool, u8, (u8, u8, u8), u8, u16, u16)]) {
     let t0 = &t0;
     let cfg = mmic::bolter::Config::default().side;
