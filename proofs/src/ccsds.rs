@@ -206,8 +206,8 @@ pub fn sample_tm<'a>(s: &mut Seed<'_>, data: &'a [u8]) -> TmRepr<'a> {
     }
 }
 
-/// Emits a packet of `kind` built from `seed` and `data` into `out`; its length.
-fn emit_sample(kind: PacketType, seed: &[u8], data: &[u8], out: &mut [u8]) -> (usize, u16) {
+/// Emits a packet of `kind` built from `seed` and `data` into `out`: its length and APID.
+pub fn emit_sample(kind: PacketType, seed: &[u8], data: &[u8], out: &mut [u8]) -> (usize, u16) {
     let s = &mut Seed::new(seed);
     let (n, apid) = match kind {
         PacketType::Tc => {
