@@ -354,7 +354,11 @@ fn a_sensed_step_timing_out_on_either_side_is_retried_from_home() {
             let o = scripted(pair_job(BolterDirection::Bolt), true, |s, _, a, step| {
                 !(s == side && a == 1 && step == failing)
             });
-            assert_eq!((o.status, o.attempt), (Status::Done, 2), "{failing:?} side {side}");
+            assert_eq!(
+                (o.status, o.attempt),
+                (Status::Done, 2),
+                "{failing:?} side {side}"
+            );
             let first = [Descend, Retract, DescendEngage, Rotate];
             let mut want = attempt(1, &first[..=[0, 2, 3][n]]);
             want.push((1, 1, ReturnHome));
@@ -429,9 +433,7 @@ fn all_four_runs_pairs_one_to_four_in_order() {
     );
     assert_eq!(o.status, Status::Done);
     let want: Vec<_> = (1..=4u8)
-        .flat_map(|p| {
-            [Descend, Retract, DescendEngage, Rotate, CounterRotate].map(|s| (p, 1u8, s))
-        })
+        .flat_map(|p| [Descend, Retract, DescendEngage, Rotate, CounterRotate].map(|s| (p, 1u8, s)))
         .collect();
     assert_eq!(o.trace, want);
 }

@@ -542,7 +542,10 @@ mod gravity_tests {
                     found |= consistent(&Config::default(), &r).contains(s);
                 }
             }
-            assert!(found, "{s}: the plant's gravity {ga:?} {gb:?} is not estimated as {s}");
+            assert!(
+                found,
+                "{s}: the plant's gravity {ga:?} {gb:?} is not estimated as {s}"
+            );
         }
     }
 }
