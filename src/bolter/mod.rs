@@ -205,3 +205,58 @@ impl From<BolterAttempt> for u8 {
         a.get()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{BolterAttempt, BolterPair, MuxLines};
+
+    /// The paper's order of the select lines: pairs 1–4 take A0-A1 low-low, low-high,
+    /// high-low, high-high; the wire byte has A0 in bit 0 and A1 in bit 1, and refuses others.
+    #[test]
+    fn mux_lines_per_pair_and_on_the_wire() {
+        let want = [(false, false), (false, true), (true, false), (true, true)];
+        for (n, (a0, a1)) in (1..=4u8).zip(want) {
+            let p = BolterPair::from_number(n).unwrap();
+            assert_eq!(MuxLines::for_pair(p), MuxLines { a0, a1 }, "pair {n}");
+        }
+        for b in 0..=u8::MAX {
+            let got = MuxLines::from_wire(b);
+            if b > 3 {
+                assert_eq!(got, None, "{b:#x}");
+            } else {
+                let m = MuxLines {
+                    a0: b & 1 == 1,
+                    a1: b >> 1 == 1,
+                };
+                assert_eq!(got, Some(m), "{b:#x}");
+                assert_eq!(m.to_wire(), b);
+            }
+        }
+        assert_eq!(
+            MuxLines {
+                a0: true,
+                a1: false
+            }
+            .to_wire(),
+            1
+        );
+        assert_eq!(
+            MuxLines {
+                a0: false,
+                a1: true
+            }
+            .to_wire(),
+            2
+        );
+    }
+
+    #[test]
+    fn bolter_attempt_range() {
+        for n in 0..=u8::MAX {
+            match BolterAttempt::new(n) {
+                Ok(a) => assert!(n <= 3 && a.get() == n && u8::from(a) == n),
+                Err(e) => assert!(n > 3 && e.found == u32::from(n)),
+            }
+        }
+    }
+}
