@@ -437,3 +437,135 @@ fn all_four_runs_pairs_one_to_four_in_order() {
         .collect();
     assert_eq!(o.trace, want);
 }
+
+/// A side's report moves the job only if it is the report of the order in force: its sequence
+/// number, step, pair and direction all equal the order's. A report finished or timed out but
+/// wrong in any one of them (a stale report of the previous order, another pair's, the other
+/// direction's) neither advances the step nor starts a retry, from either side.
+#[test]
+fn only_a_report_of_the_order_in_force_moves_the_job() {
+    use mmic::wire::internal_heartbeat::BolterAux;
+    let cfg = Config::default();
+    let mut coord = Coordinator::new();
+    coord.start(
+        Job {
+            direction: BolterDirection::Bolt,
+            fasteners: Fasteners::Pair(BolterPair::P2),
+        },
+        0,
+    );
+    let (seq, order) = coord.order().expect("running");
+    let mut a = BolterSide::new();
+    a.order(seq, Some(order), 0);
+    a.tick(
+        &cfg.side,
+        10,
+        Sensed {
+            i_bo: PUSHING_MA,
+            at_home: false,
+        },
+    );
+    let done = a.aux();
+    assert!(done.threshold_reached && !done.timed_out);
+    let timed_out = BolterAux {
+        threshold_reached: false,
+        timed_out: true,
+        ..done
+    };
+    let running = BolterAux {
+        threshold_reached: false,
+        ..done
+    };
+    for report in [done, timed_out] {
+        let wrong = [
+            BolterAux {
+                seq: seq.wrapping_sub(1),
+                ..report
+            },
+            BolterAux {
+                step: Some(BolterStep::Retract),
+                ..report
+            },
+            BolterAux {
+                pair: Some(BolterPair::P1),
+                ..report
+            },
+            BolterAux {
+                direction: Some(BolterDirection::Unbolt),
+                ..report
+            },
+        ];
+        // A finished step needs both sides' reports; a timeout needs one side's: the wrong
+        // report goes with the right one for a finish, with a running one for a timeout.
+        let other = if report.timed_out { running } else { report };
+        for w in wrong {
+            for (ra, rb) in [(other, w), (w, other)] {
+                let mut c = coord;
+                let out = c.step(&cfg, 20, &ra, Some(&rb));
+                assert_eq!(out.order, Some((seq, order)), "A {ra:?} B {rb:?}");
+                assert_eq!(out.status, Status::Running);
+            }
+        }
+        // The right report from both sides moves it: on to Retract, or back home to retry.
+        let mut c = coord;
+        let out = c.step(&cfg, 20, &report, Some(&report));
+        let want = if report.timed_out {
+            BolterStep::ReturnHome
+        } else {
+            BolterStep::Retract
+        };
+        assert_eq!(out.order.map(|o| o.1.step), Some(want));
+    }
+}
+
+/// Table 1's "move bolters down": pair 1's bolters descend and nothing else is ordered; the
+/// job ends Done when both touch, or when a descent times out (nothing was bolted: no bolting
+/// failure, no retry).
+#[test]
+fn move_bolters_down_ends_done_when_both_touch_or_a_descent_times_out() {
+    let cfg = Config::default();
+    for touch in [[true, true], [true, false], [false, true], [false, false]] {
+        let mut coord = Coordinator::new();
+        coord.start_down(0);
+        assert!(coord.descend_only());
+        let mut sides = [BolterSide::new(), BolterSide::new()];
+        let mut end = None;
+        for tick in 0..2_000u32 {
+            let now = tick * 10;
+            let b = sides[1].aux();
+            let out = coord.step(&cfg, now, &sides[0].aux(), Some(&b));
+            if out.status != Status::Running {
+                end = Some((out.status, now));
+                break;
+            }
+            let (seq, order) = out.order.expect("running");
+            assert_eq!(
+                (order.step, order.pair),
+                (BolterStep::Descend, BolterPair::P1)
+            );
+            for (i, side) in sides.iter_mut().enumerate() {
+                side.order(seq, Some(order), now);
+                let i_bo = if touch[i] && now >= 100 {
+                    PUSHING_MA
+                } else {
+                    RUNNING_MA
+                };
+                side.tick(
+                    &cfg.side,
+                    now,
+                    Sensed {
+                        i_bo,
+                        at_home: false,
+                    },
+                );
+            }
+        }
+        let (status, at) = end.expect("ended");
+        assert_eq!(status, Status::Done, "{touch:?}");
+        if touch == [true, true] {
+            assert!(at <= 200, "{touch:?}: ended at {at} ms");
+        } else {
+            assert!(at > cfg.side.sensed_ms, "{touch:?}: ended at {at} ms");
+        }
+    }
+}
