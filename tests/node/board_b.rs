@@ -1,0 +1,74 @@
+//! Board B on its own: it follows A's targets for each servo separately, holds on A's stop
+//! flag, and judges the A→B link silent exactly past its timeout.
+
+use mmic::node::board_b::{BoardB, Config, Inputs};
+use mmic::units::{Electrical, PulseWidth};
+use mmic::wire::b_command::{BCommandRepr, BPower};
+
+fn command(seq: u8, arm: PulseWidth, gripper: PulseWidth, stop: bool) -> [u8; 15] {
+    BCommandRepr {
+        seq,
+        power: BPower {
+            regulator: true,
+            arm: true,
+            gripper: true,
+            bolter: true,
+        },
+        stop,
+        arm_target: arm,
+        gripper_target: gripper,
+        bolter: None,
+    }
+    .to_bytes()
+}
+
+fn inputs(command: Option<[u8; 15]>) -> Inputs {
+    Inputs {
+        command,
+        electrical: Electrical {
+            v_bat: 12_000,
+            v_reg: 7_400,
+            ..Electrical::default()
+        },
+        arm_contracted: true,
+        ..Inputs::default()
+    }
+}
+
+/// Each servo goes to its own target: a command that moves only the gripper moves the
+/// gripper (and not the arm), one that moves only the arm moves the arm.
+#[test]
+fn each_servo_follows_its_own_target() {
+    let cfg = Config::default();
+    let pw = |us| PulseWidth::new(us).unwrap();
+    let (arm0, grip0) = (cfg.arm.contracted, cfg.gripper.extended);
+    for (arm, grip) in [(arm0, pw(1500)), (pw(1500), grip0), (pw(1400), pw(1600))] {
+        let mut b = BoardB::new(cfg);
+        let mut last = None;
+        for t in 0..300u32 {
+            // A re-sends its snapshot every 50 ms, with a new number each time.
+            let c = (t % 5 == 0).then(|| command((t / 5) as u8, arm, grip, false));
+            last = Some(b.tick(t * 10, &inputs(c)));
+        }
+        let out = last.unwrap();
+        assert_eq!(out.arm, Some(arm), "arm to {arm:?}");
+        assert_eq!(out.gripper, Some(grip), "gripper to {grip:?}");
+    }
+}
+
+/// The link is silent strictly after `link_timeout_ms` without a command: B holds and says
+/// so at the first tick past it, not at the timeout itself.
+#[test]
+fn the_link_is_lost_exactly_past_its_timeout() {
+    let cfg = Config::default();
+    for heard_at in [0u32, 1_000, u32::MAX - 200] {
+        let mut b = BoardB::new(cfg);
+        let c = command(1, cfg.arm.contracted, cfg.gripper.extended, false);
+        assert!(!b.tick(heard_at, &inputs(Some(c))).link_lost);
+        let at = heard_at.wrapping_add(cfg.link_timeout_ms);
+        assert!(!b.tick(at, &inputs(None)).link_lost, "at the timeout");
+        let out = b.tick(at.wrapping_add(1), &inputs(None));
+        assert!(out.link_lost, "one ms past it");
+        assert_eq!(out.bolter, mmic::bolter::Drive::Idle);
+    }
+}
