@@ -72,3 +72,47 @@ fn the_link_is_lost_exactly_past_its_timeout() {
         assert_eq!(out.bolter, mmic::bolter::Drive::Idle);
     }
 }
+
+/// B holds its servos where they are when the link falls silent, and when its ADC is lost
+/// (then also saying nothing), each on its own, mid-move; a command afterwards moves it on.
+#[test]
+fn silence_or_a_lost_adc_alone_holds_the_servos_mid_move() {
+    let cfg = Config::default();
+    let target = PulseWidth::new(1500).unwrap();
+    for cause in ["silence", "adc"] {
+        let mut b = BoardB::new(cfg);
+        let mut t = 0u32;
+        let mut out = b.tick(
+            t,
+            &inputs(Some(command(1, target, cfg.gripper.extended, false))),
+        );
+        // Moving: heard every 50 ms for 300 ms.
+        for k in 1..=30u32 {
+            t += 10;
+            let c = (k % 5 == 0).then(|| command(1 + k as u8, target, cfg.gripper.extended, false));
+            out = b.tick(t, &inputs(c));
+        }
+        let moving = out.arm;
+        assert_ne!(moving, Some(target), "still on its way");
+        let mut held = None;
+        for _ in 0..100 {
+            t += 10;
+            let mut inp = inputs(None);
+            inp.lost.adc = cause == "adc";
+            out = b.tick(t, &inp);
+            if cause == "adc" {
+                assert_eq!(out.heartbeat, None, "blind B says nothing");
+            }
+            if out.link_lost || cause == "adc" {
+                let h = *held.get_or_insert(out.arm);
+                assert_eq!(out.arm, h, "{cause}: the arm holds");
+            }
+        }
+        assert!(held.is_some(), "{cause}: held");
+        assert_ne!(
+            held,
+            Some(Some(target)),
+            "{cause}: held short of the target"
+        );
+    }
+}
