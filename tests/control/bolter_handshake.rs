@@ -139,7 +139,7 @@ fn check(w: &World) {
     }
 }
 
-fn explore(job: Job, lossy: bool) -> (usize, usize, [usize; 3]) {
+fn explore(job: Job, lossy: bool) -> Counts {
     let cfg = Config::default();
     let mut start = World {
         coord: Coordinator::new(),
@@ -229,11 +229,8 @@ fn explore(job: Job, lossy: bool) -> (usize, usize, [usize; 3]) {
 
 /// The counts the README quotes, per direction: (states, transitions, terminal states
 /// done / bolting failure / motion timeout), full model then fairness model.
-const COUNTS: [(
-    BolterDirection,
-    (usize, usize, [usize; 3]),
-    (usize, usize, [usize; 3]),
-); 2] = [
+type Counts = (usize, usize, [usize; 3]);
+const COUNTS: [(BolterDirection, Counts, Counts); 2] = [
     (
         BolterDirection::Bolt,
         (2_803_572, 19_960_800, [1280, 3584, 36196]),

@@ -117,7 +117,7 @@ fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
     let c = &c;
     let power_before = powered(s0.mode(), s0.enabled());
     let mut s = *s0;
-    let out = s.step(&input);
+    let out = s.step(input);
     let ctx = || {
         format!("{name} {s0:?} / {c:?} / faults {faults:?} / motion {in_motion} / hip {hip_at_home} / init {initial_state_ok}")
     };
