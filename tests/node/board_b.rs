@@ -116,3 +116,67 @@ fn silence_or_a_lost_adc_alone_holds_the_servos_mid_move() {
         );
     }
 }
+
+/// B's heartbeat goes out every `heartbeat_period_ms`, on the first tick of each period and
+/// on no other.
+#[test]
+fn heartbeats_every_period_and_no_more() {
+    let cfg = Config::default();
+    let mut b = BoardB::new(cfg);
+    let mut sent = vec![];
+    for t in (0..1_000u32).step_by(10) {
+        if b.tick(t, &inputs(None)).heartbeat.is_some() {
+            sent.push(t);
+        }
+    }
+    let want: Vec<u32> = (0..1_000)
+        .step_by(cfg.heartbeat_period_ms as usize)
+        .collect();
+    assert_eq!(sent, want);
+}
+
+/// B drives its bolter only with the regulator on and the bolter powered, and not while it
+/// holds.
+#[test]
+fn the_bolter_is_driven_only_when_powered_and_not_held() {
+    use mmic::bolter::{BolterDirection, BolterPair, BolterStep, Drive};
+    use mmic::wire::b_command::BolterOrder;
+    let cfg = Config::default();
+    let order = BolterOrder {
+        pair: BolterPair::P1,
+        direction: BolterDirection::Bolt,
+        step: BolterStep::Descend,
+    };
+    for (regulator, bolter, stop) in [
+        (true, true, false),
+        (false, true, false),
+        (true, false, false),
+        (true, true, true),
+    ] {
+        let mut b = BoardB::new(cfg);
+        let c = BCommandRepr {
+            seq: 1,
+            power: BPower {
+                regulator,
+                arm: true,
+                gripper: true,
+                bolter,
+            },
+            stop,
+            arm_target: cfg.arm.contracted,
+            gripper_target: cfg.gripper.extended,
+            bolter: Some(order),
+        }
+        .to_bytes();
+        let out = b.tick(0, &inputs(Some(c)));
+        let want = if regulator && bolter && !stop {
+            Drive::Down
+        } else {
+            Drive::Idle
+        };
+        assert_eq!(
+            out.bolter, want,
+            "regulator {regulator} bolter {bolter} stop {stop}"
+        );
+    }
+}
