@@ -250,6 +250,15 @@ mod tests {
         );
     }
 
+    #[cfg(feature = "serde")]
+    #[test]
+    fn bolter_attempt_from_a_number() {
+        for n in 0..=5u8 {
+            let got: Result<BolterAttempt, _> = serde_json::from_slice(&[b'0' + n]);
+            assert_eq!(got.ok(), BolterAttempt::new(n).ok(), "{n}");
+        }
+    }
+
     #[test]
     fn bolter_attempt_range() {
         for n in 0..=u8::MAX {
@@ -257,6 +266,7 @@ mod tests {
                 Ok(a) => assert!(n <= 3 && a.get() == n && u8::from(a) == n),
                 Err(e) => assert!(n > 3 && e.found == u32::from(n)),
             }
+            assert_eq!(BolterAttempt::try_from(n), BolterAttempt::new(n));
         }
     }
 }

@@ -148,6 +148,7 @@ fn the_bolter_is_driven_only_when_powered_and_not_held() {
         step: BolterStep::Descend,
     };
     for (regulator, bolter, stop) in [
+        (false, false, false),
         (true, true, false),
         (false, true, false),
         (true, false, false),
@@ -169,6 +170,9 @@ fn the_bolter_is_driven_only_when_powered_and_not_held() {
         }
         .to_bytes();
         let out = b.tick(0, &inputs(Some(c)));
+        // The servos' pulses likewise need the regulator (and their own power bit, on here).
+        assert_eq!(out.arm.is_some(), regulator);
+        assert_eq!(out.gripper.is_some(), regulator);
         let want = if regulator && bolter && !stop {
             Drive::Down
         } else {
@@ -178,5 +182,37 @@ fn the_bolter_is_driven_only_when_powered_and_not_held() {
             out.bolter, want,
             "regulator {regulator} bolter {bolter} stop {stop}"
         );
+    }
+}
+
+/// A servo gets its pulse only with the regulator on and its own power bit set.
+#[test]
+fn each_servo_is_driven_only_with_the_regulator_and_its_power_bit() {
+    let cfg = Config::default();
+    for (regulator, arm, gripper) in [
+        (true, true, false),
+        (true, false, true),
+        (false, true, true),
+        (true, true, true),
+    ] {
+        let mut b = BoardB::new(cfg);
+        let c = BCommandRepr {
+            seq: 1,
+            power: BPower {
+                regulator,
+                arm,
+                gripper,
+                bolter: false,
+            },
+            stop: false,
+            arm_target: cfg.arm.contracted,
+            gripper_target: cfg.gripper.extended,
+            bolter: None,
+        }
+        .to_bytes();
+        let out = b.tick(0, &inputs(Some(c)));
+        assert_eq!(out.arm.is_some(), regulator && arm);
+        assert_eq!(out.gripper.is_some(), regulator && gripper);
+        assert_eq!(out.regulator, regulator);
     }
 }
