@@ -246,6 +246,7 @@ fn scripted(
     let mut coord = Coordinator::new();
     let mut sides = [BolterSide::new(), BolterSide::new()];
     coord.start(job, 0);
+    assert!(!coord.descend_only(), "a bolting job is no move-bolters-down");
     let mut trace = vec![];
     let mut since = (None, 0u32);
     for tick in 0..100_000u32 {
