@@ -333,6 +333,7 @@ mod tests {
         let mut c = CommMonitor::default();
         c.tick(0);
         c.tick(500);
+        assert_eq!(c.silent_ms(), 500);
         assert!(!c.lost(&cfg));
         c.tick(501);
         assert!(c.lost(&cfg));

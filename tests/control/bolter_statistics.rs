@@ -246,7 +246,10 @@ fn scripted(
     let mut coord = Coordinator::new();
     let mut sides = [BolterSide::new(), BolterSide::new()];
     coord.start(job, 0);
-    assert!(!coord.descend_only(), "a bolting job is no move-bolters-down");
+    assert!(
+        !coord.descend_only(),
+        "a bolting job is no move-bolters-down"
+    );
     let mut trace = vec![];
     let mut since = (None, 0u32);
     for tick in 0..100_000u32 {
@@ -255,6 +258,7 @@ fn scripted(
         let out = coord.step(&cfg, now, &sides[0].aux(), b_reports.then_some(&b_aux));
         if out.status != Status::Running {
             assert_eq!(out.order, None, "an ended job orders nothing");
+            assert_eq!((out.active, out.attempt.get()), (None, 0));
             return Outcome {
                 status: out.status,
                 attempt: coord.attempt(),
@@ -263,6 +267,9 @@ fn scripted(
             };
         }
         let (seq, order) = out.order.expect("running");
+        // Heartbeat bytes 55-56 while running: the pair and the attempt.
+        assert_eq!(out.active, Some(order.pair));
+        assert_eq!(out.attempt.get(), coord.attempt());
         if since.0 != Some(seq) {
             since = (Some(seq), now);
             trace.push((order.pair.number(), coord.attempt(), order.step));
@@ -568,5 +575,36 @@ fn move_bolters_down_ends_done_when_both_touch_or_a_descent_times_out() {
         } else {
             assert!(at > cfg.side.sensed_ms, "{touch:?}: ended at {at} ms");
         }
+    }
+}
+
+/// After a pause (a Stop, then Reset), `resume` restarts the step's clock: the time paused
+/// does not count towards the coordinator's patience with side B.
+#[test]
+fn resume_restarts_the_steps_clock() {
+    let cfg = Config::default();
+    let limit = cfg.side.sensed_ms.max(cfg.side.home_ms) + cfg.link_margin_ms;
+    for resumed in [false, true] {
+        let mut coord = Coordinator::new();
+        coord.start(
+            Job {
+                direction: BolterDirection::Bolt,
+                fasteners: Fasteners::Pair(BolterPair::P1),
+            },
+            0,
+        );
+        let idle = BolterSide::new().aux();
+        coord.step(&cfg, 10, &idle, Some(&idle));
+        let back = 10 + 2 * limit;
+        if resumed {
+            coord.resume(back);
+        }
+        let out = coord.step(&cfg, back + 10, &idle, Some(&idle));
+        let want = if resumed {
+            Status::Running
+        } else {
+            Status::Failed(Fault::MotionTimeout)
+        };
+        assert_eq!(out.status, want, "resumed {resumed}");
     }
 }
