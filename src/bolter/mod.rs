@@ -259,6 +259,47 @@ mod tests {
         }
     }
 
+    /// A side's executor times a sensed step out past `sensed_ms` and a step that ends at home
+    /// past `home_ms` (different here), selects its order's pair on the multiplexer and
+    /// reports its direction.
+    #[test]
+    fn side_timeouts_mux_and_direction() {
+        use super::{BolterDirection, BolterSide, BolterStep, Sensed, SideConfig};
+        use crate::wire::b_command::BolterOrder;
+        let cfg = SideConfig {
+            sensed_ms: 1_000,
+            home_ms: 3_000,
+            ..SideConfig::default()
+        };
+        let nothing = Sensed {
+            i_bo: 0,
+            at_home: false,
+        };
+        for (step, limit) in [
+            (BolterStep::Descend, 1_000),
+            (BolterStep::DescendEngage, 1_000),
+            (BolterStep::Rotate, 1_000),
+            (BolterStep::Retract, 3_000),
+            (BolterStep::CounterRotate, 3_000),
+            (BolterStep::ReturnHome, 3_000),
+        ] {
+            let mut s = BolterSide::new();
+            assert_eq!((s.direction(), s.mux()), (None, MuxLines::default()));
+            let order = BolterOrder {
+                pair: BolterPair::P4,
+                direction: BolterDirection::Unbolt,
+                step,
+            };
+            s.order(7, Some(order), 0);
+            s.tick(&cfg, limit, nothing);
+            assert!(!s.aux().timed_out, "{step:?} at its limit");
+            s.tick(&cfg, limit + 1, nothing);
+            assert!(s.aux().timed_out, "{step:?} past its limit");
+            assert_eq!(s.direction(), Some(BolterDirection::Unbolt));
+            assert_eq!(s.mux(), MuxLines { a0: true, a1: true });
+        }
+    }
+
     #[test]
     fn bolter_attempt_range() {
         for n in 0..=u8::MAX {

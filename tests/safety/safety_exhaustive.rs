@@ -177,6 +177,13 @@ fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
     // Every command gets an answer; accepted ones are allowed in the mode.
     if let Some(inc) = c {
         let ans = out.answer.unwrap_or_else(|| panic!("no answer: {}", ctx()));
+        assert_eq!(
+            ans.refusal(),
+            match ans {
+                Answer::Refused(r) => Some(r),
+                Answer::Accepted(_) => None,
+            }
+        );
         match (inc, ans) {
             (Incoming::Malformed(r), a) => assert_eq!(a, Answer::Refused(*r)),
             (Incoming::Command(cm), Answer::Accepted(a)) => {
