@@ -205,3 +205,109 @@ impl From<BolterAttempt> for u8 {
         a.get()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{BolterAttempt, BolterPair, MuxLines};
+
+    /// The paper's order of the select lines: pairs 1–4 take A0-A1 low-low, low-high,
+    /// high-low, high-high; the wire byte has A0 in bit 0 and A1 in bit 1, and refuses others.
+    #[test]
+    fn mux_lines_per_pair_and_on_the_wire() {
+        let want = [(false, false), (false, true), (true, false), (true, true)];
+        for (n, (a0, a1)) in (1..=4u8).zip(want) {
+            let p = BolterPair::from_number(n).unwrap();
+            assert_eq!(MuxLines::for_pair(p), MuxLines { a0, a1 }, "pair {n}");
+        }
+        for b in 0..=u8::MAX {
+            let got = MuxLines::from_wire(b);
+            if b > 3 {
+                assert_eq!(got, None, "{b:#x}");
+            } else {
+                let m = MuxLines {
+                    a0: b & 1 == 1,
+                    a1: b >> 1 == 1,
+                };
+                assert_eq!(got, Some(m), "{b:#x}");
+                assert_eq!(m.to_wire(), b);
+            }
+        }
+        assert_eq!(
+            MuxLines {
+                a0: true,
+                a1: false
+            }
+            .to_wire(),
+            1
+        );
+        assert_eq!(
+            MuxLines {
+                a0: false,
+                a1: true
+            }
+            .to_wire(),
+            2
+        );
+    }
+
+    #[cfg(feature = "serde")]
+    #[test]
+    fn bolter_attempt_from_a_number() {
+        for n in 0..=5u8 {
+            let got: Result<BolterAttempt, _> = serde_json::from_slice(&[b'0' + n]);
+            assert_eq!(got.ok(), BolterAttempt::new(n).ok(), "{n}");
+        }
+    }
+
+    /// A side's executor times a sensed step out past `sensed_ms` and a step that ends at home
+    /// past `home_ms` (different here), selects its order's pair on the multiplexer and
+    /// reports its direction.
+    #[test]
+    fn side_timeouts_mux_and_direction() {
+        use super::{BolterDirection, BolterSide, BolterStep, Sensed, SideConfig};
+        use crate::wire::b_command::BolterOrder;
+        let cfg = SideConfig {
+            sensed_ms: 1_000,
+            home_ms: 3_000,
+            ..SideConfig::default()
+        };
+        let nothing = Sensed {
+            i_bo: 0,
+            at_home: false,
+        };
+        for (step, limit) in [
+            (BolterStep::Descend, 1_000),
+            (BolterStep::DescendEngage, 1_000),
+            (BolterStep::Rotate, 1_000),
+            (BolterStep::Retract, 3_000),
+            (BolterStep::CounterRotate, 3_000),
+            (BolterStep::ReturnHome, 3_000),
+        ] {
+            let mut s = BolterSide::new();
+            assert_eq!((s.direction(), s.mux()), (None, MuxLines::default()));
+            let order = BolterOrder {
+                pair: BolterPair::P4,
+                direction: BolterDirection::Unbolt,
+                step,
+            };
+            s.order(7, Some(order), 0);
+            s.tick(&cfg, limit, nothing);
+            assert!(!s.aux().timed_out, "{step:?} at its limit");
+            s.tick(&cfg, limit + 1, nothing);
+            assert!(s.aux().timed_out, "{step:?} past its limit");
+            assert_eq!(s.direction(), Some(BolterDirection::Unbolt));
+            assert_eq!(s.mux(), MuxLines { a0: true, a1: true });
+        }
+    }
+
+    #[test]
+    fn bolter_attempt_range() {
+        for n in 0..=u8::MAX {
+            match BolterAttempt::new(n) {
+                Ok(a) => assert!(n <= 3 && a.get() == n && u8::from(a) == n),
+                Err(e) => assert!(n > 3 && e.found == u32::from(n)),
+            }
+            assert_eq!(BolterAttempt::try_from(n), BolterAttempt::new(n));
+        }
+    }
+}

@@ -316,6 +316,15 @@ mod tests {
         assert!(!d.update(1000, true, 500));
         assert!(!d.update(900, true, 500));
         assert_eq!(d.held_ms(), 0);
+        // Forward, it counts the time between samples that hold, across the clock's wrap.
+        assert!(!d.update(1_200, true, 500));
+        assert_eq!(d.held_ms(), 300);
+        let mut d = Debounce::default();
+        d.update(u32::MAX - 99, true, 500);
+        d.update(150, true, 500);
+        assert_eq!(d.held_ms(), 250);
+        d.update(151, false, 500);
+        assert_eq!(d.held_ms(), 0);
     }
 
     #[test]
@@ -324,6 +333,7 @@ mod tests {
         let mut c = CommMonitor::default();
         c.tick(0);
         c.tick(500);
+        assert_eq!(c.silent_ms(), 500);
         assert!(!c.lost(&cfg));
         c.tick(501);
         assert!(c.lost(&cfg));

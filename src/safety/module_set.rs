@@ -61,3 +61,39 @@ impl ModuleSet {
         Module::ALL.into_iter().filter(move |m| self.contains(*m))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::ModuleSet;
+    use crate::units::Module;
+
+    /// Every set against its members: bits, from_bits (the 8th bit dropped), subset,
+    /// intersection, with/without, and the hip-and-arms constant.
+    #[test]
+    fn every_set_agrees_with_its_members() {
+        let members = |s: ModuleSet| Module::ALL.map(|m| s.contains(m));
+        for b in 0..=u8::MAX {
+            let s = ModuleSet::from_bits(b);
+            assert_eq!(s.bits(), b & 0x7f);
+            for (i, m) in Module::ALL.into_iter().enumerate() {
+                assert_eq!(s.contains(m), b & (1 << i) != 0);
+                assert!(s.with(m).contains(m) && !s.without(m).contains(m));
+            }
+            assert_eq!(s.is_empty(), b & 0x7f == 0);
+            for c in 0..0x80u8 {
+                let o = ModuleSet::from_bits(c);
+                let subset = members(s).iter().zip(members(o)).all(|(x, y)| !x || y);
+                assert_eq!(s.is_subset(o), subset, "{b:#x} {c:#x}");
+                assert_eq!(s.intersect(o).bits(), b & c & 0x7f);
+            }
+        }
+        let hip_and_arms = [Module::Hip, Module::ArmA, Module::ArmB];
+        for m in Module::ALL {
+            assert_eq!(
+                ModuleSet::HIP_AND_ARMS.contains(m),
+                hip_and_arms.contains(&m)
+            );
+        }
+        assert_eq!(ModuleSet::ALL.iter().count(), 7);
+    }
+}

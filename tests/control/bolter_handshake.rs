@@ -9,8 +9,21 @@
 //! - side B never runs a step A has not ordered, and is never more than one order behind;
 //! - when B is one order behind while A proceeds normally (not a retry), B's step is finished:
 //!   A moved on only on B's report that it had completed that same step;
-//! - from every reachable state the job can still end (Done or Failed): no stuck state;
-//! - a bolting failure is declared only on the last attempt (or when a bolter cannot get home).
+//! - from every reachable state the job can still end (Done or Failed);
+//! - a bolting failure is declared only on the last attempt's failed sensed step, or at any
+//!   attempt when a step that ends at home (Retract, CounterRotate, ReturnHome) times out: the
+//!   bolter cannot get home, so no retry makes sense (`Coordinator::attempt_failed`);
+//! - liveness under fairness, in the same model without time jumps (no timeouts) and without
+//!   losses on either link: no failure is reachable, and from every reachable state Done is
+//!   reachable. In a finite graph, that means every run that takes each transition enabled
+//!   infinitely often infinitely often (strong fairness: every delivery, heartbeat and end
+//!   signal eventually happens) reaches Done — a run staying away from Done forever would
+//!   visit some state infinitely often and, by fairness, every state reachable from it,
+//!   Done among them. The first property alone (the job can end) would hold through the
+//!   timeouts even if the handshake could never complete.
+//!
+//! The state and transition counts are asserted: a change to the coordinator or executor that
+//! changes the reachable space shows here and in the README's row.
 
 use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Sensed, Status};
 use mmic::command::{BolterPair, Fasteners};
@@ -32,7 +45,9 @@ struct World {
 
 const JUMP: u32 = 1 << 30; // past every timeout, and the clock cycles through 4 values
 
-fn successors(cfg: &Config, w: &World) -> Vec<World> {
+/// `lossy`: links may lose messages and time may jump past every timeout (the full model);
+/// otherwise neither happens (the fairness model).
+fn successors(cfg: &Config, w: &World, lossy: bool) -> Vec<World> {
     let (push, lock) = (cfg.side.push_threshold_ma, cfg.side.lock_threshold_ma);
     // The end event: I_bo just reaches the higher threshold (so every sensed step's), home.
     let all = Sensed {
@@ -69,9 +84,11 @@ fn successors(cfg: &Config, w: &World) -> Vec<World> {
         let mut x = *w;
         x.b.order(seq, order, x.now);
         out.push(x);
-        let mut x = *w;
-        x.ab = None;
-        out.push(x);
+        if lossy {
+            let mut x = *w;
+            x.ab = None;
+            out.push(x);
+        }
     }
     // B sends its heartbeat; B→A delivered (duplicable) or lost.
     let mut x = *w;
@@ -82,14 +99,18 @@ fn successors(cfg: &Config, w: &World) -> Vec<World> {
         let mut x = *w;
         x.b_seen = Some(aux);
         out.push(x);
-        let mut x = *w;
-        x.ba = None;
-        out.push(x);
+        if lossy {
+            let mut x = *w;
+            x.ba = None;
+            out.push(x);
+        }
     }
     // Time jumps past every timeout.
-    let mut x = *w;
-    x.now = x.now.wrapping_add(JUMP);
-    out.push(x);
+    if lossy {
+        let mut x = *w;
+        x.now = x.now.wrapping_add(JUMP);
+        out.push(x);
+    }
     out
 }
 
@@ -118,7 +139,7 @@ fn check(w: &World) {
     }
 }
 
-fn explore(job: Job) -> (usize, usize, [usize; 3]) {
+fn explore(job: Job, lossy: bool) -> Counts {
     let cfg = Config::default();
     let mut start = World {
         coord: Coordinator::new(),
@@ -148,7 +169,7 @@ fn explore(job: Job) -> (usize, usize, [usize; 3]) {
         if matches!(w.coord.status(), Status::Done | Status::Failed(_)) {
             continue;
         }
-        for n in successors(&cfg, &w) {
+        for n in successors(&cfg, &w, lossy) {
             let j = *index.entry(n).or_insert_with(|| {
                 states.push(n);
                 edges.push(vec![]);
@@ -193,21 +214,56 @@ fn explore(job: Job) -> (usize, usize, [usize; 3]) {
     }
     let stuck = can_end.iter().filter(|c| !**c).count();
     assert_eq!(stuck, 0, "{stuck} states cannot reach the end of the job");
+    if !lossy {
+        // Only Done ends a job here, so "can end" is "can reach Done".
+        assert!(
+            states
+                .iter()
+                .all(|w| !matches!(w.coord.status(), Status::Failed(_))),
+            "a job failed with no timeout and no loss"
+        );
+    }
     let transitions = edges.iter().map(Vec::len).sum();
     (states.len(), transitions, terminal)
 }
 
+/// The counts the README quotes, per direction: (states, transitions, terminal states
+/// done / bolting failure / motion timeout), full model then fairness model.
+type Counts = (usize, usize, [usize; 3]);
+const COUNTS: [(BolterDirection, Counts, Counts); 2] = [
+    (
+        BolterDirection::Bolt,
+        (2_803_572, 19_960_800, [1280, 3584, 36196]),
+        (122, 716, [1, 0, 0]),
+    ),
+    (
+        BolterDirection::Unbolt,
+        (2_803_572, 19_960_800, [1280, 3584, 36196]),
+        (122, 716, [1, 0, 0]),
+    ),
+];
+
 #[test]
 fn handshake_single_pair_bolt_and_unbolt() {
-    for direction in [BolterDirection::Bolt, BolterDirection::Unbolt] {
-        let (n, t, term) = explore(Job {
+    for (direction, full, fair) in COUNTS {
+        let job = Job {
             direction,
             fasteners: Fasteners::Pair(BolterPair::P2),
-        });
-        println!("bolter handshake ({direction:?}, one pair): {n} states, {t} transitions, terminal done/bolting-failure/motion-timeout {term:?}");
+        };
+        let got = explore(job, true);
+        println!("bolter handshake ({direction:?}, one pair): {} states, {} transitions, terminal done/bolting-failure/motion-timeout {:?}", got.0, got.1, got.2);
         assert!(
-            term.iter().all(|&c| c > 0),
-            "every outcome must be reachable: {term:?}"
+            got.2.iter().all(|&c| c > 0),
+            "every outcome must be reachable: {:?}",
+            got.2
+        );
+        let got_fair = explore(job, false);
+        println!("  no timeouts, no losses: {} states, {} transitions, terminal {:?}; every one reaches Done", got_fair.0, got_fair.1, got_fair.2);
+        assert!(got_fair.2[0] > 0);
+        assert_eq!(
+            (got, got_fair),
+            (full, fair),
+            "{direction:?}: counts changed"
         );
     }
 }

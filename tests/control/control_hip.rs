@@ -1,5 +1,5 @@
 //! The hip PI controller on a servo plant model with a gravity load: from any start to any
-//! target it settles within tolerance, its overshoot stays under a bound, and it never leaves
+//! target it settles within tolerance (0.5°, and stays within it to the end of the run), its overshoot stays under a bound, and it never leaves
 //! the pulse range.
 //!
 //! Plant (per 10 ms tick): the continuous servo turns at 10 (0.01°/s) per µs away from 1500 µs
@@ -95,10 +95,12 @@ fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run
                 run.overshoot = run.overshoot.max(true_err.abs());
             }
         }
+        // Settled: within TOL from this tick to the end of the run. Any later tick outside
+        // the band, by any amount, un-settles it.
         if true_err.abs() <= TOL {
             run.settled_at.get_or_insert(tick);
-        } else if true_err.abs() > TOL + 30.0 {
-            run.settled_at = None; // left the band (beyond quantisation): not settled
+        } else {
+            run.settled_at = None;
         }
     }
     run.detour = run.travelled - shortest;

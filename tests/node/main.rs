@@ -2,6 +2,8 @@
 //!
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
+mod board_a;
+mod board_b;
 mod node_boards;
 mod node_fidelity;
 mod node_handoff;

@@ -5,6 +5,7 @@
 use mmic::command::{for_each_variant_class, Command};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
+use mmic::motion::geometry::single_move;
 use mmic::motion::State;
 use mmic::node::board_a::{self, BoardA, Event, Inputs};
 use mmic::node::board_b::{self, BoardB};
@@ -44,6 +45,130 @@ fn executed(events: &[Event]) -> Vec<u16> {
             _ => None,
         })
         .collect()
+}
+
+/// spec/modes.toml's `[accepts]`: the command kinds Table 7 accepts in each mode.
+fn accepted_kinds() -> std::collections::BTreeMap<String, Vec<String>> {
+    #[derive(serde::Deserialize)]
+    struct Spec {
+        accepts: std::collections::BTreeMap<String, Vec<String>>,
+    }
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/modes.toml");
+    let s: Spec = toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+    s.accepts
+}
+
+/// The answer Table 7 and the refusal codes (spec/modes.toml, src/refusal.rs's meanings) give
+/// command `c` met in `mode` by a robot at rest in state a, with no fault and nothing stopped
+/// (none = accepted): a kind the mode does not accept is `not_allowed_in_mode`; Reset with
+/// nothing kept is `nothing_to_resume`; a reconfiguration from another state, or a primitive
+/// whose final state is not one move from a, is `initial_state_mismatch`.
+fn table7_answer(mode: Mode, c: &Command) -> Option<Refusal> {
+    let accepts = accepted_kinds();
+    if !accepts[mode.name()].iter().any(|k| k == c.kind().name()) {
+        return Some(Refusal::NotAllowedInMode);
+    }
+    match c {
+        Command::Reset => Some(Refusal::NothingToResume),
+        Command::Reconfigure(r) if r.initial() != State::A => Some(Refusal::InitialStateMismatch),
+        Command::Primitive(m)
+            if single_move(State::A, m.target()).map(|(_, p)| p) != Some(m.primitive()) =>
+        {
+            Some(Refusal::InitialStateMismatch)
+        }
+        _ => None,
+    }
+}
+
+/// Every command class in every mode, met by boards A and B linked and at rest in state a:
+/// the answer is exactly the one [`table7_answer`] gives (a supervisor accepting a primitive
+/// in Standby, or refusing an arm command in Safed, fails here), and the supervisor's mode
+/// after it is the one the command asks for, or unchanged.
+#[test]
+fn every_command_class_in_every_mode_gets_the_answer_table_7_gives() {
+    let mut cases = 0;
+    for start in [Mode::Standby, Mode::Operational, Mode::Safed] {
+        for_each_variant_class(PulseWidth::CENTER, HipAngle::new(9000).unwrap(), |c| {
+            let mut a = BoardA::in_state(board_a::Config::default(), State::A);
+            let mut b = BoardB::with_pose(
+                board_b::Config::default(),
+                board_a::Config::default().arm.contracted,
+                board_a::Config::default().gripper.extended,
+            );
+            let mut linked = Linked::default();
+            if start != Mode::Standby {
+                linked.tick(&mut a, &mut b, Some((Command::Mode(Mode::Operational), 1)));
+            }
+            if start == Mode::Safed {
+                linked.tick(&mut a, &mut b, Some((Command::Mode(Mode::Safed), 2)));
+            }
+            for _ in 0..150 {
+                linked.tick(&mut a, &mut b, None);
+            }
+            assert_eq!(a.mode(), start);
+            assert!(!a.in_motion() && a.faults().is_empty(), "at rest, no fault");
+            let hb = linked
+                .tick(&mut a, &mut b, Some((c, 10)))
+                .expect("answered");
+            assert_eq!(hb.last_seq, 10);
+            assert_eq!(hb.refusal, table7_answer(start, &c), "{start} {c:?}");
+            match (c, hb.refusal) {
+                (Command::Mode(m), None) => assert_eq!(a.mode(), m, "{c:?}"),
+                (Command::SystemFault, None) if start == Mode::Operational => {
+                    assert_eq!(a.mode(), Mode::Standby)
+                }
+                _ => assert_eq!(a.mode(), start, "{start} {c:?}"),
+            }
+            cases += 1;
+        });
+    }
+    assert_eq!(cases, 3 * 61);
+}
+
+/// Boards A and B wired to each other, ticking every 10 ms.
+#[derive(Default)]
+struct Linked {
+    now: u32,
+    to_b: Option<[u8; mmic::wire::b_command::B_COMMAND_LEN]>,
+    to_a: Option<[u8; mmic::wire::internal_heartbeat::INTERNAL_HEARTBEAT_LEN]>,
+}
+
+impl Linked {
+    /// One tick of both boards, with a command for A; returns A's heartbeat.
+    fn tick(
+        &mut self,
+        a: &mut BoardA,
+        b: &mut BoardB,
+        command: Option<(Command, u16)>,
+    ) -> Option<HeartbeatRepr> {
+        self.now += 10;
+        let packet = command.map(|(command, seq)| {
+            CommandRepr {
+                board: BoardNumber::ONE,
+                command,
+                seq,
+            }
+            .to_bytes()
+        });
+        let out_a = a.tick(
+            self.now,
+            &Inputs {
+                command: packet,
+                from_b: self.to_a,
+                ..Inputs::at_home()
+            },
+        );
+        let out_b = b.tick(
+            self.now,
+            &board_b::Inputs {
+                command: self.to_b,
+                ..b_inputs()
+            },
+        );
+        self.to_b = out_a.to_b;
+        self.to_a = out_b.heartbeat;
+        out_a.heartbeat.map(|h| HeartbeatRepr::parse(&h).unwrap())
+    }
 }
 
 #[test]

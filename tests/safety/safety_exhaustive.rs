@@ -105,6 +105,174 @@ fn table8_mode(faults: Faults, in_motion: bool) -> (Mode, bool) {
     }
 }
 
+/// Every property of one step from `s0` on `input`; returns the state after it.
+fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
+    let Input {
+        faults,
+        command: c,
+        in_motion,
+        hip_at_home,
+        initial_state_ok,
+    } = *input;
+    let c = &c;
+    let power_before = powered(s0.mode(), s0.enabled());
+    let mut s = *s0;
+    let out = s.step(input);
+    let ctx = || {
+        format!("{name} {s0:?} / {c:?} / faults {faults:?} / motion {in_motion} / hip {hip_at_home} / init {initial_state_ok}")
+    };
+
+    // Table 7 (spec/modes.toml [power]), as equalities: Standby powers
+    // nothing, regulator off; Safed exactly the enabled ones among hip and
+    // arms; Operational exactly the enabled modules; the regulator is on
+    // outside Standby whenever anything is powered.
+    let hip_and_arms = ModuleSet::EMPTY
+        .with(Module::Hip)
+        .with(Module::ArmA)
+        .with(Module::ArmB);
+    let want = match out.mode {
+        Mode::Standby => ModuleSet::EMPTY,
+        Mode::Safed => s.enabled().intersect(hip_and_arms),
+        Mode::Operational => s.enabled(),
+    };
+    assert_eq!(out.powered, want, "{}", ctx());
+    assert_eq!(
+        out.regulator,
+        out.mode != Mode::Standby && !want.is_empty(),
+        "{}",
+        ctx()
+    );
+    assert_eq!(out.mode, s.mode(), "{}", ctx());
+    // Operational is entered only by command, and not while a condition holds.
+    if s0.mode() != Mode::Operational && out.mode == Mode::Operational {
+        assert_eq!(
+            *c,
+            Some(Incoming::Command(Command::Mode(Mode::Operational))),
+            "{}",
+            ctx()
+        );
+        assert!(!faults.iter().any(is_condition), "{}", ctx());
+        assert!(out.go_home, "{}", ctx());
+    }
+    // Faults are latched, and change the mode only from Operational.
+    assert!(faults.is_subset_of(out.faults), "{}", ctx());
+    if c.is_none() {
+        let (want, pending) = if s0.mode() == Mode::Operational {
+            let (m, p) = table8_mode(faults, in_motion);
+            // An earlier deferred fault acts at the first tick without motion.
+            if m == Mode::Operational && s0.standby_pending() && !in_motion {
+                (Mode::Standby, false)
+            } else {
+                (m, p || (m == Mode::Operational && s0.standby_pending()))
+            }
+        } else {
+            (s0.mode(), false)
+        };
+        assert_eq!(out.mode, want, "{}", ctx());
+        assert_eq!(out.standby_pending, pending, "{}", ctx());
+        // A fault never raises power.
+        assert!(out.powered.is_subset(power_before), "{}", ctx());
+        assert!(out.answer.is_none());
+    }
+    // Every command gets an answer; accepted ones are allowed in the mode.
+    if let Some(inc) = c {
+        let ans = out.answer.unwrap_or_else(|| panic!("no answer: {}", ctx()));
+        assert_eq!(
+            ans.refusal(),
+            match ans {
+                Answer::Refused(r) => Some(r),
+                Answer::Accepted(_) => None,
+            }
+        );
+        match (inc, ans) {
+            (Incoming::Malformed(r), a) => assert_eq!(a, Answer::Refused(*r)),
+            (Incoming::Command(cm), Answer::Accepted(a)) => {
+                assert_eq!(*cm, a);
+                let k = cm.kind();
+                if k.moves() {
+                    // Faults are handled first, so `out.mode` is the mode the command met
+                    // (a reconfiguration is accepted only with agreeing states, so it
+                    // never changes the mode itself).
+                    assert!(
+                        out.mode == Mode::Operational
+                            || (out.mode == Mode::Safed
+                                && matches!(k, CommandKind::Arm | CommandKind::Hip)),
+                        "{}",
+                        ctx()
+                    );
+                    // Not while a Stop keeps a motion (unless a fault just
+                    // changed the mode, which dropped it).
+                    assert!(!s0.stopped() || out.mode != s0.mode(), "{}", ctx());
+                }
+            }
+            (Incoming::Command(cm), Answer::Refused(r)) => {
+                let k = cm.kind();
+                let mode_met = if r == Refusal::InitialStateMismatch {
+                    s0.mode()
+                } else {
+                    out.mode
+                };
+                match r {
+                    Refusal::NotAllowedInMode => {
+                        assert!(!accepts(mode_met, k), "{}", ctx())
+                    }
+                    Refusal::FaultConditionHolds => assert!(
+                        faults.iter().any(is_condition)
+                            && matches!(cm, Command::Mode(Mode::Operational)),
+                        "{}",
+                        ctx()
+                    ),
+                    Refusal::InitialStateMismatch => {
+                        assert!(
+                            !initial_state_ok && k == CommandKind::Reconfiguration,
+                            "{}",
+                            ctx()
+                        );
+                        assert!(out.faults.contains(Fault::InitialStateMismatch));
+                    }
+                    Refusal::Stopped => {
+                        assert!(s0.stopped() && k.moves(), "{}", ctx())
+                    }
+                    // Nothing kept, or a mode change this step dropped it.
+                    Refusal::NothingToResume => assert!(
+                        *cm == Command::Reset && (!s0.stopped() || out.mode != s0.mode()),
+                        "{}",
+                        ctx()
+                    ),
+                    other => panic!("unexpected refusal {other:?}: {}", ctx()),
+                }
+            }
+        }
+    }
+    // Stop is obeyed and heartbeat requests answered in every mode. A motion in
+    // progress (outside Standby) is kept for Reset, as is one kept before in
+    // the same mode; a mode change drops it.
+    if let Some(Incoming::Command(Command::Stop)) = c {
+        let kept =
+            out.mode == s0.mode() && (s0.stopped() || (in_motion && out.mode != Mode::Standby));
+        assert!(out.stop_motion, "{}", ctx());
+        assert_eq!(s.stopped(), kept, "{}", ctx());
+    }
+    // Reset resumes exactly what was kept, in the mode it was kept in.
+    if let Some(Incoming::Command(Command::Reset)) = c {
+        let resumes = s0.stopped() && out.mode == s0.mode();
+        assert_eq!(out.resume, resumes, "{}", ctx());
+        assert!(!s.stopped(), "{}", ctx());
+    }
+    if s.mode() != s0.mode() {
+        assert!(!s.stopped() && out.stop_motion, "{}", ctx());
+    }
+    if let Some(Incoming::Command(Command::Heartbeat)) = c {
+        assert_eq!(
+            out.answer,
+            Some(Answer::Accepted(Command::Heartbeat)),
+            "{}",
+            ctx()
+        );
+    }
+    s
+}
+
 #[test]
 fn supervisor_properties_hold_on_the_whole_domain() {
     let starts = start_states();
@@ -112,7 +280,6 @@ fn supervisor_properties_hold_on_the_whole_domain() {
     let n_faults = 1u32 << Fault::ALL.len();
     let mut steps: u64 = 0;
     for (name, s0) in &starts {
-        let power_before = powered(s0.mode(), s0.enabled());
         for c in &cmds {
             // hip/initial-state facts only matter to two commands: enumerate them there.
             let facts: &[(bool, bool)] = match c {
@@ -133,156 +300,8 @@ fn supervisor_properties_hold_on_the_whole_domain() {
                             hip_at_home,
                             initial_state_ok,
                         };
-                        let mut s = *s0;
-                        let out = s.step(&input);
+                        check_step(name, s0, &input);
                         steps += 1;
-                        let ctx = || {
-                            format!("{name} / {c:?} / faults {raw:#06x} / motion {in_motion} / hip {hip_at_home} / init {initial_state_ok}")
-                        };
-
-                        // Standby powers nothing; Safed only hip and arms.
-                        match out.mode {
-                            Mode::Standby => {
-                                assert!(out.powered.is_empty() && !out.regulator, "{}", ctx())
-                            }
-                            Mode::Safed => {
-                                assert!(out.powered.is_subset(ModuleSet::HIP_AND_ARMS), "{}", ctx())
-                            }
-                            Mode::Operational => {
-                                assert!(out.powered.is_subset(s.enabled()), "{}", ctx())
-                            }
-                        }
-                        // Operational is entered only by command, and not while a condition holds.
-                        if s0.mode() != Mode::Operational && out.mode == Mode::Operational {
-                            assert_eq!(
-                                *c,
-                                Some(Incoming::Command(Command::Mode(Mode::Operational))),
-                                "{}",
-                                ctx()
-                            );
-                            assert!(!faults.iter().any(is_condition), "{}", ctx());
-                            assert!(out.go_home, "{}", ctx());
-                        }
-                        // Faults are latched, and change the mode only from Operational.
-                        assert!(faults.is_subset_of(out.faults), "{}", ctx());
-                        if c.is_none() {
-                            let (want, pending) = if s0.mode() == Mode::Operational {
-                                let (m, p) = table8_mode(faults, in_motion);
-                                // An earlier deferred fault acts at the first tick without motion.
-                                if m == Mode::Operational && s0.standby_pending() && !in_motion {
-                                    (Mode::Standby, false)
-                                } else {
-                                    (m, p || (m == Mode::Operational && s0.standby_pending()))
-                                }
-                            } else {
-                                (s0.mode(), false)
-                            };
-                            assert_eq!(out.mode, want, "{}", ctx());
-                            assert_eq!(out.standby_pending, pending, "{}", ctx());
-                            // A fault never raises power.
-                            assert!(out.powered.is_subset(power_before), "{}", ctx());
-                            assert!(out.answer.is_none());
-                        }
-                        // Every command gets an answer; accepted ones are allowed in the mode.
-                        if let Some(inc) = c {
-                            let ans = out.answer.unwrap_or_else(|| panic!("no answer: {}", ctx()));
-                            match (inc, ans) {
-                                (Incoming::Malformed(r), a) => assert_eq!(a, Answer::Refused(*r)),
-                                (Incoming::Command(cm), Answer::Accepted(a)) => {
-                                    assert_eq!(*cm, a);
-                                    let k = cm.kind();
-                                    if k.moves() {
-                                        // Faults are handled first, so `out.mode` is the mode the command met
-                                        // (a reconfiguration is accepted only with agreeing states, so it
-                                        // never changes the mode itself).
-                                        assert!(
-                                            out.mode == Mode::Operational
-                                                || (out.mode == Mode::Safed
-                                                    && matches!(
-                                                        k,
-                                                        CommandKind::Arm | CommandKind::Hip
-                                                    )),
-                                            "{}",
-                                            ctx()
-                                        );
-                                        // Not while a Stop keeps a motion (unless a fault just
-                                        // changed the mode, which dropped it).
-                                        assert!(
-                                            !s0.stopped() || out.mode != s0.mode(),
-                                            "{}",
-                                            ctx()
-                                        );
-                                    }
-                                }
-                                (Incoming::Command(cm), Answer::Refused(r)) => {
-                                    let k = cm.kind();
-                                    let mode_met = if r == Refusal::InitialStateMismatch {
-                                        s0.mode()
-                                    } else {
-                                        out.mode
-                                    };
-                                    match r {
-                                        Refusal::NotAllowedInMode => {
-                                            assert!(!accepts(mode_met, k), "{}", ctx())
-                                        }
-                                        Refusal::FaultConditionHolds => assert!(
-                                            faults.iter().any(is_condition)
-                                                && matches!(cm, Command::Mode(Mode::Operational)),
-                                            "{}",
-                                            ctx()
-                                        ),
-                                        Refusal::InitialStateMismatch => {
-                                            assert!(
-                                                !initial_state_ok
-                                                    && k == CommandKind::Reconfiguration,
-                                                "{}",
-                                                ctx()
-                                            );
-                                            assert!(out
-                                                .faults
-                                                .contains(Fault::InitialStateMismatch));
-                                        }
-                                        Refusal::Stopped => {
-                                            assert!(s0.stopped() && k.moves(), "{}", ctx())
-                                        }
-                                        // Nothing kept, or a mode change this step dropped it.
-                                        Refusal::NothingToResume => assert!(
-                                            *cm == Command::Reset
-                                                && (!s0.stopped() || out.mode != s0.mode()),
-                                            "{}",
-                                            ctx()
-                                        ),
-                                        other => panic!("unexpected refusal {other:?}: {}", ctx()),
-                                    }
-                                }
-                            }
-                        }
-                        // Stop is obeyed and heartbeat requests answered in every mode. A motion in
-                        // progress (outside Standby) is kept for Reset, as is one kept before in
-                        // the same mode; a mode change drops it.
-                        if let Some(Incoming::Command(Command::Stop)) = c {
-                            let kept = out.mode == s0.mode()
-                                && (s0.stopped() || (in_motion && out.mode != Mode::Standby));
-                            assert!(out.stop_motion, "{}", ctx());
-                            assert_eq!(s.stopped(), kept, "{}", ctx());
-                        }
-                        // Reset resumes exactly what was kept, in the mode it was kept in.
-                        if let Some(Incoming::Command(Command::Reset)) = c {
-                            let resumes = s0.stopped() && out.mode == s0.mode();
-                            assert_eq!(out.resume, resumes, "{}", ctx());
-                            assert!(!s.stopped(), "{}", ctx());
-                        }
-                        if s.mode() != s0.mode() {
-                            assert!(!s.stopped() && out.stop_motion, "{}", ctx());
-                        }
-                        if let Some(Incoming::Command(Command::Heartbeat)) = c {
-                            assert_eq!(
-                                out.answer,
-                                Some(Answer::Accepted(Command::Heartbeat)),
-                                "{}",
-                                ctx()
-                            );
-                        }
                     }
                 }
             }
@@ -293,6 +312,103 @@ fn supervisor_properties_hold_on_the_whole_domain() {
         steps,
         starts.len() as u64 * (cmds.len() as u64 + 2 * 3) * n_faults as u64 * 2
     );
+}
+
+/// The fault sets the breadth-first search feeds: every subset of one representative per
+/// class of fault the supervisor tells apart (its Table 8 mode, deferred or not, a condition or
+/// an event). The supervisor reads a step's faults only through those classes (`raise`: any
+/// Safed-class, any immediate-Standby, any deferred; entering Operational: any condition),
+/// apart from latching them and ClearFaults keeping the latched ones still present, which act
+/// fault by fault; every one of the 2^15 fault subsets is fed from the start states of
+/// `supervisor_properties_hold_on_the_whole_domain`.
+fn fault_classes() -> Vec<Faults> {
+    let mut reps: Vec<Fault> = vec![];
+    for f in Fault::ALL {
+        let class = |g: Fault| (fault_action(g), is_condition(g));
+        if !reps.iter().any(|r| class(*r) == class(f)) {
+            reps.push(f);
+        }
+    }
+    assert_eq!(reps.len(), 5, "classes: {reps:?}");
+    (0..1u32 << reps.len())
+        .map(|m| {
+            reps.iter()
+                .enumerate()
+                .filter(|(i, _)| m & (1 << i) != 0)
+                .fold(Faults::EMPTY, |acc, (_, f)| acc.with(*f))
+        })
+        .collect()
+}
+
+/// Every supervisor state reachable from start-up (`Supervisor::new()`), breadth-first, over
+/// every incoming class × fault class subset × in-motion flag × hip/initial-state facts; every
+/// property of `check_step` on every step from every one of them. The states are counted by
+/// what the supervisor branches on (mode, enabled modules, deferred Standby pending, a motion
+/// kept by Stop); the latched fault set rides along as data: no branch reads it (it is only
+/// output, widened by each step's faults and narrowed by ClearFaults).
+#[test]
+fn every_reachable_supervisor_state_satisfies_the_properties() {
+    use std::collections::{HashSet, VecDeque};
+    let t0 = std::time::Instant::now();
+    let cmds = incoming();
+    let faults = fault_classes();
+    let key = |s: &Supervisor| (s.mode(), s.enabled(), s.standby_pending(), s.stopped());
+    let start = Supervisor::new();
+    let mut seen = HashSet::from([key(&start)]);
+    let mut queue = VecDeque::from([start]);
+    let (mut steps, mut latched_seen, mut stopped_safed_latched) = (0u64, 0usize, 0usize);
+    while let Some(s0) = queue.pop_front() {
+        latched_seen += usize::from(!s0.faults().is_empty());
+        stopped_safed_latched +=
+            usize::from(s0.stopped() && s0.mode() == Mode::Safed && !s0.faults().is_empty());
+        for c in &cmds {
+            let facts: &[(bool, bool)] = match c {
+                Some(Incoming::Command(Command::Mode(Mode::Operational)))
+                | Some(Incoming::Command(Command::Reconfigure(_))) => {
+                    &[(true, true), (true, false), (false, true), (false, false)]
+                }
+                _ => &[(true, true)],
+            };
+            for &f in &faults {
+                for in_motion in [false, true] {
+                    for &(hip_at_home, initial_state_ok) in facts {
+                        let input = Input {
+                            faults: f,
+                            command: *c,
+                            in_motion,
+                            hip_at_home,
+                            initial_state_ok,
+                        };
+                        let s = check_step("reachable", &s0, &input);
+                        steps += 1;
+                        if seen.insert(key(&s)) {
+                            queue.push_back(s);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let modes: HashSet<Mode> = seen.iter().map(|k| k.0).collect();
+    println!(
+        "supervisor: {} reachable states (mode x enabled modules x standby pending x stopped), {steps} steps checked, {:.1} s",
+        seen.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    // Every mode, and the states the hand-built starts lacked, are among them.
+    assert_eq!(modes.len(), 3);
+    assert!(
+        seen.iter().any(|k| k.0 == Mode::Safed && k.3),
+        "stopped in Safed"
+    );
+    assert!(
+        stopped_safed_latched > 0 && latched_seen > 0,
+        "with latched faults"
+    );
+    assert!(seen
+        .iter()
+        .any(|k| k.0 == Mode::Safed && k.1 == ModuleSet::EMPTY));
+    assert_eq!(seen.len(), 896, "reachable states");
 }
 
 /// Deferred faults act exactly at motion end, never before, and are never lost: a deferred

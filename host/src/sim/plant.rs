@@ -14,19 +14,21 @@
 //! than it can go), and more still once the rotating head stalls on a locked fastener; the
 //! firmware decides the end of those steps from I_bo alone. Only "at home" is a switch.
 //!
-//! Simplifications, stated: the gravity readings are those the paper's model predicts for the
-//! state the robot last reached (the plant does not integrate the kinematics); both sides'
+//! Simplifications, stated: the gravity readings are those of the pose of the state the robot
+//! last reached (the plant does not integrate the kinematics), computed here from the arm
+//! directions, a hip axis and the IMU frames ([`imu_gravity`]), not through the estimator's
+//! model (`mmic::motion::estimate::predict`), so that the simulator tests the estimate; both sides'
 //! bolters share one lock roll per attempt (a face's fastener pair locks or does not);
 //! the lock probability of consecutive attempts on one pair follows Figure 10's demo
 //! (2307/2524, then 103/217, then 28/114); unbolting uses the same roll, "locked" then meaning
 //! "released" (the head stalls at the end of the unlocking turn alike).
 
 use mmic::bolter::{Drive, MuxLines};
-use mmic::motion::estimate::{self, predict};
+use mmic::motion::geometry::arm_direction;
 use mmic::motion::State;
 use mmic::sensors::adc::{Channel, Scaling, CODE_MAX};
 use mmic::sensors::frontend::Raw;
-use mmic::units::{Axis, Gravity, PulseWidth, Sign};
+use mmic::units::{Axis, Gravity, PulseWidth, Side, Sign};
 
 /// Plant parameters and injected faults.
 #[derive(Debug, Clone)]
@@ -227,11 +229,11 @@ impl Plant {
         p
     }
 
-    /// The robot reached `s`: its IMUs now read what the model predicts there.
+    /// The robot reached `s`: its IMUs now read gravity in that pose.
     pub fn set_state(&mut self, s: State) {
         self.state = s;
-        let r = predict(&estimate::Config::default(), s).next();
-        self.gravity = (r.and_then(|r| r.gravity_a), r.and_then(|r| r.gravity_b));
+        let (a, b) = imu_gravity(s);
+        self.gravity = (Some(a), Some(b));
     }
 
     /// Board A's outputs (side A and the hip).
@@ -444,6 +446,106 @@ impl Plant {
                 && self.arm[side] <= self.cfg.arm_contracted.micros() as f64 + 15.0
                 && !(side == 0 && at_or_after(self.cfg.arm_switch_dead_at, now)),
             bolter_at_home: b.pos <= 0.0,
+        }
+    }
+}
+
+/// Gravity as the two IMUs read it in state `s`, from the plant's own geometry: the structure
+/// stands with its +Z up (gravity −Z); each board's IMU frame is x = its arm's direction,
+/// z = the hip axis, y = z × x (spec/motion/estimation.md); the hip axis is arm A × arm B when
+/// the arms are at an angle, and in a pose with the arms in line (where no sensor shows it) the
+/// first of ±X, ±Y, ±Z across the arms; an IMU reads gravity as its largest component. Only
+/// the arm directions (the definition of the states) come from the library.
+pub fn imu_gravity(s: State) -> (Gravity, Gravity) {
+    type V = [i32; 3];
+    let v = |x: [i8; 3]| -> V { [x[0].into(), x[1].into(), x[2].into()] };
+    let cross = |p: V, q: V| -> V {
+        [
+            p[1] * q[2] - p[2] * q[1],
+            p[2] * q[0] - p[0] * q[2],
+            p[0] * q[1] - p[1] * q[0],
+        ]
+    };
+    let dot = |p: V, q: V| -> i32 { p[0] * q[0] + p[1] * q[1] + p[2] * q[2] };
+    let (a, b) = (v(arm_direction(s, Side::A)), v(arm_direction(s, Side::B)));
+    let hip = match cross(a, b) {
+        [0, 0, 0] => [
+            [1, 0, 0],
+            [-1, 0, 0],
+            [0, 1, 0],
+            [0, -1, 0],
+            [0, 0, 1],
+            [0, 0, -1],
+        ]
+        .into_iter()
+        .find(|h| dot(*h, a) == 0)
+        .unwrap_or([0, 0, 1]),
+        c => c,
+    };
+    let g: V = [0, 0, -1];
+    let read = |arm: V| -> Gravity {
+        let comps = [
+            (Axis::X, dot(g, arm)),
+            (Axis::Y, dot(g, cross(hip, arm))),
+            (Axis::Z, dot(g, hip)),
+        ];
+        let (axis, val) = comps
+            .into_iter()
+            .max_by_key(|c| c.1.abs())
+            .unwrap_or((Axis::Z, -1));
+        Gravity {
+            axis,
+            sign: if val > 0 {
+                Sign::Positive
+            } else {
+                Sign::Negative
+            },
+        }
+    };
+    (read(a), read(b))
+}
+
+#[cfg(test)]
+mod gravity_tests {
+    use super::imu_gravity;
+    use mmic::motion::estimate::{consistent, Config, Readings};
+    use mmic::motion::State;
+    use mmic::units::HipAngle;
+
+    /// The plant's gravity (its own geometry) against the library's estimator: in every state,
+    /// with the hip at the state's angle and the switches of its pose, the estimate holds the
+    /// true state. A plant that read its gravity through `predict` could not fail this.
+    #[test]
+    fn the_plants_gravity_is_estimated_as_the_true_state() {
+        for s in State::ALL {
+            let (ga, gb) = imu_gravity(s);
+            let hips: &[u16] = if s.kind() == mmic::motion::StateKind::Turn {
+                &[9000, 27000]
+            } else {
+                &[18000]
+            };
+            let arms: &[(bool, bool)] = if s.is_matched() {
+                &[(true, true)]
+            } else {
+                &[(true, false), (false, true), (false, false)]
+            };
+            let mut found = false;
+            for &h in hips {
+                for &(ca, cb) in arms {
+                    let r = Readings {
+                        gravity_a: Some(ga),
+                        gravity_b: Some(gb),
+                        arm_a_contracted: ca,
+                        arm_b_contracted: cb,
+                        hip: HipAngle::new(h).unwrap(),
+                    };
+                    found |= consistent(&Config::default(), &r).contains(s);
+                }
+            }
+            assert!(
+                found,
+                "{s}: the plant's gravity {ga:?} {gb:?} is not estimated as {s}"
+            );
         }
     }
 }
