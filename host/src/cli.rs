@@ -158,7 +158,7 @@ pub enum Cmd {
     /// Run the host simulator: opsUI, server board, boards A and B and a plant model over
     /// real transports, driving a plan (the built-in demo without --plan).
     #[command(long_about = crate::simcli::SIM_HELP, after_help = crate::simcli::SIM_AFTER)]
-    Sim(crate::simcli::SimArgs),
+    Sim(Box<crate::simcli::SimArgs>),
     /// Scale benchmark: N simulated robots, each with its own server link, against one ground
     /// process; reports the largest N for which every heartbeat arrives within the timeout.
     #[command(after_help = "Example: mmic bench --max 64 --seconds 30")]
@@ -331,7 +331,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
             }
             .map_err(CliError::Output)?;
         }
-        Cmd::Sim(args) => crate::simcli::sim(args, out)?,
+        Cmd::Sim(args) => crate::simcli::sim(*args, out)?,
         Cmd::Bench { max, seconds } => crate::simcli::bench(max, seconds, out)?,
         Cmd::Spec { write: None } => {
             for (_, page) in pages::all() {

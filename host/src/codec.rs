@@ -127,6 +127,17 @@ fn decode_as<R: Repr + serde::Serialize>(bytes: &[u8]) -> Result<String, CodecEr
     })
 }
 
+fn value_as<R: Repr + serde::Serialize>(bytes: &[u8]) -> Option<serde_json::Value> {
+    serde_json::to_value(R::parse(bytes).ok()?).ok()
+}
+
+/// [`decode_any`] as a JSON value (what [`decode_any`] prints, without printing it: the
+/// simulator logs every packet this way).
+pub fn decode_value(bytes: &[u8]) -> Option<serde_json::Value> {
+    let kind = PacketKind::from_header(bytes.get(..mmic::wire::HEADER_LEN)?)?;
+    by_kind!(kind, value_as(bytes))
+}
+
 /// Decodes a packet of whichever kind its header names; none if it is no valid packet.
 pub fn decode_any(bytes: &[u8]) -> Option<String> {
     let kind = PacketKind::from_header(bytes.get(..mmic::wire::HEADER_LEN)?)?;
@@ -135,7 +146,13 @@ pub fn decode_any(bytes: &[u8]) -> Option<String> {
 
 /// Lowercase hex, no separators.
 pub fn to_hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
+    const DIGITS: &[u8; 16] = b"0123456789abcdef";
+    let mut s = String::with_capacity(bytes.len() * 2);
+    for b in bytes {
+        s.push(DIGITS[(b >> 4) as usize] as char);
+        s.push(DIGITS[(b & 0xf) as usize] as char);
+    }
+    s
 }
 
 /// Parses hex; accepts an optional `0x` prefix per byte group and spaces, colons, commas or

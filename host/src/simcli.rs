@@ -14,26 +14,34 @@ fn ms(s: Option<f64>) -> Option<u32> {
 
 /// `mmic sim --help`'s description (then [`sim_help`] adds the injections).
 pub const SIM_HELP: &str = "\
-Run the host simulator. The four nodes of the paper's Figure 3 run the real mmic library:
-the opsUI plan runner and the server board talk over an OS pipe (the RS232 line), the server
-board connects to board A over TCP on loopback for each command (the WiFi link), boards A and
-B talk over OS pipes (the wired serial line), and a plant model moves the servos, draws
-currents, drains the battery and locks fasteners with the paper's Figure 10 probabilities.
+Run the host simulator. The four nodes of the paper's Figure 3 run the real mmic library: the
+opsUI plan runner, the server board (relay, or PUS gateway), board A's WiFi task and control
+task joined by the library's hand-off queues, and board B, around a plant model that moves the
+servos, draws currents, drains the battery and locks fasteners with the paper's Figure 10
+probabilities.
+
+By default they run in virtual time: a discrete-event simulation in one thread, with simulated
+links (latency, jitter, loss, duplication, reordering, cuts). It is deterministic -- the same
+options and --seed give a byte-identical log -- and runs the demo at thousands of times real
+time. --realtime runs the same nodes on the wall clock instead: threads, OS pipes (the serial
+lines), TCP on loopback for each visit (the WiFi link), UDP with --protocol pus, at --scale
+times real time; its timing depends on how busy the host is.
 
 Live progress goes to stderr; at the end a summary is printed, the JSON-lines log of every
 packet and event is written (OUT/sim.jsonl), and two SVG plots: OUT/wifi-efficiency.svg
 (Figure 11 analogue) and OUT/bolting-attempts.svg (Figure 10 analogue).
 
 --protocol pus runs the same plan over CCSDS space packets with PUS-C services: the ground
-sends each step as a TC(8,1) function over UDP on loopback to the server board, which runs the
-PUS gateway (legacy commands to board A as before) and answers with ST[1] verification
-reports, periodic ST[3] housekeeping and ST[5] events; a step is done at its ST[1] completion.
-Every packet (TC, TM, legacy) is logged with its hex and kind. --serial-loss applies to the
-UDP link; every injection works as in the legacy run. The default is --protocol legacy.
+sends each step as a TC(8,1) function to the server board, which runs the PUS gateway (legacy
+commands to board A as before) and answers with ST[1] verification reports, periodic ST[3]
+housekeeping and ST[5] events; a step is done at its ST[1] completion. Every packet (TC, TM,
+legacy) is logged with its hex and kind. --serial-loss applies to the ground link; every
+injection works as in the legacy run. The default is --protocol legacy.
 
-The clock is paced: simulated time never runs more than 20 ms ahead of the slowest node, so a
-busy host slows the run down instead of making the firmware's timeouts fire. Before anything
-is sent, the plan is checked against the robot's state, from its `start` line (`a` if none).";
+With --realtime the clock is paced: simulated time never runs more than 20 ms ahead of the
+slowest node, so a busy host slows the run down instead of making the firmware's timeouts fire.
+Before anything is sent, the plan is checked against the robot's state, from its `start` line
+(`a` if none).";
 
 /// `mmic sim --help`'s part on `--summary-json`, with the refusal names of the library
 /// (spec/modes.toml `[refusals]`).
@@ -98,13 +106,15 @@ Examples:
   mmic sim --inject low-battery@25 --summary-json out.json   the battery sags mid-reconfiguration
   mmic sim --inject hip-mismatch@0           the hip encoder reads off from power-up
   mmic sim --inject stop@28 --inject reset@31   the operator stops the motion and resumes it
-  mmic sim --protocol pus                    the demo over PUS: telecommands and telemetry over UDP
+  mmic sim --protocol pus                    the demo over PUS: telecommands and telemetry
+  mmic sim --wifi-dup 0.2 --wifi-jitter 5    virtual-time links: duplicated, jittered WiFi packets
+  mmic sim --realtime --scale 20             the same on real threads, pipes and TCP
 
 Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
 2 bad arguments or a malformed plan file, or a step that does not fit the robot's state
-(line and column are given); 3 an I/O error; 4 the host fell so far behind the simulated
-clock that the outcome may be the host's (the paced clock prevents this: it waits for the
-slowest node, so a busy host slows the run down instead).";
+(line and column are given); 3 an I/O error; 4 (--realtime only) the host fell so far behind
+the simulated clock that the outcome may be the host's (the paced clock prevents this: it
+waits for the slowest node, so a busy host slows the run down instead).";
 
 /// Arguments of `mmic sim`.
 #[derive(Debug, clap::Args)]
@@ -116,7 +126,7 @@ pub struct SimArgs {
     /// line) or pus (PUS-C telecommands and telemetry over UDP, the server board as gateway).
     #[arg(long, default_value = "legacy", value_parser = protocol)]
     pub protocol: sim::Protocol,
-    /// Simulated seconds per wall second.
+    /// With --realtime: simulated seconds per wall second.
     #[arg(long, default_value_t = 10.0)]
     pub scale: f64,
     /// Seed for losses and fastener locks.
@@ -169,6 +179,24 @@ pub struct SimArgs {
     /// one, printed in the first line).
     #[arg(long, value_name = "PORT", requires = "ground_tm_to")]
     pub ground_tc_port: Option<u16>,
+    /// Run on the wall clock instead of in virtual time: real threads, OS pipes, TCP and UDP
+    /// on loopback, at --scale times real time (the transports' own test; its timing depends
+    /// on how busy the host is). The default is the virtual-time engine: deterministic, one
+    /// thread, as fast as the host goes.
+    #[arg(long)]
+    pub realtime: bool,
+    /// Virtual time: latency of each direction of the WiFi link, ms (jitter: --wifi-jitter).
+    #[arg(long, value_name = "MS")]
+    pub wifi_latency: Option<f64>,
+    /// Virtual time: up to this much extra delay per WiFi packet, ms.
+    #[arg(long, value_name = "MS")]
+    pub wifi_jitter: Option<f64>,
+    /// Virtual time: probability that a WiFi packet arrives twice, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub wifi_dup: f64,
+    /// Virtual time: probability that a WiFi packet is held back 50 ms and overtaken, 0..1.
+    #[arg(long, default_value_t = 0.0, value_parser = probability)]
+    pub wifi_reorder: f64,
     /// Parse the plan and follow the robot's state through it, then exit without running:
     /// a step that does not fit the state is reported with its line and column.
     #[arg(long)]
@@ -274,6 +302,16 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     for s in scheduled {
         cfg.inject(s)?;
     }
+    cfg.realtime = a.realtime;
+    if let Some(l) = a.wifi_latency {
+        cfg.links.wifi.latency_us = (l.max(0.0) * 1000.0) as u64;
+    }
+    if let Some(j) = a.wifi_jitter {
+        cfg.links.wifi.jitter_us = (j.max(0.0) * 1000.0) as u64;
+    }
+    cfg.links.wifi.duplicate = a.wifi_dup;
+    cfg.links.wifi.reorder = a.wifi_reorder;
+    cfg.links.wifi.reorder_us = 50_000;
     cfg.max_sim_ms = ms(Some(a.max_seconds)).unwrap_or(u32::MAX);
     cfg.log_path = Some(a.out.join("sim.jsonl"));
     cfg.progress = !a.quiet;
@@ -316,6 +354,7 @@ fn external(
             "--ground-tm-to and --ground-tc-port need --protocol pus".into(),
         ));
     }
+    cfg.realtime = true;
     cfg.scale = 1.0;
     cfg.paced = false;
     cfg.progress = false;

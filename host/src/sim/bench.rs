@@ -45,7 +45,8 @@ pub fn trial(robots: u8, seconds: u32) -> std::io::Result<Trial> {
         text: format!("wait {seconds}s"),
         step: PlanStep::Wait { ms: seconds * 1000 },
     }]);
-    cfg.robots = robots;
+    cfg.robots = robots.into();
+    cfg.realtime = true;
     cfg.scale = 1.0;
     cfg.paced = false; // real time: the benchmark measures what the host keeps up with
     cfg.log_packets = false;

@@ -17,7 +17,8 @@
 //! assert!(r.run_until(5_000, |r| !r.a.in_motion()));
 //! ```
 
-use super::plant::{Drives, Plant, PlantConfig};
+use super::plant::{Plant, PlantConfig};
+use super::shell::{tick_a, tick_b};
 use mmic::command::Command;
 use mmic::motion::State;
 use mmic::node::board_a::{self, BoardA, Event};
@@ -93,58 +94,18 @@ impl Robot {
     pub fn tick_with(&mut self, command: Option<CommandRepr>) -> Option<HeartbeatRepr> {
         self.now += TICK_MS;
         let now = self.now;
-        self.plant.advance(now);
-        let sa = self.plant.sense(0, now);
-        let sb = self.plant.sense(1, now);
-        let fa = self.sensors.0.push(&sa.raw);
-        let fb = self.sensors.1.push(&sb.raw);
         let from_b = self.to_a.take().filter(|_| self.b_to_a);
         let to_b = self.to_b.take().filter(|_| self.a_to_b);
-        let out_a = self.a.tick(
+        let out_a = tick_a(
+            &mut self.a,
+            &mut self.sensors.0,
+            &mut self.plant,
             now,
-            &board_a::Inputs {
-                command: command.map(|c| c.to_bytes()),
-                from_b,
-                electrical: fa.electrical,
-                hip: fa.hip,
-                gravity: fa.gravity,
-                arm_contracted: sa.arm_contracted,
-                bolter_at_home: sa.bolter_at_home,
-                lost: fa.lost,
-            },
+            command.map(|c| c.to_bytes()),
+            from_b,
         );
-        let out_b = self.b.tick(
-            now,
-            &board_b::Inputs {
-                command: to_b,
-                electrical: fb.electrical,
-                gravity: fb.gravity,
-                arm_contracted: sb.arm_contracted,
-                bolter_at_home: sb.bolter_at_home,
-                lost: fb.lost,
-            },
-        );
-        self.plant.drive_a(
-            Drives {
-                arm: out_a.arm,
-                gripper: out_a.gripper,
-                regulator: out_a.regulator,
-                bolter: out_a.bolter,
-                mux: out_a.mux,
-            },
-            out_a.hip,
-        );
-        self.plant.drive_b(Drives {
-            arm: out_b.arm,
-            gripper: out_b.gripper,
-            regulator: out_b.regulator,
-            bolter: out_b.bolter,
-            mux: out_b.mux,
-        });
+        let out_b = tick_b(&mut self.b, &mut self.sensors.1, &mut self.plant, now, to_b);
         for e in &out_a.events {
-            if let Event::Reached(s) = e {
-                self.plant.set_state(*s);
-            }
             self.events.push((now, *e));
         }
         self.to_b = out_a.to_b;

@@ -2,8 +2,11 @@
 //!
 //! Every record has `t_ms` (simulated time) and `kind`. Packets: `{"kind":"packet","link":
 //! "wifi","from":"server","to":"robot","fate":"delivered","hex":"4d49..","packet":{..}}`,
-//! with `fate` one of `delivered`, `lost` (injected loss), `cut` (board B cut off) or
-//! `unconnected` (a heartbeat with no server connection to carry it), and `packet_kind` one of
+//! with `fate` one of `delivered`, `lost` (injected loss), `cut` (the link is cut: board B cut
+//! off, or a cut of the virtual-time engine's link model), `unconnected` (a heartbeat with no
+//! server connection to carry it), `duplicated` (a copy the virtual-time engine's link made,
+//! logged after the original) or `closed` (written to a connection the other end had
+//! closed), and `packet_kind` one of
 //! the legacy kinds (`command`, `heartbeat`, `internal_heartbeat`, `b_command`) or, with
 //! `--protocol pus`, `tc` or `tm` (`packet` then holds the headers and what the service data
 //! reads as: the function or request, the ST\[1\] report, the event, the housekeeping
@@ -12,21 +15,50 @@
 use serde_json::{json, Value};
 use std::io::Write;
 use std::sync::mpsc::{Receiver, Sender};
+use std::sync::{Arc, Mutex};
 
 /// One record.
 pub type Record = Value;
 
-/// A cloneable handle that sends records to the writer thread.
+/// A cloneable handle to the log: it sends records to a writer thread (the realtime engine's
+/// nodes, on threads of their own), or keeps them in memory in the order they are made (the
+/// virtual-time engine, one thread: [`Log::memory`]).
 #[derive(Clone)]
 pub struct Log {
-    tx: Sender<Record>,
+    sink: Sink,
+}
+
+#[derive(Clone)]
+enum Sink {
+    Channel(Sender<Record>),
+    Memory(Arc<Mutex<Vec<Record>>>),
 }
 
 impl Log {
     /// A log and the receiving end for [`write_all`].
     pub fn new() -> (Log, Receiver<Record>) {
         let (tx, rx) = std::sync::mpsc::channel();
-        (Log { tx }, rx)
+        (
+            Log {
+                sink: Sink::Channel(tx),
+            },
+            rx,
+        )
+    }
+
+    /// A log kept in memory; [`Log::take`] hands its records over.
+    pub fn memory() -> Log {
+        Log {
+            sink: Sink::Memory(Arc::new(Mutex::new(Vec::new()))),
+        }
+    }
+
+    /// The records of a memory log so far, oldest first (none for a channel's).
+    pub fn take(&self) -> Vec<Record> {
+        match &self.sink {
+            Sink::Channel(_) => Vec::new(),
+            Sink::Memory(m) => std::mem::take(&mut *m.lock().unwrap_or_else(|e| e.into_inner())),
+        }
     }
 
     /// Logs a packet on a link.
@@ -45,8 +77,13 @@ impl Log {
 
     /// Logs any record.
     pub fn send(&self, r: Record) {
-        // The writer outlives every node; a send after it stopped has nowhere to go.
-        let _ = self.tx.send(r);
+        match &self.sink {
+            // The writer outlives every node; a send after it stopped has nowhere to go.
+            Sink::Channel(tx) => {
+                let _ = tx.send(r);
+            }
+            Sink::Memory(m) => m.lock().unwrap_or_else(|e| e.into_inner()).push(r),
+        }
     }
 }
 
@@ -64,9 +101,7 @@ pub fn decode(bytes: &[u8]) -> (&'static str, Value) {
             PacketKind::InternalHeartbeat => "internal_heartbeat",
             PacketKind::BCommand => "b_command",
         };
-        let v = crate::codec::decode_any(bytes)
-            .and_then(|s| serde_json::from_str::<Value>(&s).ok())
-            .unwrap_or(Value::Null);
+        let v = crate::codec::decode_value(bytes).unwrap_or(Value::Null);
         return (name, v);
     }
     pus(bytes).unwrap_or(("unknown", Value::Null))
@@ -137,6 +172,15 @@ fn pus(bytes: &[u8]) -> Option<(&'static str, Value)> {
 /// Lowercase hex.
 pub fn hex(bytes: &[u8]) -> String {
     crate::codec::to_hex(bytes)
+}
+
+/// Writes records as JSON lines, one per line.
+pub fn write_lines(records: &[Record], out: &mut dyn Write) -> std::io::Result<()> {
+    for r in records {
+        serde_json::to_writer(&mut *out, r)?;
+        out.write_all(b"\n")?;
+    }
+    out.flush()
 }
 
 /// Writes every record until all senders are gone; returns the records for the report.

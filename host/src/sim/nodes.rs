@@ -6,13 +6,11 @@
 
 use super::clock::{Clock, NodeClock};
 use super::log::Log;
-use super::plant::{Drives, Plant};
-use mmic::node::board_a::{self, BoardA, Event};
-use mmic::node::board_b::{self, BoardB};
+use super::plant::Plant;
+use super::shell::{SideA, SideB};
 use mmic::node::gateway::{self, Gateway, Out};
 use mmic::node::handoff::{Consumer, Producer};
 use mmic::node::server::{Accepted, Server};
-use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::deframer::{Deframed, Deframer};
@@ -178,30 +176,7 @@ impl Node<'_> {
     }
 }
 
-/// Board A's event as JSON.
-pub fn event_json(e: &Event) -> Value {
-    match e {
-        Event::Executed {
-            seq,
-            command,
-            refusal,
-        } => json!({"type": "executed", "seq": seq, "command": command, "refusal": refusal}),
-        Event::Duplicate { seq } => json!({"type": "duplicate", "seq": seq}),
-        Event::Stale { seq } => json!({"type": "stale", "seq": seq}),
-        Event::Rejected(w) => json!({"type": "rejected", "error": w.to_string()}),
-        Event::OtherRobot { board } => json!({"type": "other_robot", "board": board.get()}),
-        Event::Faults(f) => json!({"type": "faults", "faults": f}),
-        Event::Mode { from, to } => json!({"type": "mode", "from": from, "to": to}),
-        Event::Reached(s) => json!({"type": "reached", "state": s}),
-        Event::Bolting(f) => json!({"type": "bolting", "fault": f}),
-        Event::Pair { pair, attempts, ok } => {
-            json!({"type": "pair", "pair": pair.number(), "attempts": attempts, "ok": ok})
-        }
-        Event::BoltersDown { contact } => json!({"type": "bolters_down", "contact": contact}),
-        Event::Paused => json!({"type": "paused"}),
-        Event::Resumed => json!({"type": "resumed"}),
-    }
-}
+pub use super::shell::event_json;
 
 /// Board A's WiFi task (core 0): accepts the server's connections, deframes command packets
 /// into the hand-off queue, writes heartbeats from the other queue back.
@@ -316,8 +291,8 @@ fn frames(d: &mut Deframer<256>, bytes: &[u8]) -> Vec<mmic::wire::deframer::Fram
 
 /// Board A's control loop (core 1): one library tick every 10 ms.
 pub struct ControlTask<'q> {
-    /// The library's board A.
-    pub a: BoardA,
+    /// The library's board A and side A's sensor front end.
+    pub a: SideA,
     /// Commands from the WiFi task (the rx queue).
     pub commands: Consumer<'q, COMMAND_LEN, 8>,
     /// Heartbeats to the WiFi task (the tx queue).
@@ -335,50 +310,16 @@ pub struct ControlTask<'q> {
 impl ControlTask<'_> {
     /// Runs until the run stops.
     pub fn run(mut self, node: Node<'_>) {
-        let mut sensors = Frontend::<WINDOW>::new(frontend::Config::default());
-        node.every_tick(|now| self.tick(&node, &mut sensors, now));
+        node.every_tick(|now| self.tick(&node, now));
     }
 
-    fn tick(&mut self, node: &Node<'_>, sensors: &mut Frontend<WINDOW>, now: u32) {
+    fn tick(&mut self, node: &Node<'_>, now: u32) {
         let command = self.commands.pop();
         let from_b = self.from_b.try_recv().ok().and_then(|v| v.try_into().ok());
-        let s = {
+        let out = {
             let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
-            p.advance(now);
-            p.sense(0, now)
+            self.a.tick(&mut p, now, command, from_b)
         };
-        let f = sensors.push(&s.raw);
-        let out = self.a.tick(
-            now,
-            &board_a::Inputs {
-                command,
-                from_b,
-                electrical: f.electrical,
-                hip: f.hip,
-                gravity: f.gravity,
-                arm_contracted: s.arm_contracted,
-                bolter_at_home: s.bolter_at_home,
-                lost: f.lost,
-            },
-        );
-        {
-            let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
-            p.drive_a(
-                Drives {
-                    arm: out.arm,
-                    gripper: out.gripper,
-                    regulator: out.regulator,
-                    bolter: out.bolter,
-                    mux: out.mux,
-                },
-                out.hip,
-            );
-            for e in &out.events {
-                if let Event::Reached(st) = e {
-                    p.set_state(*st);
-                }
-            }
-        }
         for e in &out.events {
             node.event(now, event_json(e));
         }
@@ -395,18 +336,15 @@ impl ControlTask<'_> {
             }
         }
         if let Ok(mut st) = self.status.lock() {
-            *st = json!({
-                "mode": self.a.mode(), "faults": self.a.faults(), "state": self.a.state(),
-                "in_motion": self.a.in_motion(), "t_ms": now,
-            });
+            *st = self.a.status(now);
         }
     }
 }
 
 /// Board B: one library tick every 10 ms.
 pub struct BoardBTask {
-    /// The library's board B.
-    pub b: BoardB,
+    /// The library's board B and side B's sensor front end.
+    pub b: SideB,
     /// Packets from board A's serial line.
     pub from_a: Receiver<Vec<u8>>,
     /// Board A's serial line.
@@ -419,39 +357,12 @@ impl BoardBTask {
     /// Runs until the run stops.
     pub fn run(mut self, node: Node<'_>) {
         let mut was_lost = false;
-        let mut sensors = Frontend::<WINDOW>::new(frontend::Config {
-            hip_encoder: false,
-            ..frontend::Config::default()
-        });
         node.every_tick(|now| {
             let command = self.from_a.try_recv().ok().and_then(|v| v.try_into().ok());
-            let s = self
-                .plant
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .sense(1, now);
-            let f = sensors.push(&s.raw);
-            let out = self.b.tick(
-                now,
-                &board_b::Inputs {
-                    command,
-                    electrical: f.electrical,
-                    gravity: f.gravity,
-                    arm_contracted: s.arm_contracted,
-                    bolter_at_home: s.bolter_at_home,
-                    lost: f.lost,
-                },
-            );
-            self.plant
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .drive_b(Drives {
-                    arm: out.arm,
-                    gripper: out.gripper,
-                    regulator: out.regulator,
-                    bolter: out.bolter,
-                    mux: out.mux,
-                });
+            let out = {
+                let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
+                self.b.tick(&mut p, now, command)
+            };
             if out.link_lost != was_lost {
                 was_lost = out.link_lost;
                 node.event(now, json!({"type": "link_lost", "holding": was_lost}));

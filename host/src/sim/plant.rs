@@ -334,6 +334,11 @@ impl Plant {
         (self.arm[side % 2], self.gripper[side % 2])
     }
 
+    /// Whether side `side`'s arm and gripper servos moved in the last step of the physics.
+    pub fn moving(&self, side: usize) -> (bool, bool) {
+        (self.arm_moving[side % 2], self.gripper_moving[side % 2])
+    }
+
     /// What side `side`'s bolter motor was last driven to do.
     pub fn bolter_drive(&self, side: usize) -> Drive {
         self.bolter[side % 2].drive.unwrap_or(Drive::Idle)

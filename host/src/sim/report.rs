@@ -340,8 +340,13 @@ pub fn text(s: &Summary) -> String {
     if s.protocol == super::Protocol::Pus {
         let _ = writeln!(
             t,
-            "protocol: pus -- PUS-C telecommands and telemetry over UDP on loopback between the \
-             ground and the server board (the PUS gateway); legacy commands to board A"
+            "protocol: pus -- PUS-C telecommands and telemetry {} between the ground and the \
+             server board (the PUS gateway); legacy commands to board A",
+            if s.realtime {
+                "over UDP on loopback"
+            } else {
+                "over a simulated datagram link"
+            }
         );
         if let Some(c) = pus_counts(s) {
             let _ = writeln!(
@@ -402,18 +407,27 @@ pub fn text(s: &Summary) -> String {
     } else {
         String::new()
     };
-    let _ = writeln!(
-        t,
-        "host: board ticks started at most {} ms (simulated) late{}{held}",
-        s.max_tick_lateness_ms,
-        match (s.host_fell_behind(), s.pace_slack_ms) {
-            (true, _) => " -- the host fell behind the simulated clock, so timeouts and faults \
+    if !s.realtime {
+        let _ = writeln!(
+            t,
+            "engine: virtual time -- every tick on time by construction; the same seed and \
+             options give the same run and log (--realtime: threads and real transports)"
+        );
+    } else {
+        let _ = writeln!(
+            t,
+            "host: board ticks started at most {} ms (simulated) late{}{held}",
+            s.max_tick_lateness_ms,
+            match (s.host_fell_behind(), s.pace_slack_ms) {
+                (true, _) =>
+                    " -- the host fell behind the simulated clock, so timeouts and faults \
                           in this run may come from the host, not the robot"
-                .to_string(),
-            (false, Some(slack)) => format!(" (paced, bound {slack} ms)"),
-            (false, None) => String::new(),
-        }
-    );
+                        .to_string(),
+                (false, Some(slack)) => format!(" (paced, bound {slack} ms)"),
+                (false, None) => String::new(),
+            }
+        );
+    }
     let executed = s.events("executed").count();
     let dups = s.events("duplicate").count() + s.events("stale").count();
     let twice = executed_twice(s);

@@ -1,0 +1,983 @@
+//! The virtual-time engine (the default of `mmic sim`): every node of Figure 3 — the ground's
+//! plan runners, each robot's server board (the legacy relay or the PUS gateway), board A's
+//! WiFi task and control task with the library's hand-off queues between them, board B, and
+//! the plant — runs on one virtual clock, as a discrete-event simulation in one thread. No wall
+//! clock, no OS thread, no socket: the links between the nodes are simulated ([`link`]: latency,
+//! jitter, loss, duplication, reordering, cuts, per link and direction, each from its own
+//! seeded stream), and events at the same instant run in the order they were scheduled. The
+//! same configuration and seed give the same run, byte for byte of its log, on any host at any
+//! load, as fast as the host goes (the demo plan runs at thousands of times real time).
+//!
+//! ```
+//! use mmic_host::sim::{engine, SimConfig};
+//! let mut cfg = SimConfig::demo();
+//! cfg.progress = false;
+//! let a = engine::run(&cfg).unwrap();
+//! let b = engine::run(&cfg).unwrap();
+//! assert!(a.completed());
+//! assert_eq!(a.records, b.records); // deterministic
+//! ```
+//!
+//! The nodes are the same as the realtime engine's ([`super::shell`]): one control tick of each
+//! board, the ground's plan runners, the server board's relay and the gateway are the library's
+//! pure nodes, and the engine only moves bytes between them at the right virtual times:
+//!
+//! * boards A and B tick every 10 ms (board B at its own phase, [`SimConfig::b_phase_us`]);
+//!   board A's control task takes at most one command from the WiFi hand-off queue and one
+//!   internal heartbeat per tick, as the firmware does;
+//! * board A's WiFi task runs when the server board opens a connection (it discards the
+//!   heartbeats made while nobody was connected, as the firmware does), when command bytes
+//!   arrive (deframed into the hand-off queue), and [`WIFI_TASK_US`] after the control task
+//!   queued a heartbeat (written to the connection, if one is open);
+//! * the server board visits its robot as the firmware does (open a connection, send the
+//!   command, wait up to `visit_ms` for the heartbeat, forward it, close) and reads the ground's
+//!   line only between visits; the PUS gateway wakes at its own next deadline;
+//! * the ground ticks its plan runners every [`GROUND_TICK_MS`] and takes each packet from a
+//!   server board when it arrives.
+
+pub mod link;
+pub mod watch;
+
+use super::log::{self, Log};
+use super::plant::Plant;
+use super::shell::{Ground, GroundSide, LegacyGround, SideA, SideB};
+use super::{Protocol, SimConfig, Summary};
+use link::{Fate, Link, LinkModel};
+use mmic::node::board_a::{self, BoardA};
+use mmic::node::board_b::{self, BoardB};
+use mmic::node::gateway::{Gateway, Out};
+use mmic::node::handoff::PacketQueue;
+use mmic::node::plan_runner::PlanRunner;
+use mmic::node::server::{Accepted, Server};
+use mmic::units::BoardNumber;
+use mmic::wire::command::{CommandRepr, COMMAND_LEN};
+use mmic::wire::deframer::{Deframed, Deframer};
+use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
+use mmic::wire::PacketKind;
+use serde_json::{json, Value};
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, VecDeque};
+use std::time::Instant;
+use watch::Watch;
+
+/// The boards' control period, ms.
+pub const TICK_MS: u32 = 10;
+/// How often the ground's loop ticks its plan runners, ms (packets from the server boards are
+/// taken as they arrive; this is the resolution of the runners' own timers: the 1.2 s slots
+/// and 0.7 s answer windows).
+pub const GROUND_TICK_MS: u32 = 10;
+/// How soon board A's WiFi task writes a heartbeat the control task queued, µs: the firmware's
+/// WiFi task polls its connection with a 2 ms read timeout and then drains the queue, 1 ms
+/// later on average.
+pub const WIFI_TASK_US: u64 = 1_000;
+
+/// The links of every robot in the virtual-time engine: the model of each (both directions
+/// alike); the losses are the run's `wifi_loss`, `serial_loss` and `ab_loss`, and board B's cut
+/// is `cut_b_at`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Links {
+    /// The WiFi link between the server board and board A (a TCP connection per visit).
+    pub wifi: LinkModel,
+    /// The ground's link to the server board: the serial line (legacy) or UDP (PUS).
+    pub ground: LinkModel,
+    /// The serial line between boards A and B.
+    pub ab: LinkModel,
+}
+
+impl Default for Links {
+    fn default() -> Links {
+        Links {
+            wifi: LinkModel::wifi(),
+            ground: LinkModel::serial(),
+            ab: LinkModel::serial(),
+        }
+    }
+}
+
+/// A bug the engine's shells can be told to have, so that a test can show the fault swarm
+/// finds it (`mmic swarm --plant-bug double-exec`). None is ever on in a plain run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PlantedBug {
+    /// No bug.
+    #[default]
+    None,
+    /// Board A's WiFi task hands a copy of a command the WiFi link duplicated to the control
+    /// task with its sequence number cleared (an unsequenced command, which board A runs
+    /// whatever its log says: the paper's scheme): a double execution on a duplicated packet.
+    DoubleExec,
+}
+
+impl std::str::FromStr for PlantedBug {
+    type Err = String;
+    fn from_str(s: &str) -> Result<PlantedBug, String> {
+        match s {
+            "none" => Ok(PlantedBug::None),
+            "double-exec" => Ok(PlantedBug::DoubleExec),
+            _ => Err(format!("{s:?} is no planted bug: none or double-exec")),
+        }
+    }
+}
+
+/// The hops of one robot's links, each one direction of a link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Hop {
+    GroundToServer = 0,
+    ServerToGround = 1,
+    ServerToA = 2,
+    AToServer = 3,
+    AToB = 4,
+    BToA = 5,
+}
+
+/// Something that happens at a virtual instant.
+#[derive(Debug)]
+enum Ev {
+    /// Board A's control task ticks.
+    TickA(usize),
+    /// Board B ticks.
+    TickB(usize),
+    /// Board A's WiFi task drains the heartbeat queue.
+    Wifi(usize),
+    /// Bytes arrive at the end of a hop (`conn`: the WiFi connection they were written to).
+    Deliver {
+        robot: usize,
+        hop: Hop,
+        conn: u64,
+        bytes: Vec<u8>,
+    },
+    /// The server board's connection reaches board A's WiFi task.
+    Open { robot: usize, conn: u64 },
+    /// The server board's disconnection reaches board A's WiFi task.
+    Close { robot: usize, conn: u64 },
+    /// The server board stops waiting for the visit's heartbeat.
+    VisitTimeout { robot: usize, conn: u64 },
+    /// The server board's loop runs (the gateway's next deadline).
+    Server { robot: usize, token: u64 },
+    /// The ground's loop ticks every plan runner.
+    GroundTick,
+}
+
+struct Queued {
+    at: u64,
+    seq: u64,
+    ev: Ev,
+}
+
+impl PartialEq for Queued {
+    fn eq(&self, o: &Self) -> bool {
+        (self.at, self.seq) == (o.at, o.seq)
+    }
+}
+impl Eq for Queued {}
+impl PartialOrd for Queued {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Queued {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        (self.at, self.seq).cmp(&(o.at, o.seq))
+    }
+}
+
+/// One robot, eight waiting telecommands, 64 remembered keys (as the realtime engine's).
+type SimGateway = Gateway<1, 8, 64>;
+
+/// The largest telemetry packet the gateway writes, bytes.
+const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + mmic::node::gateway::MAX_TM_DATA;
+
+/// The server board's logic: the legacy relay, or the PUS gateway.
+enum Board {
+    Relay(Server<4>),
+    Gateway(Box<SimGateway>),
+}
+
+/// A visit of board A in progress: the connection, where its bytes are deframed.
+struct Visit {
+    conn: u64,
+    reader: Deframer<256>,
+}
+
+/// One robot's nodes and links.
+struct Robot {
+    number: BoardNumber,
+    names: [String; 3],
+    a: SideA,
+    b: SideB,
+    plant: Plant,
+    commands: PacketQueue<COMMAND_LEN, 8>,
+    heartbeats: PacketQueue<HEARTBEAT_LEN, 8>,
+    /// Board A's serial reader (from board B) and what it has deframed.
+    a_reader: Deframer<256>,
+    a_from_b: VecDeque<[u8; mmic::wire::internal_heartbeat::INTERNAL_HEARTBEAT_LEN]>,
+    /// Board B's serial reader (from board A).
+    b_reader: Deframer<256>,
+    b_from_a: VecDeque<[u8; mmic::wire::b_command::B_COMMAND_LEN]>,
+    b_lost: bool,
+    /// Board A's WiFi task: the open connection, its reader.
+    wifi_open: Option<u64>,
+    wifi_reader: Deframer<256>,
+    board: Board,
+    visit: Option<Visit>,
+    /// Packets from the ground waiting for the server board's loop.
+    inbox: VecDeque<Vec<u8>>,
+    server_reader: Deframer<256>,
+    /// The gateway's next wake, and its token (a wake with an older token is stale).
+    server_wake: Option<(u64, u64)>,
+    /// The ground's reader of this robot's serial line (legacy).
+    ground_reader: Deframer<256>,
+    links: [Link; 6],
+}
+
+/// The engine's state for one run.
+struct Engine<'c, G: Ground> {
+    cfg: &'c SimConfig,
+    now: u64,
+    seq: u64,
+    queue: BinaryHeap<Reverse<Queued>>,
+    robots: Vec<Robot>,
+    ground: GroundSide<G>,
+    log: Option<Log>,
+    packet_log: bool,
+    conns: u64,
+    tokens: u64,
+    watch: Option<Watch>,
+    status: Value,
+}
+
+/// Runs the simulation to the end of every robot's plan (or the time limit) in virtual time.
+pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
+    run_watched(cfg, false).map(|(s, _)| s)
+}
+
+/// [`run`], also watching the invariants of the fault swarm on every tick ([`watch`]) when
+/// `watched`.
+pub fn run_watched(cfg: &SimConfig, watched: bool) -> std::io::Result<(Summary, Option<Watch>)> {
+    if cfg.external.is_some() {
+        return Err(std::io::Error::other(
+            "an external ground runs on the wall clock: use the realtime engine",
+        ));
+    }
+    let n = cfg.robots.max(1) as usize;
+    match cfg.protocol {
+        Protocol::Legacy => {
+            let runners = (0..n)
+                .map(|i| LegacyGround {
+                    run: PlanRunner::new(cfg.ground, board_number(i)),
+                    last: None,
+                })
+                .collect();
+            Engine::new(cfg, runners, watched).run()
+        }
+        Protocol::Pus => {
+            let runners = (0..n)
+                .map(|i| PlanRunner::pus(cfg.pus, board_number(i)))
+                .collect();
+            Engine::new(cfg, runners, watched).run()
+        }
+    }
+}
+
+/// Robot `i`'s board number: 1..=255 by index (each robot has its own server board, so
+/// numbers may repeat in a larger fleet: they only need to match between a robot's ground
+/// runner, server board and board A).
+fn board_number(i: usize) -> BoardNumber {
+    BoardNumber::new((i % 255) as u8 + 1).unwrap_or(BoardNumber::ONE)
+}
+
+/// The packets a deframer finds in `bytes`.
+fn frames(d: &mut Deframer<256>, bytes: &[u8]) -> Vec<mmic::wire::deframer::Frame> {
+    let mut out = Vec::new();
+    d.feed(bytes, |e| {
+        if let Deframed::Frame(f) = e {
+            out.push(f);
+        }
+    });
+    out
+}
+
+impl<'c, G: Ground> Engine<'c, G> {
+    fn new(cfg: &'c SimConfig, runners: Vec<G>, watched: bool) -> Engine<'c, G> {
+        let n = runners.len();
+        let log = (cfg.log_events || cfg.log_packets || cfg.log_path.is_some()).then(Log::memory);
+        let ground = GroundSide::new(
+            &cfg.steps,
+            cfg.start_state,
+            &cfg.injections,
+            runners,
+            cfg.progress,
+            log.clone(),
+        );
+        let robots = (0..n).map(|i| Robot::new(cfg, i)).collect();
+        let mut e = Engine {
+            cfg,
+            now: 0,
+            seq: 0,
+            queue: BinaryHeap::new(),
+            robots,
+            ground,
+            log,
+            packet_log: cfg.log_packets,
+            conns: 0,
+            tokens: 0,
+            watch: watched.then(|| Watch::new(cfg, n)),
+            status: Value::Null,
+        };
+        for i in 0..n {
+            e.at(0, Ev::TickA(i));
+            e.at(cfg.b_phase_us % 10_000, Ev::TickB(i));
+            if cfg.protocol == Protocol::Pus {
+                e.wake_server(i, 0);
+            }
+        }
+        e.at(0, Ev::GroundTick);
+        e
+    }
+
+    fn at(&mut self, at: u64, ev: Ev) {
+        self.seq += 1;
+        self.queue.push(Reverse(Queued {
+            at,
+            seq: self.seq,
+            ev,
+        }));
+    }
+
+    fn now_ms(&self) -> u32 {
+        (self.now / 1000) as u32
+    }
+
+    fn run(mut self) -> std::io::Result<(Summary, Option<Watch>)> {
+        let wall = Instant::now();
+        let max_us = (self.cfg.max_sim_ms as u64 + 1) * 1000;
+        while let Some(Reverse(q)) = self.queue.pop() {
+            if q.at > max_us {
+                break;
+            }
+            self.now = q.at;
+            if !self.handle(q.ev) {
+                break;
+            }
+        }
+        let now = self.now_ms();
+        if let Some(w) = &mut self.watch {
+            for (i, r) in self.robots.iter().enumerate() {
+                w.finish(i, now, &r.a.board, &self.ground.open_commands(i));
+            }
+        }
+        let (ends, stats) = self.ground.finish(now);
+        let records = self.log.as_ref().map(Log::take).unwrap_or_default();
+        if let Some(p) = &self.cfg.log_path {
+            let f = std::fs::File::create(p)?;
+            log::write_lines(&records, &mut std::io::BufWriter::new(f))?;
+        }
+        let cfg = self.cfg;
+        let summary = Summary {
+            protocol: cfg.protocol,
+            ends,
+            plan: cfg.steps.clone(),
+            start_state: cfg.start_state,
+            wifi_loss: cfg.wifi_loss,
+            visit_ms: match cfg.protocol {
+                Protocol::Legacy => cfg.visit_ms,
+                Protocol::Pus => cfg.gateway.uplink.timeout_ms,
+            },
+            sim_ms: stats.sim_ms,
+            wall: wall.elapsed(),
+            records,
+            efficiency: stats.efficiency,
+            attempts: stats.attempts,
+            max_latency_ms: stats.max_latency_ms,
+            status: self.status,
+            max_tick_lateness_ms: 0,
+            held_ms: 0,
+            pace_slack_ms: None,
+            last_heartbeat: stats.last_heartbeat,
+            realtime: false,
+        };
+        Ok((summary, self.watch))
+    }
+
+    /// Handles one event; false when the run is over.
+    fn handle(&mut self, ev: Ev) -> bool {
+        match ev {
+            Ev::TickA(i) => {
+                self.tick_a(i);
+                self.at(self.now + TICK_MS as u64 * 1000, Ev::TickA(i));
+            }
+            Ev::TickB(i) => {
+                self.tick_b(i);
+                self.at(self.now + TICK_MS as u64 * 1000, Ev::TickB(i));
+            }
+            Ev::Wifi(i) => self.wifi_drain(i),
+            Ev::Deliver {
+                robot,
+                hop,
+                conn,
+                bytes,
+            } => self.deliver(robot, hop, conn, bytes),
+            Ev::Open { robot, conn } => self.wifi_opened(robot, conn),
+            Ev::Close { robot, conn } => {
+                let r = &mut self.robots[robot];
+                if r.wifi_open == Some(conn) {
+                    r.wifi_open = None;
+                }
+            }
+            Ev::VisitTimeout { robot, conn } => {
+                if self.robots[robot].visit.as_ref().map(|v| v.conn) == Some(conn) {
+                    self.end_visit(robot);
+                    self.server_loop(robot);
+                }
+            }
+            Ev::Server { robot, token } => {
+                if self.robots[robot].server_wake.map(|(_, t)| t) == Some(token) {
+                    self.robots[robot].server_wake = None;
+                    self.server_loop(robot);
+                }
+            }
+            Ev::GroundTick => return self.ground_tick(),
+        }
+        true
+    }
+
+    fn event(&self, node: &str, what: Value) {
+        if let (Some(l), true) = (&self.log, self.cfg.log_events) {
+            l.event(self.now_ms(), node, what);
+        }
+    }
+
+    /// Writes `bytes` to robot `i`'s `hop` at the current instant: logged with its fate, and
+    /// delivered (once or twice) unless lost or cut.
+    fn send(&mut self, i: usize, hop: Hop, conn: u64, bytes: &[u8]) -> Fate {
+        let now = self.now;
+        let sent = self.robots[i].links[hop as usize].send(now);
+        if self.packet_log {
+            if let Some(l) = &self.log {
+                let (link, from, to) = self.robots[i].ends(hop, self.cfg.protocol);
+                let t = self.now_ms();
+                l.packet(t, link, from, to, sent.fate.name(), bytes);
+                if sent.at_us.len() > 1 {
+                    l.packet(t, link, from, to, "duplicated", bytes);
+                }
+            }
+        }
+        if let Some(w) = &mut self.watch {
+            w.sent(i, hop as usize, sent.fate, self.now);
+        }
+        for (k, at) in sent.at_us.iter().enumerate() {
+            self.at(
+                *at,
+                Ev::Deliver {
+                    robot: i,
+                    hop,
+                    conn: if k == 0 { conn } else { conn | DUPLICATE },
+                    bytes: bytes.to_vec(),
+                },
+            );
+        }
+        sent.fate
+    }
+
+    fn ground_tick(&mut self) -> bool {
+        let now = self.now_ms();
+        if now > self.cfg.max_sim_ms || self.ground.all_ended() {
+            return false;
+        }
+        for i in 0..self.robots.len() {
+            if self.ground.ended(i) {
+                continue;
+            }
+            for p in self.ground.tick(i, now) {
+                self.ground_sends(i, &p);
+            }
+        }
+        self.ground.progress(now);
+        if self.ground.all_ended() {
+            return false;
+        }
+        self.at(self.now + GROUND_TICK_MS as u64 * 1000, Ev::GroundTick);
+        true
+    }
+
+    /// The ground writes `p` to robot `i`'s server board.
+    fn ground_sends(&mut self, i: usize, p: &[u8]) {
+        if self.cfg.protocol == Protocol::Legacy {
+            if let Some(w) = &mut self.watch {
+                w.commanded(i, p, self.now);
+            }
+        }
+        self.send(i, Hop::GroundToServer, 0, p);
+    }
+
+    fn deliver(&mut self, i: usize, hop: Hop, conn: u64, bytes: Vec<u8>) {
+        match hop {
+            Hop::GroundToServer => {
+                let r = &mut self.robots[i];
+                match r.board {
+                    Board::Relay(_) => {
+                        for f in frames(&mut r.server_reader, &bytes) {
+                            r.inbox.push_back(f.as_bytes().to_vec());
+                        }
+                    }
+                    Board::Gateway(_) => r.inbox.push_back(bytes),
+                }
+                self.server_loop(i);
+            }
+            Hop::ServerToGround => {
+                let now = self.now_ms();
+                let packets = match self.cfg.protocol {
+                    Protocol::Legacy => frames(&mut self.robots[i].ground_reader, &bytes)
+                        .into_iter()
+                        .map(|f| f.as_bytes().to_vec())
+                        .collect(),
+                    Protocol::Pus => vec![bytes],
+                };
+                for p in packets {
+                    for out in self.ground.receive(i, now, &p) {
+                        self.ground_sends(i, &out);
+                    }
+                }
+            }
+            Hop::ServerToA => self.wifi_bytes(i, conn, &bytes),
+            Hop::AToServer => self.heartbeat_at_server(i, conn, &bytes),
+            Hop::AToB => {
+                let r = &mut self.robots[i];
+                for f in frames(&mut r.b_reader, &bytes) {
+                    if let Ok(p) = f.as_bytes().try_into() {
+                        r.b_from_a.push_back(p);
+                    }
+                }
+            }
+            Hop::BToA => {
+                let r = &mut self.robots[i];
+                for f in frames(&mut r.a_reader, &bytes) {
+                    if let Ok(p) = f.as_bytes().try_into() {
+                        r.a_from_b.push_back(p);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Board A's control task: one tick.
+    fn tick_a(&mut self, i: usize) {
+        let now = self.now_ms();
+        let r = &mut self.robots[i];
+        let command = r.commands.split().1.pop();
+        let from_b = r.a_from_b.pop_front();
+        let out = r.a.tick(&mut r.plant, now, command, from_b);
+        if let Some(w) = &mut self.watch {
+            w.tick_a(i, now, command.as_ref(), &r.a.board, &r.plant, &out);
+        }
+        let name = r.names[0].clone();
+        if self.cfg.log_events {
+            for e in &out.events {
+                self.event(&name, super::shell::event_json(e));
+            }
+        }
+        if let Some(b) = out.to_b {
+            self.send(i, Hop::AToB, 0, &b);
+        }
+        if let Some(hb) = out.heartbeat {
+            let r = &mut self.robots[i];
+            if let Err(full) = r.heartbeats.split().0.push(hb) {
+                self.event(
+                    &name,
+                    json!({"type": "handoff_full", "hex": log::hex(&full.0)}),
+                );
+            }
+            self.at(self.now + WIFI_TASK_US, Ev::Wifi(i));
+        }
+        if i == 0 {
+            self.status = self.robots[0].a.status(now);
+        }
+    }
+
+    /// Board B: one tick.
+    fn tick_b(&mut self, i: usize) {
+        let now = self.now_ms();
+        let r = &mut self.robots[i];
+        let command = r.b_from_a.pop_front();
+        let out = r.b.tick(&mut r.plant, now, command);
+        if let Some(w) = &mut self.watch {
+            w.tick_b(i, now, &r.plant);
+        }
+        if out.link_lost != r.b_lost {
+            r.b_lost = out.link_lost;
+            let (name, holding) = (r.names[1].clone(), r.b_lost);
+            self.event(&name, json!({"type": "link_lost", "holding": holding}));
+        }
+        if let Some(hb) = out.heartbeat {
+            self.send(i, Hop::BToA, 0, &hb);
+        }
+    }
+
+    /// Board A's WiFi task takes a connection: heartbeats made while nobody was connected
+    /// are discarded (the firmware's behaviour), then it serves this one.
+    fn wifi_opened(&mut self, i: usize, conn: u64) {
+        let r = &mut self.robots[i];
+        r.wifi_open = Some(conn);
+        r.wifi_reader = Deframer::new();
+        self.wifi_discard(i);
+    }
+
+    fn wifi_discard(&mut self, i: usize) {
+        let now = self.now_ms();
+        while let Some(hb) = self.robots[i].heartbeats.split().1.pop() {
+            if self.packet_log {
+                if let Some(l) = &self.log {
+                    let r = &self.robots[i];
+                    l.packet(now, "wifi", &r.names[0], &r.names[2], "unconnected", &hb);
+                }
+            }
+        }
+    }
+
+    /// Board A's WiFi task writes the queued heartbeats to the open connection.
+    fn wifi_drain(&mut self, i: usize) {
+        let Some(conn) = self.robots[i].wifi_open else {
+            self.wifi_discard(i);
+            return;
+        };
+        while let Some(hb) = self.robots[i].heartbeats.split().1.pop() {
+            self.send(i, Hop::AToServer, conn, &hb);
+        }
+    }
+
+    /// Command bytes reach board A's WiFi task on connection `conn`.
+    fn wifi_bytes(&mut self, i: usize, conn: u64, bytes: &[u8]) {
+        let copy = conn & DUPLICATE != 0;
+        let r = &mut self.robots[i];
+        if r.wifi_open != Some(conn & !DUPLICATE) {
+            let name = r.names[0].clone();
+            self.event(
+                &name,
+                json!({"type": "wifi_closed", "hex": log::hex(bytes)}),
+            );
+            return;
+        }
+        let mut packets: Vec<[u8; COMMAND_LEN]> = frames(&mut r.wifi_reader, bytes)
+            .into_iter()
+            .filter(|f| f.kind() == PacketKind::Command)
+            .filter_map(|f| f.as_bytes().try_into().ok())
+            .collect();
+        if copy && self.cfg.planted_bug == PlantedBug::DoubleExec {
+            for p in packets.iter_mut() {
+                if let Ok(mut c) = CommandRepr::parse(p) {
+                    let origin = *p;
+                    c.seq = 0;
+                    *p = c.to_bytes();
+                    if let Some(w) = &mut self.watch {
+                        w.same_origin(i, &origin, p);
+                    }
+                }
+            }
+        }
+        let name = r.names[0].clone();
+        for p in packets {
+            let r = &mut self.robots[i];
+            if let Err(full) = r.commands.split().0.push(p) {
+                self.event(
+                    &name,
+                    json!({"type": "handoff_full", "hex": log::hex(&full.0)}),
+                );
+            }
+        }
+    }
+
+    /// A heartbeat reaches the server board on connection `conn`.
+    fn heartbeat_at_server(&mut self, i: usize, conn: u64, bytes: &[u8]) {
+        let now = self.now_ms();
+        let r = &mut self.robots[i];
+        let current = r
+            .visit
+            .as_ref()
+            .is_some_and(|v| v.conn == conn & !DUPLICATE);
+        if !current {
+            let name = r.names[2].clone();
+            self.event(
+                &name,
+                json!({"type": "heartbeat_after_visit", "hex": log::hex(bytes)}),
+            );
+            return;
+        }
+        let Some(v) = r.visit.as_mut() else { return };
+        let Some(hb) = frames(&mut v.reader, bytes)
+            .into_iter()
+            .find(|f| f.kind() == PacketKind::Heartbeat)
+        else {
+            return;
+        };
+        let hb = hb.as_bytes().to_vec();
+        match &mut r.board {
+            Board::Relay(_) => {
+                self.end_visit(i);
+                self.send(i, Hop::ServerToGround, 0, &hb);
+            }
+            Board::Gateway(g) => {
+                let out = HeartbeatRepr::parse(&hb).map(|h| g.heartbeat(now, &h));
+                self.end_visit(i);
+                if let Ok(out) = out {
+                    self.reports(i, out);
+                }
+            }
+        }
+        self.server_loop(i);
+    }
+
+    /// The server board closes the visit's connection.
+    fn end_visit(&mut self, i: usize) {
+        if let Some(v) = self.robots[i].visit.take() {
+            let at = self.now
+                + self.robots[i].links[Hop::ServerToA as usize]
+                    .model()
+                    .latency_us;
+            self.at(
+                at,
+                Ev::Close {
+                    robot: i,
+                    conn: v.conn,
+                },
+            );
+        }
+    }
+
+    /// The server board opens a connection to board A and writes `packet` to it.
+    fn start_visit(&mut self, i: usize, packet: [u8; COMMAND_LEN], wait_ms: u32) {
+        self.conns += 1;
+        let conn = self.conns;
+        let at = self.now
+            + self.robots[i].links[Hop::ServerToA as usize]
+                .model()
+                .latency_us;
+        self.at(at, Ev::Open { robot: i, conn });
+        self.robots[i].visit = Some(Visit {
+            conn,
+            reader: Deframer::new(),
+        });
+        if self.cfg.protocol == Protocol::Pus {
+            if let Some(w) = &mut self.watch {
+                w.commanded(i, &packet, self.now);
+            }
+        }
+        self.send(i, Hop::ServerToA, conn, &packet);
+        self.at(
+            self.now + wait_ms as u64 * 1000,
+            Ev::VisitTimeout { robot: i, conn },
+        );
+    }
+
+    /// The server board's loop, between visits: the ground's packets, then the next visit.
+    fn server_loop(&mut self, i: usize) {
+        if self.robots[i].visit.is_some() {
+            return;
+        }
+        let now = self.now_ms();
+        let inbox: Vec<Vec<u8>> = self.robots[i].inbox.drain(..).collect();
+        let name = self.robots[i].names[2].clone();
+        let number = self.robots[i].number;
+        if let Board::Relay(_) = self.robots[i].board {
+            for p in inbox {
+                let Board::Relay(srv) = &mut self.robots[i].board else {
+                    return;
+                };
+                let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(p.as_slice()) else {
+                    continue;
+                };
+                let what = match srv.accept(&packet) {
+                    Ok(Accepted::Queued) => json!({"type": "queued"}),
+                    Ok(Accepted::Resend) => json!({"type": "resend"}),
+                    Ok(Accepted::Superseded(old)) => {
+                        json!({"type": "superseded", "old": log::hex(&old)})
+                    }
+                    Err(e) => json!({"type": "refused", "error": e.to_string()}),
+                };
+                self.event(&name, what);
+            }
+            let Board::Relay(srv) = &mut self.robots[i].board else {
+                return;
+            };
+            if let Some((board, packet)) = srv.next_visit() {
+                srv.delivered(board, &packet);
+                if board == number {
+                    self.start_visit(i, packet, self.cfg.visit_ms);
+                } else {
+                    self.event(
+                        &name,
+                        json!({"type": "no_such_robot", "board": board.get()}),
+                    );
+                }
+            }
+            return;
+        }
+        for p in inbox {
+            let Board::Gateway(g) = &mut self.robots[i].board else {
+                return;
+            };
+            match g.tc_packet(&p) {
+                Ok(out) => self.reports(i, out),
+                Err(e) => self.event(
+                    &name,
+                    json!({"type": "tc_refused", "error": e.to_string(), "hex": log::hex(&p)}),
+                ),
+            }
+        }
+        let Board::Gateway(g) = &mut self.robots[i].board else {
+            return;
+        };
+        let out = g.tick(now);
+        let visit = out
+            .to_robots
+            .iter()
+            .find(|(b, _)| *b == number)
+            .map(|(_, c)| c.to_bytes());
+        self.reports(i, out);
+        if let Some(packet) = visit {
+            self.start_visit(i, packet, self.cfg.gateway.uplink.timeout_ms);
+            return;
+        }
+        let Board::Gateway(g) = &self.robots[i].board else {
+            return;
+        };
+        if let Some(t) = g.next_deadline(now) {
+            let at = (t.max(now.saturating_add(1)) as u64) * 1000;
+            self.wake_server(i, at);
+        }
+    }
+
+    /// Schedules the gateway's loop at `at` (µs) unless it runs sooner already.
+    fn wake_server(&mut self, i: usize, at: u64) {
+        if self.robots[i].server_wake.is_some_and(|(t, _)| t <= at) {
+            return;
+        }
+        self.tokens += 1;
+        let token = self.tokens;
+        self.robots[i].server_wake = Some((at, token));
+        self.at(at, Ev::Server { robot: i, token });
+    }
+
+    /// The gateway's reports, written to the ground.
+    fn reports<const M: usize>(&mut self, i: usize, out: Out<M>) {
+        let now = self.now_ms();
+        if out.overflow > 0 {
+            let name = self.robots[i].names[2].clone();
+            self.event(&name, json!({"type": "overflow", "count": out.overflow}));
+        }
+        for tm in &out.reports {
+            let Board::Gateway(g) = &mut self.robots[i].board else {
+                return;
+            };
+            let mut b = [0u8; MAX_TM_LEN];
+            match g.encode(tm, now, &mut b) {
+                Ok(n) => {
+                    let p = b.get(..n).unwrap_or(&[]).to_vec();
+                    self.send(i, Hop::ServerToGround, 0, &p);
+                }
+                Err(e) => {
+                    let name = self.robots[i].names[2].clone();
+                    self.event(
+                        &name,
+                        json!({"type": "tm_unwritten", "error": e.to_string()}),
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Marks the copy of a duplicated packet in its delivery's connection number (connection
+/// numbers count up from 1 and stay far below this bit).
+const DUPLICATE: u64 = 1 << 63;
+
+impl Robot {
+    fn new(cfg: &SimConfig, i: usize) -> Robot {
+        let number = board_number(i);
+        let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
+        let plant = Plant::new(
+            super::PlantConfig {
+                seed,
+                ..cfg.plant.clone()
+            },
+            cfg.start_state,
+        );
+        let mut ab = cfg.links.ab.clone();
+        if let Some(t) = cfg.cut_b_at {
+            ab.cuts.push((t, None));
+        }
+        let link = |model: &LinkModel, loss: f64, k: u64, stream: bool| {
+            Link::new(
+                model.clone(),
+                loss,
+                seed.wrapping_add(k * 7919) ^ 0x11_4c_5e_ed,
+                stream,
+            )
+        };
+        let ground_stream = cfg.protocol == Protocol::Legacy;
+        let links = [
+            link(&cfg.links.ground, cfg.serial_loss, 4, ground_stream),
+            link(&cfg.links.ground, cfg.serial_loss, 3, ground_stream),
+            link(&cfg.links.wifi, cfg.wifi_loss, 5, true),
+            link(&cfg.links.wifi, cfg.wifi_loss, 6, true),
+            link(&ab, cfg.ab_loss, 1, true),
+            link(&ab, cfg.ab_loss, 2, true),
+        ];
+        let board = match cfg.protocol {
+            Protocol::Legacy => Board::Relay(Server::new()),
+            Protocol::Pus => {
+                let mut g = Box::new(SimGateway::new(cfg.gateway));
+                g.add(number);
+                Board::Gateway(g)
+            }
+        };
+        Robot {
+            number,
+            names: [
+                format!("board_a{}", i + 1),
+                format!("board_b{}", i + 1),
+                format!("server{}", i + 1),
+            ],
+            a: SideA::new(BoardA::in_state(
+                board_a::Config {
+                    board: number,
+                    ..board_a::Config::default()
+                },
+                cfg.start_state,
+            )),
+            b: SideB::new(BoardB::new(board_b::Config::default())),
+            plant,
+            commands: PacketQueue::new(),
+            heartbeats: PacketQueue::new(),
+            a_reader: Deframer::new(),
+            a_from_b: VecDeque::new(),
+            b_reader: Deframer::new(),
+            b_from_a: VecDeque::new(),
+            b_lost: false,
+            wifi_open: None,
+            wifi_reader: Deframer::new(),
+            board,
+            visit: None,
+            inbox: VecDeque::new(),
+            server_reader: Deframer::new(),
+            server_wake: None,
+            ground_reader: Deframer::new(),
+            links,
+        }
+    }
+
+    /// A hop's link name and its two ends' names in the log (as the realtime engine names them).
+    fn ends(&self, hop: Hop, protocol: Protocol) -> (&'static str, &str, &str) {
+        let ground_link = match protocol {
+            Protocol::Legacy => "serial_ground",
+            Protocol::Pus => "udp_ground",
+        };
+        let [a, b, s] = &self.names;
+        match hop {
+            Hop::GroundToServer => (ground_link, "ground", s),
+            Hop::ServerToGround => (ground_link, s, "ground"),
+            Hop::ServerToA => ("wifi", s, a),
+            Hop::AToServer => ("wifi", a, s),
+            Hop::AToB => ("serial_ab", a, b),
+            Hop::BToA => ("serial_ab", b, a),
+        }
+    }
+}

@@ -1,0 +1,450 @@
+//! The realtime engine (`mmic sim --realtime`): the four nodes of Figure 3 run the real
+//! library over real transports — the opsUI and the server board over an OS pipe (the
+//! RS232-over-USB line; UDP on loopback with `--protocol pus`), the server and board A over TCP
+//! on loopback (the WiFi link, connected and disconnected each server loop), board A's WiFi task
+//! and control loop on two threads joined by the library's hand-off queues, board A and board B
+//! over OS pipes (the wired serial line) — around the plant, on the wall clock multiplied by a
+//! scale ([`super::clock`], paced). Eight OS threads per robot: it proves the transports, but its
+//! outcome can depend on how busy the host is, which the virtual-time engine
+//! ([`super::engine`], the default) cannot.
+
+use super::clock::{self, Clock};
+use super::log;
+use super::nodes::{self, Lossy};
+use super::plant::{self, PlantConfig};
+use super::shell::{Ground, GroundSide, GroundStats, LegacyGround, SideA, SideB};
+use super::{Protocol, SimConfig, Summary, PACE_SLACK_MS};
+use mmic::node::board_a::{self, BoardA};
+use mmic::node::board_b::{self, BoardB};
+use mmic::node::handoff::PacketQueue;
+use mmic::node::plan_runner::{PlanEnd, PlanRunner};
+use mmic::units::BoardNumber;
+use serde_json::{json, Value};
+use std::io::Write;
+use std::net::{TcpListener, UdpSocket};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+/// A robot's board A listening for the server board's connections (the WiFi link).
+struct Robot {
+    addr: std::net::SocketAddr,
+    listener: TcpListener,
+}
+
+/// A serial line: its two ends as OS pipes, with a reader thread deframing packets into a
+/// channel at the receiving end.
+struct Serial {
+    write: std::io::PipeWriter,
+    read: std::sync::mpsc::Receiver<Vec<u8>>,
+}
+
+/// The ground's end of a robot's link: the writer, the packets read, the robot's number.
+type GroundLink = (
+    Lossy<Box<dyn Write + Send>>,
+    std::sync::mpsc::Receiver<Vec<u8>>,
+    BoardNumber,
+);
+
+/// What every robot's threads share within one run.
+struct RunEnv<'a> {
+    cfg: &'a SimConfig,
+    clock: Clock<'a>,
+    stop: &'a AtomicBool,
+    late: &'a AtomicU32,
+    /// Events (always), packets (when logged).
+    log: Option<log::Log>,
+    packet_log: Option<log::Log>,
+}
+
+impl<'a> RunEnv<'a> {
+    /// The context of one node loop, holding a slot of the paced clock.
+    fn node(&self, name: &str, log: &Option<log::Log>) -> nodes::Node<'a> {
+        nodes::Node {
+            name: name.to_string(),
+            clock: self.clock.node(),
+            log: log.clone(),
+            stop: self.stop,
+            late: self.late,
+        }
+    }
+
+    /// A lossy writer for one direction of a link; its loss draws are seeded from the robot's
+    /// seed and `k`, so each direction draws its own sequence.
+    #[allow(clippy::too_many_arguments)]
+    fn lossy<W: Write>(
+        &self,
+        out: W,
+        link: &'static str,
+        (from, to): (&str, &str),
+        loss: f64,
+        cut_at: Option<u32>,
+        seed: u64,
+        k: u64,
+    ) -> Lossy<W> {
+        Lossy {
+            out,
+            link,
+            from: from.to_string(),
+            to: to.to_string(),
+            loss,
+            cut_at,
+            rng: fastrand::Rng::with_seed(seed.wrapping_add(k * 7919)),
+            log: self.packet_log.clone(),
+        }
+    }
+}
+
+/// Opens a serial line and starts its reader.
+fn serial<'scope>(scope: &'scope std::thread::Scope<'scope, '_>) -> std::io::Result<Serial> {
+    let (r, write) = std::io::pipe()?;
+    let (tx, read) = std::sync::mpsc::channel();
+    scope.spawn(move || nodes::reader(r, tx));
+    Ok(Serial { write, read })
+}
+
+/// Starts robot `i`'s four nodes (board A's WiFi and control tasks joined by `queues`, board
+/// B, the server board) and returns the ground's end of its serial line.
+fn spawn_robot<'scope, 'env>(
+    scope: &'scope std::thread::Scope<'scope, 'env>,
+    env: &RunEnv<'env>,
+    i: usize,
+    robot: Robot,
+    queues: &'env mut (PacketQueue<14, 8>, PacketQueue<66, 8>),
+    status: Arc<Mutex<Value>>,
+) -> std::io::Result<GroundLink> {
+    let cfg = env.cfg;
+    let board = BoardNumber::new(i as u8 + 1).unwrap_or(BoardNumber::ONE);
+    let (name_a, name_b, name_s) = (
+        format!("board_a{}", i + 1),
+        format!("board_b{}", i + 1),
+        format!("server{}", i + 1),
+    );
+    let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
+    let plant = Arc::new(Mutex::new(plant::Plant::new(
+        PlantConfig {
+            seed,
+            ..cfg.plant.clone()
+        },
+        cfg.start_state,
+    )));
+    let (a_to_b, b_to_a) = (serial(scope)?, serial(scope)?);
+    let (cmd_queue, hb_queue) = (&mut queues.0, &mut queues.1);
+    let (cmd_p, cmd_c) = cmd_queue.split();
+    let (hb_p, hb_c) = hb_queue.split();
+    let wifi = nodes::WifiTask {
+        listener: robot.listener,
+        commands: cmd_p,
+        heartbeats: hb_c,
+        loss: cfg.wifi_loss,
+        seed: seed ^ 0x5eed,
+    };
+    let control = nodes::ControlTask {
+        a: SideA::new(BoardA::in_state(
+            board_a::Config {
+                board,
+                ..board_a::Config::default()
+            },
+            cfg.start_state,
+        )),
+        commands: cmd_c,
+        heartbeats: hb_p,
+        from_b: b_to_a.read,
+        to_b: env.lossy(
+            a_to_b.write,
+            "serial_ab",
+            (&name_a, &name_b),
+            cfg.ab_loss,
+            cfg.cut_b_at,
+            seed,
+            1,
+        ),
+        plant: plant.clone(),
+        status,
+    };
+    let b = nodes::BoardBTask {
+        b: SideB::new(BoardB::new(board_b::Config::default())),
+        from_a: a_to_b.read,
+        to_a: env.lossy(
+            b_to_a.write,
+            "serial_ab",
+            (&name_b, &name_a),
+            cfg.ab_loss,
+            cfg.cut_b_at,
+            seed,
+            2,
+        ),
+        plant,
+    };
+    // The WiFi task logs its packets (the packet log) and the hand-off events with them.
+    let nodes = (
+        env.node(&name_a, &env.packet_log),
+        env.node(&name_a, &env.log),
+        env.node(&name_b, &env.log),
+        env.node(&name_s, &env.log),
+    );
+    scope.spawn(move || wifi.run(nodes.0));
+    scope.spawn(move || control.run(nodes.1));
+    scope.spawn(move || b.run(nodes.2));
+    match cfg.protocol {
+        Protocol::Legacy => {
+            let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
+            let server = nodes::ServerTask {
+                from_ground: ground_to_server.read,
+                to_ground: env.lossy(
+                    server_to_ground.write,
+                    "serial_ground",
+                    (&name_s, "ground"),
+                    cfg.serial_loss,
+                    None,
+                    seed,
+                    3,
+                ),
+                robots: vec![(board, robot.addr)],
+                visit_ms: cfg.visit_ms,
+            };
+            scope.spawn(move || server.run(nodes.3));
+            let to_server = env.lossy(
+                ground_to_server.write,
+                "serial_ground",
+                ("ground", &name_s),
+                cfg.serial_loss,
+                None,
+                seed,
+                4,
+            );
+            Ok((to_server.boxed(), server_to_ground.read, board))
+        }
+        Protocol::Pus => {
+            // UDP on loopback: one socket at the ground, one at the server board.
+            let ground = UdpSocket::bind("127.0.0.1:0")?;
+            let server =
+                UdpSocket::bind(("127.0.0.1", cfg.external.as_ref().map_or(0, |x| x.tc_port)))?;
+            let (mut ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
+            if let Some(x) = &cfg.external {
+                ground_addr = x.tm_to;
+                x.wire
+                    .line(json!({"ready": true, "tc_port": server_addr.port()}));
+            }
+            server.set_nonblocking(true)?;
+            let to_ground = nodes::UdpOut {
+                sock: server.try_clone()?,
+                peer: ground_addr,
+            };
+            let to_server = nodes::UdpOut {
+                sock: ground.try_clone()?,
+                peer: server_addr,
+            };
+            let gw = nodes::GatewayTask {
+                from_ground: server,
+                to_ground: env.lossy(
+                    to_ground,
+                    "udp_ground",
+                    (&name_s, "ground"),
+                    cfg.serial_loss,
+                    None,
+                    seed,
+                    3,
+                ),
+                robot: (board, robot.addr),
+                config: cfg.gateway,
+                wire: cfg.external.as_ref().map(|x| x.wire.clone()),
+            };
+            scope.spawn(move || gw.run(nodes.3));
+            let (tx, rx) = std::sync::mpsc::channel();
+            let stop = env.stop;
+            scope.spawn(move || nodes::udp_reader(ground, tx, stop));
+            let to_server = env.lossy(
+                to_server,
+                "udp_ground",
+                ("ground", &name_s),
+                cfg.serial_loss,
+                None,
+                seed,
+                4,
+            );
+            Ok((to_server.boxed(), rx, board))
+        }
+    }
+}
+
+/// Runs the simulation on the wall clock to the end of every robot's plan (or the time limit).
+pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
+    let n = cfg.robots.max(1) as usize;
+    let (logger, log_rx) = log::Log::new();
+    let robots = (0..n)
+        .map(|_| {
+            let listener = TcpListener::bind("127.0.0.1:0")?;
+            Ok(Robot {
+                addr: listener.local_addr()?,
+                listener,
+            })
+        })
+        .collect::<std::io::Result<Vec<Robot>>>()?;
+    let mut queues: Vec<(PacketQueue<14, 8>, PacketQueue<66, 8>)> = (0..n)
+        .map(|_| (PacketQueue::new(), PacketQueue::new()))
+        .collect();
+    // Four paced nodes per robot (board A's two tasks, board B, the server board) and the
+    // ground; an unpaced run hands out no slots.
+    let pace = clock::Pace::new(if cfg.paced { 4 * n + 1 } else { 0 }, PACE_SLACK_MS);
+    let clock = if cfg.paced {
+        Clock::paced(cfg.scale, &pace)
+    } else {
+        Clock::start(cfg.scale)
+    };
+    let statuses: Vec<Arc<Mutex<Value>>> =
+        (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
+    let (stop, lateness) = (AtomicBool::new(false), AtomicU32::new(0));
+    let writer = spawn_log_writer(cfg.log_path.clone(), log_rx);
+    let env = RunEnv {
+        cfg,
+        clock,
+        stop: &stop,
+        late: &lateness,
+        log: Some(logger.clone()),
+        packet_log: cfg.log_packets.then(|| logger.clone()),
+    };
+    drop(logger);
+    let result = std::thread::scope(|scope| -> std::io::Result<_> {
+        let mut ground_links = Vec::new();
+        for (i, (robot, q)) in robots.into_iter().zip(queues.iter_mut()).enumerate() {
+            ground_links.push(spawn_robot(scope, &env, i, robot, q, statuses[i].clone())?);
+        }
+        let out = match &cfg.external {
+            None => ground_loop(cfg, ground_links, clock.node(), env.log.clone()),
+            Some(_) => external_ground(cfg, &clock),
+        };
+        stop.store(true, Ordering::Relaxed);
+        Ok(out)
+    });
+    drop(env);
+    let (ends, stats) = result?;
+    let records = writer
+        .join()
+        .map_err(|_| std::io::Error::other("log writer panicked"))??;
+    let status = statuses[0].lock().map(|s| s.clone()).unwrap_or(Value::Null);
+    Ok(Summary {
+        protocol: cfg.protocol,
+        ends,
+        plan: cfg.steps.clone(),
+        start_state: cfg.start_state,
+        wifi_loss: cfg.wifi_loss,
+        visit_ms: match cfg.protocol {
+            Protocol::Legacy => cfg.visit_ms,
+            Protocol::Pus => cfg.gateway.uplink.timeout_ms,
+        },
+        sim_ms: stats.sim_ms,
+        wall: clock.wall_elapsed(),
+        records,
+        efficiency: stats.efficiency,
+        attempts: stats.attempts,
+        max_latency_ms: stats.max_latency_ms,
+        status,
+        max_tick_lateness_ms: lateness.load(Ordering::Relaxed),
+        held_ms: clock.held_ms(),
+        pace_slack_ms: clock.slack_ms(),
+        last_heartbeat: stats.last_heartbeat,
+        realtime: true,
+    })
+}
+
+/// The thread that writes the log (to a file, or nowhere) and returns its records when every
+/// sender has gone.
+fn spawn_log_writer(
+    path: Option<PathBuf>,
+    rx: std::sync::mpsc::Receiver<log::Record>,
+) -> std::thread::JoinHandle<std::io::Result<Vec<Value>>> {
+    std::thread::spawn(move || match path {
+        Some(p) => {
+            let f = std::fs::File::create(p)?;
+            log::write_all(rx, &mut std::io::BufWriter::new(f))
+        }
+        None => log::write_all(rx, &mut std::io::sink()),
+    })
+}
+
+/// An external ground does the commanding: wait out the run's time.
+fn external_ground(cfg: &SimConfig, clock: &Clock) -> (Vec<Option<PlanEnd>>, GroundStats) {
+    while clock.now_ms() < cfg.max_sim_ms {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let stats = GroundStats {
+        sim_ms: clock.now_ms(),
+        ..GroundStats::default()
+    };
+    (vec![None; cfg.robots.max(1) as usize], stats)
+}
+
+/// The opsUI over the configured protocol.
+fn ground_loop(
+    cfg: &SimConfig,
+    links: Vec<GroundLink>,
+    clock: clock::NodeClock<'_>,
+    log: Option<log::Log>,
+) -> (Vec<Option<PlanEnd>>, GroundStats) {
+    match cfg.protocol {
+        Protocol::Legacy => {
+            let runners = links
+                .iter()
+                .map(|(_, _, b)| LegacyGround {
+                    run: PlanRunner::new(cfg.ground, *b),
+                    last: None,
+                })
+                .collect();
+            run_ground(cfg, links, runners, clock, log)
+        }
+        Protocol::Pus => {
+            let runners = links
+                .iter()
+                .map(|(_, _, b)| PlanRunner::pus(cfg.pus, *b))
+                .collect();
+            run_ground(cfg, links, runners, clock, log)
+        }
+    }
+}
+
+/// The opsUI: one plan runner per robot, in one thread (one ground process).
+fn run_ground<G: Ground>(
+    cfg: &SimConfig,
+    mut links: Vec<GroundLink>,
+    runners: Vec<G>,
+    clock: clock::NodeClock<'_>,
+    log: Option<log::Log>,
+) -> (Vec<Option<PlanEnd>>, GroundStats) {
+    let mut ground = GroundSide::new(
+        &cfg.steps,
+        cfg.start_state,
+        &cfg.injections,
+        runners,
+        cfg.progress,
+        log,
+    );
+    let mut now;
+    loop {
+        now = clock.now_ms();
+        clock.ready(now);
+        if now > cfg.max_sim_ms || ground.all_ended() {
+            break;
+        }
+        for (i, (writer, rx, _)) in links.iter_mut().enumerate() {
+            if ground.ended(i) {
+                continue;
+            }
+            for p in ground.tick(i, now) {
+                writer.send(now, &p);
+            }
+            while let Ok(bytes) = rx.try_recv() {
+                let t = clock.now_ms();
+                for p in ground.receive(i, t, &bytes) {
+                    writer.send(t, &p);
+                }
+            }
+        }
+        ground.progress(now);
+        std::thread::sleep(Duration::from_micros(500));
+    }
+    let out = ground.finish(now);
+    let _ = std::io::stderr().flush();
+    out
+}
