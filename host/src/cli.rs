@@ -159,6 +159,11 @@ pub enum Cmd {
     /// real transports, driving a plan (the built-in demo without --plan).
     #[command(long_about = crate::simcli::SIM_HELP, after_help = crate::simcli::SIM_AFTER)]
     Sim(Box<crate::simcli::SimArgs>),
+    /// The fault swarm: random scenarios (plans, link faults, plant faults, the operator's Stop
+    /// and Reset) in virtual time, invariants checked on every tick; a failing seed prints the
+    /// command that replays it.
+    #[command(long_about = crate::swarm::cli::HELP, after_help = crate::swarm::cli::AFTER)]
+    Swarm(Box<crate::swarm::cli::SwarmArgs>),
     /// Scale benchmark: N simulated robots, each with its own server link, against one ground
     /// process; reports the largest N for which every heartbeat arrives within the timeout.
     #[command(after_help = "Example: mmic bench --max 64 --seconds 30")]
@@ -332,6 +337,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
             .map_err(CliError::Output)?;
         }
         Cmd::Sim(args) => crate::simcli::sim(*args, out)?,
+        Cmd::Swarm(args) => crate::swarm::cli::run(*args, out)?,
         Cmd::Bench { max, seconds } => crate::simcli::bench(max, seconds, out)?,
         Cmd::Spec { write: None } => {
             for (_, page) in pages::all() {

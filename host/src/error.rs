@@ -74,6 +74,12 @@ pub enum CliError {
         /// The latest tick, simulated ms.
         late_ms: u32,
     },
+    /// The fault swarm found a broken invariant (the replay command is in the message).
+    #[error("{0}")]
+    Invariant(String),
+    /// A fleet run missed its goal (an answer later than 0.7 s, or none).
+    #[error("{0}")]
+    Fleet(String),
     /// Options that do not go together.
     #[error("{0}")]
     Usage(String),
@@ -91,7 +97,7 @@ impl CliError {
             CliError::Spec(_) | CliError::Usage(_) => EXIT_INPUT,
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
             CliError::Plan { .. } | CliError::Inject(_) => EXIT_INPUT,
-            CliError::Incomplete(_) => 1,
+            CliError::Incomplete(_) | CliError::Invariant(_) | CliError::Fleet(_) => 1,
             CliError::HostBehind { .. } => EXIT_HOST,
             CliError::Write { .. }
             | CliError::Output(_)

@@ -157,6 +157,9 @@ pub struct SimConfig {
     pub log_events: bool,
     /// Virtual time: a bug planted in the engine's shells, for the fault swarm's own test.
     pub planted_bug: engine::PlantedBug,
+    /// Virtual time: run on to [`SimConfig::max_sim_ms`] after every plan ended (the robots
+    /// idle, still watched), instead of stopping there.
+    pub run_to_end: bool,
 }
 
 /// An external ground on UDP (`mmic sim --protocol pus --ground-tm-to ADDR --ground-tc-port
@@ -233,6 +236,7 @@ impl SimConfig {
             b_phase_us: 3_000,
             log_events: true,
             planted_bug: engine::PlantedBug::None,
+            run_to_end: false,
         }
     }
 }

@@ -424,13 +424,10 @@ fn run_ground<G: Ground>(
     loop {
         now = clock.now_ms();
         clock.ready(now);
-        if now > cfg.max_sim_ms || ground.all_ended() {
+        if now > cfg.max_sim_ms || ground.all_done() {
             break;
         }
         for (i, (writer, rx, _)) in links.iter_mut().enumerate() {
-            if ground.ended(i) {
-                continue;
-            }
             for p in ground.tick(i, now) {
                 writer.send(now, &p);
             }

@@ -367,6 +367,10 @@ pub struct GroundSide<G: Ground> {
     /// Per robot: the commands sent and not yet done, by number, with their first
     /// transmission's time.
     open: Vec<std::collections::BTreeMap<u16, u32>>,
+    /// Per robot: the numbers of the last commands done. A link may transmit a command again
+    /// after it is done (the PUS link asks about a started motion until its completion
+    /// report): such a transmission opens nothing.
+    recent: Vec<std::collections::VecDeque<u16>>,
     next_injection: Vec<usize>,
     stats: GroundStats,
     progress: Progress,
@@ -393,6 +397,7 @@ impl<G: Ground> GroundSide<G> {
             ends: vec![None; n],
             sent_at: vec![None; n],
             open: vec![Default::default(); n],
+            recent: vec![Default::default(); n],
             next_injection: vec![0; n],
             stats: GroundStats::default(),
             progress: Progress::new(progress, plan.to_vec(), start),
@@ -415,6 +420,13 @@ impl<G: Ground> GroundSide<G> {
         self.ends.iter().all(Option::is_some)
     }
 
+    /// Every robot's plan has ended and every command sent has ended too (a plan can end
+    /// with an out-of-band command still outstanding: its link goes on until that command is
+    /// answered or given up, and its outcome is logged like any other).
+    pub fn all_done(&self) -> bool {
+        self.all_ended() && self.open.iter().all(|m| m.is_empty())
+    }
+
     /// Robot `i`'s runner.
     pub fn runner(&self, i: usize) -> Option<&G> {
         self.runners.get(i)
@@ -427,10 +439,12 @@ impl<G: Ground> GroundSide<G> {
     }
 
     /// Robot `i` at `now`: the injections due, then the runner's tick. Returns the packets to
-    /// send to its server board.
+    /// send to its server board. A runner whose plan ended still runs its link (resends and
+    /// answers of a command outstanding when the plan ended; an injection is then refused by
+    /// the runner, and logged so).
     pub fn tick(&mut self, i: usize, now: u32) -> Vec<Vec<u8>> {
         self.stats.sim_ms = self.stats.sim_ms.max(now);
-        if self.ended(i) || i >= self.runners.len() {
+        if i >= self.runners.len() {
             return Vec::new();
         }
         while let Some(inj) = self
@@ -456,7 +470,7 @@ impl<G: Ground> GroundSide<G> {
 
     /// A packet from robot `i`'s server board at `now`; returns the packets to send.
     pub fn receive(&mut self, i: usize, now: u32, bytes: &[u8]) -> Vec<Vec<u8>> {
-        if self.ended(i) || i >= self.runners.len() {
+        if i >= self.runners.len() {
             return Vec::new();
         }
         let Some((t, answers)) = self.runners[i].receive(&self.steps, now, bytes) else {
@@ -472,7 +486,10 @@ impl<G: Ground> GroundSide<G> {
     fn handle(&mut self, i: usize, now: u32, t: PlanTick<G::Packet>) -> Option<Vec<u8>> {
         let send = t.send.map(|p| {
             self.sent_at[i] = Some(now);
-            self.open[i].entry(G::seq(&p)).or_insert(now);
+            let seq = G::seq(&p);
+            if !self.recent[i].contains(&seq) {
+                self.open[i].entry(seq).or_insert(now);
+            }
             G::bytes(&p)
         });
         if let Some(ok) = t.attempt {
@@ -486,6 +503,11 @@ impl<G: Ground> GroundSide<G> {
         }
         if let Some(d) = t.done {
             self.open[i].remove(&d.seq);
+            let recent = &mut self.recent[i];
+            if recent.len() >= 16 {
+                recent.pop_front();
+            }
+            recent.push_back(d.seq);
             self.event(
                 now,
                 json!({
@@ -504,7 +526,7 @@ impl<G: Ground> GroundSide<G> {
                 );
             }
         }
-        if let Some(e) = t.end {
+        if let (Some(e), None) = (t.end, self.ends[i]) {
             self.ends[i] = Some(e);
             self.event(
                 now,

@@ -361,8 +361,8 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
         let now = self.now_ms();
         if let Some(w) = &mut self.watch {
-            for (i, r) in self.robots.iter().enumerate() {
-                w.finish(i, now, &r.a.board, &self.ground.open_commands(i));
+            for i in 0..self.robots.len() {
+                w.finish(i, now, &self.ground.open_commands(i));
             }
         }
         let (ends, stats) = self.ground.finish(now);
@@ -480,19 +480,17 @@ impl<'c, G: Ground> Engine<'c, G> {
 
     fn ground_tick(&mut self) -> bool {
         let now = self.now_ms();
-        if now > self.cfg.max_sim_ms || self.ground.all_ended() {
+        let over = self.ground.all_done() && !self.cfg.run_to_end;
+        if now > self.cfg.max_sim_ms || over {
             return false;
         }
         for i in 0..self.robots.len() {
-            if self.ground.ended(i) {
-                continue;
-            }
             for p in self.ground.tick(i, now) {
                 self.ground_sends(i, &p);
             }
         }
         self.ground.progress(now);
-        if self.ground.all_ended() {
+        if self.ground.all_done() && !self.cfg.run_to_end {
             return false;
         }
         self.at(self.now + GROUND_TICK_MS as u64 * 1000, Ev::GroundTick);
@@ -567,7 +565,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         let from_b = r.a_from_b.pop_front();
         let out = r.a.tick(&mut r.plant, now, command, from_b);
         if let Some(w) = &mut self.watch {
-            w.tick_a(i, now, command.as_ref(), &r.a.board, &r.plant, &out);
+            w.tick_a(i, now, &watch::TickA::of(command, &r.a.board, &r.plant, &out));
         }
         let name = r.names[0].clone();
         if self.cfg.log_events {
@@ -600,7 +598,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         let command = r.b_from_a.pop_front();
         let out = r.b.tick(&mut r.plant, now, command);
         if let Some(w) = &mut self.watch {
-            w.tick_b(i, now, &r.plant);
+            w.tick_b(i, now, &watch::SideMotion::of(&r.plant, 1));
         }
         if out.link_lost != r.b_lost {
             r.b_lost = out.link_lost;

@@ -20,7 +20,8 @@
 //!   Safed or Standby in the same tick as `mmic::safety::policy::fault_action` (Table 8) says;
 //!   a deferred one (low battery, assembly system) keeps Operational while the motion runs and
 //!   gives Standby in the tick the motion ends. A fault raised in Safed or Standby never
-//!   raises power.
+//!   raises power (unless a mode command taken in the same tick does: Standby to Operational
+//!   stops at Safed when the hip check on the way in fails, as Table 8 says).
 //! * **Every command ends**: at the end of the run, every command the ground sent is done
 //!   (accepted, refused or reported unacknowledged), except one sent less than its longest
 //!   life (attempts × period + answer window) before the end.
@@ -120,6 +121,117 @@ pub struct Checked {
     pub commands_ended: u64,
 }
 
+/// What board A drives (its outputs that power something).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Driven {
+    /// The 7.4 V regulator.
+    pub regulator: bool,
+    /// A hip pulse.
+    pub hip: bool,
+    /// An arm pulse.
+    pub arm: bool,
+    /// A gripper pulse.
+    pub gripper: bool,
+    /// The bolter motor, other than idle.
+    pub bolter: bool,
+}
+
+impl Driven {
+    /// Board A's outputs, as what they drive.
+    pub fn of(out: &board_a::Outputs) -> Driven {
+        Driven {
+            regulator: out.regulator,
+            hip: out.hip.is_some(),
+            arm: out.arm.is_some(),
+            gripper: out.gripper.is_some(),
+            bolter: out.bolter != Drive::Idle,
+        }
+    }
+
+    /// Anything at all.
+    pub fn any(&self) -> bool {
+        self.regulator || self.hip || self.arm || self.gripper || self.bolter
+    }
+}
+
+/// What moves on one side of the plant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SideMotion {
+    /// The arm servo moved in the last step of the physics.
+    pub arm: bool,
+    /// The gripper servo moved.
+    pub gripper: bool,
+    /// What the bolter motor does.
+    pub bolter: Drive,
+}
+
+impl SideMotion {
+    /// Side `side` of `plant`.
+    pub fn of(plant: &Plant, side: usize) -> SideMotion {
+        let (arm, gripper) = plant.moving(side);
+        SideMotion {
+            arm,
+            gripper,
+            bolter: plant.bolter_drive(side),
+        }
+    }
+}
+
+/// One board A tick as the watch needs it.
+#[derive(Debug, Clone)]
+pub struct TickA {
+    /// The command packet the control task took from the hand-off queue.
+    pub command: Option<[u8; COMMAND_LEN]>,
+    /// Board A admitted it (an `executed` event: run, or refused after judging).
+    pub admitted: bool,
+    /// The command board A admitted and accepted (ran) this tick, if any.
+    pub accepted: Option<mmic::command::Command>,
+    /// Board A's mode, faults and motion after the tick.
+    pub mode: Mode,
+    /// Its latched faults.
+    pub faults: Faults,
+    /// In motion.
+    pub in_motion: bool,
+    /// What board A drives.
+    pub driven: Driven,
+    /// The plant's gripper pulses, sides A and B, µs.
+    pub grippers: [f64; 2],
+    /// What moves on side A.
+    pub side: SideMotion,
+}
+
+impl TickA {
+    /// The tick that took `command` and gave `out`, with board A and the plant as it left them.
+    pub fn of(
+        command: Option<[u8; COMMAND_LEN]>,
+        a: &BoardA,
+        plant: &Plant,
+        out: &board_a::Outputs,
+    ) -> TickA {
+        TickA {
+            command,
+            admitted: out
+                .events
+                .iter()
+                .any(|e| matches!(e, Event::Executed { .. })),
+            accepted: out.events.iter().find_map(|e| match e {
+                Event::Executed {
+                    command,
+                    refusal: None,
+                    ..
+                } => *command,
+                _ => None,
+            }),
+            mode: a.mode(),
+            faults: a.faults(),
+            in_motion: a.in_motion(),
+            driven: Driven::of(out),
+            grippers: [plant.servos(0).1, plant.servos(1).1],
+            side: SideMotion::of(plant, 0),
+        }
+    }
+}
+
 #[derive(Debug, Default)]
 struct RobotWatch {
     origins: HashMap<[u8; COMMAND_LEN], u64>,
@@ -146,6 +258,8 @@ pub struct Watch {
     pub checked: Checked,
     /// Per robot: the faults board A raised, with the time, in order.
     pub raised: Vec<Vec<(u32, Fault)>>,
+    /// Per robot: board A's latched faults from each time on (a row per change), in order.
+    pub faults: Vec<Vec<(u32, Faults)>>,
     /// Per robot: packets lost or cut on the A–B line (either way), with the time, ms.
     pub ab_dropped: Vec<Vec<u32>>,
 }
@@ -172,6 +286,7 @@ impl Watch {
             violations: Vec::new(),
             checked: Checked::default(),
             raised: vec![Vec::new(); n],
+            faults: vec![Vec::new(); n],
             ab_dropped: vec![Vec::new(); n],
         }
     }
@@ -226,80 +341,65 @@ impl Watch {
         }
     }
 
-    /// Board A's control tick at `now` took `command` and gave `out`; `a` and `plant` are as
-    /// the tick left them.
-    pub fn tick_a(
-        &mut self,
-        i: usize,
-        now: u32,
-        command: Option<&[u8; COMMAND_LEN]>,
-        a: &BoardA,
-        plant: &Plant,
-        out: &board_a::Outputs,
-    ) {
-        self.admissions(i, now, command, out);
-        self.fault_modes(i, now, a);
-        if a.in_motion() {
+    /// Board A's control tick at `now`, as the engine saw it ([`TickA`]).
+    pub fn tick_a(&mut self, i: usize, now: u32, t: &TickA) {
+        self.admissions(i, now, t.command.as_ref(), t.admitted);
+        // A mode command taken this tick may raise power itself (Standby to Operational, held
+        // at Safed by a fault found on the way in: Table 8's hip mismatch is checked on
+        // entering Operational); a fault alone never does.
+        let commanded = matches!(t.accepted, Some(mmic::command::Command::Mode(_)));
+        self.fault_modes(i, now, t.faults, t.mode, t.in_motion, commanded);
+        if t.in_motion {
             self.checked.motion_ticks += 1;
-            let closed = |side: usize| {
-                (plant.servos(side).1 - self.gripper_closed_us).abs() <= GRIP_TOLERANCE_US
-            };
-            if !closed(0) && !closed(1) {
-                let (ga, gb) = (plant.servos(0).1, plant.servos(1).1);
+            let closed = |g: f64| (g - self.gripper_closed_us).abs() <= GRIP_TOLERANCE_US;
+            let [ga, gb] = t.grippers;
+            if !closed(ga) && !closed(gb) {
                 self.violation(
                     now,
                     i,
                     Invariant::GripperOpenInMotion,
-                    format!("both grippers open in motion: A at {ga:.0} us, B at {gb:.0} us (closed: {:.0})", self.gripper_closed_us),
+                    format!(
+                        "both grippers open in motion: A at {ga:.0} us, B at {gb:.0} us (closed: {:.0} us)",
+                        self.gripper_closed_us
+                    ),
                 );
             }
         }
-        let r = &mut self.robots[i];
-        if a.mode() == Mode::Standby {
-            let since = *r.standby_since.get_or_insert(now);
+        if t.mode == Mode::Standby {
+            let since = *self.robots[i].standby_since.get_or_insert(now);
             self.checked.standby_ticks += 1;
-            let driven = out.regulator
-                || out.hip.is_some()
-                || out.arm.is_some()
-                || out.gripper.is_some()
-                || out.bolter != Drive::Idle;
-            if driven {
+            if t.driven.any() {
                 self.violation(
                     now,
                     i,
                     Invariant::MovedInStandby,
-                    format!(
-                        "board A drives in Standby: regulator {}, hip {:?}, arm {:?}, gripper {:?}, bolter {:?}",
-                        out.regulator, out.hip, out.arm, out.gripper, out.bolter
-                    ),
+                    format!("board A drives in Standby: {:?}", t.driven),
                 );
             }
-            self.plant_still(i, now, since, plant, 0);
+            self.still(i, now, since, &t.side, 0);
         } else {
-            r.standby_since = None;
+            self.robots[i].standby_since = None;
         }
     }
 
-    /// Board B's tick at `now`, `plant` as it left it.
-    pub fn tick_b(&mut self, i: usize, now: u32, plant: &Plant) {
+    /// Board B's tick at `now`: side B of the plant as it left it.
+    pub fn tick_b(&mut self, i: usize, now: u32, side: &SideMotion) {
         if let Some(since) = self.robots[i].standby_since {
-            self.plant_still(i, now, since, plant, 1);
+            self.still(i, now, since, side, 1);
         }
     }
 
-    fn plant_still(&mut self, i: usize, now: u32, since: u32, plant: &Plant, side: usize) {
+    fn still(&mut self, i: usize, now: u32, since: u32, m: &SideMotion, side: usize) {
         if now < since.saturating_add(STANDBY_GRACE_MS) {
             return;
         }
-        let (arm, gripper) = plant.moving(side);
-        let bolter = plant.bolter_drive(side);
-        if arm || gripper || bolter != Drive::Idle {
+        if m.arm || m.gripper || m.bolter != Drive::Idle {
             self.violation(
                 now,
                 i,
                 Invariant::MovedInStandby,
                 format!(
-                    "side {} moves {} ms into Standby: arm moving {arm}, gripper moving {gripper}, bolter {bolter:?}",
+                    "side {} moves {} ms into Standby: {m:?}",
                     if side == 0 { "A" } else { "B" },
                     now - since
                 ),
@@ -312,16 +412,11 @@ impl Watch {
         i: usize,
         now: u32,
         command: Option<&[u8; COMMAND_LEN]>,
-        out: &board_a::Outputs,
+        admitted: bool,
     ) {
-        let Some(p) = command else { return };
-        let admitted = out
-            .events
-            .iter()
-            .any(|e| matches!(e, Event::Executed { .. }));
-        if !admitted {
+        let (Some(p), true) = (command, admitted) else {
             return;
-        }
+        };
         self.checked.admissions += 1;
         let r = &mut self.robots[i];
         let Some(origin) = r.origins.get(p).copied() else {
@@ -329,17 +424,14 @@ impl Watch {
                 now,
                 i,
                 Invariant::ExecutedTwice,
-                format!(
-                    "board A admitted a command no sender wrote: {}",
-                    crate::sim::log::hex(p)
-                ),
+                format!("board A admitted a command no sender wrote: {}", crate::sim::log::hex(p)),
             );
             return;
         };
         if let Some(first) = r.admitted.insert(origin, now) {
             r.admitted.insert(origin, first);
             let what = mmic::wire::command::CommandRepr::parse(p)
-                .map(|c| format!("{:?} (seq {})", c.command, c.seq))
+                .map(|c| format!("{:?} (this copy numbered {})", c.command, c.seq))
                 .unwrap_or_else(|e| e.to_string());
             self.violation(
                 now,
@@ -350,9 +442,16 @@ impl Watch {
         }
     }
 
-    fn fault_modes(&mut self, i: usize, now: u32, a: &BoardA) {
+    fn fault_modes(
+        &mut self,
+        i: usize,
+        now: u32,
+        faults: Faults,
+        mode: Mode,
+        in_motion: bool,
+        commanded: bool,
+    ) {
         let r = &mut self.robots[i];
-        let (faults, mode) = (a.faults(), a.mode());
         let before = r.last_mode.unwrap_or(mode);
         let new: Vec<Fault> = faults
             .iter()
@@ -361,6 +460,9 @@ impl Watch {
         r.last_faults = faults;
         r.last_mode = Some(mode);
         let deferred_since = r.deferred_since;
+        if self.faults[i].last().map(|(_, f)| *f) != Some(faults) {
+            self.faults[i].push((now, faults));
+        }
         for f in &new {
             self.raised[i].push((now, *f));
         }
@@ -378,7 +480,7 @@ impl Watch {
                     Some(Mode::Safed)
                 } else if standby {
                     Some(Mode::Standby)
-                } else if a.in_motion() {
+                } else if in_motion {
                     self.robots[i].deferred_since.get_or_insert(now);
                     Some(Mode::Operational)
                 } else {
@@ -393,7 +495,7 @@ impl Watch {
                     );
                 }
             }
-            Mode::Safed | Mode::Standby if !new.is_empty() => {
+            Mode::Safed | Mode::Standby if !new.is_empty() && !commanded => {
                 let raised = matches!(
                     (before, mode),
                     (Mode::Standby, Mode::Safed | Mode::Operational)
@@ -414,7 +516,7 @@ impl Watch {
         if let Some(since) = deferred_since {
             if mode != Mode::Operational {
                 self.robots[i].deferred_since = None;
-            } else if !a.in_motion() {
+            } else if !in_motion {
                 self.robots[i].deferred_since = None;
                 self.violation(
                     now,
@@ -427,7 +529,7 @@ impl Watch {
     }
 
     /// The run ended at `now`: robot `i`'s commands still open (number, first sent, ms).
-    pub fn finish(&mut self, i: usize, now: u32, _a: &BoardA, open: &[(u16, u32)]) {
+    pub fn finish(&mut self, i: usize, now: u32, open: &[(u16, u32)]) {
         for &(seq, sent) in open {
             if now.saturating_sub(sent) > self.command_life_ms {
                 self.violation(
@@ -447,5 +549,241 @@ impl Watch {
     /// Commands that ended (counted by the swarm from the ground's `done` events).
     pub fn ended(&mut self, n: u64) {
         self.checked.commands_ended += n;
+    }
+
+    /// Whether robot `i`'s board A had `fault` latched at some tick in `[from, to]` (ms).
+    pub fn had(&self, i: usize, fault: Fault, from: u32, to: u32) -> bool {
+        let h = &self.faults[i];
+        // The set in force at `from`, and every change up to `to`.
+        let before = h.iter().rev().find(|(t, _)| *t <= from);
+        before
+            .into_iter()
+            .chain(h.iter().filter(|(t, _)| *t > from && *t <= to))
+            .any(|(_, f)| f.contains(fault))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mmic::command::Command;
+    use mmic::units::BoardNumber;
+    use mmic::wire::command::CommandRepr;
+
+    const CLOSED: f64 = 2000.0;
+    const OPEN: f64 = 1000.0;
+
+    fn watch() -> Watch {
+        Watch::new(&SimConfig::demo(), 1)
+    }
+
+    fn still() -> SideMotion {
+        SideMotion {
+            arm: false,
+            gripper: false,
+            bolter: Drive::Idle,
+        }
+    }
+
+    fn tick(mode: Mode) -> TickA {
+        TickA {
+            command: None,
+            admitted: false,
+            accepted: None,
+            mode,
+            faults: Faults::EMPTY,
+            in_motion: false,
+            driven: Driven::default(),
+            grippers: [CLOSED, CLOSED],
+            side: still(),
+        }
+    }
+
+    fn kinds(w: &Watch) -> Vec<Invariant> {
+        w.violations.iter().map(|v| v.invariant).collect()
+    }
+
+    fn packet(seq: u16) -> [u8; COMMAND_LEN] {
+        CommandRepr {
+            board: BoardNumber::ONE,
+            command: Command::Stop,
+            seq,
+        }
+        .to_bytes()
+    }
+
+    #[test]
+    fn a_packet_admitted_twice_is_caught_whatever_its_number() {
+        let mut w = watch();
+        let (p, copy) = (packet(7), packet(0));
+        w.commanded(0, &p, 0);
+        let mut t = tick(Mode::Operational);
+        t.command = Some(p);
+        t.admitted = true;
+        w.tick_a(0, 10, &t);
+        // A copy answered from the log (not admitted) is no execution.
+        t.admitted = false;
+        w.tick_a(0, 20, &t);
+        assert!(w.violations.is_empty());
+        // The same command again under another number (a shell that stripped it).
+        w.same_origin(0, &p, &copy);
+        t.command = Some(copy);
+        t.admitted = true;
+        w.tick_a(0, 30, &t);
+        assert_eq!(kinds(&w), [Invariant::ExecutedTwice]);
+        assert!(w.violations[0].detail.contains("at 10 ms and again at 30 ms"));
+        assert_eq!(w.checked.admissions, 2);
+        // A packet nobody wrote.
+        let mut w = watch();
+        t.command = Some(packet(9));
+        w.tick_a(0, 10, &t);
+        assert_eq!(kinds(&w), [Invariant::ExecutedTwice]);
+    }
+
+    #[test]
+    fn both_grippers_open_in_motion_is_caught_one_is_not() {
+        let mut w = watch();
+        let mut t = tick(Mode::Operational);
+        t.in_motion = true;
+        t.grippers = [OPEN, CLOSED - GRIP_TOLERANCE_US];
+        w.tick_a(0, 10, &t);
+        t.grippers = [CLOSED + 5.0, OPEN];
+        w.tick_a(0, 20, &t);
+        assert!(w.violations.is_empty());
+        t.grippers = [OPEN, CLOSED - GRIP_TOLERANCE_US - 1.0];
+        w.tick_a(0, 30, &t);
+        assert_eq!(kinds(&w), [Invariant::GripperOpenInMotion]);
+        // Outside a motion, the grippers are the operator's.
+        let mut w = watch();
+        t.in_motion = false;
+        w.tick_a(0, 10, &t);
+        assert!(w.violations.is_empty());
+    }
+
+    #[test]
+    fn standby_drives_nothing_and_nothing_moves_after_the_grace() {
+        let mut w = watch();
+        let mut t = tick(Mode::Standby);
+        t.side.arm = true; // still settling: within the grace
+        w.tick_a(0, 1_000, &t);
+        w.tick_b(0, 1_000 + STANDBY_GRACE_MS - 1, &t.side);
+        assert!(w.violations.is_empty());
+        w.tick_b(0, 1_000 + STANDBY_GRACE_MS, &t.side);
+        assert_eq!(kinds(&w), [Invariant::MovedInStandby]);
+        // Board A driving anything in Standby, at once.
+        let mut w = watch();
+        let mut t = tick(Mode::Standby);
+        t.driven.regulator = true;
+        w.tick_a(0, 10, &t);
+        assert_eq!(kinds(&w), [Invariant::MovedInStandby]);
+        // The same outputs in Operational are fine.
+        let mut w = watch();
+        t.mode = Mode::Operational;
+        t.side.bolter = Drive::Rotate;
+        w.tick_a(0, 10, &t);
+        assert!(w.violations.is_empty());
+    }
+
+    #[test]
+    fn a_fault_must_reach_its_table8_mode_in_its_tick() {
+        // Safed fault in Operational: Safed at once.
+        let mut w = watch();
+        let mut t = tick(Mode::Operational);
+        w.tick_a(0, 10, &t);
+        t.faults = Faults::EMPTY.with(Fault::InternalCommLoss);
+        w.tick_a(0, 20, &t);
+        assert_eq!(kinds(&w), [Invariant::FaultMode]);
+        let mut w = watch();
+        w.tick_a(0, 10, &tick(Mode::Operational));
+        t.mode = Mode::Safed;
+        w.tick_a(0, 20, &t);
+        assert!(w.violations.is_empty());
+        assert_eq!(w.raised[0], [(20, Fault::InternalCommLoss)]);
+        // Safed and Standby faults together: Safed.
+        let mut w = watch();
+        w.tick_a(0, 10, &tick(Mode::Operational));
+        t.faults = t.faults.with(Fault::BoltingFailure);
+        t.mode = Mode::Standby;
+        w.tick_a(0, 20, &t);
+        assert_eq!(kinds(&w), [Invariant::FaultMode]);
+    }
+
+    #[test]
+    fn a_deferred_fault_waits_for_the_motion_then_gives_standby() {
+        let mut moving = tick(Mode::Operational);
+        moving.in_motion = true;
+        let mut low = moving.clone();
+        low.faults = Faults::EMPTY.with(Fault::LowBattery);
+        // Raised in motion: Operational until the motion ends, Standby then.
+        let mut w = watch();
+        w.tick_a(0, 10, &moving);
+        w.tick_a(0, 20, &low);
+        w.tick_a(0, 30, &low);
+        let mut end = low.clone();
+        end.in_motion = false;
+        end.mode = Mode::Standby;
+        w.tick_a(0, 40, &end);
+        assert!(w.violations.is_empty(), "{:?}", w.violations);
+        // The motion ends and the robot stays Operational: caught.
+        let mut w = watch();
+        w.tick_a(0, 10, &moving);
+        w.tick_a(0, 20, &low);
+        end.mode = Mode::Operational;
+        w.tick_a(0, 30, &end);
+        assert_eq!(kinds(&w), [Invariant::FaultMode]);
+        // Going to Standby at once, mid-motion: caught too.
+        let mut w = watch();
+        w.tick_a(0, 10, &moving);
+        low.mode = Mode::Standby;
+        w.tick_a(0, 20, &low);
+        assert_eq!(kinds(&w), [Invariant::FaultMode]);
+    }
+
+    #[test]
+    fn a_fault_in_safed_or_standby_never_raises_power_a_mode_command_may() {
+        let mut w = watch();
+        w.tick_a(0, 10, &tick(Mode::Safed));
+        let mut t = tick(Mode::Operational);
+        t.faults = Faults::EMPTY.with(Fault::LowBattery);
+        w.tick_a(0, 20, &t);
+        assert_eq!(kinds(&w), [Invariant::FaultMode]);
+        // Standby, the operator asks for Operational, the hip check fails on the way in: Safed.
+        let mut w = watch();
+        w.tick_a(0, 10, &tick(Mode::Standby));
+        let mut t = tick(Mode::Safed);
+        t.faults = Faults::EMPTY.with(Fault::HipMismatch);
+        w.tick_a(0, 20, &t);
+        assert_eq!(kinds(&w), [Invariant::FaultMode], "no command: the fault raised power");
+        let mut w = watch();
+        w.tick_a(0, 10, &tick(Mode::Standby));
+        t.accepted = Some(mmic::command::Command::Mode(Mode::Operational));
+        w.tick_a(0, 20, &t);
+        assert!(w.violations.is_empty(), "{:?}", w.violations);
+    }
+
+    #[test]
+    fn a_command_older_than_its_longest_life_is_lost() {
+        let mut w = watch();
+        let life = w.command_life_ms;
+        w.finish(0, 100_000, &[(3, 100_000 - life)]);
+        assert!(w.violations.is_empty());
+        w.finish(0, 100_000, &[(3, 100_000 - life - 1)]);
+        assert_eq!(kinds(&w), [Invariant::CommandLost]);
+    }
+
+    #[test]
+    fn the_fault_history_answers_what_was_latched_when() {
+        let mut w = watch();
+        let mut t = tick(Mode::Safed);
+        w.tick_a(0, 10, &t);
+        t.faults = Faults::EMPTY.with(Fault::SensorLoss);
+        w.tick_a(0, 500, &t);
+        t.faults = Faults::EMPTY;
+        w.tick_a(0, 900, &t);
+        assert!(w.had(0, Fault::SensorLoss, 400, 600));
+        assert!(w.had(0, Fault::SensorLoss, 600, 700), "latched since 500");
+        assert!(!w.had(0, Fault::SensorLoss, 900, 2_000), "cleared at 900");
+        assert!(!w.had(0, Fault::SensorLoss, 0, 499));
+        assert!(!w.had(0, Fault::LowBattery, 0, 2_000));
     }
 }

@@ -1,0 +1,401 @@
+//! `mmic swarm`: the fault swarm. Seed after seed, a random scenario ([`scenario`]: a plan, the
+//! links' loss, duplication, reordering, jitter and cuts, a fault schedule of battery sags,
+//! obstacles, jammed fasteners, stuck switches, encoder offsets, silent sensors, a cut A–B line,
+//! the operator's Stop and Reset, resent commands) runs in virtual time
+//! ([`crate::sim::engine`]) with the invariants watched on every tick
+//! ([`crate::sim::engine::watch`]), and each injected fault the firmware must see is checked
+//! to have been raised in time ([`expectations`]). A failing seed prints the one command that
+//! replays it; the replay runs the same scenario, byte for byte, and writes its whole log.
+//!
+//! ```
+//! use mmic_host::swarm::{run_one, scenario::Options};
+//! let opts = Options { horizon_ms: 20_000, ..Options::default() };
+//! let r = run_one(3, &opts);
+//! assert!(r.violations.is_empty(), "{:?}", r.violations);
+//! assert_eq!(r.sim_ms, 20_000);
+//! ```
+
+pub mod cli;
+pub mod scenario;
+
+use crate::sim::engine::watch::{Checked, Invariant, Violation, Watch};
+use crate::sim::engine::{self, PlantedBug};
+use crate::sim::inject::{Device, Injection};
+use crate::sim::Summary;
+use mmic::faults::{Fault, Table8};
+use scenario::{Options, Scenario};
+use serde_json::Value;
+use std::time::{Duration, Instant};
+
+/// A fault the firmware must have latched within a window.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Expect {
+    /// Why (the injection, or the command that raises it).
+    pub why: String,
+    /// Any of these faults.
+    pub faults: Vec<Fault>,
+    /// From, ms.
+    pub from: u32,
+    /// To, ms (inclusive).
+    pub to: u32,
+}
+
+/// The injections of `s` that the firmware must see, whatever the robot is doing, and the
+/// window it has: a sagging battery (low battery within 1.5 s: the 0.5 s average, then the
+/// 0.5 s debounce), an obstacle on arm, gripper or bolter A (its overcurrent within 1 s: the
+/// 50-sample average crosses the absolute limit before the 0.5 s pulse ends), a cut A–B line
+/// (internal comm loss within 1 s: the 500 ms silence), a silent ADC or encoder on side A
+/// (sensor loss within 1 s: one averaging window), a silent ADC on side B (board B falls
+/// silent after a window, then internal comm loss: 1.5 s). Side A's currents and battery are
+/// judged only while its ADC answers, so an obstacle or a sag is expected only if side A's ADC
+/// was not silenced before the window ends. The other injections act only if the robot does
+/// something that meets them (a bolting after a jam, an arm contraction after a dead switch,
+/// entering Operational after an encoder offset, the next reconfiguration after a misstated
+/// one): for them the swarm checks only that, once raised, the fault reaches its mode.
+///
+/// Two ground commands raise a fault when board A accepts them: the System fault command
+/// (assembly system) and a reconfiguration refused for its initial state (initial state
+/// mismatch); each accepted (refused) one is expected to have latched its fault by the time
+/// the ground heard of it.
+pub fn expectations(s: &Scenario, summary: &Summary) -> Vec<Expect> {
+    let cfg = &s.cfg;
+    let adc_a_alive_until = |to: u32| cfg.plant.adc_silent_at[0].is_none_or(|t| t > to);
+    let mut out = Vec::new();
+    for inj in &cfg.injections {
+        let t = inj.at_ms;
+        let (faults, window, needs_adc_a): (Vec<Fault>, u32, bool) = match inj.injection {
+            Injection::Fault(Table8::LowBattery) => (vec![Fault::LowBattery], 1_500, true),
+            Injection::Fault(Table8::LocomotionOvercurrent) => (
+                vec![Fault::LocomotionOvercurrent, Fault::LocomotionOvercurrentIdle],
+                1_000,
+                true,
+            ),
+            Injection::Fault(Table8::GripperOvercurrent) => (
+                vec![Fault::GripperOvercurrent, Fault::GripperOvercurrentIdle],
+                1_000,
+                true,
+            ),
+            Injection::Fault(Table8::BolterOvercurrent) => (
+                vec![Fault::BolterOvercurrent, Fault::BolterOvercurrentIdle],
+                1_000,
+                true,
+            ),
+            Injection::Fault(Table8::InternalCommLoss) => {
+                (vec![Fault::InternalCommLoss], 1_000, false)
+            }
+            Injection::Silent(Device::AdcA) | Injection::Silent(Device::Encoder) => {
+                (vec![Fault::SensorLoss], 1_000, false)
+            }
+            Injection::Silent(Device::AdcB) => (vec![Fault::InternalCommLoss], 1_500, false),
+            _ => continue,
+        };
+        let to = t.saturating_add(window);
+        if to > cfg.max_sim_ms || (needs_adc_a && !adc_a_alive_until(to)) {
+            continue;
+        }
+        out.push(Expect {
+            why: format!("{}@{:.3}", inj.injection.name(), t as f64 / 1000.0),
+            faults,
+            from: t,
+            to,
+        });
+    }
+    for r in &summary.records {
+        let e = &r["event"];
+        if r["kind"] != "event" || e["type"] != "done" {
+            continue;
+        }
+        let t = r["t_ms"].as_u64().unwrap_or(0) as u32;
+        let fault = if e["command"] == "system_fault" && e["outcome"] == "accepted" {
+            Some(Fault::AssemblySystem)
+        } else if e["command"].get("reconfigure").is_some()
+            && e["outcome"]["refused"] == "initial_state_mismatch"
+        {
+            Some(Fault::InitialStateMismatch)
+        } else {
+            None
+        };
+        if let Some(f) = fault {
+            out.push(Expect {
+                why: format!("{} {} at {t} ms", e["command"], e["outcome"]),
+                faults: vec![f],
+                from: t.saturating_sub(2_000),
+                to: t,
+            });
+        }
+    }
+    out
+}
+
+/// What one seed's run gave.
+#[derive(Debug, Clone)]
+pub struct RunOutcome {
+    /// The seed.
+    pub seed: u64,
+    /// The scenario, in one line.
+    pub scenario: String,
+    /// Simulated ms covered.
+    pub sim_ms: u32,
+    /// Every broken invariant.
+    pub violations: Vec<Violation>,
+    /// The opportunities each invariant had.
+    pub checked: Checked,
+    /// Injected faults checked to have been raised.
+    pub expected: u64,
+    /// Whether the plan completed.
+    pub completed: bool,
+    /// The run's summary (none if it panicked).
+    pub summary: Option<Summary>,
+}
+
+/// Runs the scenario of `seed` and judges it.
+pub fn run_one(seed: u64, opts: &Options) -> RunOutcome {
+    let s = Scenario::from_seed(seed, opts);
+    judge(&s)
+}
+
+/// Runs scenario `s` (its own configuration: log and all) and judges it.
+pub fn judge(s: &Scenario) -> RunOutcome {
+    let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        engine::run_watched(&s.cfg, true)
+    }));
+    let mut out = RunOutcome {
+        seed: s.seed,
+        scenario: s.describe(),
+        sim_ms: 0,
+        violations: Vec::new(),
+        checked: Checked::default(),
+        expected: 0,
+        completed: false,
+        summary: None,
+    };
+    let (summary, watch) = match run {
+        Ok(Ok((summary, Some(watch)))) => (summary, watch),
+        Ok(Ok((_, None))) | Ok(Err(_)) => {
+            out.violations.push(Violation {
+                t_ms: 0,
+                robot: 0,
+                invariant: Invariant::Panic,
+                detail: "the run did not start (configuration refused)".to_string(),
+            });
+            return out;
+        }
+        Err(p) => {
+            let what = p
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            out.violations.push(Violation {
+                t_ms: 0,
+                robot: 0,
+                invariant: Invariant::Panic,
+                detail: format!("panicked: {what}"),
+            });
+            return out;
+        }
+    };
+    let mut watch: Watch = watch;
+    let ended = summary
+        .records
+        .iter()
+        .filter(|r| r["kind"] == "event" && r["event"]["type"] == "done")
+        .count();
+    watch.ended(ended as u64);
+    let expects = expectations(s, &summary);
+    out.expected = expects.len() as u64;
+    for e in &expects {
+        if !e.faults.iter().any(|f| watch.had(0, *f, e.from, e.to)) {
+            let raised: Vec<String> = watch.raised[0]
+                .iter()
+                .map(|(t, f)| format!("{}@{t}", f.name()))
+                .collect();
+            watch.violations.push(Violation {
+                t_ms: e.to,
+                robot: 0,
+                invariant: Invariant::InjectedFaultMissed,
+                detail: format!(
+                    "{}: none of {:?} latched in {}..={} ms (raised: {})",
+                    e.why,
+                    e.faults.iter().map(|f| f.name()).collect::<Vec<_>>(),
+                    e.from,
+                    e.to,
+                    raised.join(", ")
+                ),
+            });
+        }
+    }
+    out.sim_ms = summary.sim_ms;
+    out.completed = summary.completed();
+    out.violations = watch.violations;
+    out.checked = watch.checked;
+    out.summary = Some(summary);
+    out
+}
+
+/// The command that replays seed `seed` with these options.
+pub fn replay_command(seed: u64, opts: &Options) -> String {
+    let mut c = format!("mmic swarm --replay {seed}");
+    if opts.horizon_ms != Options::default().horizon_ms {
+        c.push_str(&format!(" --sim-seconds {}", opts.horizon_ms / 1000));
+    }
+    if opts.planted_bug == PlantedBug::DoubleExec {
+        c.push_str(" --plant-bug double-exec");
+    }
+    c
+}
+
+/// How a swarm went.
+#[derive(Debug, Clone, Default)]
+pub struct Report {
+    /// Runs made.
+    pub runs: u64,
+    /// Simulated ms covered, all runs.
+    pub sim_ms: u64,
+    /// Wall time.
+    pub wall: Duration,
+    /// The failing runs (their first violations).
+    pub failures: Vec<RunOutcome>,
+    /// The opportunities each invariant had, all runs.
+    pub checked: Checked,
+    /// Injected faults checked to have been raised, all runs.
+    pub expected: u64,
+    /// Runs whose plan completed.
+    pub completed: u64,
+}
+
+impl Report {
+    /// Runs per wall second.
+    pub fn runs_per_second(&self) -> f64 {
+        self.runs as f64 / self.wall.as_secs_f64().max(1e-9)
+    }
+
+    /// Simulated hours covered.
+    pub fn sim_hours(&self) -> f64 {
+        self.sim_ms as f64 / 3_600_000.0
+    }
+
+    /// The summary as text (the failures each with their replay command).
+    pub fn text(&self, opts: &Options) -> String {
+        let c = &self.checked;
+        let mut t = format!(
+            "swarm: {} runs in {:.1} s wall ({:.1} runs/s), {:.2} simulated hours ({:.0}x real time); \
+             {} plans completed, {} cut short by their faults\n\
+             checked: {} admissions traced to their sender's packet, {} board A ticks in motion \
+             (grippers), {} ticks in Standby (drives, motion), {} faults raised (their mode), \
+             {} commands ended, {} injected faults expected in time, every run for panics\n",
+            self.runs,
+            self.wall.as_secs_f64(),
+            self.runs_per_second(),
+            self.sim_hours(),
+            self.sim_ms as f64 / 1000.0 / self.wall.as_secs_f64().max(1e-9),
+            self.completed,
+            self.runs - self.completed,
+            c.admissions,
+            c.motion_ticks,
+            c.standby_ticks,
+            c.faults_raised,
+            c.commands_ended,
+            self.expected,
+        );
+        if self.failures.is_empty() {
+            t.push_str("result: no invariant broken\n");
+        }
+        for f in &self.failures {
+            t.push_str(&format!("FAILED {}\n", f.scenario));
+            for v in &f.violations {
+                t.push_str(&format!(
+                    "  {} at {} ms (robot {}): {}\n",
+                    v.invariant.name(),
+                    v.t_ms,
+                    v.robot + 1,
+                    v.detail
+                ));
+            }
+            t.push_str(&format!("  replay: {}\n", replay_command(f.seed, opts)));
+        }
+        t
+    }
+
+    /// As JSON.
+    pub fn json(&self, opts: &Options) -> Value {
+        let c = &self.checked;
+        serde_json::json!({
+            "runs": self.runs,
+            "wall_s": self.wall.as_secs_f64(),
+            "runs_per_second": self.runs_per_second(),
+            "sim_hours": self.sim_hours(),
+            "completed": self.completed,
+            "checked": {
+                "admissions": c.admissions, "motion_ticks": c.motion_ticks,
+                "standby_ticks": c.standby_ticks, "faults_raised": c.faults_raised,
+                "commands_ended": c.commands_ended, "injected_faults_raised": self.expected,
+            },
+            "failures": self.failures.iter().map(|f| serde_json::json!({
+                "seed": f.seed,
+                "replay": replay_command(f.seed, opts),
+                "violations": f.violations.iter().map(|v| serde_json::json!({
+                    "invariant": v.invariant.name(), "t_ms": v.t_ms, "detail": v.detail,
+                })).collect::<Vec<_>>(),
+            })).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// Runs seeds from `seed_start` on until `budget` of wall time is spent (or `max_runs` runs,
+/// or `stop_at_failures` failures); `progress` gets a line every few seconds.
+pub fn swarm(
+    seed_start: u64,
+    budget: Duration,
+    max_runs: Option<u64>,
+    stop_at_failures: usize,
+    opts: &Options,
+    progress: &mut dyn FnMut(String),
+) -> Report {
+    let start = Instant::now();
+    let mut last = start;
+    let mut r = Report::default();
+    let mut seed = seed_start;
+    while start.elapsed() < budget && max_runs.is_none_or(|m| r.runs < m) {
+        let mut o = run_one(seed, opts);
+        r.runs += 1;
+        r.sim_ms += o.sim_ms as u64;
+        r.expected += o.expected;
+        r.completed += o.completed as u64;
+        let c = &mut r.checked;
+        c.admissions += o.checked.admissions;
+        c.motion_ticks += o.checked.motion_ticks;
+        c.standby_ticks += o.checked.standby_ticks;
+        c.faults_raised += o.checked.faults_raised;
+        c.commands_ended += o.checked.commands_ended;
+        if !o.violations.is_empty() {
+            o.summary = None;
+            progress(format!(
+                "seed {seed}: {} -- replay: {}",
+                o.violations
+                    .iter()
+                    .map(|v| format!("{} at {} ms", v.invariant.name(), v.t_ms))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                replay_command(seed, opts)
+            ));
+            r.failures.push(o);
+            if r.failures.len() >= stop_at_failures {
+                break;
+            }
+        }
+        if last.elapsed() >= Duration::from_secs(10) {
+            last = Instant::now();
+            progress(format!(
+                "{} runs, {:.1} simulated hours, {} failed, {:.0} s left",
+                r.runs,
+                r.sim_ms as f64 / 3_600_000.0,
+                r.failures.len(),
+                budget.saturating_sub(start.elapsed()).as_secs_f64()
+            ));
+        }
+        seed += 1;
+    }
+    r.wall = start.elapsed();
+    r
+}

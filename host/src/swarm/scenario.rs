@@ -1,0 +1,260 @@
+//! One seed's scenario: a plan, link impairments and a fault schedule, all drawn from the
+//! seed, so that the seed alone replays the run.
+
+use crate::plan;
+use crate::sim::engine::link::LinkModel;
+use crate::sim::engine::{Links, PlantedBug};
+use crate::sim::inject::{Device, Injection, Scheduled};
+use crate::sim::{Protocol, SimConfig};
+use mmic::faults::Table8;
+use mmic::motion::State;
+
+/// What every scenario shares: the simulated span and a planted bug, if any.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Simulated ms each run lasts (the robot idles, still watched, after its plan ends).
+    pub horizon_ms: u32,
+    /// A bug planted in the engine's shells (for the swarm's own test).
+    pub planted_bug: PlantedBug,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            horizon_ms: 200_000,
+            planted_bug: PlantedBug::None,
+        }
+    }
+}
+
+/// A seed's scenario.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// The seed it was drawn from.
+    pub seed: u64,
+    /// The protocol between the ground and the server board.
+    pub protocol: Protocol,
+    /// The plan's text (a plan file).
+    pub plan: String,
+    /// The run's simulator configuration (plan, links, losses, injections).
+    pub cfg: SimConfig,
+}
+
+/// The injections a scenario may draw, with the plant and link ones once each (the ground's
+/// may repeat).
+const PLANT_FAULTS: [Injection; 13] = [
+    Injection::Fault(Table8::BoltingFailure),
+    Injection::Fault(Table8::ArmNotContracted),
+    Injection::Fault(Table8::BolterOvercurrent),
+    Injection::Fault(Table8::GripperOvercurrent),
+    Injection::Fault(Table8::LocomotionOvercurrent),
+    Injection::Fault(Table8::HipMismatch),
+    Injection::Fault(Table8::InitialStateMismatch),
+    Injection::Fault(Table8::InternalCommLoss),
+    Injection::Fault(Table8::LowBattery),
+    Injection::Fault(Table8::AssemblySystem),
+    Injection::Silent(Device::AdcA),
+    Injection::Silent(Device::AdcB),
+    Injection::Silent(Device::Encoder),
+];
+
+/// A random plan from a random state (any of the 15): Operational, a few reconfigurations (each
+/// to a matched state, from where the previous one left the robot), bolts, unbolts and waits,
+/// Standby; three seeds in ten run the demo plan instead.
+fn random_plan(rng: &mut fastrand::Rng) -> String {
+    if rng.f64() < 0.3 {
+        return crate::sim::DEMO_PLAN.to_string();
+    }
+    let states = State::ALL;
+    let mut at = states[rng.usize(..states.len())];
+    let mut text = format!("robot 1\nstart {}\nmode operational\n", at.letter());
+    for _ in 0..rng.usize(2..=6) {
+        match rng.u8(0..10) {
+            0..=4 => {
+                // A reconfiguration ends in a matched state (Table 5), another than the start.
+                let mut to = at;
+                while to == at || !to.is_matched() {
+                    to = states[rng.usize(..states.len())];
+                }
+                text.push_str(&format!("reconfigure {} -> {}\n", at.letter(), to.letter()));
+                at = to;
+            }
+            5 | 6 => text.push_str(&format!("bolt {}\n", pair(rng))),
+            7 => text.push_str(&format!("unbolt {}\n", pair(rng))),
+            _ => text.push_str(&format!("wait {}s\n", rng.u8(1..=5))),
+        }
+    }
+    text.push_str("mode standby\n");
+    text
+}
+
+fn pair(rng: &mut fastrand::Rng) -> String {
+    match rng.u8(0..5) {
+        0 => "all".to_string(),
+        p => p.to_string(),
+    }
+}
+
+/// A probability drawn as 0 most of the time, else uniform in `0..max`.
+fn sometimes(rng: &mut fastrand::Rng, p: f64, max: f64) -> f64 {
+    if rng.f64() < p {
+        rng.f64() * max
+    } else {
+        0.0
+    }
+}
+
+/// Up to three cuts of a link, each 0.2..5 s, before the horizon.
+fn cuts(rng: &mut fastrand::Rng, p: f64, horizon_ms: u32) -> Vec<(u32, Option<u32>)> {
+    let mut out = Vec::new();
+    for _ in 0..3 {
+        let (take, from, len) = (
+            rng.f64() < p,
+            rng.u32(1_000..horizon_ms.max(2_000)),
+            rng.u32(200..5_000),
+        );
+        if take {
+            out.push((from, Some(from + len)));
+        }
+    }
+    out
+}
+
+impl Scenario {
+    /// The scenario of `seed`.
+    pub fn from_seed(seed: u64, opts: &Options) -> Scenario {
+        let mut rng = fastrand::Rng::with_seed(seed ^ 0x5_3a4a_0000);
+        let horizon = opts.horizon_ms.max(10_000);
+        let protocol = if rng.bool() {
+            Protocol::Legacy
+        } else {
+            Protocol::Pus
+        };
+        let plan_text = random_plan(&mut rng);
+        // Every drawn plan parses and fits its states (tested over many seeds); the demo
+        // stands in should one not.
+        let (steps, start) = match plan::parse(&plan_text) {
+            Ok(p) => (
+                crate::sim::steps_of(&p),
+                p.start.unwrap_or(SimConfig::DEFAULT_START),
+            ),
+            Err(_) => (crate::sim::demo_steps(), SimConfig::DEFAULT_START),
+        };
+        let mut cfg = SimConfig::with_steps(steps);
+        cfg.start_state = start;
+        cfg.protocol = protocol;
+        cfg.seed = seed;
+        cfg.progress = false;
+        cfg.log_packets = false;
+        cfg.log_events = true;
+        cfg.max_sim_ms = horizon;
+        cfg.run_to_end = true;
+        cfg.planted_bug = opts.planted_bug;
+        cfg.b_phase_us = rng.u64(0..10_000);
+        cfg.wifi_loss = sometimes(&mut rng, 0.5, 0.3);
+        cfg.serial_loss = sometimes(&mut rng, 0.3, 0.1);
+        cfg.ab_loss = sometimes(&mut rng, 0.3, 0.05);
+        cfg.links = Links {
+            wifi: LinkModel {
+                latency_us: rng.u64(500..20_000),
+                jitter_us: rng.u64(0..10_000),
+                duplicate: sometimes(&mut rng, 0.6, 0.2),
+                reorder: sometimes(&mut rng, 0.3, 0.1),
+                reorder_us: rng.u64(10_000..100_000),
+                cuts: cuts(&mut rng, 0.2, horizon),
+            },
+            ground: LinkModel {
+                latency_us: rng.u64(500..5_000),
+                jitter_us: rng.u64(0..2_000),
+                // Resent commands: the ground's line delivers a packet twice.
+                duplicate: sometimes(&mut rng, 0.3, 0.2),
+                reorder: if protocol == Protocol::Pus {
+                    sometimes(&mut rng, 0.2, 0.1)
+                } else {
+                    0.0
+                },
+                reorder_us: rng.u64(10_000..200_000),
+                cuts: cuts(&mut rng, 0.1, horizon),
+            },
+            ab: LinkModel {
+                latency_us: rng.u64(200..2_000),
+                jitter_us: rng.u64(0..500),
+                duplicate: 0.0,
+                reorder: 0.0,
+                reorder_us: 0,
+                cuts: cuts(&mut rng, 0.1, horizon),
+            },
+        };
+        // Faults: none to three plant or link faults, each once; the operator's Stop (and,
+        // usually, Reset) and the System fault command, which may repeat.
+        let latest = horizon.saturating_sub(3_000).max(2_000);
+        let at = |rng: &mut fastrand::Rng| rng.u32(1_000..latest);
+        let mut pool = PLANT_FAULTS.to_vec();
+        rng.shuffle(&mut pool);
+        let k = [0, 0, 1, 1, 1, 2, 2, 3][rng.usize(..8)];
+        for injection in pool.into_iter().take(k) {
+            let t = at(&mut rng);
+            let _ = cfg.inject(Scheduled {
+                injection,
+                at_ms: t,
+            });
+        }
+        for _ in 0..[0, 0, 1, 1, 2][rng.usize(..5)] {
+            let t = at(&mut rng);
+            let _ = cfg.inject(Scheduled {
+                injection: Injection::Stop,
+                at_ms: t,
+            });
+            if rng.f64() < 0.8 {
+                let _ = cfg.inject(Scheduled {
+                    injection: Injection::Reset,
+                    at_ms: (t + rng.u32(100..8_000)).min(latest),
+                });
+            }
+        }
+        Scenario {
+            seed,
+            protocol,
+            plan: plan_text,
+            cfg,
+        }
+    }
+
+    /// One line: protocol, plan, links, faults.
+    pub fn describe(&self) -> String {
+        let c = &self.cfg;
+        let steps: Vec<&str> = c
+            .steps
+            .iter()
+            .map(|s| s.text.split('#').next().unwrap_or_default().trim())
+            .collect();
+        let inj: Vec<String> = c
+            .injections
+            .iter()
+            .map(|s| format!("{}@{:.3}", s.injection.name(), s.at_ms as f64 / 1000.0))
+            .collect();
+        let w = &c.links.wifi;
+        format!(
+            "seed {}: {} from {}: [{}]; wifi loss {:.2} dup {:.2} reorder {:.2} latency {:.1} ms \
+             jitter {:.1} ms cuts {:?}; ground loss {:.2} dup {:.2} cuts {:?}; a-b loss {:.3} \
+             cuts {:?}; b phase {:.1} ms; injections [{}]",
+            self.seed,
+            self.protocol.name(),
+            c.start_state.letter(),
+            steps.join("; "),
+            c.wifi_loss,
+            w.duplicate,
+            w.reorder,
+            w.latency_us as f64 / 1000.0,
+            w.jitter_us as f64 / 1000.0,
+            w.cuts,
+            c.serial_loss,
+            c.links.ground.duplicate,
+            c.links.ground.cuts,
+            c.ab_loss,
+            c.links.ab.cuts,
+            c.b_phase_us as f64 / 1000.0,
+            inj.join(", ")
+        )
+    }
+}
