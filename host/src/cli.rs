@@ -164,6 +164,11 @@ pub enum Cmd {
     /// command that replays it.
     #[command(long_about = crate::swarm::cli::HELP, after_help = crate::swarm::cli::AFTER)]
     Swarm(Box<crate::swarm::cli::SwarmArgs>),
+    /// A fleet of N robots, each with its own server board, against one ground polling every
+    /// robot at 1.2 s: in virtual time (robot-seconds per wall second) or on the wall clock
+    /// with async tasks (every answer within 0.7 s?); --sweep over sizes with a plot.
+    #[command(long_about = crate::fleet::cli::HELP, after_help = crate::fleet::cli::AFTER)]
+    Fleet(Box<crate::fleet::cli::FleetArgs>),
     /// Scale benchmark: N simulated robots, each with its own server link, against one ground
     /// process; reports the largest N for which every heartbeat arrives within the timeout.
     #[command(after_help = "Example: mmic bench --max 64 --seconds 30")]
@@ -338,6 +343,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
         }
         Cmd::Sim(args) => crate::simcli::sim(*args, out)?,
         Cmd::Swarm(args) => crate::swarm::cli::run(*args, out)?,
+        Cmd::Fleet(args) => crate::fleet::cli::run(*args, out)?,
         Cmd::Bench { max, seconds } => crate::simcli::bench(max, seconds, out)?,
         Cmd::Spec { write: None } => {
             for (_, page) in pages::all() {

@@ -18,14 +18,18 @@ fn every_drawn_plan_fits_the_robot_and_a_seed_always_draws_the_same_scenario() {
         let s = Scenario::from_seed(seed, &opts);
         let p = mmic_host::plan::parse(&s.plan).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
         let start = p.start.unwrap_or(mmic::motion::State::A);
-        p.trace(start).unwrap_or_else(|e| panic!("seed {seed}: {e}\n{}", s.plan));
+        p.trace(start)
+            .unwrap_or_else(|e| panic!("seed {seed}: {e}\n{}", s.plan));
         assert_eq!(s.cfg.steps.len(), p.steps.len());
         assert_eq!(Scenario::from_seed(seed, &opts).describe(), s.describe());
         protocols.insert(s.protocol.name());
         starts.insert(start.letter());
         for i in &s.cfg.injections {
             injected.insert(i.injection.name());
-            assert!(i.at_ms + 2_000 <= s.cfg.max_sim_ms, "seed {seed}: {i:?} too late");
+            assert!(
+                i.at_ms + 2_000 <= s.cfg.max_sim_ms,
+                "seed {seed}: {i:?} too late"
+            );
         }
     }
     assert_eq!(protocols.len(), 2);
@@ -44,7 +48,14 @@ fn the_invariants_hold_on_the_firmware_for_a_batch_of_seeds() {
         horizon_ms: 60_000,
         ..Options::default()
     };
-    let r = swarm(1, Duration::from_secs(600), Some(40), 40, &opts, &mut |_| {});
+    let r = swarm(
+        1,
+        Duration::from_secs(600),
+        Some(40),
+        40,
+        &opts,
+        &mut |_| {},
+    );
     assert_eq!(r.runs, 40);
     assert!(r.failures.is_empty(), "{}", r.text(&opts));
     // Every invariant had opportunities.
@@ -68,7 +79,14 @@ fn a_planted_double_execution_is_found_and_its_seed_replays_it() {
         horizon_ms: 60_000,
         planted_bug: PlantedBug::DoubleExec,
     };
-    let r = swarm(1, Duration::from_secs(300), Some(200), 1, &opts, &mut |_| {});
+    let r = swarm(
+        1,
+        Duration::from_secs(300),
+        Some(200),
+        1,
+        &opts,
+        &mut |_| {},
+    );
     let f = r.failures.first().expect("the planted bug is found");
     assert!(
         f.violations

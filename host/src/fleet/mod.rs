@@ -7,7 +7,7 @@
 //! * **virtual time** ([`run_virtual`]): the discrete-event engine ([`crate::sim::engine`]) runs
 //!   every robot's nodes on one virtual clock; the figure of merit is simulated robot-seconds
 //!   per wall second;
-//! * **realtime** (`realtime::run`): the same nodes on the wall clock, every robot's boards,
+//! * **realtime** ([`realtime::run`]): the same nodes on the wall clock, every robot's boards,
 //!   server board and links as tasks of one async runtime with a few threads (no thread per
 //!   robot), the ground polling over real sockets; the figure of merit is whether every answer
 //!   came within 0.7 s.
@@ -19,6 +19,9 @@
 //! assert_eq!(r.attempts.0, r.attempts.1); // every poll answered
 //! assert!(r.robot_seconds_per_wall_second() > 100.0);
 //! ```
+
+pub mod cli;
+pub mod realtime;
 
 use crate::sim::{self, engine, Protocol, SimConfig, SimStep};
 use mmic::node::plan_runner::{PlanEnd, PlanStep};
@@ -32,7 +35,9 @@ pub struct FleetConfig {
     /// Simulated seconds (virtual time) or wall seconds (realtime) to run.
     pub seconds: u32,
     /// The plan every robot runs; none: wait `seconds` while the ground polls every robot at
-    /// its 1.2 s cadence (the paper's scale scenario).
+    /// its 1.2 s cadence (the paper's scale scenario; the legacy protocol's: over PUS the
+    /// gateway polls board A itself and the ground sends nothing while it waits, so a PUS
+    /// fleet needs a plan).
     pub plan: Option<Vec<SimStep>>,
     /// Between the ground and each server board.
     pub protocol: Protocol,
@@ -77,7 +82,10 @@ impl FleetConfig {
         cfg.protocol = self.protocol;
         cfg.seed = self.seed;
         cfg.wifi_loss = self.wifi_loss;
-        cfg.max_sim_ms = self.seconds.saturating_mul(1000);
+        // A polling wait ends when the poll in flight at its end is answered: that poll goes
+        // out in the uplink's next 1.2 s slot, so leave a slot and an answer window of room.
+        let room = if self.plan.is_none() { 2_000 } else { 0 };
+        cfg.max_sim_ms = self.seconds.saturating_mul(1000) + room;
         cfg.log_packets = false;
         cfg.log_events = false;
         cfg.log_path = None;

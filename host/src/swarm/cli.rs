@@ -152,7 +152,10 @@ fn replay(seed: u64, opts: &Options, dir: &PathBuf, out: &mut dyn Write) -> Resu
     let w = |out: &mut dyn Write, t: String| writeln!(out, "{t}").map_err(CliError::Output);
     w(out, o.scenario.clone())?;
     if let Some(summary) = &o.summary {
-        w(out, crate::sim::report::text(summary).trim_end().to_string())?;
+        w(
+            out,
+            crate::sim::report::text(summary).trim_end().to_string(),
+        )?;
     }
     w(out, format!("log: {}", dir.join("sim.jsonl").display()))?;
     w(out, format!("plan: {}", plan_path.display()))?;

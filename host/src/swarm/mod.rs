@@ -66,7 +66,10 @@ pub fn expectations(s: &Scenario, summary: &Summary) -> Vec<Expect> {
         let (faults, window, needs_adc_a): (Vec<Fault>, u32, bool) = match inj.injection {
             Injection::Fault(Table8::LowBattery) => (vec![Fault::LowBattery], 1_500, true),
             Injection::Fault(Table8::LocomotionOvercurrent) => (
-                vec![Fault::LocomotionOvercurrent, Fault::LocomotionOvercurrentIdle],
+                vec![
+                    Fault::LocomotionOvercurrent,
+                    Fault::LocomotionOvercurrentIdle,
+                ],
                 1_000,
                 true,
             ),

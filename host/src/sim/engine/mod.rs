@@ -565,7 +565,11 @@ impl<'c, G: Ground> Engine<'c, G> {
         let from_b = r.a_from_b.pop_front();
         let out = r.a.tick(&mut r.plant, now, command, from_b);
         if let Some(w) = &mut self.watch {
-            w.tick_a(i, now, &watch::TickA::of(command, &r.a.board, &r.plant, &out));
+            w.tick_a(
+                i,
+                now,
+                &watch::TickA::of(command, &r.a.board, &r.plant, &out),
+            );
         }
         let name = r.names[0].clone();
         if self.cfg.log_events {

@@ -424,7 +424,10 @@ impl Watch {
                 now,
                 i,
                 Invariant::ExecutedTwice,
-                format!("board A admitted a command no sender wrote: {}", crate::sim::log::hex(p)),
+                format!(
+                    "board A admitted a command no sender wrote: {}",
+                    crate::sim::log::hex(p)
+                ),
             );
             return;
         };
@@ -631,7 +634,9 @@ mod tests {
         t.admitted = true;
         w.tick_a(0, 30, &t);
         assert_eq!(kinds(&w), [Invariant::ExecutedTwice]);
-        assert!(w.violations[0].detail.contains("at 10 ms and again at 30 ms"));
+        assert!(w.violations[0]
+            .detail
+            .contains("at 10 ms and again at 30 ms"));
         assert_eq!(w.checked.admissions, 2);
         // A packet nobody wrote.
         let mut w = watch();
@@ -753,7 +758,11 @@ mod tests {
         let mut t = tick(Mode::Safed);
         t.faults = Faults::EMPTY.with(Fault::HipMismatch);
         w.tick_a(0, 20, &t);
-        assert_eq!(kinds(&w), [Invariant::FaultMode], "no command: the fault raised power");
+        assert_eq!(
+            kinds(&w),
+            [Invariant::FaultMode],
+            "no command: the fault raised power"
+        );
         let mut w = watch();
         w.tick_a(0, 10, &tick(Mode::Standby));
         t.accepted = Some(mmic::command::Command::Mode(Mode::Operational));
