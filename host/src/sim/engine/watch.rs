@@ -20,8 +20,9 @@
 //!   Safed or Standby in the same tick as `mmic::safety::policy::fault_action` (Table 8) says;
 //!   a deferred one (low battery, assembly system) keeps Operational while the motion runs and
 //!   gives Standby in the tick the motion ends. A fault raised in Safed or Standby never
-//!   raises power (unless a mode command taken in the same tick does: Standby to Operational
-//!   stops at Safed when the hip check on the way in fails, as Table 8 says).
+//!   raises power. A mode command board A takes in the same tick sets the mode the faults act
+//!   on (Standby to Operational stops at Safed when the hip check on the way in fails, as Table
+//!   8 says; the operator's Standby in the tick a Safed fault comes up stays Standby).
 //! * **Every command ends**: at the end of the run, every command the ground sent is done
 //!   (accepted, refused or reported unacknowledged), except one sent less than its longest
 //!   life (attempts × period + answer window) before the end.
@@ -344,10 +345,15 @@ impl Watch {
     /// Board A's control tick at `now`, as the engine saw it ([`TickA`]).
     pub fn tick_a(&mut self, i: usize, now: u32, t: &TickA) {
         self.admissions(i, now, t.command.as_ref(), t.admitted);
-        // A mode command taken this tick may raise power itself (Standby to Operational, held
-        // at Safed by a fault found on the way in: Table 8's hip mismatch is checked on
-        // entering Operational); a fault alone never does.
-        let commanded = matches!(t.accepted, Some(mmic::command::Command::Mode(_)));
+        // A mode command taken this tick changes the mode the faults act on: Standby to
+        // Operational, held at Safed by a fault found on the way in (Table 8's hip mismatch
+        // is checked on entering Operational); Operational to Standby by the operator in the
+        // tick a Safed fault comes up, which leaves the robot in Standby (a fault never raises
+        // power).
+        let commanded = match t.accepted {
+            Some(mmic::command::Command::Mode(m)) => Some(m),
+            _ => None,
+        };
         self.fault_modes(i, now, t.faults, t.mode, t.in_motion, commanded);
         if t.in_motion {
             self.checked.motion_ticks += 1;
@@ -452,10 +458,10 @@ impl Watch {
         faults: Faults,
         mode: Mode,
         in_motion: bool,
-        commanded: bool,
+        commanded: Option<Mode>,
     ) {
         let r = &mut self.robots[i];
-        let before = r.last_mode.unwrap_or(mode);
+        let before = commanded.or(r.last_mode).unwrap_or(mode);
         let new: Vec<Fault> = faults
             .iter()
             .filter(|f| !r.last_faults.contains(*f))
@@ -494,11 +500,18 @@ impl Watch {
                         now,
                         i,
                         Invariant::FaultMode,
-                        format!("{new:?} raised in Operational: {mode:?}, Table 8 says {w:?}"),
+                        format!(
+                            "{new:?} raised in Operational{}: {mode:?}, Table 8 says {w:?}",
+                            if commanded.is_some() {
+                                " (commanded this tick)"
+                            } else {
+                                ""
+                            }
+                        ),
                     );
                 }
             }
-            Mode::Safed | Mode::Standby if !new.is_empty() && !commanded => {
+            Mode::Safed | Mode::Standby if !new.is_empty() => {
                 let raised = matches!(
                     (before, mode),
                     (Mode::Standby, Mode::Safed | Mode::Operational)
@@ -509,7 +522,14 @@ impl Watch {
                         now,
                         i,
                         Invariant::FaultMode,
-                        format!("{new:?} raised in {before:?} raised power: {mode:?}"),
+                        format!(
+                            "{new:?} raised in {before:?} raised power: {mode:?}{}",
+                            if commanded.is_some() {
+                                " (mode commanded this tick)"
+                            } else {
+                                ""
+                            }
+                        ),
                     );
                 }
             }
@@ -768,6 +788,20 @@ mod tests {
         t.accepted = Some(mmic::command::Command::Mode(Mode::Operational));
         w.tick_a(0, 20, &t);
         assert!(w.violations.is_empty(), "{:?}", w.violations);
+        // Operational, the operator's Standby and a Safed fault in one tick: Standby.
+        let mut w = watch();
+        w.tick_a(0, 10, &tick(Mode::Operational));
+        let mut t = tick(Mode::Standby);
+        t.faults = Faults::EMPTY.with(Fault::InternalCommLoss);
+        t.accepted = Some(mmic::command::Command::Mode(Mode::Standby));
+        w.tick_a(0, 20, &t);
+        assert!(w.violations.is_empty(), "{:?}", w.violations);
+        // ... but not Operational.
+        let mut w = watch();
+        w.tick_a(0, 10, &tick(Mode::Operational));
+        t.mode = Mode::Operational;
+        w.tick_a(0, 20, &t);
+        assert_eq!(kinds(&w), [Invariant::FaultMode]);
     }
 
     #[test]
