@@ -155,8 +155,9 @@ pub enum Cmd {
         #[arg(long)]
         json: bool,
     },
-    /// Run the host simulator: opsUI, server board, boards A and B and a plant model over
-    /// real transports, driving a plan (the built-in demo without --plan).
+    /// Run the host simulator: opsUI, server board, boards A and B and a plant model, in
+    /// virtual time (deterministic) or with --realtime on real transports, driving a plan (the
+    /// built-in demo without --plan).
     #[command(long_about = crate::simcli::SIM_HELP, after_help = crate::simcli::SIM_AFTER)]
     Sim(Box<crate::simcli::SimArgs>),
     /// The fault swarm: random scenarios (plans, link faults, plant faults, the operator's Stop
@@ -169,8 +170,9 @@ pub enum Cmd {
     /// with async tasks (every answer within 0.7 s?); --sweep over sizes with a plot.
     #[command(long_about = crate::fleet::cli::HELP, after_help = crate::fleet::cli::AFTER)]
     Fleet(Box<crate::fleet::cli::FleetArgs>),
-    /// Scale benchmark: N simulated robots, each with its own server link, against one ground
-    /// process; reports the largest N for which every heartbeat arrives within the timeout.
+    /// Scale benchmark of the realtime threaded engine (eight threads per robot): the largest N
+    /// for which every heartbeat arrives within the timeout (`mmic fleet` runs fleets as async
+    /// tasks or in virtual time).
     #[command(after_help = "Example: mmic bench --max 64 --seconds 30")]
     Bench {
         /// Largest number of robots to try (doubling from 1, then bisecting).

@@ -22,7 +22,8 @@
 //! board, the ground's plan runners, the server board's relay and the gateway are the library's
 //! pure nodes, and the engine only moves bytes between them at the right virtual times:
 //!
-//! * boards A and B tick every 10 ms (board B at its own phase, [`SimConfig::b_phase_us`]);
+//! * boards A and B tick every 10 ms (board B at its own phase, [`SimConfig::b_phase_us`]; the
+//!   boards A of a fleet tick in one event, robot by robot, and so do its boards B);
 //!   board A's control task takes at most one command from the WiFi hand-off queue and one
 //!   internal heartbeat per tick, as the firmware does;
 //! * board A's WiFi task runs when the server board opens a connection (it discards the
@@ -132,10 +133,10 @@ enum Hop {
 /// Something that happens at a virtual instant.
 #[derive(Debug)]
 enum Ev {
-    /// Board A's control task ticks.
-    TickA(usize),
-    /// Board B ticks.
-    TickB(usize),
+    /// Every robot's board A control task ticks (in robot order; all boards A share a phase).
+    TickA,
+    /// Every robot's board B ticks (all boards B share their phase).
+    TickB,
     /// Board A's WiFi task drains the heartbeat queue.
     Wifi(usize),
     /// Bytes arrive at the end of a hop (`conn`: the WiFi connection they were written to).
@@ -323,10 +324,10 @@ impl<'c, G: Ground> Engine<'c, G> {
             watch: watched.then(|| Watch::new(cfg, n)),
             status: Value::Null,
         };
-        for i in 0..n {
-            e.at(0, Ev::TickA(i));
-            e.at(cfg.b_phase_us % 10_000, Ev::TickB(i));
-            if cfg.protocol == Protocol::Pus {
+        e.at(0, Ev::TickA);
+        e.at(cfg.b_phase_us % 10_000, Ev::TickB);
+        if cfg.protocol == Protocol::Pus {
+            for i in 0..n {
                 e.wake_server(i, 0);
             }
         }
@@ -365,6 +366,9 @@ impl<'c, G: Ground> Engine<'c, G> {
                 w.finish(i, now, &self.ground.open_commands(i));
             }
         }
+        if let Some(r) = self.robots.first() {
+            self.status = r.a.status(now - now % TICK_MS);
+        }
         let (ends, stats) = self.ground.finish(now);
         let records = self.log.as_ref().map(Log::take).unwrap_or_default();
         if let Some(p) = &self.cfg.log_path {
@@ -401,13 +405,17 @@ impl<'c, G: Ground> Engine<'c, G> {
     /// Handles one event; false when the run is over.
     fn handle(&mut self, ev: Ev) -> bool {
         match ev {
-            Ev::TickA(i) => {
-                self.tick_a(i);
-                self.at(self.now + TICK_MS as u64 * 1000, Ev::TickA(i));
+            Ev::TickA => {
+                for i in 0..self.robots.len() {
+                    self.tick_a(i);
+                }
+                self.at(self.now + TICK_MS as u64 * 1000, Ev::TickA);
             }
-            Ev::TickB(i) => {
-                self.tick_b(i);
-                self.at(self.now + TICK_MS as u64 * 1000, Ev::TickB(i));
+            Ev::TickB => {
+                for i in 0..self.robots.len() {
+                    self.tick_b(i);
+                }
+                self.at(self.now + TICK_MS as u64 * 1000, Ev::TickB);
             }
             Ev::Wifi(i) => self.wifi_drain(i),
             Ev::Deliver {
@@ -440,9 +448,10 @@ impl<'c, G: Ground> Engine<'c, G> {
         true
     }
 
-    fn event(&self, node: &str, what: Value) {
+    /// Logs robot `i`'s event from its node `node` (0 board A, 1 board B, 2 the server board).
+    fn node_event(&self, i: usize, node: usize, what: Value) {
         if let (Some(l), true) = (&self.log, self.cfg.log_events) {
-            l.event(self.now_ms(), node, what);
+            l.event(self.now_ms(), &self.robots[i].names[node], what);
         }
     }
 
@@ -571,10 +580,9 @@ impl<'c, G: Ground> Engine<'c, G> {
                 &watch::TickA::of(command, &r.a.board, &r.plant, &out),
             );
         }
-        let name = r.names[0].clone();
         if self.cfg.log_events {
             for e in &out.events {
-                self.event(&name, super::shell::event_json(e));
+                self.node_event(i, 0, super::shell::event_json(e));
             }
         }
         if let Some(b) = out.to_b {
@@ -583,15 +591,13 @@ impl<'c, G: Ground> Engine<'c, G> {
         if let Some(hb) = out.heartbeat {
             let r = &mut self.robots[i];
             if let Err(full) = r.heartbeats.split().0.push(hb) {
-                self.event(
-                    &name,
+                self.node_event(
+                    i,
+                    0,
                     json!({"type": "handoff_full", "hex": log::hex(&full.0)}),
                 );
             }
             self.at(self.now + WIFI_TASK_US, Ev::Wifi(i));
-        }
-        if i == 0 {
-            self.status = self.robots[0].a.status(now);
         }
     }
 
@@ -606,8 +612,8 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
         if out.link_lost != r.b_lost {
             r.b_lost = out.link_lost;
-            let (name, holding) = (r.names[1].clone(), r.b_lost);
-            self.event(&name, json!({"type": "link_lost", "holding": holding}));
+            let holding = r.b_lost;
+            self.node_event(i, 1, json!({"type": "link_lost", "holding": holding}));
         }
         if let Some(hb) = out.heartbeat {
             self.send(i, Hop::BToA, 0, &hb);
@@ -651,11 +657,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         let copy = conn & DUPLICATE != 0;
         let r = &mut self.robots[i];
         if r.wifi_open != Some(conn & !DUPLICATE) {
-            let name = r.names[0].clone();
-            self.event(
-                &name,
-                json!({"type": "wifi_closed", "hex": log::hex(bytes)}),
-            );
+            self.node_event(i, 0, json!({"type": "wifi_closed", "hex": log::hex(bytes)}));
             return;
         }
         let mut packets: Vec<[u8; COMMAND_LEN]> = frames(&mut r.wifi_reader, bytes)
@@ -675,12 +677,12 @@ impl<'c, G: Ground> Engine<'c, G> {
                 }
             }
         }
-        let name = r.names[0].clone();
         for p in packets {
             let r = &mut self.robots[i];
             if let Err(full) = r.commands.split().0.push(p) {
-                self.event(
-                    &name,
+                self.node_event(
+                    i,
+                    0,
                     json!({"type": "handoff_full", "hex": log::hex(&full.0)}),
                 );
             }
@@ -696,9 +698,9 @@ impl<'c, G: Ground> Engine<'c, G> {
             .as_ref()
             .is_some_and(|v| v.conn == conn & !DUPLICATE);
         if !current {
-            let name = r.names[2].clone();
-            self.event(
-                &name,
+            self.node_event(
+                i,
+                2,
                 json!({"type": "heartbeat_after_visit", "hex": log::hex(bytes)}),
             );
             return;
@@ -776,7 +778,6 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
         let now = self.now_ms();
         let inbox: Vec<Vec<u8>> = self.robots[i].inbox.drain(..).collect();
-        let name = self.robots[i].names[2].clone();
         let number = self.robots[i].number;
         if let Board::Relay(_) = self.robots[i].board {
             for p in inbox {
@@ -794,7 +795,7 @@ impl<'c, G: Ground> Engine<'c, G> {
                     }
                     Err(e) => json!({"type": "refused", "error": e.to_string()}),
                 };
-                self.event(&name, what);
+                self.node_event(i, 2, what);
             }
             let Board::Relay(srv) = &mut self.robots[i].board else {
                 return;
@@ -804,10 +805,7 @@ impl<'c, G: Ground> Engine<'c, G> {
                 if board == number {
                     self.start_visit(i, packet, self.cfg.visit_ms);
                 } else {
-                    self.event(
-                        &name,
-                        json!({"type": "no_such_robot", "board": board.get()}),
-                    );
+                    self.node_event(i, 2, json!({"type": "no_such_robot", "board": board.get()}));
                 }
             }
             return;
@@ -818,8 +816,9 @@ impl<'c, G: Ground> Engine<'c, G> {
             };
             match g.tc_packet(&p) {
                 Ok(out) => self.reports(i, out),
-                Err(e) => self.event(
-                    &name,
+                Err(e) => self.node_event(
+                    i,
+                    2,
                     json!({"type": "tc_refused", "error": e.to_string(), "hex": log::hex(&p)}),
                 ),
             }
@@ -862,8 +861,7 @@ impl<'c, G: Ground> Engine<'c, G> {
     fn reports<const M: usize>(&mut self, i: usize, out: Out<M>) {
         let now = self.now_ms();
         if out.overflow > 0 {
-            let name = self.robots[i].names[2].clone();
-            self.event(&name, json!({"type": "overflow", "count": out.overflow}));
+            self.node_event(i, 2, json!({"type": "overflow", "count": out.overflow}));
         }
         for tm in &out.reports {
             let Board::Gateway(g) = &mut self.robots[i].board else {
@@ -876,9 +874,9 @@ impl<'c, G: Ground> Engine<'c, G> {
                     self.send(i, Hop::ServerToGround, 0, &p);
                 }
                 Err(e) => {
-                    let name = self.robots[i].names[2].clone();
-                    self.event(
-                        &name,
+                    self.node_event(
+                        i,
+                        2,
                         json!({"type": "tm_unwritten", "error": e.to_string()}),
                     );
                 }
