@@ -243,7 +243,8 @@ pub trait Ground {
     fn status(&self) -> Option<HeartbeatRepr>;
     /// The attempts answered, Figure 11.
     fn efficiency(&self) -> Efficiency;
-    /// An injection's ground part ([`ground_injection`]).
+    /// An injection's ground part: an out-of-band command handed to the runner, or the next
+    /// reconfiguration misstated; returns why the runner did not take it, if it did not.
     fn inject(&mut self, injection: inject::Injection) -> Option<String>;
 }
 
