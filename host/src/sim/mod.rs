@@ -286,6 +286,42 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// A virtual-time run's summary of `cfg`: how the plans ended and what the ground
+    /// measured, the log's records, robot 1's final status, the wall time it took (the
+    /// realtime engine sets its own clock's figures over this).
+    pub fn of_run(
+        cfg: &SimConfig,
+        ends: Vec<Option<PlanEnd>>,
+        stats: shell::GroundStats,
+        records: Vec<Value>,
+        status: Value,
+        wall: Duration,
+    ) -> Summary {
+        Summary {
+            protocol: cfg.protocol,
+            ends,
+            plan: cfg.steps.clone(),
+            start_state: cfg.start_state,
+            wifi_loss: cfg.wifi_loss,
+            visit_ms: match cfg.protocol {
+                Protocol::Legacy => cfg.visit_ms,
+                Protocol::Pus => cfg.gateway.uplink.timeout_ms,
+            },
+            sim_ms: stats.sim_ms,
+            wall,
+            records,
+            efficiency: stats.efficiency,
+            attempts: stats.attempts,
+            max_latency_ms: stats.max_latency_ms,
+            status,
+            max_tick_lateness_ms: 0,
+            held_ms: 0,
+            pace_slack_ms: None,
+            last_heartbeat: stats.last_heartbeat,
+            realtime: false,
+        }
+    }
+
     /// Whether the host fell behind far enough to change what the firmware saw: a tick later
     /// than [`nodes::OVERRUN_MS`]. A paced run cannot get there (its ticks are at most
     /// [`PACE_SLACK_MS`] late); an unpaced run on a loaded host can, and then its timeouts

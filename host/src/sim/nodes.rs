@@ -7,7 +7,7 @@
 use super::clock::{Clock, NodeClock};
 use super::log::Log;
 use super::plant::Plant;
-use super::shell::{SideA, SideB};
+use super::shell::{frames, SideA, SideB};
 use mmic::node::gateway::{self, Gateway, Out};
 use mmic::node::handoff::{Consumer, Producer};
 use mmic::node::server::{Accepted, Server};
@@ -276,17 +276,6 @@ impl WifiTask<'_> {
             }
         }
     }
-}
-
-/// The packets the deframer finds in `bytes`.
-fn frames(d: &mut Deframer<256>, bytes: &[u8]) -> Vec<mmic::wire::deframer::Frame> {
-    let mut out = Vec::new();
-    d.feed(bytes, |e| {
-        if let Deframed::Frame(f) = e {
-            out.push(f);
-        }
-    });
-    out
 }
 
 /// Board A's control loop (core 1): one library tick every 10 ms.

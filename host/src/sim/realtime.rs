@@ -325,27 +325,11 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         .map_err(|_| std::io::Error::other("log writer panicked"))??;
     let status = statuses[0].lock().map(|s| s.clone()).unwrap_or(Value::Null);
     Ok(Summary {
-        protocol: cfg.protocol,
-        ends,
-        plan: cfg.steps.clone(),
-        start_state: cfg.start_state,
-        wifi_loss: cfg.wifi_loss,
-        visit_ms: match cfg.protocol {
-            Protocol::Legacy => cfg.visit_ms,
-            Protocol::Pus => cfg.gateway.uplink.timeout_ms,
-        },
-        sim_ms: stats.sim_ms,
-        wall: clock.wall_elapsed(),
-        records,
-        efficiency: stats.efficiency,
-        attempts: stats.attempts,
-        max_latency_ms: stats.max_latency_ms,
-        status,
         max_tick_lateness_ms: lateness.load(Ordering::Relaxed),
         held_ms: clock.held_ms(),
         pace_slack_ms: clock.slack_ms(),
-        last_heartbeat: stats.last_heartbeat,
         realtime: true,
+        ..Summary::of_run(cfg, ends, stats, records, status, clock.wall_elapsed())
     })
 }
 

@@ -19,6 +19,7 @@ use mmic::node::pus_ground::{self, TcLink, TcOut};
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::wire::b_command::B_COMMAND_LEN;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
+use mmic::wire::deframer::{Deframed, Deframer, Frame};
 use mmic::wire::heartbeat::HeartbeatRepr;
 use mmic::wire::internal_heartbeat::INTERNAL_HEARTBEAT_LEN;
 use serde_json::{json, Value};
@@ -174,6 +175,17 @@ pub fn tick_b(
         regulator: out.regulator,
         bolter: out.bolter,
         mux: out.mux,
+    });
+    out
+}
+
+/// The packets a deframer finds in `bytes` (a stream's next read).
+pub fn frames(d: &mut Deframer<256>, bytes: &[u8]) -> Vec<Frame> {
+    let mut out = Vec::new();
+    d.feed(bytes, |e| {
+        if let Deframed::Frame(f) = e {
+            out.push(f);
+        }
     });
     out
 }

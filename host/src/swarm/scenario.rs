@@ -4,9 +4,8 @@
 use crate::plan;
 use crate::sim::engine::link::LinkModel;
 use crate::sim::engine::{Links, PlantedBug};
-use crate::sim::inject::{Device, Injection, Scheduled};
+use crate::sim::inject::{Injection, Scheduled};
 use crate::sim::{Protocol, SimConfig};
-use mmic::faults::Table8;
 use mmic::motion::State;
 
 /// What every scenario shares: the simulated span and a planted bug, if any.
@@ -40,23 +39,14 @@ pub struct Scenario {
     pub cfg: SimConfig,
 }
 
-/// The injections a scenario may draw, with the plant and link ones once each (the ground's
-/// may repeat).
-const PLANT_FAULTS: [Injection; 13] = [
-    Injection::Fault(Table8::BoltingFailure),
-    Injection::Fault(Table8::ArmNotContracted),
-    Injection::Fault(Table8::BolterOvercurrent),
-    Injection::Fault(Table8::GripperOvercurrent),
-    Injection::Fault(Table8::LocomotionOvercurrent),
-    Injection::Fault(Table8::HipMismatch),
-    Injection::Fault(Table8::InitialStateMismatch),
-    Injection::Fault(Table8::InternalCommLoss),
-    Injection::Fault(Table8::LowBattery),
-    Injection::Fault(Table8::AssemblySystem),
-    Injection::Silent(Device::AdcA),
-    Injection::Silent(Device::AdcB),
-    Injection::Silent(Device::Encoder),
-];
+/// The faults a scenario draws from: every injection but the operator's Stop and Reset (which
+/// it schedules in pairs of its own).
+fn faults() -> Vec<Injection> {
+    Injection::ALL
+        .into_iter()
+        .filter(|i| !matches!(i, Injection::Stop | Injection::Reset))
+        .collect()
+}
 
 /// A random plan from a random state (any of the 15): Operational, a few reconfigurations (each
 /// to a matched state, from where the previous one left the robot), bolts, unbolts and waits,
@@ -189,7 +179,7 @@ impl Scenario {
         // usually, Reset) and the System fault command, which may repeat.
         let latest = horizon.saturating_sub(3_000).max(2_000);
         let at = |rng: &mut fastrand::Rng| rng.u32(1_000..latest);
-        let mut pool = PLANT_FAULTS.to_vec();
+        let mut pool = faults();
         rng.shuffle(&mut pool);
         let k = [0, 0, 1, 1, 1, 2, 2, 3][rng.usize(..8)];
         for injection in pool.into_iter().take(k) {

@@ -41,7 +41,7 @@ pub mod watch;
 
 use super::log::{self, Log};
 use super::plant::Plant;
-use super::shell::{Ground, GroundSide, LegacyGround, SideA, SideB};
+use super::shell::{frames, Ground, GroundSide, LegacyGround, SideA, SideB};
 use super::{Protocol, SimConfig, Summary};
 use link::{Fate, Link, LinkModel};
 use mmic::node::board_a::{self, BoardA};
@@ -52,7 +52,7 @@ use mmic::node::plan_runner::PlanRunner;
 use mmic::node::server::{Accepted, Server};
 use mmic::units::BoardNumber;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
-use mmic::wire::deframer::{Deframed, Deframer};
+use mmic::wire::deframer::Deframer;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 use mmic::wire::PacketKind;
 use serde_json::{json, Value};
@@ -286,17 +286,6 @@ fn board_number(i: usize) -> BoardNumber {
     BoardNumber::new((i % 255) as u8 + 1).unwrap_or(BoardNumber::ONE)
 }
 
-/// The packets a deframer finds in `bytes`.
-fn frames(d: &mut Deframer<256>, bytes: &[u8]) -> Vec<mmic::wire::deframer::Frame> {
-    let mut out = Vec::new();
-    d.feed(bytes, |e| {
-        if let Deframed::Frame(f) = e {
-            out.push(f);
-        }
-    });
-    out
-}
-
 impl<'c, G: Ground> Engine<'c, G> {
     fn new(cfg: &'c SimConfig, runners: Vec<G>, watched: bool) -> Engine<'c, G> {
         let n = runners.len();
@@ -375,30 +364,7 @@ impl<'c, G: Ground> Engine<'c, G> {
             let f = std::fs::File::create(p)?;
             log::write_lines(&records, &mut std::io::BufWriter::new(f))?;
         }
-        let cfg = self.cfg;
-        let summary = Summary {
-            protocol: cfg.protocol,
-            ends,
-            plan: cfg.steps.clone(),
-            start_state: cfg.start_state,
-            wifi_loss: cfg.wifi_loss,
-            visit_ms: match cfg.protocol {
-                Protocol::Legacy => cfg.visit_ms,
-                Protocol::Pus => cfg.gateway.uplink.timeout_ms,
-            },
-            sim_ms: stats.sim_ms,
-            wall: wall.elapsed(),
-            records,
-            efficiency: stats.efficiency,
-            attempts: stats.attempts,
-            max_latency_ms: stats.max_latency_ms,
-            status: self.status,
-            max_tick_lateness_ms: 0,
-            held_ms: 0,
-            pace_slack_ms: None,
-            last_heartbeat: stats.last_heartbeat,
-            realtime: false,
-        };
+        let summary = Summary::of_run(self.cfg, ends, stats, records, self.status, wall.elapsed());
         Ok((summary, self.watch))
     }
 
