@@ -8,15 +8,19 @@
 use mmic::bolter::Drive;
 use mmic::command::{BolterCommand, Command, ServoTarget};
 use mmic::command::{BolterPair, Fasteners};
+use mmic::faults::Fault;
 use mmic::mode::Mode;
-use mmic::motion::State;
-use mmic::node::board_a::{self, BoardA, Inputs};
+use mmic::motion::{map, Primitive, State};
+use mmic::node::board_a::{self, BoardA, Event, Inputs};
 use mmic::node::board_b::{self, BoardB};
-use mmic::units::{BoardNumber, Electrical, Side};
+use mmic::refusal::Refusal;
+use mmic::units::{BoardNumber, Electrical, HipAngle, PulseWidth, Side};
 use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
 
+/// Boards A and B linked both ways every tick, and the plant they drive: each side's arm
+/// contraction switch and bolter.
 struct Rig {
     a: BoardA,
     b: BoardB,
@@ -26,6 +30,56 @@ struct Rig {
     to_a: Option<[u8; mmic::wire::internal_heartbeat::INTERNAL_HEARTBEAT_LEN]>,
     /// The last A→B command sent.
     last_b: Option<BCommandRepr>,
+    /// Each side's arm pulse at the last tick (none: unpowered, where it was).
+    arm_pulse: [Option<PulseWidth>; 2],
+    /// A side whose arm switch never closes (an arm stuck short of contracted).
+    switch_stuck: [bool; 2],
+    /// Each side's bolter.
+    bolters: [Bolter; 2],
+    /// Each side's bolter drive at the last tick.
+    drives: [Drive; 2],
+}
+
+/// A bolter over a fastener, as its current sensor and home switch see it: driven down, it
+/// travels `CONTACT_MS` before it touches and pushes (I_bo past the push threshold); rotated
+/// while touching, it locks the fastener after `LOCK_MS` and stalls (I_bo past the lock
+/// threshold) — unless the fastener is `seized`, when it turns freely and never locks; driven
+/// up, it is back on its home switch after as long as it went down.
+#[derive(Debug, Clone, Copy, Default)]
+struct Bolter {
+    travel_ms: u32,
+    rotated_ms: u32,
+    i_bo: u16,
+    seized: bool,
+}
+
+const CONTACT_MS: u32 = 500;
+const LOCK_MS: u32 = 300;
+
+impl Bolter {
+    fn step(&mut self, d: Drive, ms: u32) {
+        let touching = |b: &Bolter| b.travel_ms == CONTACT_MS;
+        match d {
+            Drive::Down => self.travel_ms = (self.travel_ms + ms).min(CONTACT_MS),
+            Drive::Rotate if touching(self) && !self.seized => self.rotated_ms += ms,
+            Drive::Up | Drive::CounterRotateUp => {
+                self.travel_ms = self.travel_ms.saturating_sub(ms);
+                self.rotated_ms = 0;
+            }
+            _ => {}
+        }
+        self.i_bo = match d {
+            Drive::Idle => 0,
+            Drive::Down if touching(self) => 1_100,
+            Drive::Rotate if self.rotated_ms >= LOCK_MS => 1_300,
+            Drive::Rotate => 500,
+            _ => 300,
+        };
+    }
+
+    fn at_home(&self) -> bool {
+        self.travel_ms == 0
+    }
 }
 
 /// What both boards drove in one tick.
@@ -51,6 +105,10 @@ impl Rig {
             to_b: None,
             to_a: None,
             last_b: None,
+            arm_pulse: [None; 2],
+            switch_stuck: [false; 2],
+            bolters: [Bolter::default(); 2],
+            drives: [Drive::Idle; 2],
         };
         r.send(Command::Mode(Mode::Operational));
         r.run(150);
@@ -59,8 +117,17 @@ impl Rig {
         r
     }
 
+    /// Side `i`'s arm switch: closed within 15 µs of the contracted pulse.
+    fn switch(&self, i: usize) -> bool {
+        let contracted = board_a::Config::default().arm.contracted.micros();
+        !self.switch_stuck[i] && self.arm_pulse[i].is_none_or(|p| p.micros() <= contracted + 15)
+    }
+
     fn tick(&mut self, command: Option<Command>) -> Tick {
         self.now += 10;
+        for (b, d) in self.bolters.iter_mut().zip(self.drives) {
+            b.step(d, 10);
+        }
         let packet = command.map(|command| {
             self.seq += 1;
             CommandRepr {
@@ -70,11 +137,22 @@ impl Rig {
             }
             .to_bytes()
         });
+        let electrical = Electrical {
+            v_bat: 12_000,
+            v_reg: 7_400,
+            ..Electrical::default()
+        };
         let a = self.a.tick(
             self.now,
             &Inputs {
                 command: packet,
                 from_b: self.to_a,
+                electrical: Electrical {
+                    i_bo: self.bolters[0].i_bo,
+                    ..electrical
+                },
+                arm_contracted: self.switch(0),
+                bolter_at_home: self.bolters[0].at_home(),
                 ..Inputs::at_home()
             },
         );
@@ -83,11 +161,11 @@ impl Rig {
             &board_b::Inputs {
                 command: self.to_b,
                 electrical: Electrical {
-                    v_bat: 12_000,
-                    v_reg: 7_400,
-                    ..Electrical::default()
+                    i_bo: self.bolters[1].i_bo,
+                    ..electrical
                 },
-                arm_contracted: true,
+                arm_contracted: self.switch(1),
+                bolter_at_home: self.bolters[1].at_home(),
                 ..board_b::Inputs::default()
             },
         );
@@ -96,6 +174,12 @@ impl Rig {
         if let Some(bytes) = a.to_b {
             self.last_b = Some(BCommandRepr::parse(&bytes).unwrap());
         }
+        for (i, pulse) in [a.arm, b.arm].into_iter().enumerate() {
+            if pulse.is_some() {
+                self.arm_pulse[i] = pulse;
+            }
+        }
+        self.drives = [a.bolter, b.bolter];
         Tick {
             a: a.clone(),
             b,
@@ -241,5 +325,285 @@ fn stop_mid_turn_holds_the_hip_where_it_is_read() {
     for _ in 0..50 {
         let t = r.tick(None);
         assert_eq!(t.a.hip, rest.a.hip, "the hip holds at its reading");
+    }
+}
+
+/// The first move of the map from state a that turns nothing: an arm extends, the hip stays
+/// straight (the rig's encoder reads 180° throughout).
+fn extend_from_a() -> Command {
+    let (_, to, p) = map::moves()
+        .find(|(from, _, p)| {
+            *from == State::A && matches!(p, Primitive::FwdExtend | Primitive::BackExtend)
+        })
+        .expect("a primitive extends an arm from a");
+    Command::primitive(p, to).unwrap()
+}
+
+/// One motion at a time: from the tick after a primitive is accepted until the idle check at
+/// its end, the robot counts as in motion at every tick (`BoardA::in_motion`) and a command
+/// that moves is refused as busy — also at the ticks where every module has reached one
+/// step's targets and the next step has not yet set its own, when no servo is on its way.
+#[test]
+fn a_primitive_is_in_motion_and_refuses_other_moves_at_every_tick_until_it_ends() {
+    let mut r = Rig::operational();
+    r.send(extend_from_a());
+    let mut ms = 0;
+    loop {
+        // Each tick, another move is asked for: refused, and the primitive goes on.
+        let t = r.tick(Some(arm(Side::B, ServoTarget::Extend)));
+        ms += 10;
+        assert_eq!(
+            t.hb.and_then(|h| h.refusal),
+            Some(Refusal::Busy),
+            "a second motion accepted {ms} ms into the primitive"
+        );
+        assert!(r.a.in_motion(), "not in motion {ms} ms into the primitive");
+        if t.a.events.iter().any(|e| matches!(e, Event::Reached(_))) {
+            break;
+        }
+        assert!(ms < 30_000, "the primitive did not end in 30 s");
+    }
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    assert_ne!(r.a.state(), Some(State::A), "the primitive moved the robot");
+}
+
+/// Section 7's idle check at the end of a reconfiguration reads the currents at rest: after
+/// the primitive reaches its state the robot stays busy, and command complete (heartbeat byte
+/// 54) stays unset, until it has been still for `idle_settle_ms` (the sensor averages no
+/// longer hold the motion's currents); then the check passes and command complete is set.
+#[test]
+fn command_complete_waits_until_the_robot_has_rested_idle_settle_ms_after_the_primitive() {
+    let settle = board_a::Config::default().idle_settle_ms;
+    let mut r = Rig::operational();
+    r.send(extend_from_a());
+    let mut reached_at = None;
+    for _ in 0..3_000 {
+        let t = r.tick(None);
+        if t.a.events.iter().any(|e| matches!(e, Event::Reached(_))) {
+            reached_at = Some(r.now);
+            break;
+        }
+    }
+    let reached_at = reached_at.expect("the primitive reaches its state");
+    // Still busy, and not complete, while the robot settles.
+    while r.now + 10 < reached_at + settle {
+        let t = r.tick(Some(Command::ClearFaults));
+        assert!(
+            r.a.in_motion(),
+            "idle {} ms after the state was reached",
+            r.now - reached_at
+        );
+        assert!(
+            !t.hb.unwrap().command_complete,
+            "complete before the idle check"
+        );
+    }
+    // Then, within two link periods of the settle time, complete.
+    let mut complete = false;
+    for _ in 0..10 {
+        let t = r.tick(Some(Command::ClearFaults));
+        if !r.a.in_motion() && t.hb.unwrap().command_complete {
+            complete = true;
+            break;
+        }
+    }
+    assert!(
+        complete,
+        "not complete {} ms after the state was reached",
+        r.now - reached_at
+    );
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+}
+
+/// A reconfiguration accepted while the averaged currents still hold the last motion waits for
+/// the idle check at its start (Section 7; `Config::idle_settle_ms`): its first primitive
+/// starts — the moving side's gripper releases — only once the robot has been still for
+/// `idle_settle_ms`, not as soon as it is accepted.
+#[test]
+fn a_primitive_accepted_right_after_a_motion_starts_once_the_robot_has_rested() {
+    let settle = board_a::Config::default().idle_settle_ms;
+    let mut r = Rig::operational();
+    // A single-module move there and back; the primitive comes at the first idle tick.
+    for target in [ServoTarget::Extend, ServoTarget::Contract] {
+        r.send(arm(Side::A, target));
+        while {
+            r.tick(None);
+            r.a.in_motion()
+        } {}
+    }
+    let still_at = r.now;
+    let hb = r.send(extend_from_a()).hb.unwrap();
+    // The grippers' targets: side A's as A drives it, side B's as A commands B.
+    let before = (hb.gripper_a_target, r.last_b.unwrap().gripper_target);
+    // Nothing moves while the robot settles; then the moving side's gripper releases.
+    let mut started = None;
+    for _ in 0..(settle / 10 + 20) {
+        let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+        if (hb.gripper_a_target, r.last_b.unwrap().gripper_target) != before {
+            started = Some(r.now);
+            break;
+        }
+    }
+    let started = started.expect("the primitive starts");
+    assert!(
+        started >= still_at + settle,
+        "started {} ms after the robot came to rest",
+        started - still_at
+    );
+    assert!(started <= still_at + settle + 100);
+}
+
+/// Entering Operational sends the hip to the configured home angle (`safety.hip_home`: the
+/// contracted-gripped configuration the hip mismatch check reads against), not to a fixed
+/// 180°: a robot whose home is at 90°, reading 90°, is held there.
+#[test]
+fn entering_operational_sends_the_hip_to_its_configured_home() {
+    let home = HipAngle::new(9_000).unwrap();
+    let mut cfg = board_a::Config::default();
+    cfg.safety.hip_home = home;
+    // The pulse that holds a hip at its target (a default board at rest at 180°).
+    let mut reference = Rig::operational();
+    let hold = reference.tick(None).a.hip;
+    let mut a = BoardA::new(cfg);
+    let inputs = |command| Inputs {
+        command,
+        hip: Some(home),
+        ..Inputs::at_home()
+    };
+    let packet = CommandRepr {
+        board: BoardNumber::ONE,
+        command: Command::Mode(Mode::Operational),
+        seq: 1,
+    }
+    .to_bytes();
+    let out = a.tick(10, &inputs(Some(packet)));
+    let hb = HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
+    assert_eq!((hb.mode, hb.refusal), (Mode::Operational, None));
+    assert!(hb.faults.is_empty(), "{:?}", hb.faults);
+    assert_eq!(hb.hip_target, home, "the hip is sent home");
+    for t in 2..100 {
+        let out = a.tick(t * 10, &inputs(None));
+        assert_eq!(out.hip, hold, "the hip is driven away from its home");
+    }
+}
+
+fn gripper(side: Side, target: ServoTarget) -> Command {
+    Command::Gripper { side, target }
+}
+
+/// Waits (at most 10 s) until board A no longer counts a motion.
+fn until_idle(r: &mut Rig) {
+    for _ in 0..1_000 {
+        r.tick(None);
+        if !r.a.in_motion() {
+            return;
+        }
+    }
+    panic!("still in motion after 10 s");
+}
+
+/// A single-module move (Table 1's arm and gripper commands, on either side) is a motion
+/// until its servo is at the target, as the heartbeat reports it: meanwhile the robot is in
+/// motion, another move is refused as busy, and command complete (byte 54) is unset; then
+/// the motion ends with command complete set (spec/decisions.toml, `command-complete`).
+#[test]
+fn a_single_module_move_is_a_motion_until_its_servo_is_at_its_target() {
+    let cfg = board_a::Config::default();
+    for c in [
+        arm(Side::A, ServoTarget::Extend),
+        arm(Side::B, ServoTarget::Extend),
+        gripper(Side::A, ServoTarget::Contract),
+        gripper(Side::B, ServoTarget::Contract),
+    ] {
+        let mut r = Rig::operational();
+        r.send(c);
+        let t = r.tick(Some(Command::Hip(mmic::command::HipTarget::Straight)));
+        assert_eq!(
+            t.hb.unwrap().refusal,
+            Some(Refusal::Busy),
+            "{c:?}: a second move accepted"
+        );
+        // The servo as the heartbeat reports it (side B's as board B reported it).
+        let there = |hb: &HeartbeatRepr| match c {
+            Command::Arm { side: Side::A, .. } => {
+                hb.arm_a_now == hb.arm_a_target && hb.arm_a_target == cfg.arm.extended
+            }
+            Command::Arm { side: Side::B, .. } => {
+                hb.arm_b_now == hb.arm_b_target && hb.arm_b_target == cfg.arm.extended
+            }
+            Command::Gripper { side: Side::A, .. } => {
+                hb.gripper_a_now == hb.gripper_a_target
+                    && hb.gripper_a_target == cfg.gripper.contracted
+            }
+            _ => {
+                hb.gripper_b_now == hb.gripper_b_target
+                    && hb.gripper_b_target == cfg.gripper.contracted
+            }
+        };
+        let mut ms = 10;
+        loop {
+            let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+            ms += 10;
+            if !there(&hb) {
+                assert!(r.a.in_motion(), "{c:?}: not in motion at {ms} ms");
+                assert!(!hb.command_complete, "{c:?}: complete at {ms} ms");
+            }
+            if !r.a.in_motion() {
+                assert!(there(&hb), "{c:?}");
+                assert!(hb.command_complete, "{c:?}: ended, not complete");
+                break;
+            }
+            assert!(ms < 10_000, "{c:?}: still moving after 10 s");
+        }
+        assert!(ms > 500, "{c:?}: a full travel takes time");
+    }
+}
+
+/// Table 8's "arm not fully contracted": after a contract arm command, once the arm has
+/// finished its travel, its contraction switch must close within the confirm time
+/// (`motion.confirm_ms`). A switch that stays open raises the fault (and the robot is
+/// safed) — not while the arm is still on its way, and not when the switch closes.
+#[test]
+fn an_arm_contraction_is_a_fault_when_the_switch_stays_open_past_the_confirm_time() {
+    let cfg = board_a::Config::default();
+    let confirm = cfg.motion.confirm_ms;
+    for side in [Side::A, Side::B] {
+        for stuck in [false, true] {
+            let mut r = Rig::operational();
+            r.send(arm(side, ServoTarget::Extend));
+            until_idle(&mut r);
+            r.switch_stuck[side as usize] = stuck;
+            r.send(arm(side, ServoTarget::Contract));
+            let mut arrived = None;
+            let mut faulted = None;
+            for _ in 0..800 {
+                let t = r.tick(None);
+                let pulse = match side {
+                    Side::A => t.a.arm,
+                    Side::B => t.b.arm,
+                };
+                if arrived.is_none() && pulse == Some(cfg.arm.contracted) {
+                    arrived = Some(r.now);
+                }
+                if r.a.faults().contains(Fault::ArmNotContracted) {
+                    faulted = Some(r.now);
+                    break;
+                }
+            }
+            let arrived = arrived.unwrap_or_else(|| panic!("{side:?}: arm never contracted"));
+            if stuck {
+                let at = faulted.unwrap_or_else(|| panic!("{side:?}: stuck switch, no fault"));
+                assert!(
+                    at > arrived + confirm,
+                    "{side:?}: fault {} ms after the arm arrived",
+                    at as i64 - arrived as i64
+                );
+                assert!(at <= arrived + confirm + 200, "{side:?}: fault late");
+                assert_eq!(r.a.mode(), Mode::Safed);
+            } else {
+                assert_eq!(faulted, None, "{side:?}: the switch closed");
+                assert_eq!(r.a.mode(), Mode::Operational);
+            }
+        }
     }
 }
