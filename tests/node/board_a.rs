@@ -5,7 +5,7 @@
 //! board B, B's own servo and bolter outputs. Boards A and B are linked tick by tick, at rest in
 //! state a and Operational before each motion.
 
-use mmic::bolter::Drive;
+use mmic::bolter::{Drive, MuxLines};
 use mmic::command::{BolterCommand, Command, ServoTarget};
 use mmic::command::{BolterPair, Fasteners};
 use mmic::faults::Fault;
@@ -41,16 +41,32 @@ struct Rig {
 }
 
 /// A bolter over a fastener, as its current sensor and home switch see it: driven down, it
-/// travels `CONTACT_MS` before it touches and pushes (I_bo past the push threshold); rotated
-/// while touching, it locks the fastener after `LOCK_MS` and stalls (I_bo past the lock
-/// threshold) — unless the fastener is `seized`, when it turns freely and never locks; driven
-/// up, it is back on its home switch after as long as it went down.
-#[derive(Debug, Clone, Copy, Default)]
+/// travels `CONTACT_MS` before it touches and pushes (I_bo past the push threshold) — unless
+/// no fastener is `there`, when it never touches; rotated while touching, it locks the
+/// fastener after `LOCK_MS` and stalls (I_bo past the lock threshold) — unless the fastener is
+/// seized, when the head turns on it without locking (for the first `seized` rotations);
+/// driven up, it is back on its home switch after as long as it went down.
+#[derive(Debug, Clone, Copy)]
 struct Bolter {
     travel_ms: u32,
     rotated_ms: u32,
+    rotating: bool,
     i_bo: u16,
-    seized: bool,
+    there: bool,
+    seized: u8,
+}
+
+impl Default for Bolter {
+    fn default() -> Bolter {
+        Bolter {
+            travel_ms: 0,
+            rotated_ms: 0,
+            rotating: false,
+            i_bo: 0,
+            there: true,
+            seized: 0,
+        }
+    }
 }
 
 const CONTACT_MS: u32 = 500;
@@ -58,19 +74,27 @@ const LOCK_MS: u32 = 300;
 
 impl Bolter {
     fn step(&mut self, d: Drive, ms: u32) {
-        let touching = |b: &Bolter| b.travel_ms == CONTACT_MS;
+        let touching = self.there && self.travel_ms >= CONTACT_MS;
+        if self.rotating && d != Drive::Rotate && self.seized > 0 {
+            self.seized -= 1;
+        }
+        self.rotating = d == Drive::Rotate;
         match d {
-            Drive::Down => self.travel_ms = (self.travel_ms + ms).min(CONTACT_MS),
-            Drive::Rotate if touching(self) && !self.seized => self.rotated_ms += ms,
+            Drive::Down => self.travel_ms = (self.travel_ms + ms).min(CONTACT_MS + 1_000),
+            Drive::Rotate if touching && self.seized == 0 => self.rotated_ms += ms,
             Drive::Up | Drive::CounterRotateUp => {
                 self.travel_ms = self.travel_ms.saturating_sub(ms);
                 self.rotated_ms = 0;
             }
             _ => {}
         }
+        if self.there {
+            self.travel_ms = self.travel_ms.min(CONTACT_MS);
+        }
+        let touching = self.there && self.travel_ms >= CONTACT_MS;
         self.i_bo = match d {
             Drive::Idle => 0,
-            Drive::Down if touching(self) => 1_100,
+            Drive::Down if touching => 1_100,
             Drive::Rotate if self.rotated_ms >= LOCK_MS => 1_300,
             Drive::Rotate => 500,
             _ => 300,
@@ -605,5 +629,151 @@ fn an_arm_contraction_is_a_fault_when_the_switch_stays_open_past_the_confirm_tim
                 assert_eq!(r.a.mode(), Mode::Operational);
             }
         }
+    }
+}
+
+/// Runs until board A reports the end of a bolting job or of a "move bolters down" (at most
+/// `max_ms`), checking at every tick before it that the job counts as a motion (another move
+/// is refused as busy) and that both sides' multiplexers select the pair being worked on.
+/// Returns every event of board A meanwhile, the last tick's included.
+fn bolt_until_end(r: &mut Rig, max_ms: u32) -> Vec<Event> {
+    let mut events = Vec::new();
+    let mut pair = None;
+    for i in 0..max_ms / 10 {
+        // Every 7th tick, another move is asked for.
+        let probe = i % 7 == 3;
+        let moving = r.a.in_motion();
+        let t = r.tick(probe.then_some(arm(Side::A, ServoTarget::Extend)));
+        events.extend(t.a.events.iter().copied());
+        let end =
+            t.a.events
+                .iter()
+                .any(|e| matches!(e, Event::Bolting(_) | Event::BoltersDown { .. }));
+        if end {
+            return events;
+        }
+        assert!(i == 0 || moving, "not in motion {} ms into the job", i * 10);
+        if probe {
+            assert_eq!(
+                t.hb.unwrap().refusal,
+                Some(Refusal::Busy),
+                "a move accepted {} ms into the job",
+                i * 10
+            );
+        }
+        // The pair in force, as the heartbeat's active bolter names it (byte 55).
+        if let Some(p) = r.last_b.and_then(|b| b.bolter).map(|o| o.pair) {
+            pair = Some(p);
+        }
+        if t.a.bolter != Drive::Idle {
+            assert_eq!(t.a.mux, MuxLines::for_pair(pair.unwrap()), "side A's mux");
+        }
+        if t.b.bolter != Drive::Idle {
+            assert_eq!(t.b.mux, MuxLines::for_pair(pair.unwrap()), "side B's mux");
+        }
+    }
+    panic!("the job did not end in {max_ms} ms: {events:?}");
+}
+
+fn pairs(events: &[Event]) -> Vec<(BolterPair, u8, bool)> {
+    events
+        .iter()
+        .filter_map(|e| match e {
+            Event::Pair { pair, attempts, ok } => Some((*pair, *attempts, *ok)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Bolting all four pairs, boards A and B linked, the plant's fasteners answering as they
+/// should: both sides run Figure 8's steps pair after pair, each pair is fastened at the first
+/// attempt (events name them in order), the job ends done with no fault, the robot is in
+/// motion (and refuses other moves) until then and reports command complete after.
+#[test]
+fn bolting_all_four_pairs_runs_both_sides_pair_after_pair_to_done() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::All)));
+    let events = bolt_until_end(&mut r, 60_000);
+    assert_eq!(
+        pairs(&events),
+        [
+            (BolterPair::P1, 1, true),
+            (BolterPair::P2, 1, true),
+            (BolterPair::P3, 1, true),
+            (BolterPair::P4, 1, true)
+        ]
+    );
+    assert_eq!(events.last(), Some(&Event::Bolting(None)));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+    assert!(!r.a.in_motion());
+    assert!(hb.command_complete, "bolting done: command complete");
+    assert_eq!(r.a.mode(), Mode::Operational);
+}
+
+/// A fastener that side B's head cannot lock at first (it turns on it; Rotate times out):
+/// the attempt is abandoned — both bolters go home — and the pair is tried again, fastened at
+/// the second attempt (Figure 10's "twice"); the other pairs are unaffected.
+#[test]
+fn a_pair_that_does_not_lock_at_first_is_fastened_at_its_second_attempt() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::P3,
+    ))));
+    r.bolters[1].seized = 1;
+    let events = bolt_until_end(&mut r, 60_000);
+    assert_eq!(pairs(&events), [(BolterPair::P3, 2, true)]);
+    assert_eq!(events.last(), Some(&Event::Bolting(None)));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    assert_eq!(r.a.mode(), Mode::Operational);
+}
+
+/// A fastener that never locks on side A: after the third failed attempt (Table 8: three) the
+/// pair is given up, the job fails with Table 8's (un)bolting failure, and the robot goes to
+/// Standby (fully gripped: cutting power cannot drop it).
+#[test]
+fn a_pair_that_never_locks_fails_the_job_after_three_attempts() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::P1,
+    ))));
+    r.bolters[0].seized = u8::MAX;
+    let events = bolt_until_end(&mut r, 60_000);
+    assert_eq!(pairs(&events), [(BolterPair::P1, 3, false)]);
+    assert!(
+        events.contains(&Event::Bolting(Some(Fault::BoltingFailure))),
+        "{events:?}"
+    );
+    assert!(r.a.faults().contains(Fault::BoltingFailure));
+    assert_eq!(r.a.mode(), Mode::Standby);
+}
+
+/// Table 1's "move bolters down": both bolters descend until their currents say they touch,
+/// and stop there; the job ends reporting contact, with no fault. When one side finds nothing
+/// to touch, its descent times out: the job still ends (nothing was bolted, so no failure),
+/// reporting no contact.
+#[test]
+fn moving_the_bolters_down_ends_when_both_touch_or_a_descent_times_out() {
+    for b_there in [true, false] {
+        let mut r = Rig::operational();
+        r.bolters[1].there = b_there;
+        r.send(Command::Bolter(BolterCommand::Down));
+        let start = r.now;
+        let events = bolt_until_end(&mut r, 10_000);
+        assert_eq!(
+            events.last(),
+            Some(&Event::BoltersDown { contact: b_there })
+        );
+        let took = r.now - start;
+        if b_there {
+            assert!(took < CONTACT_MS + 500, "took {took} ms");
+        } else {
+            assert!(took > board_a::Config::default().bolter.side.sensed_ms);
+        }
+        assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+        // Down and stopped there: neither bolter is driven any more.
+        let t = r.run(20);
+        assert_eq!((t.a.bolter, t.b.bolter), (Drive::Idle, Drive::Idle));
+        assert!(!r.a.in_motion());
     }
 }
