@@ -949,3 +949,22 @@ fn a_module_switched_off_is_not_driven_and_the_others_are() {
         assert_eq!(side_a(&r.run(10)), [true; 3], "{m:?} on");
     }
 }
+
+/// Power Control of a bolter: with bolter A switched off, a bolting job leaves side A's motor
+/// unpowered (idle) while side B's descends.
+#[test]
+fn a_bolter_switched_off_is_not_driven() {
+    use mmic::command::PowerTarget;
+    use mmic::units::Module;
+    let mut r = Rig::operational();
+    r.send(Command::Power {
+        target: PowerTarget::Module(Module::BolterA),
+        on: false,
+    });
+    r.send(Command::Bolter(BolterCommand::Down));
+    for _ in 0..20 {
+        let t = r.tick(None);
+        assert_eq!(t.a.bolter, Drive::Idle, "bolter A driven while off");
+    }
+    assert_eq!(r.tick(None).b.bolter, Drive::Down, "bolter B descends");
+}
