@@ -380,6 +380,10 @@ fn a_primitive_is_in_motion_and_refuses_other_moves_at_every_tick_until_it_ends(
             "a second motion accepted {ms} ms into the primitive"
         );
         assert!(r.a.in_motion(), "not in motion {ms} ms into the primitive");
+        assert!(
+            !t.hb.unwrap().command_complete,
+            "command complete {ms} ms into the primitive"
+        );
         if t.a.events.iter().any(|e| matches!(e, Event::Reached(_))) {
             break;
         }
@@ -967,4 +971,67 @@ fn a_bolter_switched_off_is_not_driven() {
         assert_eq!(t.a.bolter, Drive::Idle, "bolter A driven while off");
     }
     assert_eq!(r.tick(None).b.bolter, Drive::Down, "bolter B descends");
+}
+
+/// Table 1's hip commands set the hip's target: a preset to its angle, any other angle to
+/// itself, home to the configured home angle.
+#[test]
+fn a_hip_command_sets_the_angle_it_names() {
+    use mmic::command::HipTarget;
+    let home = board_a::Config::default().safety.hip_home;
+    let angle = HipAngle::new(12_345).unwrap();
+    for (h, want) in [
+        (HipTarget::RightAngleCw, HipAngle::new(9_000).unwrap()),
+        (HipTarget::RightAngleCcw, HipAngle::new(27_000).unwrap()),
+        (HipTarget::Angle(angle), angle),
+        (HipTarget::Home, home),
+    ] {
+        let mut r = Rig::operational();
+        r.send(Command::Hip(h));
+        let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+        assert_eq!(hb.hip_target, want, "{h:?}");
+    }
+}
+
+/// A reconfiguration over primitives that turn nothing (the rig's hip reads 180° throughout):
+/// from a to a matched state two or more primitives away, run primitive after primitive, it
+/// reaches its target, which the board then tracks, with no fault and command complete.
+#[test]
+fn a_reconfiguration_runs_its_primitives_to_its_target() {
+    use mmic::motion::route;
+    let straight = |p: &Primitive| {
+        matches!(
+            p,
+            Primitive::FwdExtend
+                | Primitive::BackExtend
+                | Primitive::FwdContract
+                | Primitive::BackContract
+        )
+    };
+    let target = State::ALL
+        .into_iter()
+        .find(|s| {
+            let plan = route::lookup(State::A, *s);
+            s.is_matched() && plan.primitives().len() >= 2 && plan.primitives().iter().all(straight)
+        })
+        .expect("a matched state reached without turning");
+    let mut r = Rig::operational();
+    r.send(Command::reconfigure(State::A, target).unwrap());
+    let mut reached = Vec::new();
+    for _ in 0..6_000 {
+        let t = r.tick(None);
+        reached.extend(t.a.events.iter().filter_map(|e| match e {
+            Event::Reached(s) => Some(*s),
+            _ => None,
+        }));
+        if !r.a.in_motion() {
+            break;
+        }
+    }
+    assert_eq!(reached.last(), Some(&target), "{reached:?}");
+    assert_eq!(r.a.state(), Some(target));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+    assert!(hb.command_complete);
+    assert_eq!(hb.target_state, Some(target));
 }
