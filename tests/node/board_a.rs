@@ -18,6 +18,7 @@ use mmic::units::{BoardNumber, Electrical, HipAngle, PulseWidth, Side};
 use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
+use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
 
 /// Boards A and B linked both ways every tick, and the plant they drive: each side's arm
 /// contraction switch and bolter.
@@ -40,10 +41,14 @@ struct Rig {
     drives: [Drive; 2],
     /// Each side's filtered voltages and currents (I_bo aside: the bolter's).
     electrical: [Electrical; 2],
+    /// The last internal heartbeat board A received, and whether it came at the last tick.
+    heard_b: Option<(InternalHeartbeatRepr, bool)>,
+    /// Board B's heartbeats are lost on the serial line until this time, ms.
+    b_lost_until: u32,
 }
 
 /// A bolter over a fastener, as its current sensor and home switch see it: driven down, it
-/// travels `CONTACT_MS` before it touches and pushes (I_bo past the push threshold) — unless
+/// travels `contact_ms` (default `CONTACT_MS`) before it touches and pushes (I_bo past the push threshold) — unless
 /// no fastener is `there`, when it never touches; rotated while touching, it locks the
 /// fastener after `LOCK_MS` and stalls (I_bo past the lock threshold) — unless the fastener is
 /// seized, when the head turns on it without locking (for the first `seized` rotations);
@@ -56,6 +61,7 @@ struct Bolter {
     i_bo: u16,
     there: bool,
     seized: u8,
+    contact_ms: u32,
 }
 
 impl Default for Bolter {
@@ -67,6 +73,7 @@ impl Default for Bolter {
             i_bo: 0,
             there: true,
             seized: 0,
+            contact_ms: CONTACT_MS,
         }
     }
 }
@@ -76,13 +83,13 @@ const LOCK_MS: u32 = 300;
 
 impl Bolter {
     fn step(&mut self, d: Drive, ms: u32) {
-        let touching = self.there && self.travel_ms >= CONTACT_MS;
+        let touching = self.there && self.travel_ms >= self.contact_ms;
         if self.rotating && d != Drive::Rotate && self.seized > 0 {
             self.seized -= 1;
         }
         self.rotating = d == Drive::Rotate;
         match d {
-            Drive::Down => self.travel_ms = (self.travel_ms + ms).min(CONTACT_MS + 1_000),
+            Drive::Down => self.travel_ms = (self.travel_ms + ms).min(self.contact_ms + 1_000),
             Drive::Rotate if touching && self.seized == 0 => self.rotated_ms += ms,
             Drive::Up | Drive::CounterRotateUp => {
                 self.travel_ms = self.travel_ms.saturating_sub(ms);
@@ -91,9 +98,9 @@ impl Bolter {
             _ => {}
         }
         if self.there {
-            self.travel_ms = self.travel_ms.min(CONTACT_MS);
+            self.travel_ms = self.travel_ms.min(self.contact_ms);
         }
-        let touching = self.there && self.travel_ms >= CONTACT_MS;
+        let touching = self.there && self.travel_ms >= self.contact_ms;
         self.i_bo = match d {
             Drive::Idle => 0,
             Drive::Down if touching => 1_100,
@@ -136,6 +143,8 @@ impl Rig {
             bolters: [Bolter::default(); 2],
             drives: [Drive::Idle; 2],
             electrical: [Inputs::at_home().electrical; 2],
+            heard_b: None,
+            b_lost_until: 0,
         };
         r.send(Command::Mode(Mode::Operational));
         r.run(150);
@@ -178,6 +187,10 @@ impl Rig {
                 ..Inputs::at_home()
             },
         );
+        self.heard_b = match self.to_a {
+            Some(bytes) => Some((InternalHeartbeatRepr::parse(&bytes).unwrap(), true)),
+            None => self.heard_b.map(|(h, _)| (h, false)),
+        };
         let b = self.b.tick(
             self.now,
             &board_b::Inputs {
@@ -192,7 +205,7 @@ impl Rig {
             },
         );
         self.to_b = a.to_b;
-        self.to_a = b.heartbeat;
+        self.to_a = b.heartbeat.filter(|_| self.now >= self.b_lost_until);
         if let Some(bytes) = a.to_b {
             self.last_b = Some(BCommandRepr::parse(&bytes).unwrap());
         }
@@ -1034,4 +1047,91 @@ fn a_reconfiguration_runs_its_primitives_to_its_target() {
     let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
     assert!(hb.command_complete);
     assert_eq!(hb.target_state, Some(target));
+}
+
+/// A bolting job accepted while board B still reports a bolter order (its last job's) waits
+/// until B reports its bolter idle, so that B cannot take the new job's first order for its
+/// previous one (spec/control/bolter.md): meanwhile neither side is ordered anything; then the
+/// job runs.
+#[test]
+fn a_new_bolting_job_waits_until_board_b_reports_its_bolter_idle() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Down));
+    bolt_until_end(&mut r, 10_000);
+    // At once the next job: B's last report, as A heard it, still names the first job's step.
+    r.send(Command::Bolter(BolterCommand::Down));
+    let mut waited = 0;
+    for _ in 0..100 {
+        let t = r.tick(None);
+        let (heard, _) = r.heard_b.unwrap();
+        if heard.bolter_aux.step.is_none() {
+            break;
+        }
+        waited += 1;
+        assert_eq!(t.a.bolter, Drive::Idle, "side A ordered while B is busy");
+        assert_eq!(r.last_b.unwrap().bolter, None, "B ordered while busy");
+    }
+    assert!(
+        waited > 0,
+        "B reported idle before the job came: nothing tested"
+    );
+    let events = bolt_until_end(&mut r, 10_000);
+    assert_eq!(events.last(), Some(&Event::BoltersDown { contact: true }));
+}
+
+/// Stop, then Reset at once, mid-descent after board B reported its bolter touching: the
+/// resumed step is ordered afresh on both sides, and only a report B makes of it since — one
+/// naming an A→B packet sent after the Reset — counts for side B. B's report from before the
+/// Stop never completes it, even when side A completes at once and B's next heartbeats are
+/// lost on the line for a while (spec/control/bolter.md, "Stop and Reset").
+#[test]
+fn a_report_from_before_a_stop_never_completes_the_resumed_step() {
+    let mut r = Rig::operational();
+    r.bolters[1].contact_ms = 200;
+    r.bolters[0].contact_ms = 2_000;
+    r.send(Command::Bolter(BolterCommand::Down));
+    // Until A hears that B's bolter touches.
+    for _ in 0..200 {
+        r.tick(None);
+        if r.heard_b
+            .is_some_and(|(h, _)| h.bolter_aux.threshold_reached)
+        {
+            break;
+        }
+    }
+    assert!(r.heard_b.unwrap().0.bolter_aux.threshold_reached);
+    r.send(Command::Stop);
+    let t = r.send(Command::Reset);
+    // Side A's fastener is right under it: it touches within a tick or two of resuming; B's
+    // heartbeats of the next 200 ms are lost (well within the link's 500 ms timeout).
+    r.bolters[0].contact_ms = r.bolters[0].travel_ms + 10;
+    r.b_lost_until = r.now + 200;
+    let mut since_reset: Vec<u8> =
+        t.a.to_b
+            .map(|b| BCommandRepr::parse(&b).unwrap().seq)
+            .into_iter()
+            .collect();
+    let mut fresh = false;
+    for _ in 0..500 {
+        let t = r.tick(None);
+        if let Some((h, true)) = r.heard_b {
+            fresh |= h.bolter_aux.step.is_some() && since_reset.contains(&h.bolter_aux.seq);
+        }
+        if let Some(b) = t.a.to_b {
+            since_reset.push(BCommandRepr::parse(&b).unwrap().seq);
+        }
+        if let Some(e) =
+            t.a.events
+                .iter()
+                .find(|e| matches!(e, Event::BoltersDown { .. }))
+        {
+            assert!(
+                fresh,
+                "the resumed step ended on B's report from before the Stop"
+            );
+            assert_eq!(e, &Event::BoltersDown { contact: true });
+            return;
+        }
+    }
+    panic!("the resumed job did not end");
 }
