@@ -1135,3 +1135,40 @@ fn a_report_from_before_a_stop_never_completes_the_resumed_step() {
     }
     panic!("the resumed job did not end");
 }
+
+/// A Stop with nothing moving holds board B too (the A→B stop flag); the next command that
+/// moves side B lifts the hold, and B's arm goes to its new target.
+#[test]
+fn after_a_stop_a_command_for_side_b_lifts_the_hold() {
+    let extended = board_a::Config::default().arm.extended;
+    let mut r = Rig::operational();
+    r.send(Command::Stop);
+    r.run(10);
+    assert!(r.last_b.unwrap().stop, "B told to hold");
+    r.send(arm(Side::B, ServoTarget::Extend));
+    until_idle(&mut r);
+    let t = r.run(10);
+    assert!(!r.last_b.unwrap().stop, "B still held");
+    assert_eq!(t.b.arm, Some(extended), "B's arm did not extend");
+}
+
+/// The time a Stop holds a bolting job is no stall: paused mid-step for longer than a step
+/// may take, the job resumes on Reset with the step's clock restarted and completes, with no
+/// timeout.
+#[test]
+fn a_bolting_job_paused_longer_than_a_step_timeout_completes_after_reset() {
+    let cfg = board_a::Config::default().bolter;
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::P2,
+    ))));
+    r.run(20);
+    r.send(Command::Stop);
+    assert!(r.a.paused());
+    r.run((cfg.side.sensed_ms + cfg.link_margin_ms) / 10 + 100);
+    r.send(Command::Reset);
+    let events = bolt_until_end(&mut r, 30_000);
+    assert_eq!(pairs(&events), [(BolterPair::P2, 1, true)]);
+    assert_eq!(events.last(), Some(&Event::Bolting(None)));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+}
