@@ -940,30 +940,49 @@ fn events_name_refused_commands_mode_changes_and_new_faults_once() {
 }
 
 /// Power Control (Table 1): a module switched off in Operational gets no pulse while the
-/// others are driven; switched on again, it is driven.
+/// others are driven — on side A by board A, on side B by board B as the A→B command's power
+/// flags tell it; switched on again, it is driven.
 #[test]
 fn a_module_switched_off_is_not_driven_and_the_others_are() {
     use mmic::command::PowerTarget;
     use mmic::units::Module;
-    let side_a = |t: &Tick| [t.a.hip.is_some(), t.a.arm.is_some(), t.a.gripper.is_some()];
-    for (i, m) in [Module::Hip, Module::ArmA, Module::GripperA]
-        .into_iter()
-        .enumerate()
-    {
+    let powered = |r: &Rig, t: &Tick| {
+        let p = r.last_b.unwrap().power;
+        [
+            t.a.hip.is_some(),
+            t.a.arm.is_some(),
+            t.a.gripper.is_some(),
+            p.arm && t.b.arm.is_some(),
+            p.gripper && t.b.gripper.is_some(),
+            p.bolter,
+        ]
+    };
+    let modules = [
+        Module::Hip,
+        Module::ArmA,
+        Module::GripperA,
+        Module::ArmB,
+        Module::GripperB,
+        Module::BolterB,
+    ];
+    for (i, m) in modules.into_iter().enumerate() {
         let mut r = Rig::operational();
-        assert_eq!(side_a(&r.tick(None)), [true; 3]);
+        let t = r.tick(None);
+        assert_eq!(powered(&r, &t), [true; 6]);
         r.send(Command::Power {
             target: PowerTarget::Module(m),
             on: false,
         });
-        let mut want = [true; 3];
+        let mut want = [true; 6];
         want[i] = false;
-        assert_eq!(side_a(&r.run(10)), want, "{m:?} off");
+        let t = r.run(10);
+        assert_eq!(powered(&r, &t), want, "{m:?} off");
         r.send(Command::Power {
             target: PowerTarget::Module(m),
             on: true,
         });
-        assert_eq!(side_a(&r.run(10)), [true; 3], "{m:?} on");
+        let t = r.run(10);
+        assert_eq!(powered(&r, &t), [true; 6], "{m:?} on");
     }
 }
 
