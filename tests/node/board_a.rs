@@ -658,10 +658,13 @@ fn an_arm_contraction_is_a_fault_when_the_switch_stays_open_past_the_confirm_tim
 
 /// Runs until board A reports the end of a bolting job or of a "move bolters down" (at most
 /// `max_ms`), checking at every tick before it that the job counts as a motion (another move
-/// is refused as busy) and that both sides' multiplexers select the pair being worked on.
-/// Returns every event of board A meanwhile, the last tick's included.
-fn bolt_until_end(r: &mut Rig, max_ms: u32) -> Vec<Event> {
+/// is refused as busy), that the heartbeat names the pair being worked on (byte 55) and an
+/// attempt 1..=3 (byte 56), and that both sides' multiplexers select that pair. Returns every
+/// event of board A meanwhile, the last tick's included, and the attempts the heartbeats
+/// reported, in order, without repeats.
+fn bolt_until_end(r: &mut Rig, max_ms: u32) -> (Vec<Event>, Vec<u8>) {
     let mut events = Vec::new();
+    let mut attempts: Vec<u8> = Vec::new();
     let mut pair = None;
     for i in 0..max_ms / 10 {
         // Every 7th tick, another move is asked for.
@@ -674,20 +677,27 @@ fn bolt_until_end(r: &mut Rig, max_ms: u32) -> Vec<Event> {
                 .iter()
                 .any(|e| matches!(e, Event::Bolting(_) | Event::BoltersDown { .. }));
         if end {
-            return events;
+            return (events, attempts);
         }
         assert!(i == 0 || moving, "not in motion {} ms into the job", i * 10);
+        // The pair in force, as board A orders it.
+        if let Some(p) = r.last_b.and_then(|b| b.bolter).map(|o| o.pair) {
+            pair = Some(p);
+        }
         if probe {
+            let hb = t.hb.unwrap();
             assert_eq!(
-                t.hb.unwrap().refusal,
+                hb.refusal,
                 Some(Refusal::Busy),
                 "a move accepted {} ms into the job",
                 i * 10
             );
-        }
-        // The pair in force, as the heartbeat's active bolter names it (byte 55).
-        if let Some(p) = r.last_b.and_then(|b| b.bolter).map(|o| o.pair) {
-            pair = Some(p);
+            assert_eq!(hb.active_bolter, pair, "byte 55");
+            let n = hb.bolter_attempt.get();
+            assert!((1..=3).contains(&n), "byte 56: attempt {n}");
+            if attempts.last() != Some(&n) {
+                attempts.push(n);
+            }
         }
         if t.a.bolter != Drive::Idle {
             assert_eq!(t.a.mux, MuxLines::for_pair(pair.unwrap()), "side A's mux");
@@ -717,7 +727,8 @@ fn pairs(events: &[Event]) -> Vec<(BolterPair, u8, bool)> {
 fn bolting_all_four_pairs_runs_both_sides_pair_after_pair_to_done() {
     let mut r = Rig::operational();
     r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::All)));
-    let events = bolt_until_end(&mut r, 60_000);
+    let (events, attempts) = bolt_until_end(&mut r, 60_000);
+    assert_eq!(attempts, [1], "every pair at its first attempt");
     assert_eq!(
         pairs(&events),
         [
@@ -745,7 +756,8 @@ fn a_pair_that_does_not_lock_at_first_is_fastened_at_its_second_attempt() {
         BolterPair::P3,
     ))));
     r.bolters[1].seized = 1;
-    let events = bolt_until_end(&mut r, 60_000);
+    let (events, attempts) = bolt_until_end(&mut r, 60_000);
+    assert_eq!(attempts, [1, 2], "the heartbeat's attempt (byte 56)");
     assert_eq!(pairs(&events), [(BolterPair::P3, 2, true)]);
     assert_eq!(events.last(), Some(&Event::Bolting(None)));
     assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
@@ -762,7 +774,8 @@ fn a_pair_that_never_locks_fails_the_job_after_three_attempts() {
         BolterPair::P1,
     ))));
     r.bolters[0].seized = u8::MAX;
-    let events = bolt_until_end(&mut r, 60_000);
+    let (events, attempts) = bolt_until_end(&mut r, 60_000);
+    assert_eq!(attempts, [1, 2, 3], "the heartbeat's attempt (byte 56)");
     assert_eq!(pairs(&events), [(BolterPair::P1, 3, false)]);
     assert!(
         events.contains(&Event::Bolting(Some(Fault::BoltingFailure))),
@@ -783,7 +796,7 @@ fn moving_the_bolters_down_ends_when_both_touch_or_a_descent_times_out() {
         r.bolters[1].there = b_there;
         r.send(Command::Bolter(BolterCommand::Down));
         let start = r.now;
-        let events = bolt_until_end(&mut r, 10_000);
+        let (events, _) = bolt_until_end(&mut r, 10_000);
         assert_eq!(
             events.last(),
             Some(&Event::BoltersDown { contact: b_there })
@@ -1094,7 +1107,7 @@ fn a_new_bolting_job_waits_until_board_b_reports_its_bolter_idle() {
         waited > 0,
         "B reported idle before the job came: nothing tested"
     );
-    let events = bolt_until_end(&mut r, 10_000);
+    let (events, _) = bolt_until_end(&mut r, 10_000);
     assert_eq!(events.last(), Some(&Event::BoltersDown { contact: true }));
 }
 
@@ -1186,7 +1199,7 @@ fn a_bolting_job_paused_longer_than_a_step_timeout_completes_after_reset() {
     assert!(r.a.paused());
     r.run((cfg.side.sensed_ms + cfg.link_margin_ms) / 10 + 100);
     r.send(Command::Reset);
-    let events = bolt_until_end(&mut r, 30_000);
+    let (events, _) = bolt_until_end(&mut r, 30_000);
     assert_eq!(pairs(&events), [(BolterPair::P2, 1, true)]);
     assert_eq!(events.last(), Some(&Event::Bolting(None)));
     assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
