@@ -5,18 +5,23 @@
 //! board B, B's own servo and bolter outputs. Boards A and B are linked tick by tick, at rest in
 //! state a and Operational before each motion.
 
-use mmic::bolter::Drive;
+use mmic::bolter::{Drive, MuxLines};
 use mmic::command::{BolterCommand, Command, ServoTarget};
 use mmic::command::{BolterPair, Fasteners};
+use mmic::faults::Fault;
 use mmic::mode::Mode;
-use mmic::motion::State;
-use mmic::node::board_a::{self, BoardA, Inputs};
+use mmic::motion::{map, Primitive, State};
+use mmic::node::board_a::{self, BoardA, Event, Inputs};
 use mmic::node::board_b::{self, BoardB};
-use mmic::units::{BoardNumber, Electrical, Side};
+use mmic::refusal::Refusal;
+use mmic::units::{BoardNumber, Electrical, HipAngle, PulseWidth, Side};
 use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
+use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
 
+/// Boards A and B linked both ways every tick, and the plant they drive: each side's arm
+/// contraction switch and bolter.
 struct Rig {
     a: BoardA,
     b: BoardB,
@@ -26,6 +31,88 @@ struct Rig {
     to_a: Option<[u8; mmic::wire::internal_heartbeat::INTERNAL_HEARTBEAT_LEN]>,
     /// The last A→B command sent.
     last_b: Option<BCommandRepr>,
+    /// Each side's arm pulse at the last tick (none: unpowered, where it was).
+    arm_pulse: [Option<PulseWidth>; 2],
+    /// A side whose arm switch never closes (an arm stuck short of contracted).
+    switch_stuck: [bool; 2],
+    /// Each side's bolter.
+    bolters: [Bolter; 2],
+    /// Each side's bolter drive at the last tick.
+    drives: [Drive; 2],
+    /// Each side's filtered voltages and currents (I_bo aside: the bolter's).
+    electrical: [Electrical; 2],
+    /// The last internal heartbeat board A received, and whether it came at the last tick.
+    heard_b: Option<(InternalHeartbeatRepr, bool)>,
+    /// Board B's heartbeats are lost on the serial line until this time, ms.
+    b_lost_until: u32,
+}
+
+/// A bolter over a fastener, as its current sensor and home switch see it: driven down, it
+/// travels `contact_ms` (default `CONTACT_MS`) before it touches and pushes (I_bo past the push threshold) — unless
+/// no fastener is `there`, when it never touches; rotated while touching, it locks the
+/// fastener after `LOCK_MS` and stalls (I_bo past the lock threshold) — unless the fastener is
+/// seized, when the head turns on it without locking (for the first `seized` rotations);
+/// driven up, it is back on its home switch after as long as it went down.
+#[derive(Debug, Clone, Copy)]
+struct Bolter {
+    travel_ms: u32,
+    rotated_ms: u32,
+    rotating: bool,
+    i_bo: u16,
+    there: bool,
+    seized: u8,
+    contact_ms: u32,
+}
+
+impl Default for Bolter {
+    fn default() -> Bolter {
+        Bolter {
+            travel_ms: 0,
+            rotated_ms: 0,
+            rotating: false,
+            i_bo: 0,
+            there: true,
+            seized: 0,
+            contact_ms: CONTACT_MS,
+        }
+    }
+}
+
+const CONTACT_MS: u32 = 500;
+const LOCK_MS: u32 = 300;
+
+impl Bolter {
+    fn step(&mut self, d: Drive, ms: u32) {
+        let touching = self.there && self.travel_ms >= self.contact_ms;
+        if self.rotating && d != Drive::Rotate && self.seized > 0 {
+            self.seized -= 1;
+        }
+        self.rotating = d == Drive::Rotate;
+        match d {
+            Drive::Down => self.travel_ms = (self.travel_ms + ms).min(self.contact_ms + 1_000),
+            Drive::Rotate if touching && self.seized == 0 => self.rotated_ms += ms,
+            Drive::Up | Drive::CounterRotateUp => {
+                self.travel_ms = self.travel_ms.saturating_sub(ms);
+                self.rotated_ms = 0;
+            }
+            _ => {}
+        }
+        if self.there {
+            self.travel_ms = self.travel_ms.min(self.contact_ms);
+        }
+        let touching = self.there && self.travel_ms >= self.contact_ms;
+        self.i_bo = match d {
+            Drive::Idle => 0,
+            Drive::Down if touching => 1_100,
+            Drive::Rotate if self.rotated_ms >= LOCK_MS => 1_300,
+            Drive::Rotate => 500,
+            _ => 300,
+        };
+    }
+
+    fn at_home(&self) -> bool {
+        self.travel_ms == 0
+    }
 }
 
 /// What both boards drove in one tick.
@@ -51,6 +138,13 @@ impl Rig {
             to_b: None,
             to_a: None,
             last_b: None,
+            arm_pulse: [None; 2],
+            switch_stuck: [false; 2],
+            bolters: [Bolter::default(); 2],
+            drives: [Drive::Idle; 2],
+            electrical: [Inputs::at_home().electrical; 2],
+            heard_b: None,
+            b_lost_until: 0,
         };
         r.send(Command::Mode(Mode::Operational));
         r.run(150);
@@ -59,8 +153,17 @@ impl Rig {
         r
     }
 
+    /// Side `i`'s arm switch: closed within 15 µs of the contracted pulse.
+    fn switch(&self, i: usize) -> bool {
+        let contracted = board_a::Config::default().arm.contracted.micros();
+        !self.switch_stuck[i] && self.arm_pulse[i].is_none_or(|p| p.micros() <= contracted + 15)
+    }
+
     fn tick(&mut self, command: Option<Command>) -> Tick {
         self.now += 10;
+        for (b, d) in self.bolters.iter_mut().zip(self.drives) {
+            b.step(d, 10);
+        }
         let packet = command.map(|command| {
             self.seq += 1;
             CommandRepr {
@@ -75,27 +178,43 @@ impl Rig {
             &Inputs {
                 command: packet,
                 from_b: self.to_a,
+                electrical: Electrical {
+                    i_bo: self.bolters[0].i_bo,
+                    ..self.electrical[0]
+                },
+                arm_contracted: self.switch(0),
+                bolter_at_home: self.bolters[0].at_home(),
                 ..Inputs::at_home()
             },
         );
+        self.heard_b = match self.to_a {
+            Some(bytes) => Some((InternalHeartbeatRepr::parse(&bytes).unwrap(), true)),
+            None => self.heard_b.map(|(h, _)| (h, false)),
+        };
         let b = self.b.tick(
             self.now,
             &board_b::Inputs {
                 command: self.to_b,
                 electrical: Electrical {
-                    v_bat: 12_000,
-                    v_reg: 7_400,
-                    ..Electrical::default()
+                    i_bo: self.bolters[1].i_bo,
+                    ..self.electrical[1]
                 },
-                arm_contracted: true,
+                arm_contracted: self.switch(1),
+                bolter_at_home: self.bolters[1].at_home(),
                 ..board_b::Inputs::default()
             },
         );
         self.to_b = a.to_b;
-        self.to_a = b.heartbeat;
+        self.to_a = b.heartbeat.filter(|_| self.now >= self.b_lost_until);
         if let Some(bytes) = a.to_b {
             self.last_b = Some(BCommandRepr::parse(&bytes).unwrap());
         }
+        for (i, pulse) in [a.arm, b.arm].into_iter().enumerate() {
+            if pulse.is_some() {
+                self.arm_pulse[i] = pulse;
+            }
+        }
+        self.drives = [a.bolter, b.bolter];
         Tick {
             a: a.clone(),
             b,
@@ -242,4 +361,846 @@ fn stop_mid_turn_holds_the_hip_where_it_is_read() {
         let t = r.tick(None);
         assert_eq!(t.a.hip, rest.a.hip, "the hip holds at its reading");
     }
+}
+
+/// The first move of the map from state a that turns nothing: an arm extends, the hip stays
+/// straight (the rig's encoder reads 180° throughout).
+fn extend_from_a() -> Command {
+    let (_, to, p) = map::moves()
+        .find(|(from, _, p)| {
+            *from == State::A && matches!(p, Primitive::FwdExtend | Primitive::BackExtend)
+        })
+        .expect("a primitive extends an arm from a");
+    Command::primitive(p, to).unwrap()
+}
+
+/// One motion at a time: from the tick after a primitive is accepted until the idle check at
+/// its end, the robot counts as in motion at every tick (`BoardA::in_motion`) and a command
+/// that moves is refused as busy — also at the ticks where every module has reached one
+/// step's targets and the next step has not yet set its own, when no servo is on its way.
+#[test]
+fn a_primitive_is_in_motion_and_refuses_other_moves_at_every_tick_until_it_ends() {
+    let mut r = Rig::operational();
+    r.send(extend_from_a());
+    let mut ms = 0;
+    loop {
+        // Each tick, another move is asked for: refused, and the primitive goes on.
+        let t = r.tick(Some(arm(Side::B, ServoTarget::Extend)));
+        ms += 10;
+        assert_eq!(
+            t.hb.and_then(|h| h.refusal),
+            Some(Refusal::Busy),
+            "a second motion accepted {ms} ms into the primitive"
+        );
+        assert!(r.a.in_motion(), "not in motion {ms} ms into the primitive");
+        assert!(
+            !t.hb.unwrap().command_complete,
+            "command complete {ms} ms into the primitive"
+        );
+        if t.a.events.iter().any(|e| matches!(e, Event::Reached(_))) {
+            break;
+        }
+        assert!(ms < 30_000, "the primitive did not end in 30 s");
+    }
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    assert_ne!(r.a.state(), Some(State::A), "the primitive moved the robot");
+}
+
+/// Section 7's idle check at the end of a reconfiguration reads the currents at rest: after
+/// the primitive reaches its state the robot stays busy, and command complete (heartbeat byte
+/// 54) stays unset, until it has been still for `idle_settle_ms` (the sensor averages no
+/// longer hold the motion's currents); then the check passes and command complete is set.
+#[test]
+fn command_complete_waits_until_the_robot_has_rested_idle_settle_ms_after_the_primitive() {
+    let settle = board_a::Config::default().idle_settle_ms;
+    let mut r = Rig::operational();
+    r.send(extend_from_a());
+    let mut reached_at = None;
+    for _ in 0..3_000 {
+        let t = r.tick(None);
+        if t.a.events.iter().any(|e| matches!(e, Event::Reached(_))) {
+            reached_at = Some(r.now);
+            break;
+        }
+    }
+    let reached_at = reached_at.expect("the primitive reaches its state");
+    // Still busy, and not complete, while the robot settles.
+    while r.now + 10 < reached_at + settle {
+        let t = r.tick(Some(Command::ClearFaults));
+        assert!(
+            r.a.in_motion(),
+            "idle {} ms after the state was reached",
+            r.now - reached_at
+        );
+        assert!(
+            !t.hb.unwrap().command_complete,
+            "complete before the idle check"
+        );
+    }
+    // Then, within two link periods of the settle time, complete.
+    let mut complete = false;
+    for _ in 0..10 {
+        let t = r.tick(Some(Command::ClearFaults));
+        if !r.a.in_motion() && t.hb.unwrap().command_complete {
+            complete = true;
+            break;
+        }
+    }
+    assert!(
+        complete,
+        "not complete {} ms after the state was reached",
+        r.now - reached_at
+    );
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+}
+
+/// A reconfiguration accepted while the averaged currents still hold the last motion waits for
+/// the idle check at its start (Section 7; `Config::idle_settle_ms`): its first primitive
+/// starts — the moving side's gripper releases — only once the robot has been still for
+/// `idle_settle_ms`, not as soon as it is accepted.
+#[test]
+fn a_primitive_accepted_right_after_a_motion_starts_once_the_robot_has_rested() {
+    let settle = board_a::Config::default().idle_settle_ms;
+    let mut r = Rig::operational();
+    // A single-module move there and back; the primitive comes at the first idle tick.
+    for target in [ServoTarget::Extend, ServoTarget::Contract] {
+        r.send(arm(Side::A, target));
+        while {
+            r.tick(None);
+            r.a.in_motion()
+        } {}
+    }
+    let still_at = r.now;
+    let hb = r.send(extend_from_a()).hb.unwrap();
+    // The grippers' targets: side A's as A drives it, side B's as A commands B.
+    let before = (hb.gripper_a_target, r.last_b.unwrap().gripper_target);
+    // Nothing moves while the robot settles; then the moving side's gripper releases.
+    let mut started = None;
+    for _ in 0..(settle / 10 + 20) {
+        let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+        if (hb.gripper_a_target, r.last_b.unwrap().gripper_target) != before {
+            started = Some(r.now);
+            break;
+        }
+    }
+    let started = started.expect("the primitive starts");
+    assert!(
+        started >= still_at + settle,
+        "started {} ms after the robot came to rest",
+        started - still_at
+    );
+    assert!(started <= still_at + settle + 100);
+}
+
+/// Entering Operational sends the hip to the configured home angle (`safety.hip_home`: the
+/// contracted-gripped configuration the hip mismatch check reads against), not to a fixed
+/// 180°: a robot whose home is at 90°, reading 90°, is held there.
+#[test]
+fn entering_operational_sends_the_hip_to_its_configured_home() {
+    let home = HipAngle::new(9_000).unwrap();
+    let mut cfg = board_a::Config::default();
+    cfg.safety.hip_home = home;
+    // The pulse that holds a hip at its target (a default board at rest at 180°).
+    let mut reference = Rig::operational();
+    let hold = reference.tick(None).a.hip;
+    let mut a = BoardA::new(cfg);
+    let inputs = |command| Inputs {
+        command,
+        hip: Some(home),
+        ..Inputs::at_home()
+    };
+    let packet = CommandRepr {
+        board: BoardNumber::ONE,
+        command: Command::Mode(Mode::Operational),
+        seq: 1,
+    }
+    .to_bytes();
+    let out = a.tick(10, &inputs(Some(packet)));
+    let hb = HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
+    assert_eq!((hb.mode, hb.refusal), (Mode::Operational, None));
+    assert!(hb.faults.is_empty(), "{:?}", hb.faults);
+    assert_eq!(hb.hip_target, home, "the hip is sent home");
+    for t in 2..100 {
+        let out = a.tick(t * 10, &inputs(None));
+        assert_eq!(out.hip, hold, "the hip is driven away from its home");
+    }
+}
+
+fn gripper(side: Side, target: ServoTarget) -> Command {
+    Command::Gripper { side, target }
+}
+
+/// Waits (at most 10 s) until board A no longer counts a motion.
+fn until_idle(r: &mut Rig) {
+    for _ in 0..1_000 {
+        r.tick(None);
+        if !r.a.in_motion() {
+            return;
+        }
+    }
+    panic!("still in motion after 10 s");
+}
+
+/// A single-module move (Table 1's arm and gripper commands, on either side) is a motion
+/// until its servo is at the target, as the heartbeat reports it: meanwhile the robot is in
+/// motion, another move is refused as busy, and command complete (byte 54) is unset; then
+/// the motion ends with command complete set (spec/decisions.toml, `command-complete`).
+#[test]
+fn a_single_module_move_is_a_motion_until_its_servo_is_at_its_target() {
+    let cfg = board_a::Config::default();
+    for c in [
+        arm(Side::A, ServoTarget::Extend),
+        arm(Side::B, ServoTarget::Extend),
+        gripper(Side::A, ServoTarget::Contract),
+        gripper(Side::B, ServoTarget::Contract),
+    ] {
+        let mut r = Rig::operational();
+        r.send(c);
+        let t = r.tick(Some(Command::Hip(mmic::command::HipTarget::Straight)));
+        assert_eq!(
+            t.hb.unwrap().refusal,
+            Some(Refusal::Busy),
+            "{c:?}: a second move accepted"
+        );
+        // The servo as the heartbeat reports it (side B's as board B reported it).
+        let there = |hb: &HeartbeatRepr| match c {
+            Command::Arm { side: Side::A, .. } => {
+                hb.arm_a_now == hb.arm_a_target && hb.arm_a_target == cfg.arm.extended
+            }
+            Command::Arm { side: Side::B, .. } => {
+                hb.arm_b_now == hb.arm_b_target && hb.arm_b_target == cfg.arm.extended
+            }
+            Command::Gripper { side: Side::A, .. } => {
+                hb.gripper_a_now == hb.gripper_a_target
+                    && hb.gripper_a_target == cfg.gripper.contracted
+            }
+            _ => {
+                hb.gripper_b_now == hb.gripper_b_target
+                    && hb.gripper_b_target == cfg.gripper.contracted
+            }
+        };
+        let mut ms = 10;
+        loop {
+            let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+            ms += 10;
+            if !there(&hb) {
+                assert!(r.a.in_motion(), "{c:?}: not in motion at {ms} ms");
+                assert!(!hb.command_complete, "{c:?}: complete at {ms} ms");
+            }
+            if !r.a.in_motion() {
+                assert!(there(&hb), "{c:?}");
+                assert!(hb.command_complete, "{c:?}: ended, not complete");
+                break;
+            }
+            assert!(ms < 10_000, "{c:?}: still moving after 10 s");
+        }
+        assert!(ms > 500, "{c:?}: a full travel takes time");
+    }
+}
+
+/// Table 8's "arm not fully contracted": after a contract arm command, once the arm has
+/// finished its travel, its contraction switch must close within the confirm time
+/// (`motion.confirm_ms`). A switch that stays open raises the fault (and the robot is
+/// safed) — not while the arm is still on its way, and not when the switch closes.
+#[test]
+fn an_arm_contraction_is_a_fault_when_the_switch_stays_open_past_the_confirm_time() {
+    let cfg = board_a::Config::default();
+    let confirm = cfg.motion.confirm_ms;
+    for side in [Side::A, Side::B] {
+        for stuck in [false, true] {
+            let mut r = Rig::operational();
+            r.send(arm(side, ServoTarget::Extend));
+            until_idle(&mut r);
+            r.switch_stuck[side as usize] = stuck;
+            r.send(arm(side, ServoTarget::Contract));
+            let mut arrived = None;
+            let mut faulted = None;
+            for _ in 0..800 {
+                let t = r.tick(None);
+                let pulse = match side {
+                    Side::A => t.a.arm,
+                    Side::B => t.b.arm,
+                };
+                if arrived.is_none() && pulse == Some(cfg.arm.contracted) {
+                    arrived = Some(r.now);
+                }
+                if r.a.faults().contains(Fault::ArmNotContracted) {
+                    faulted = Some(r.now);
+                    break;
+                }
+            }
+            let arrived = arrived.unwrap_or_else(|| panic!("{side:?}: arm never contracted"));
+            if stuck {
+                let at = faulted.unwrap_or_else(|| panic!("{side:?}: stuck switch, no fault"));
+                if side == Side::A {
+                    // Board A sees its arm at the end of its travel the tick after it drove
+                    // the last pulse; the fault comes at the first tick more than
+                    // `confirm_ms` after that, the timeout convention of the sequencer's
+                    // Confirm step.
+                    assert_eq!(at, arrived + 10 + confirm + 10, "{side:?}: fault tick");
+                } else {
+                    // Board B's report of its arm reaches A a link period or so later.
+                    assert!(
+                        at > arrived + confirm,
+                        "{side:?}: fault {} ms after the arm arrived",
+                        at as i64 - arrived as i64
+                    );
+                    assert!(at <= arrived + confirm + 200, "{side:?}: fault late");
+                }
+                assert_eq!(r.a.mode(), Mode::Safed);
+            } else {
+                assert_eq!(faulted, None, "{side:?}: the switch closed");
+                assert_eq!(r.a.mode(), Mode::Operational);
+            }
+        }
+    }
+}
+
+/// Runs until board A reports the end of a bolting job or of a "move bolters down" (at most
+/// `max_ms`), checking at every tick before it that the job counts as a motion (another move
+/// is refused as busy), that the heartbeat names the pair being worked on (byte 55) and an
+/// attempt 1..=3 (byte 56), and that both sides' multiplexers select that pair. Returns every
+/// event of board A meanwhile, the last tick's included, and the attempts the heartbeats
+/// reported, in order, without repeats.
+fn bolt_until_end(r: &mut Rig, max_ms: u32) -> (Vec<Event>, Vec<u8>) {
+    let mut events = Vec::new();
+    let mut attempts: Vec<u8> = Vec::new();
+    let mut pair = None;
+    for i in 0..max_ms / 10 {
+        // Every 7th tick, another move is asked for.
+        let probe = i % 7 == 3;
+        let moving = r.a.in_motion();
+        let t = r.tick(probe.then_some(arm(Side::A, ServoTarget::Extend)));
+        events.extend(t.a.events.iter().copied());
+        let end =
+            t.a.events
+                .iter()
+                .any(|e| matches!(e, Event::Bolting(_) | Event::BoltersDown { .. }));
+        if end {
+            return (events, attempts);
+        }
+        assert!(i == 0 || moving, "not in motion {} ms into the job", i * 10);
+        // The pair in force, as board A orders it.
+        if let Some(p) = r.last_b.and_then(|b| b.bolter).map(|o| o.pair) {
+            pair = Some(p);
+        }
+        if probe {
+            let hb = t.hb.unwrap();
+            assert_eq!(
+                hb.refusal,
+                Some(Refusal::Busy),
+                "a move accepted {} ms into the job",
+                i * 10
+            );
+            assert_eq!(hb.active_bolter, pair, "byte 55");
+            let n = hb.bolter_attempt.get();
+            assert!((1..=3).contains(&n), "byte 56: attempt {n}");
+            if attempts.last() != Some(&n) {
+                attempts.push(n);
+            }
+        }
+        if t.a.bolter != Drive::Idle {
+            assert_eq!(t.a.mux, MuxLines::for_pair(pair.unwrap()), "side A's mux");
+        }
+        if t.b.bolter != Drive::Idle {
+            assert_eq!(t.b.mux, MuxLines::for_pair(pair.unwrap()), "side B's mux");
+        }
+    }
+    panic!("the job did not end in {max_ms} ms: {events:?}");
+}
+
+fn pairs(events: &[Event]) -> Vec<(BolterPair, u8, bool)> {
+    events
+        .iter()
+        .filter_map(|e| match e {
+            Event::Pair { pair, attempts, ok } => Some((*pair, *attempts, *ok)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Bolting all four pairs, boards A and B linked, the plant's fasteners answering as they
+/// should: both sides run Figure 8's steps pair after pair, each pair is fastened at the first
+/// attempt (events name them in order), the job ends done with no fault, the robot is in
+/// motion (and refuses other moves) until then and reports command complete after.
+#[test]
+fn bolting_all_four_pairs_runs_both_sides_pair_after_pair_to_done() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::All)));
+    let (events, attempts) = bolt_until_end(&mut r, 60_000);
+    assert_eq!(attempts, [1], "every pair at its first attempt");
+    assert_eq!(
+        pairs(&events),
+        [
+            (BolterPair::P1, 1, true),
+            (BolterPair::P2, 1, true),
+            (BolterPair::P3, 1, true),
+            (BolterPair::P4, 1, true)
+        ]
+    );
+    assert_eq!(events.last(), Some(&Event::Bolting(None)));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+    assert!(!r.a.in_motion());
+    assert!(hb.command_complete, "bolting done: command complete");
+    assert_eq!(r.a.mode(), Mode::Operational);
+}
+
+/// A fastener that side B's head cannot lock at first (it turns on it; Rotate times out):
+/// the attempt is abandoned — both bolters go home — and the pair is tried again, fastened at
+/// the second attempt (Figure 10's "twice"); the other pairs are unaffected.
+#[test]
+fn a_pair_that_does_not_lock_at_first_is_fastened_at_its_second_attempt() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::P3,
+    ))));
+    r.bolters[1].seized = 1;
+    let (events, attempts) = bolt_until_end(&mut r, 60_000);
+    assert_eq!(attempts, [1, 2], "the heartbeat's attempt (byte 56)");
+    assert_eq!(pairs(&events), [(BolterPair::P3, 2, true)]);
+    assert_eq!(events.last(), Some(&Event::Bolting(None)));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    assert_eq!(r.a.mode(), Mode::Operational);
+}
+
+/// A fastener that never locks on side A: after the third failed attempt (Table 8: three) the
+/// pair is given up, the job fails with Table 8's (un)bolting failure, and the robot goes to
+/// Standby (fully gripped: cutting power cannot drop it).
+#[test]
+fn a_pair_that_never_locks_fails_the_job_after_three_attempts() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::P1,
+    ))));
+    r.bolters[0].seized = u8::MAX;
+    let (events, attempts) = bolt_until_end(&mut r, 60_000);
+    assert_eq!(attempts, [1, 2, 3], "the heartbeat's attempt (byte 56)");
+    assert_eq!(pairs(&events), [(BolterPair::P1, 3, false)]);
+    assert!(
+        events.contains(&Event::Bolting(Some(Fault::BoltingFailure))),
+        "{events:?}"
+    );
+    assert!(r.a.faults().contains(Fault::BoltingFailure));
+    assert_eq!(r.a.mode(), Mode::Standby);
+}
+
+/// Table 1's "move bolters down": both bolters descend until their currents say they touch,
+/// and stop there; the job ends reporting contact, with no fault. When one side finds nothing
+/// to touch, its descent times out: the job still ends (nothing was bolted, so no failure),
+/// reporting no contact.
+#[test]
+fn moving_the_bolters_down_ends_when_both_touch_or_a_descent_times_out() {
+    for b_there in [true, false] {
+        let mut r = Rig::operational();
+        r.bolters[1].there = b_there;
+        r.send(Command::Bolter(BolterCommand::Down));
+        let start = r.now;
+        let (events, _) = bolt_until_end(&mut r, 10_000);
+        assert_eq!(
+            events.last(),
+            Some(&Event::BoltersDown { contact: b_there })
+        );
+        let took = r.now - start;
+        if b_there {
+            assert!(took < CONTACT_MS + 500, "took {took} ms");
+        } else {
+            assert!(took > board_a::Config::default().bolter.side.sensed_ms);
+        }
+        assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+        // Down and stopped there: neither bolter is driven any more.
+        let t = r.run(20);
+        assert_eq!((t.a.bolter, t.b.bolter), (Drive::Idle, Drive::Idle));
+        assert!(!r.a.in_motion());
+    }
+}
+
+/// Section 7's idle check at the start of a reconfiguration: a current over its at-rest limit
+/// (the robot not gripping its face, an arm stuck), on either side — side A's as board A
+/// measures it, side B's as board B judged it — raises that module's idle overcurrent fault
+/// once the robot has rested, the robot is safed, and the motion does not start. The same
+/// current, below the operational limits, faults nothing while no reconfiguration starts.
+#[test]
+fn an_idle_overcurrent_at_the_start_keeps_the_primitive_from_starting() {
+    let limits = board_a::Config::default().safety.idle;
+    for side in [Side::A, Side::B] {
+        for fault in [
+            Fault::LocomotionOvercurrentIdle,
+            Fault::GripperOvercurrentIdle,
+        ] {
+            let mut r = Rig::operational();
+            let e = &mut r.electrical[side as usize];
+            match fault {
+                Fault::LocomotionOvercurrentIdle => e.i_loc = limits.locomotion + 100,
+                _ => e.i_grip = limits.gripper + 100,
+            }
+            r.run(100);
+            assert!(
+                r.a.faults().is_empty(),
+                "{side:?} {fault:?}: no check at rest"
+            );
+            let hb = r.send(extend_from_a()).hb.unwrap();
+            let grippers = (hb.gripper_a_target, r.last_b.unwrap().gripper_target);
+            r.run(100);
+            assert_eq!(r.a.faults().iter().collect::<Vec<_>>(), [fault], "{side:?}");
+            assert_eq!(r.a.mode(), Mode::Safed, "{side:?} {fault:?}");
+            let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+            assert_eq!(
+                (hb.gripper_a_target, r.last_b.unwrap().gripper_target),
+                grippers,
+                "{side:?} {fault:?}: a gripper released"
+            );
+            assert_eq!(r.a.state(), Some(State::A));
+        }
+    }
+}
+
+/// A matched state other than a.
+fn matched_other_than_a() -> State {
+    State::ALL
+        .into_iter()
+        .find(|s| *s != State::A && s.is_matched())
+        .unwrap()
+}
+
+/// Table 8's initial state mismatch: a reconfiguration whose initial state is not the state
+/// the robot is in is refused with that reason, latches the fault (Standby: the robot is
+/// gripped), and nothing moves; the same reconfiguration from where the robot is, is accepted.
+#[test]
+fn a_reconfiguration_from_another_state_is_refused_as_an_initial_state_mismatch() {
+    let target = matched_other_than_a();
+    let mut r = Rig::operational();
+    let wrong = Command::reconfigure(target, State::A).unwrap();
+    let t = r.tick(Some(wrong));
+    assert_eq!(t.hb.unwrap().refusal, Some(Refusal::InitialStateMismatch));
+    assert!(t.a.events.contains(&Event::Executed {
+        seq: r.seq,
+        command: Some(wrong),
+        refusal: Some(Refusal::InitialStateMismatch)
+    }));
+    assert!(r.a.faults().contains(Fault::InitialStateMismatch));
+    assert_eq!(r.a.mode(), Mode::Standby);
+    assert_eq!(r.a.state(), Some(State::A));
+    assert!(!r.a.in_motion());
+
+    let mut r = Rig::operational();
+    let right = Command::reconfigure(State::A, target).unwrap();
+    assert_eq!(r.tick(Some(right)).hb.unwrap().refusal, None);
+    r.run(2);
+    assert!(r.a.in_motion());
+    assert!(r.a.faults().is_empty());
+}
+
+/// The events say what happened, each once: a command refused names the command and the
+/// reason; entering a mode is one mode event (none while the mode holds); a fault latched is
+/// one fault event naming it (none while it stays latched).
+#[test]
+fn events_name_refused_commands_mode_changes_and_new_faults_once() {
+    let mut r = Rig::operational();
+    // Nothing to resume: refused, and the event names the Reset.
+    let t = r.tick(Some(Command::Reset));
+    assert_eq!(
+        t.a.events.as_slice(),
+        [Event::Executed {
+            seq: r.seq,
+            command: Some(Command::Reset),
+            refusal: Some(Refusal::NothingToResume)
+        }]
+    );
+    // The Assembly System's fault: Standby at once (nothing moves).
+    let mut events = r.tick(Some(Command::SystemFault)).a.events.to_vec();
+    for _ in 0..50 {
+        events.extend(r.tick(None).a.events.iter().copied());
+    }
+    let modes: Vec<_> = events
+        .iter()
+        .filter(|e| matches!(e, Event::Mode { .. }))
+        .collect();
+    assert_eq!(
+        modes,
+        [&Event::Mode {
+            from: Mode::Operational,
+            to: Mode::Standby
+        }]
+    );
+    let faults: Vec<_> = events
+        .iter()
+        .filter_map(|e| match e {
+            Event::Faults(f) => Some(f.iter().collect::<Vec<_>>()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(faults, [[Fault::AssemblySystem]]);
+    // Back to Operational: one mode event, no fault event (the fault is old).
+    let mut events = r
+        .tick(Some(Command::Mode(Mode::Operational)))
+        .a
+        .events
+        .to_vec();
+    for _ in 0..50 {
+        events.extend(r.tick(None).a.events.iter().copied());
+    }
+    assert_eq!(
+        events
+            .iter()
+            .filter(|e| matches!(e, Event::Mode { .. } | Event::Faults(_)))
+            .collect::<Vec<_>>(),
+        [&Event::Mode {
+            from: Mode::Standby,
+            to: Mode::Operational
+        }]
+    );
+}
+
+/// Power Control (Table 1): a module switched off in Operational gets no pulse while the
+/// others are driven — on side A by board A, on side B by board B as the A→B command's power
+/// flags tell it; switched on again, it is driven.
+#[test]
+fn a_module_switched_off_is_not_driven_and_the_others_are() {
+    use mmic::command::PowerTarget;
+    use mmic::units::Module;
+    let powered = |r: &Rig, t: &Tick| {
+        let p = r.last_b.unwrap().power;
+        [
+            t.a.hip.is_some(),
+            t.a.arm.is_some(),
+            t.a.gripper.is_some(),
+            p.arm && t.b.arm.is_some(),
+            p.gripper && t.b.gripper.is_some(),
+            p.bolter,
+        ]
+    };
+    let modules = [
+        Module::Hip,
+        Module::ArmA,
+        Module::GripperA,
+        Module::ArmB,
+        Module::GripperB,
+        Module::BolterB,
+    ];
+    for (i, m) in modules.into_iter().enumerate() {
+        let mut r = Rig::operational();
+        let t = r.tick(None);
+        assert_eq!(powered(&r, &t), [true; 6]);
+        r.send(Command::Power {
+            target: PowerTarget::Module(m),
+            on: false,
+        });
+        let mut want = [true; 6];
+        want[i] = false;
+        let t = r.run(10);
+        assert_eq!(powered(&r, &t), want, "{m:?} off");
+        r.send(Command::Power {
+            target: PowerTarget::Module(m),
+            on: true,
+        });
+        let t = r.run(10);
+        assert_eq!(powered(&r, &t), [true; 6], "{m:?} on");
+    }
+}
+
+/// Power Control of a bolter: with bolter A switched off, a bolting job leaves side A's motor
+/// unpowered (idle) while side B's descends.
+#[test]
+fn a_bolter_switched_off_is_not_driven() {
+    use mmic::command::PowerTarget;
+    use mmic::units::Module;
+    let mut r = Rig::operational();
+    r.send(Command::Power {
+        target: PowerTarget::Module(Module::BolterA),
+        on: false,
+    });
+    r.send(Command::Bolter(BolterCommand::Down));
+    for _ in 0..20 {
+        let t = r.tick(None);
+        assert_eq!(t.a.bolter, Drive::Idle, "bolter A driven while off");
+    }
+    assert_eq!(r.tick(None).b.bolter, Drive::Down, "bolter B descends");
+}
+
+/// Table 1's hip commands set the hip's target: a preset to its angle, any other angle to
+/// itself, home to the configured home angle.
+#[test]
+fn a_hip_command_sets_the_angle_it_names() {
+    use mmic::command::HipTarget;
+    let home = board_a::Config::default().safety.hip_home;
+    let angle = HipAngle::new(12_345).unwrap();
+    for (h, want) in [
+        (HipTarget::RightAngleCw, HipAngle::new(9_000).unwrap()),
+        (HipTarget::RightAngleCcw, HipAngle::new(27_000).unwrap()),
+        (HipTarget::Angle(angle), angle),
+        (HipTarget::Home, home),
+    ] {
+        let mut r = Rig::operational();
+        r.send(Command::Hip(h));
+        let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+        assert_eq!(hb.hip_target, want, "{h:?}");
+    }
+}
+
+/// A reconfiguration over primitives that turn nothing (the rig's hip reads 180° throughout):
+/// from a to a matched state two or more primitives away, run primitive after primitive, it
+/// reaches its target, which the board then tracks, with no fault and command complete.
+#[test]
+fn a_reconfiguration_runs_its_primitives_to_its_target() {
+    use mmic::motion::route;
+    let straight = |p: &Primitive| {
+        matches!(
+            p,
+            Primitive::FwdExtend
+                | Primitive::BackExtend
+                | Primitive::FwdContract
+                | Primitive::BackContract
+        )
+    };
+    let target = State::ALL
+        .into_iter()
+        .find(|s| {
+            let plan = route::lookup(State::A, *s);
+            s.is_matched() && plan.primitives().len() >= 2 && plan.primitives().iter().all(straight)
+        })
+        .expect("a matched state reached without turning");
+    let mut r = Rig::operational();
+    r.send(Command::reconfigure(State::A, target).unwrap());
+    let mut reached = Vec::new();
+    for _ in 0..6_000 {
+        let t = r.tick(None);
+        reached.extend(t.a.events.iter().filter_map(|e| match e {
+            Event::Reached(s) => Some(*s),
+            _ => None,
+        }));
+        if !r.a.in_motion() {
+            break;
+        }
+    }
+    assert_eq!(reached.last(), Some(&target), "{reached:?}");
+    assert_eq!(r.a.state(), Some(target));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
+    assert!(hb.command_complete);
+    assert_eq!(hb.target_state, Some(target));
+}
+
+/// A bolting job accepted while board B still reports a bolter order (its last job's) waits
+/// until B reports its bolter idle, so that B cannot take the new job's first order for its
+/// previous one (spec/control/bolter.md): meanwhile neither side is ordered anything; then the
+/// job runs.
+#[test]
+fn a_new_bolting_job_waits_until_board_b_reports_its_bolter_idle() {
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Down));
+    bolt_until_end(&mut r, 10_000);
+    // At once the next job: B's last report, as A heard it, still names the first job's step.
+    r.send(Command::Bolter(BolterCommand::Down));
+    let mut waited = 0;
+    for _ in 0..100 {
+        let t = r.tick(None);
+        let (heard, _) = r.heard_b.unwrap();
+        if heard.bolter_aux.step.is_none() {
+            break;
+        }
+        waited += 1;
+        assert_eq!(t.a.bolter, Drive::Idle, "side A ordered while B is busy");
+        assert_eq!(r.last_b.unwrap().bolter, None, "B ordered while busy");
+    }
+    assert!(
+        waited > 0,
+        "B reported idle before the job came: nothing tested"
+    );
+    let (events, _) = bolt_until_end(&mut r, 10_000);
+    assert_eq!(events.last(), Some(&Event::BoltersDown { contact: true }));
+}
+
+/// Stop, then Reset at once, mid-descent after board B reported its bolter touching: the
+/// resumed step is ordered afresh on both sides, and only a report B makes of it since — one
+/// naming an A→B packet sent after the Reset — counts for side B. B's report from before the
+/// Stop never completes it, even when side A completes at once and B's next heartbeats are
+/// lost on the line for a while (spec/control/bolter.md, "Stop and Reset").
+#[test]
+fn a_report_from_before_a_stop_never_completes_the_resumed_step() {
+    let mut r = Rig::operational();
+    r.bolters[1].contact_ms = 200;
+    r.bolters[0].contact_ms = 2_000;
+    r.send(Command::Bolter(BolterCommand::Down));
+    // Until A hears that B's bolter touches.
+    for _ in 0..200 {
+        r.tick(None);
+        if r.heard_b
+            .is_some_and(|(h, _)| h.bolter_aux.threshold_reached)
+        {
+            break;
+        }
+    }
+    assert!(r.heard_b.unwrap().0.bolter_aux.threshold_reached);
+    r.send(Command::Stop);
+    let t = r.send(Command::Reset);
+    // Side A's fastener is right under it: it touches within a tick or two of resuming; B's
+    // heartbeats of the next 200 ms are lost (well within the link's 500 ms timeout).
+    r.bolters[0].contact_ms = r.bolters[0].travel_ms + 10;
+    r.b_lost_until = r.now + 200;
+    let mut since_reset: Vec<u8> =
+        t.a.to_b
+            .map(|b| BCommandRepr::parse(&b).unwrap().seq)
+            .into_iter()
+            .collect();
+    let mut fresh = false;
+    for _ in 0..500 {
+        let t = r.tick(None);
+        if let Some((h, true)) = r.heard_b {
+            fresh |= h.bolter_aux.step.is_some() && since_reset.contains(&h.bolter_aux.seq);
+        }
+        if let Some(b) = t.a.to_b {
+            since_reset.push(BCommandRepr::parse(&b).unwrap().seq);
+        }
+        if let Some(e) =
+            t.a.events
+                .iter()
+                .find(|e| matches!(e, Event::BoltersDown { .. }))
+        {
+            assert!(
+                fresh,
+                "the resumed step ended on B's report from before the Stop"
+            );
+            assert_eq!(e, &Event::BoltersDown { contact: true });
+            return;
+        }
+    }
+    panic!("the resumed job did not end");
+}
+
+/// A Stop with nothing moving holds board B too (the A→B stop flag); the next command that
+/// moves side B lifts the hold, and B's arm goes to its new target.
+#[test]
+fn after_a_stop_a_command_for_side_b_lifts_the_hold() {
+    let extended = board_a::Config::default().arm.extended;
+    let mut r = Rig::operational();
+    r.send(Command::Stop);
+    r.run(10);
+    assert!(r.last_b.unwrap().stop, "B told to hold");
+    r.send(arm(Side::B, ServoTarget::Extend));
+    until_idle(&mut r);
+    let t = r.run(10);
+    assert!(!r.last_b.unwrap().stop, "B still held");
+    assert_eq!(t.b.arm, Some(extended), "B's arm did not extend");
+}
+
+/// The time a Stop holds a bolting job is no stall: paused mid-step for longer than a step
+/// may take, the job resumes on Reset with the step's clock restarted and completes, with no
+/// timeout.
+#[test]
+fn a_bolting_job_paused_longer_than_a_step_timeout_completes_after_reset() {
+    let cfg = board_a::Config::default().bolter;
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::P2,
+    ))));
+    r.run(20);
+    r.send(Command::Stop);
+    assert!(r.a.paused());
+    r.run((cfg.side.sensed_ms + cfg.link_margin_ms) / 10 + 100);
+    r.send(Command::Reset);
+    let (events, _) = bolt_until_end(&mut r, 30_000);
+    assert_eq!(pairs(&events), [(BolterPair::P2, 1, true)]);
+    assert_eq!(events.last(), Some(&Event::Bolting(None)));
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
 }

@@ -264,6 +264,27 @@ fn packets_for_others_or_broken_get_no_answer_and_malformed_ones_a_refusal() {
         (hb.last_seq, hb.refusal),
         (77, Some(Refusal::UnknownCommand))
     );
+    // The same unknown opcode, sealed, for robot 2: not ours, so no answer (robot 2 answers
+    // it), and this robot's log is untouched.
+    let mut theirs = CommandRepr {
+        board: BoardNumber::new(2).unwrap(),
+        command: Command::Stop,
+        seq: 78,
+    }
+    .to_bytes();
+    theirs[5] = 0xff;
+    let c = mmic::wire::checksum::crc16(&theirs[..12]).to_le_bytes();
+    theirs[12..].copy_from_slice(&c);
+    let out = a.tick(
+        30,
+        &Inputs {
+            command: Some(theirs),
+            ..Inputs::at_home()
+        },
+    );
+    assert!(out.heartbeat.is_none());
+    assert!(matches!(out.events[0], Event::Rejected(_)));
+    assert_eq!(a.last_command(), (77, Some(Refusal::UnknownCommand)));
 }
 
 fn b_inputs() -> board_b::Inputs {

@@ -174,6 +174,12 @@ fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
         assert!(out.powered.is_subset(power_before), "{}", ctx());
         assert!(out.answer.is_none());
     }
+    // A deferred Standby is never lost: while the motion it waits for runs and the robot stays
+    // Operational (no fault this step took it to another mode and back), it stays pending,
+    // whatever the command (a redundant "operational" included).
+    if s0.standby_pending() && in_motion && faults.is_empty() && out.mode == Mode::Operational {
+        assert!(out.standby_pending, "{}", ctx());
+    }
     // Every command gets an answer; accepted ones are allowed in the mode.
     if let Some(inc) = c {
         let ans = out.answer.unwrap_or_else(|| panic!("no answer: {}", ctx()));
