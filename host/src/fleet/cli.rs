@@ -173,74 +173,96 @@ fn verdict(all: &[FleetResult]) -> Result<(), CliError> {
     }
 }
 
-/// The sweep's plot: simulated robot-seconds per wall second (virtual time) and the longest
-/// answer (realtime, with the 0.7 s line), against log10 of the fleet size.
+/// The sweep's plot, three charts against log10 of the fleet size: simulated robot-seconds
+/// per wall second (virtual time), the longest answer to a poll with the paper's 0.7 s window,
+/// and the share of polls answered within it (realtime).
 pub fn plot(all: &[FleetResult]) -> String {
+    use crate::plot::{line_chart_with, LineOptions, Series};
     let x = |r: &FleetResult| (r.robots as f64).log10();
     let virt: Vec<(f64, f64)> = all
         .iter()
         .filter(|r| r.threads.is_none())
-        .map(|r| (x(r), r.robot_seconds_per_wall_second().log10()))
+        .map(|r| (x(r), r.robot_seconds_per_wall_second() / 1000.0))
         .collect();
-    let real: Vec<(f64, f64)> = all
+    let real: Vec<&FleetResult> = all.iter().filter(|r| r.threads.is_some()).collect();
+    let longest: Vec<(f64, f64)> = real
         .iter()
-        .filter(|r| r.threads.is_some())
         .map(|r| (x(r), r.max_latency_ms as f64))
         .collect();
-    let window: Vec<(f64, f64)> = real.iter().map(|(x, _)| (*x, 700.0)).collect();
-    let a = crate::plot::line_chart_with(
+    let window: Vec<(f64, f64)> = real.iter().map(|r| (x(r), 700.0)).collect();
+    let share: Vec<(f64, f64)> = real
+        .iter()
+        .map(|r| {
+            let (ok, n) = r.attempts;
+            (x(r), ok as f64 * 100.0 / n.max(1) as f64)
+        })
+        .collect();
+    let legend = LineOptions {
+        legend: true,
+        ..Default::default()
+    };
+    let a = line_chart_with(
         "Virtual time: simulated robot-seconds per wall second",
         "log10(robots)",
-        "log10(robot-s per wall s)",
-        crate::plot::LineOptions {
-            legend: true,
-            ..Default::default()
-        },
-        &[crate::plot::Series {
+        "thousand robot-s per wall s",
+        legend,
+        &[Series {
             name: "virtual time",
             points: &virt,
         }],
     );
-    let b = crate::plot::line_chart_with(
+    let b = line_chart_with(
         "Realtime: longest answer to a poll (the paper's window: 700 ms)",
         "log10(robots)",
         "longest answer, ms",
-        crate::plot::LineOptions {
-            legend: true,
+        LineOptions {
             y_range: Some((0.0, 800.0)),
-            ..Default::default()
+            ..legend
         },
         &[
-            crate::plot::Series {
+            Series {
                 name: "realtime",
-                points: &real,
+                points: &longest,
             },
-            crate::plot::Series {
+            Series {
                 name: "0.7 s window",
                 points: &window,
             },
         ],
     );
-    stack(&a, &b)
+    let c = line_chart_with(
+        "Realtime: polls answered within 0.7 s",
+        "log10(robots)",
+        "% of polls",
+        LineOptions {
+            y_range: Some((98.0, 100.2)),
+            ..legend
+        },
+        &[Series {
+            name: "realtime",
+            points: &share,
+        }],
+    );
+    stack(&[&a, &b, &c])
 }
 
-/// Two SVG charts one above the other in one SVG.
-fn stack(a: &str, b: &str) -> String {
-    let size = |s: &str| -> (f64, f64) {
-        let attr = |name: &str| {
-            s.split(&format!("{name}=\""))
-                .nth(1)
-                .and_then(|r| r.split('"').next())
-                .and_then(|v| v.parse::<f64>().ok())
-                .unwrap_or(0.0)
-        };
-        (attr("width"), attr("height"))
+/// SVG charts one above the other in one SVG.
+fn stack(charts: &[&str]) -> String {
+    let attr = |s: &str, name: &str| {
+        s.split(&format!("{name}=\""))
+            .nth(1)
+            .and_then(|r| r.split('"').next())
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
     };
-    let ((wa, ha), (wb, hb)) = (size(a), size(b));
+    let mut body = String::new();
+    let (mut width, mut y) = (0.0f64, 0.0);
+    for c in charts {
+        body.push_str(&format!("<g transform=\"translate(0,{y})\">{c}</g>\n"));
+        width = width.max(attr(c, "width"));
+        y += attr(c, "height");
+    }
     format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\">\n\
-         <g>{a}</g>\n<g transform=\"translate(0,{ha})\">{b}</g>\n</svg>\n",
-        w = wa.max(wb),
-        h = ha + hb
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{y}\">\n{body}</svg>\n"
     )
 }

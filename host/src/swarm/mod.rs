@@ -283,7 +283,7 @@ impl Report {
         let c = &self.checked;
         let mut t = format!(
             "swarm: {} runs in {:.1} s wall ({:.1} runs/s), {:.2} simulated hours ({:.0}x real time); \
-             {} plans completed, {} cut short by their faults\n\
+             {} plans completed, {} ended otherwise (a fault, a refusal, a Stop never reset)\n\
              checked: {} admissions traced to their sender's packet, {} board A ticks in motion \
              (grippers), {} ticks in Standby (drives, motion), {} faults raised (their mode), \
              {} commands ended, {} injected faults expected in time, every run for panics\n",
