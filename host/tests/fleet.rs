@@ -114,8 +114,8 @@ fn mmic_fleet_sweeps_and_plots() {
     let plot = std::fs::read_to_string(&svg).unwrap();
     assert_eq!(
         plot.matches("<polyline").count(),
-        3,
-        "virtual, realtime, the window"
+        4,
+        "virtual; realtime's longest answer and the window; realtime's share answered"
     );
     let bad = Command::new(env!("CARGO_BIN_EXE_mmic"))
         .args(["fleet", "--robots", "0"])
