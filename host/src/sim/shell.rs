@@ -418,16 +418,6 @@ impl<G: Ground> GroundSide<G> {
         }
     }
 
-    /// Robots.
-    pub fn robots(&self) -> usize {
-        self.runners.len()
-    }
-
-    /// Robot `i`'s plan has ended.
-    pub fn ended(&self, i: usize) -> bool {
-        self.ends.get(i).is_some_and(Option::is_some)
-    }
-
     /// Every robot's plan has ended.
     pub fn all_ended(&self) -> bool {
         self.ends.iter().all(Option::is_some)
@@ -438,11 +428,6 @@ impl<G: Ground> GroundSide<G> {
     /// answered or given up, and its outcome is logged like any other).
     pub fn all_done(&self) -> bool {
         self.all_ended() && self.open.iter().all(|m| m.is_empty())
-    }
-
-    /// Robot `i`'s runner.
-    pub fn runner(&self, i: usize) -> Option<&G> {
-        self.runners.get(i)
     }
 
     fn event(&self, now: u32, what: Value) {

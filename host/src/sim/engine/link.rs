@@ -102,25 +102,6 @@ pub struct Link {
     /// A stream keeps order: no packet arrives before the one written before it.
     stream: bool,
     last_at: u64,
-    /// Packets written, delivered (copies counted), lost, cut.
-    pub counts: Counts,
-}
-
-/// A link's packet counts.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Counts {
-    /// Written to the link.
-    pub sent: u64,
-    /// Arrivals scheduled (a duplicated packet counts twice).
-    pub delivered: u64,
-    /// Lost.
-    pub lost: u64,
-    /// Cut.
-    pub cut: u64,
-    /// Duplicated.
-    pub duplicated: u64,
-    /// Held back to be overtaken.
-    pub reordered: u64,
 }
 
 impl Link {
@@ -133,7 +114,6 @@ impl Link {
             rng: fastrand::Rng::with_seed(seed),
             stream,
             last_at: 0,
-            counts: Counts::default(),
         }
     }
 
@@ -145,18 +125,15 @@ impl Link {
     /// A packet written at `now_us`: its fate and arrival times. Every random choice is drawn
     /// whatever the outcome, so that one packet's fate never shifts the next one's draws.
     pub fn send(&mut self, now_us: u64) -> Sent {
-        self.counts.sent += 1;
         let (lost, dup, reorder) = (self.rng.f64(), self.rng.f64(), self.rng.f64());
         let (j1, j2) = (self.jitter(), self.jitter());
         if self.model.cut_at((now_us / 1000) as u32) {
-            self.counts.cut += 1;
             return Sent {
                 fate: Fate::Cut,
                 at_us: Vec::new(),
             };
         }
         if lost < self.loss {
-            self.counts.lost += 1;
             return Sent {
                 fate: Fate::Lost,
                 at_us: Vec::new(),
@@ -165,20 +142,17 @@ impl Link {
         let held = reorder < self.model.reorder;
         let mut first = now_us + self.model.latency_us + j1;
         if held {
-            self.counts.reordered += 1;
             first += self.model.reorder_us;
         } else if self.stream {
             first = first.max(self.last_at);
         }
         let mut at_us = vec![first];
         if dup < self.model.duplicate {
-            self.counts.duplicated += 1;
             at_us.push(first.max(now_us + self.model.latency_us + j2));
         }
         if !held {
             self.last_at = self.last_at.max(*at_us.iter().max().unwrap_or(&first));
         }
-        self.counts.delivered += at_us.len() as u64;
         Sent {
             fate: Fate::Delivered,
             at_us,

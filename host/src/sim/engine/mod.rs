@@ -436,9 +436,6 @@ impl<'c, G: Ground> Engine<'c, G> {
                 }
             }
         }
-        if let Some(w) = &mut self.watch {
-            w.sent(i, hop as usize, sent.fate, self.now);
-        }
         for (k, at) in sent.at_us.iter().enumerate() {
             self.at(
                 *at,
@@ -476,7 +473,7 @@ impl<'c, G: Ground> Engine<'c, G> {
     fn ground_sends(&mut self, i: usize, p: &[u8]) {
         if self.cfg.protocol == Protocol::Legacy {
             if let Some(w) = &mut self.watch {
-                w.commanded(i, p, self.now);
+                w.commanded(i, p);
             }
         }
         self.send(i, Hop::GroundToServer, 0, p);
@@ -727,7 +724,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         });
         if self.cfg.protocol == Protocol::Pus {
             if let Some(w) = &mut self.watch {
-                w.commanded(i, &packet, self.now);
+                w.commanded(i, &packet);
             }
         }
         self.send(i, Hop::ServerToA, conn, &packet);

@@ -30,7 +30,6 @@
 //! Injected faults being raised, and no panic, are judged by the swarm from the run's outcome
 //! ([`crate::swarm`]).
 
-use super::link::Fate;
 use super::SimConfig;
 use crate::sim::plant::Plant;
 use mmic::bolter::Drive;
@@ -261,8 +260,6 @@ pub struct Watch {
     pub raised: Vec<Vec<(u32, Fault)>>,
     /// Per robot: board A's latched faults from each time on (a row per change), in order.
     pub faults: Vec<Vec<(u32, Faults)>>,
-    /// Per robot: packets lost or cut on the A–B line (either way), with the time, ms.
-    pub ab_dropped: Vec<Vec<u32>>,
 }
 
 impl Watch {
@@ -288,7 +285,6 @@ impl Watch {
             checked: Checked::default(),
             raised: vec![Vec::new(); n],
             faults: vec![Vec::new(); n],
-            ab_dropped: vec![Vec::new(); n],
         }
     }
 
@@ -310,7 +306,7 @@ impl Watch {
     }
 
     /// A sender (the ground, or the gateway) writes command packet `bytes` for robot `i`.
-    pub fn commanded(&mut self, i: usize, bytes: &[u8], _now_us: u64) {
+    pub fn commanded(&mut self, i: usize, bytes: &[u8]) {
         let Ok(p) = <[u8; COMMAND_LEN]>::try_from(bytes) else {
             return;
         };
@@ -331,14 +327,6 @@ impl Watch {
         let r = &mut self.robots[i];
         if let Some(o) = r.origins.get(original).copied() {
             r.origins.insert(*copy, o);
-        }
-    }
-
-    /// A packet written to robot `i`'s hop `hop` met `fate`.
-    pub fn sent(&mut self, i: usize, hop: usize, fate: Fate, now_us: u64) {
-        // Hops 4 and 5: A→B and B→A.
-        if hop >= 4 && fate != Fate::Delivered {
-            self.ab_dropped[i].push((now_us / 1000) as u32);
         }
     }
 
@@ -639,7 +627,7 @@ mod tests {
     fn a_packet_admitted_twice_is_caught_whatever_its_number() {
         let mut w = watch();
         let (p, copy) = (packet(7), packet(0));
-        w.commanded(0, &p, 0);
+        w.commanded(0, &p);
         let mut t = tick(Mode::Operational);
         t.command = Some(p);
         t.admitted = true;
