@@ -196,9 +196,11 @@ pub enum ReconfigurationError {
 ///
 /// From a turn state a primitive can reach two states (12 such pairs,
 /// spec/motion/ambiguous-primitives.txt), so the number alone leaves the move to chance; the
-/// final state makes every one of the 72 moves of Figure 9 commandable. Built only for a
-/// final state the primitive reaches from some state: where the robot is now is board A's to
-/// check (the move must be the primitive's cell of the map from its tracked state).
+/// final state makes every one of the 60 moves of Figure 9 commandable. Built only for a
+/// final state the primitive reaches from some state in the geometric model (its 72 moves,
+/// [`map::reaches`](crate::motion::map::reaches)): where the robot is now is board A's to
+/// check (the move must be the primitive's cell of the map from its tracked state, and one of
+/// the model's 12 turns without a hip rotation is refused by that name).
 ///
 /// ```
 /// use mmic::command::{PrimitiveMove, PrimitiveMoveError};
@@ -246,6 +248,29 @@ impl PrimitiveMove {
     pub const fn is_move_from(self, from: State) -> bool {
         match crate::motion::map::primitive(from, self.target) {
             Some(p) => p as u8 == self.primitive as u8,
+            None => false,
+        }
+    }
+
+    /// Whether this names, from `from`, one of the model's 12 turns between two right-angle
+    /// states, which the robot cannot make
+    /// ([`turns_without_hip`](crate::motion::geometry::turns_without_hip)). Board A refuses
+    /// such a command by that name (`Refusal::TurnWithoutHip`), not as a wrong initial state:
+    /// the ground's belief of where the robot is holds, the move does not exist.
+    ///
+    /// ```
+    /// use mmic::command::PrimitiveMove;
+    /// use mmic::motion::{geometry, Primitive, State};
+    /// let (_, p) = geometry::single_move(State::G, State::J).unwrap();
+    /// let m = PrimitiveMove::new(p, State::J).unwrap(); // well formed: the model has the move
+    /// assert!(m.turns_without_hip_from(State::G) && !m.is_move_from(State::G));
+    /// ```
+    pub const fn turns_without_hip_from(self, from: State) -> bool {
+        match crate::motion::geometry::single_move(from, self.target) {
+            Some((_, p)) => {
+                p as u8 == self.primitive as u8
+                    && crate::motion::geometry::turns_without_hip(from, self.target)
+            }
             None => false,
         }
     }
@@ -747,18 +772,27 @@ mod tests {
     }
 
     #[test]
-    fn every_move_of_the_map_is_one_primitive_command() {
-        // 72 moves, 60 commands: a command is (primitive, final state); the robot's state
-        // supplies the row. Each command is the move of exactly the rows it names.
-        let mut moves = 0;
+    fn every_move_of_the_model_is_one_primitive_command() {
+        // 72 moves of the model, 60 commands: a command is (primitive, final state); the
+        // robot's state supplies the row. Each command is the move of exactly the rows it
+        // names: 60 moves of the map (run), 12 turns without a hip rotation (refused by name).
+        let (mut moves, mut hipless) = (0, 0);
         for m in PrimitiveMove::all() {
             for from in State::ALL {
                 let cell = crate::motion::map::primitive(from, m.target());
                 assert_eq!(m.is_move_from(from), cell == Some(m.primitive()));
+                let model = crate::motion::geometry::single_move(from, m.target());
+                assert_eq!(
+                    m.turns_without_hip_from(from),
+                    model.map(|x| x.1) == Some(m.primitive()) && cell.is_none(),
+                    "{m:?} from {from}"
+                );
+                assert!(!(m.is_move_from(from) && m.turns_without_hip_from(from)));
                 moves += usize::from(m.is_move_from(from));
+                hipless += usize::from(m.turns_without_hip_from(from));
             }
         }
-        assert_eq!((PrimitiveMove::all().count(), moves), (60, 72));
+        assert_eq!((PrimitiveMove::all().count(), moves, hipless), (60, 60, 12));
         for (from, to, p) in crate::motion::map::moves() {
             assert!(PrimitiveMove::new(p, to).is_ok_and(|m| m.is_move_from(from)));
         }

@@ -10,7 +10,8 @@
 use crate::wire_enum::wire_enum;
 
 wire_enum! {
-    /// A refused command's reason. Wire value 1..=8; 0 means accepted.
+    /// A refused command's reason. Wire value 1..=9; 0 means accepted. None of these is the
+    /// paper's: it has no refusal codes (spec/decisions.toml, `heartbeat-byte-62`).
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
     #[cfg_attr(feature = "defmt", derive(defmt::Format))]
     #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -36,11 +37,16 @@ wire_enum! {
         /// Reset with nothing to resume: no motion was interrupted by a Stop, or the mode
         /// changed since (which drops it).
         NothingToResume = 8 => "nothing_to_resume",
+        /// Primitive refused: from the robot's tracked state, the move to the final state named
+        /// is a turn between two right-angle states, which would swing the moving arm about the
+        /// holding arm's axis: the geometric model has it, the robot's joints do not (the hip's
+        /// axis is perpendicular to both arms; spec/decisions.toml, `turn-to-turn-moves`).
+        TurnWithoutHip = 9 => "turn_without_hip",
     }
 
     /// All reasons, in wire order.
     const ALL;
-    /// Wire value 1..=8.
+    /// Wire value 1..=9.
     pub const fn to_wire(self) -> u8;
     /// Reason from its wire value; `None` for 0 (accepted) and unknown values.
     pub const fn from_wire(b: u8) -> Option<Self>;

@@ -21,6 +21,8 @@ struct MoveJson {
 #[derive(Serialize)]
 struct MapJson {
     moves: Vec<MoveJson>,
+    /// The geometric model's turns between two right-angle states, no moves of the robot.
+    turns_without_hip: Vec<MoveJson>,
 }
 
 /// A state from its Table 5 letter (either case).
@@ -57,16 +59,24 @@ pub fn plan_text(from: State, to: State) -> String {
     s
 }
 
-/// `{"moves":[{"from":"a","to":"d","primitive":4}, ...]}`.
+/// `{"moves":[{"from":"a","to":"d","primitive":4}, ...],"turns_without_hip":[...]}`: the map's
+/// 60 moves, and the model's 12 turns the hip cannot make, in the same form.
 pub fn map_json() -> String {
-    let moves = map::moves()
-        .map(|(f, t, p)| MoveJson {
-            from: f.letter().to_string(),
-            to: t.letter().to_string(),
-            primitive: p.number(),
-        })
+    let json = |(f, t, p): (State, State, mmic::motion::Primitive)| MoveJson {
+        from: f.letter().to_string(),
+        to: t.letter().to_string(),
+        primitive: p.number(),
+    };
+    let moves = map::moves().map(json).collect();
+    let turns_without_hip = mmic::motion::geometry::model_moves()
+        .filter(|&(f, t, _, _)| mmic::motion::geometry::turns_without_hip(f, t))
+        .map(|(f, t, _, p)| json((f, t, p)))
         .collect();
-    serde_json::to_string(&MapJson { moves }).unwrap_or_default()
+    serde_json::to_string(&MapJson {
+        moves,
+        turns_without_hip,
+    })
+    .unwrap_or_default()
 }
 
 /// The Figure 9 grid as text, followed by its legend.

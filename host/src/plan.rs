@@ -268,6 +268,24 @@ pub enum PlanErrorKind {
         /// The line whose step put the robot there; none for the start state.
         since: Option<usize>,
     },
+    /// A primitive step that names one of the geometric model's 12 turns between two
+    /// right-angle states from the state the robot is in at that point of the plan: the moving
+    /// arm would turn about the holding arm, which the hip cannot do; the robot would refuse it
+    /// (`turn_without_hip`; spec/decisions.toml, `turn-to-turn-moves`).
+    #[error(
+        "primitive {primitive} from {tracked} to {target} is a turn between two right-angle states, which the hip cannot make (Figure 9 as read in spec/decisions.toml turn-to-turn-moves; the robot refuses it: turn_without_hip); the robot is in {tracked} here ({})",
+        since_text(*since)
+    )]
+    TurnWithoutHip {
+        /// The primitive's number.
+        primitive: u8,
+        /// The state the plan has the robot in.
+        tracked: State,
+        /// The final state of the move (named by the step, or the model's only one).
+        target: State,
+        /// The line whose step put the robot there; none for the start state.
+        since: Option<usize>,
+    },
     /// A primitive step whose final state is not where the primitive takes the robot from the
     /// state it is in at that point of the plan; the robot would refuse it (initial state
     /// mismatch).
@@ -502,12 +520,30 @@ fn fill_in(
             second,
             since,
         }),
-        (None, _) => Err(PlanErrorKind::NoSuchMove {
-            primitive: number,
-            tracked,
-            since,
+        (None, _) => Err(match hipless_target(tracked, primitive) {
+            Some(target) => PlanErrorKind::TurnWithoutHip {
+                primitive: number,
+                tracked,
+                target,
+                since,
+            },
+            None => PlanErrorKind::NoSuchMove {
+                primitive: number,
+                tracked,
+                since,
+            },
         }),
     }
+}
+
+/// The final state of the model's turn without a hip rotation that `primitive` names from
+/// `from`, if it names one (then it is the primitive's only move of the model from there).
+fn hipless_target(from: State, primitive: Primitive) -> Option<State> {
+    mmic::motion::geometry::model_moves()
+        .find(|&(f, t, _, p)| {
+            f == from && p == primitive && mmic::motion::geometry::turns_without_hip(f, t)
+        })
+        .map(|(_, t, _, _)| t)
 }
 
 /// The robot's state after `step`, from `at` (the state, and the line whose step put the robot
@@ -541,6 +577,17 @@ fn follow(
         Action::Command(Command::Primitive(m)) => {
             if m.is_move_from(tracked) {
                 return Ok((m.target(), Some(step.line)));
+            }
+            if m.turns_without_hip_from(tracked) {
+                return Err(error(
+                    column(1),
+                    PlanErrorKind::TurnWithoutHip {
+                        primitive: m.primitive().number(),
+                        tracked,
+                        target: m.target(),
+                        since,
+                    },
+                ));
             }
             let reaches: Vec<State> = mmic::motion::map::targets(tracked, m.primitive()).collect();
             let primitive = m.primitive().number();

@@ -1,8 +1,22 @@
 //! The geometric model behind Figure 9: which face each side grips in each state, the direction
-//! of each arm, and which single-side moves exist. Everything here is `const fn`, so the
+//! of each arm, which single-side moves the model allows ([`single_move`], 72) and which of them
+//! the robot's joints can make ([`robot_move`], 60). Everything here is `const fn`, so the
 //! reconfiguration map is computed at compile time, never typed in (spec/motion/model.md).
+//!
+//! ```
+//! use mmic::motion::geometry::{robot_move, single_move, turns_without_hip};
+//! use mmic::motion::{Primitive, State};
+//! use mmic::units::Side;
+//! // b -> g: B leaves the Y- face for X+, its arm turns with the hip: a move of the robot.
+//! assert_eq!(robot_move(State::B, State::G), Some((Side::B, Primitive::BackTurnCw)));
+//! // g -> j: A swings from -Y to -Z about B's +X arm. The model has the move; the hip, whose
+//! // axis is perpendicular to both arms, cannot make it.
+//! assert!(single_move(State::G, State::J).is_some());
+//! assert_eq!(robot_move(State::G, State::J), None);
+//! assert!(turns_without_hip(State::G, State::J));
+//! ```
 
-use super::{Primitive, State};
+use super::{Primitive, State, StateKind};
 use crate::units::{Axis, Side, Sign};
 
 /// A face of the reference voxel.
@@ -151,4 +165,38 @@ pub const fn single_move(from: State, to: State) -> Option<(Side, Primitive)> {
         }
     };
     Some((side, p))
+}
+
+/// Whether the geometric move `from → to` is a turn between two right-angle (turn) states: the
+/// moving arm would swing about the holding arm's axis (g → j: arm A from −Y to −Z about arm B's
+/// +X). MMIC-I's only rotary joint is the hip, whose axis is perpendicular to both arms, and
+/// Table 6's caption says each turn "include[s] a rotation of the hip": no joint makes such a
+/// move, so the robot has 12 fewer moves than the model (spec/decisions.toml,
+/// `turn-to-turn-moves`).
+pub const fn turns_without_hip(from: State, to: State) -> bool {
+    matches!(from.kind(), StateKind::Turn)
+        && matches!(to.kind(), StateKind::Turn)
+        && single_move(from, to).is_some()
+}
+
+/// The single-primitive move from `from` to `to` the robot can make: [`single_move`] but for
+/// the 12 [`turns_without_hip`]. Every straight move (primitives 1–4) is one, and every turn
+/// that has a state with the arms in line (matched or stretch) at one end, so the hip rotates
+/// between 180° and a right angle. This is the map of Figure 9 ([`super::map::MAP`]).
+pub const fn robot_move(from: State, to: State) -> Option<(Side, Primitive)> {
+    if turns_without_hip(from, to) {
+        None
+    } else {
+        single_move(from, to)
+    }
+}
+
+/// Every move of the model, as (from, to, moving side, primitive), rows and columns in Table 5
+/// order: the 72 of [`single_move`], the 12 [`turns_without_hip`] among them.
+pub fn model_moves() -> impl Iterator<Item = (State, State, Side, Primitive)> {
+    State::ALL.into_iter().flat_map(|f| {
+        State::ALL
+            .into_iter()
+            .filter_map(move |t| single_move(f, t).map(|(side, p)| (f, t, side, p)))
+    })
 }

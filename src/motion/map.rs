@@ -4,14 +4,16 @@
 //! use mmic::motion::{map, Primitive, State};
 //! assert_eq!(map::primitive(State::A, State::D), Some(Primitive::BackExtend));
 //! assert_eq!(map::primitive(State::A, State::M), None); // needs two primitives
-//! assert_eq!(map::moves().count(), 72);
+//! assert_eq!(map::moves().count(), 60);
+//! // The model's 12 turns between two right-angle states need a joint the robot lacks.
+//! assert_eq!(map::primitive(State::G, State::J), None);
 //! // From a turn state one primitive may reach two states: a primitive command names its
 //! // final state (spec/motion/ambiguous-primitives.txt).
 //! assert!(map::targets(State::E, Primitive::BackTurnCw).eq([State::A, State::D]));
 //! assert_eq!(map::ambiguous().count(), 12);
 //! ```
 
-use super::geometry::single_move;
+use super::geometry::{robot_move, single_move};
 use super::{Primitive, State};
 use core::fmt::Write as _;
 
@@ -24,7 +26,7 @@ const fn build() -> [[Option<Primitive>; N]; N] {
         let mut j = 0;
         while j < N {
             if let (Some(from), Some(to)) = (State::from_index(i), State::from_index(j)) {
-                if let Some((_, p)) = single_move(from, to) {
+                if let Some((_, p)) = robot_move(from, to) {
                     m[i][j] = Some(p);
                 }
             }
@@ -35,7 +37,8 @@ const fn build() -> [[Option<Primitive>; N]; N] {
     m
 }
 
-/// Figure 9: the primitive that takes row state to column state, if one does.
+/// Figure 9: the primitive that takes row state to column state, if the robot can make the
+/// move ([`robot_move`]: the model's 72 moves but the 12 turns without a hip rotation).
 pub const MAP: [[Option<Primitive>; N]; N] = build();
 
 /// The primitive for a single-primitive reconfiguration from `from` to `to`.
@@ -63,15 +66,19 @@ pub fn targets(from: State, p: Primitive) -> impl Iterator<Item = State> {
         .filter(move |&to| primitive(from, to) == Some(p))
 }
 
-/// Whether some state is taken to `to` by `p`: whether `to` can be the final state of a
-/// primitive command for `p` at all (a command naming another is malformed, whatever state
-/// the robot is in).
+/// Whether the model takes some state to `to` by `p` ([`single_move`], the 72 moves): whether
+/// `to` can be the final state of a primitive command for `p` at all (a command naming another
+/// is malformed, whatever state the robot is in). The model's moves, not the map's: a command
+/// naming one of the 12 turns without a hip rotation is well formed, and board A refuses it by
+/// that name when the robot is where the move starts (`Refusal::TurnWithoutHip`).
 pub const fn reaches(p: Primitive, to: State) -> bool {
     let mut i = 0;
     while i < N {
-        if let Some(q) = MAP[i][to.index()] {
-            if q as u8 == p as u8 {
-                return true;
+        if let Some(from) = State::from_index(i) {
+            if let Some((_, q)) = single_move(from, to) {
+                if q as u8 == p as u8 {
+                    return true;
+                }
             }
         }
         i += 1;
@@ -115,8 +122,9 @@ pub fn used_between_matched(from: State, to: State) -> bool {
 /// Renders the map as a text grid in the manner of Figure 9: rows are initial states, columns
 /// target states; a cell holds the primitive number, `F` when the target is a final (matched)
 /// state or `i` when intermediate, and `*` when no chosen plan between matched states uses the
-/// move; `--` marks the diagonal and `.` pairs with no single-primitive move ([`write_legend`]
-/// says so for readers of the grid). Each column is five characters wide, the cell text
+/// move; `--` marks the diagonal, `x` the model's turns without a hip rotation (no move of the
+/// robot) and `.` the other pairs with no single-primitive move ([`write_legend`] says so for
+/// readers of the grid). Each column is five characters wide, the cell text
 /// right-aligned under its state letter and the `*` after it; lines carry no trailing blanks.
 pub fn render(out: &mut impl core::fmt::Write) -> core::fmt::Result {
     let mut line: heapless::String<128> = heapless::String::new();
@@ -140,6 +148,7 @@ pub fn render(out: &mut impl core::fmt::Write) -> core::fmt::Result {
                 continue;
             }
             match primitive(f, t) {
+                None if super::geometry::turns_without_hip(f, t) => write!(line, " {:>3} ", "x")?,
                 None => write!(line, " {:>3} ", ".")?,
                 Some(p) => {
                     let kind = if t.is_matched() { 'F' } else { 'i' };
@@ -162,6 +171,9 @@ pub fn write_legend(out: &mut impl core::fmt::Write) -> core::fmt::Result {
          2F   primitive 2 takes it to a final (matched) state (F: blue in Figure 9)\n\
          *    possible, but no chosen plan between matched states uses the move (Figure 9's\n\
          \x20    asterisk)\n\
+         x    a turn between two right-angle states: the geometric model has it, but the moving\n\
+         \x20    arm would turn about the holding arm, which the hip cannot do: no move of the\n\
+         \x20    robot (grey, as read here; spec/decisions.toml turn-to-turn-moves)\n\
          .    no single primitive does it (grey in Figure 9); a sequence may\n\
          --   the same state: not a reconfiguration (black in Figure 9)\n\
          primitives:",

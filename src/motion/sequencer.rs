@@ -30,7 +30,7 @@
 //! assert_eq!(s.status(), Status::Done);
 //! ```
 
-use super::geometry::single_move;
+use super::geometry::robot_move;
 use super::{Primitive, State};
 use crate::command::{preset_angle, HipTarget, ServoTarget};
 use crate::faults::Fault;
@@ -130,7 +130,7 @@ pub enum Status {
 /// `from → to` is not a single-primitive move.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[error("no single primitive takes {from} to {to}")]
+#[error("no single primitive of the robot takes {from} to {to} (Figure 9)")]
 pub struct NotAMove {
     /// Initial state.
     pub from: State,
@@ -147,10 +147,10 @@ pub struct NotAMove {
 /// the structure frame (a → e → n: B CCW, then A CCW) folds back to 180°, where adding +90° twice
 /// would have left the hip at 0°, a pose no state has.
 ///
-/// - straight primitives (1–4) and turns between two right-angle states: `None`. A turn from one
-///   right-angle state to another (e → k: A swings from −X to −Z about B's arm, +Y) rotates
-///   about the holding arm, not about the hip axis; the model's map has 12 such moves and the
-///   hip keeps its angle through them (spec/motion/sequencer.md);
+/// - straight primitives (1–4): `None`. So is a turn from one right-angle state to another
+///   (e → k: A would swing from −X to −Z about B's arm, +Y), which no hip rotation makes: no
+///   move of the robot ([`super::geometry::turns_without_hip`]), and [`Sequencer::start`]
+///   refuses it;
 /// - into a state with the arms in line (matched, stretch): [`HipTarget::Straight`], 180°;
 /// - from arms in line into a right angle: [`HipTarget::RightAngleCw`] (90°) for a CW
 ///   primitive, [`HipTarget::RightAngleCcw`] (270°) for a CCW one. Either sign is a valid pose
@@ -199,7 +199,7 @@ impl Sequencer {
         targets: Targets,
         now: u32,
     ) -> Result<Sequencer, NotAMove> {
-        let (side, primitive) = single_move(from, to).ok_or(NotAMove { from, to })?;
+        let (side, primitive) = robot_move(from, to).ok_or(NotAMove { from, to })?;
         let contracting = to.is_matched();
         let (steps, n) = if contracting {
             ([Step::Release, Step::Move, Step::Confirm, Step::Grip], 4)

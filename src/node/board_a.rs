@@ -896,10 +896,18 @@ impl BoardA {
         }
         if let Command::Primitive(m) = c {
             if self.sup.mode() == Mode::Operational && self.primitive_move(m).is_none() {
-                // The command holds only where the primitive takes some state to its final
-                // state; the robot is in none of them: the ground's belief of where the robot
-                // is does not hold, as with a reconfiguration's initial state.
-                return Received::Refuse(seq, c, Refusal::InitialStateMismatch);
+                // From where the robot is, the model's move is a turn the hip cannot make: the
+                // ground's belief holds, the move does not exist.
+                let hipless = self.tracked.is_some_and(|t| m.turns_without_hip_from(t));
+                // Otherwise the command holds only where the primitive takes some state to its
+                // final state; the robot is in none of them: the ground's belief of where the
+                // robot is does not hold, as with a reconfiguration's initial state.
+                let why = if hipless {
+                    Refusal::TurnWithoutHip
+                } else {
+                    Refusal::InitialStateMismatch
+                };
+                return Received::Refuse(seq, c, why);
             }
         }
         Received::Run(seq, Incoming::Command(c))

@@ -20,10 +20,30 @@ fn inverse(p: Primitive) -> Primitive {
     }
 }
 
+/// The moves the robot can make, decided here from the joints, not from the library's rule:
+/// the moving arm turns from `u` to `v` about `u × v`, and the only rotary joint, the hip, turns
+/// about an axis perpendicular to the holding arm `w` (the hip axis is perpendicular to both
+/// arms). So a move is the robot's when it is straight (`u × v = 0`) or `(u × v) · w = 0`.
+pub(crate) fn robot_moves_oracle() -> Vec<(State, State, Primitive)> {
+    use mmic::motion::geometry::{arm_direction, cross, model_moves};
+    model_moves()
+        .filter(|&(f, t, side, _)| {
+            let hold = if side == Side::A { Side::B } else { Side::A };
+            let axis = cross(arm_direction(f, side), arm_direction(t, side));
+            let w = arm_direction(f, hold);
+            (0..3)
+                .map(|i| i32::from(axis[i]) * i32::from(w[i]))
+                .sum::<i32>()
+                == 0
+        })
+        .map(|(f, t, _, p)| (f, t, p))
+        .collect()
+}
+
 #[test]
-fn seventy_two_moves_each_with_its_inverse() {
+fn sixty_moves_each_with_its_inverse() {
     let moves: Vec<_> = map::moves().collect();
-    assert_eq!(moves.len(), 72);
+    assert_eq!(moves.len(), 60);
     for &(f, t, p) in &moves {
         assert_eq!(map::primitive(t, f), Some(inverse(p)), "{f} -> {t} by {p}");
         let (side, q) = single_move(f, t).unwrap();
@@ -44,14 +64,55 @@ fn seventy_two_moves_each_with_its_inverse() {
     }
 }
 
-/// Floyd–Warshall over the map: the oracle.
+/// Table 6's caption: the turns "include a rotation of the hip". The model's 72 moves include
+/// 12 turns between two right-angle states (e↔f, e↔k, f↔i, g↔i, g↔j, j↔k), in which the moving
+/// arm would turn about the holding arm; the map is exactly the model's moves the joints make.
+#[test]
+fn the_map_is_the_models_moves_the_hip_can_make() {
+    use mmic::motion::geometry::{model_moves, turns_without_hip};
+    let oracle = robot_moves_oracle();
+    assert_eq!(map::moves().collect::<Vec<_>>(), oracle);
+    let hipless: Vec<(char, char)> = model_moves()
+        .filter(|&(f, t, _, p)| !oracle.contains(&(f, t, p)))
+        .map(|(f, t, _, _)| (f.letter(), t.letter()))
+        .collect();
+    let mut expected = vec![];
+    for (x, y) in [
+        ('e', 'f'),
+        ('e', 'k'),
+        ('f', 'i'),
+        ('g', 'i'),
+        ('g', 'j'),
+        ('j', 'k'),
+    ] {
+        expected.extend([(x, y), (y, x)]);
+    }
+    expected.sort();
+    assert_eq!(hipless, expected);
+    for (f, t, _, p) in model_moves() {
+        let robot = oracle.contains(&(f, t, p));
+        assert_eq!(turns_without_hip(f, t), !robot, "{f} -> {t}");
+        assert_eq!(
+            mmic::motion::geometry::robot_move(f, t).is_some(),
+            robot,
+            "{f} -> {t}"
+        );
+        // Every turn the robot makes has arms in line at one end: the hip turns between 180°
+        // and a right angle.
+        if robot && p.number() >= 5 {
+            assert!(f.kind() != StateKind::Turn || t.kind() != StateKind::Turn);
+        }
+    }
+}
+
+/// Floyd–Warshall over the moves the joints make ([`robot_moves_oracle`]): the oracle.
 fn all_pairs() -> [[u32; 15]; 15] {
     let inf = 99;
     let mut d = [[inf; 15]; 15];
     for i in 0..15 {
         d[i][i] = 0;
     }
-    for (f, t, _) in map::moves() {
+    for (f, t, _) in robot_moves_oracle() {
         d[f.index()][t.index()] = 1;
     }
     for k in 0..15 {
@@ -66,8 +127,9 @@ fn all_pairs() -> [[u32; 15]; 15] {
     d
 }
 
-/// Every shortest state sequence from `f` to `t`, by brute force.
+/// Every shortest state sequence from `f` to `t`, by brute force over the oracle's moves.
 fn all_shortest(f: State, t: State, len: u32) -> Vec<Vec<State>> {
+    let moves = robot_moves_oracle();
     let mut out = Vec::new();
     let mut stack = vec![(f, Vec::new())];
     while let Some((at, path)) = stack.pop() {
@@ -77,7 +139,7 @@ fn all_shortest(f: State, t: State, len: u32) -> Vec<Vec<State>> {
             }
             continue;
         }
-        for (a, b, _) in map::moves() {
+        for &(a, b, _) in &moves {
             if a == at {
                 let mut p = path.clone();
                 p.push(b);
@@ -114,6 +176,10 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
                     Some(*prim),
                     "{f} -> {t}: step {k} invalid"
                 );
+                assert!(
+                    !mmic::motion::geometry::turns_without_hip(at, next),
+                    "{f} -> {t}: step {k} turns without the hip"
+                );
                 at = next;
             }
             assert_eq!(at, t);
@@ -132,9 +198,20 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
     }
     assert_eq!(
         histogram,
-        [0, 72, 126, 12],
+        [0, 60, 102, 48],
         "plan lengths over the 210 ordered pairs"
     );
+    // Four plans between matched states took a turn without the hip while the map had those
+    // moves (g -> j in b -> c, j -> g in c -> b, e -> f in n -> o, f -> e in o -> n); each has
+    // a plan of the same length the robot can make.
+    for (f, t) in [
+        (State::B, State::C),
+        (State::C, State::B),
+        (State::N, State::O),
+        (State::O, State::N),
+    ] {
+        assert_eq!(route::lookup(f, t).len(), 3, "{f} -> {t}");
+    }
     assert_eq!(
         matched,
         [0, 0, 18, 12],
@@ -154,11 +231,11 @@ fn rendered_grid_is_current_in_spec() {
         return;
     }
     assert_eq!(on_disk, grid, "spec/motion/map.txt is stale; regenerate with: MMIC_REGENERATE=1 cargo test --test motion motion_map");
-    // 72 move cells, 15 diagonal cells; the asterisks are exactly the moves no matched plan uses.
+    // 60 move cells, 15 diagonal cells; the asterisks are exactly the moves no matched plan uses.
     let used = map::moves()
         .filter(|(f, t, _)| map::used_between_matched(*f, *t))
         .count();
-    assert_eq!(grid.matches('*').count(), 72 - used);
+    assert_eq!(grid.matches('*').count(), 60 - used);
 }
 
 /// spec/motion/ambiguous-primitives.txt: the (state, primitive) pairs with two targets.
@@ -250,7 +327,7 @@ fn fwd_back_readings_compared_on_every_move() {
     // Under (b): (from, fwd, straight, ccw), i.e. the Table 6 name, -> the states it reaches.
     let mut ends_b: std::collections::BTreeMap<(State, bool, bool, bool), Vec<State>> =
         Default::default();
-    for (from, to, p) in map::moves() {
+    for (from, to, _, p) in mmic::motion::geometry::model_moves() {
         let (side, _) = single_move(from, to).unwrap();
         let pick = |s: State| match side {
             Side::A => faces(s).0,

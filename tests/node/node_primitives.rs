@@ -176,20 +176,22 @@ impl Rig {
     /// Commands primitive `p` ending in `target`, which board A must refuse as not the move
     /// from where the robot is: nothing runs, the state stays.
     fn refused(&mut self, p: Primitive, target: State) {
+        self.refused_with(p, target, Refusal::InitialStateMismatch);
+    }
+
+    /// Commands primitive `p` ending in `target`, which board A must refuse with `why`,
+    /// moving nothing and raising no fault.
+    fn refused_with(&mut self, p: Primitive, target: State, why: Refusal) {
         let before = self.a.state();
         let (refusal, events) = self.send(Command::primitive(p, target).unwrap());
-        assert_eq!(
-            refusal,
-            Some(Refusal::InitialStateMismatch),
-            "{before:?} by {p} to {target}"
-        );
+        assert_eq!(refusal, Some(why), "{before:?} by {p} to {target}");
         assert!(
             events.iter().any(|e| matches!(
                 e,
                 Event::Executed {
-                    refusal: Some(Refusal::InitialStateMismatch),
+                    refusal: Some(r),
                     ..
-                }
+                } if *r == why
             )),
             "{events:?}"
         );
@@ -263,4 +265,33 @@ fn the_first_targets_run_too_and_no_move_is_refused() {
     rig.settle(500);
     assert!(!rig.a.in_motion());
     assert_eq!(rig.a.state(), Some(State::A));
+}
+
+/// The geometric model's 12 turns between two right-angle states need a joint the robot does
+/// not have (spec/decisions.toml, turn-to-turn-moves): from where each starts, board A refuses
+/// it by that name, moves nothing and raises no fault; from another state the same command is
+/// a wrong belief of where the robot is, as before. Fails with the map of before issue 24,
+/// which ran them with the hip held.
+#[test]
+fn a_turn_without_the_hip_is_refused_by_name() {
+    use mmic::motion::geometry::{model_moves, turns_without_hip};
+    let mut n = 0;
+    for (from, to, _, p) in model_moves().filter(|&(f, t, _, _)| turns_without_hip(f, t)) {
+        let mut rig = Rig::new();
+        rig.go_to(from);
+        rig.refused_with(p, to, Refusal::TurnWithoutHip);
+        // The robot still moves: back to a by its plan.
+        let back = route::lookup(from, State::A);
+        for (q, next) in back.primitives().iter().zip(back.states()) {
+            rig.primitive(*q, *next);
+        }
+        n += 1;
+    }
+    assert_eq!(n, 12);
+    // From a, where no such turn starts, the same command is a wrong initial state.
+    let (from, to, _, p) = model_moves()
+        .find(|&(f, t, _, _)| turns_without_hip(f, t))
+        .unwrap();
+    assert_ne!(from, State::A);
+    Rig::new().refused(p, to);
 }

@@ -318,8 +318,21 @@ fn plan_and_map_commands() {
     fails(&["plan", "a", "z"], 2, "unknown state \"z\"");
     let map: Value = serde_json::from_str(&ok(&["map", "--json"])).unwrap();
     let moves = map["moves"].as_array().unwrap();
-    assert_eq!(moves.len(), 72);
+    assert_eq!(moves.len(), 60);
     assert_eq!(moves[0], json!({"from": "a", "to": "d", "primitive": 4}));
+    let hipless = map["turns_without_hip"].as_array().unwrap();
+    assert_eq!(hipless.len(), 12);
+    assert!(hipless.contains(&json!({"from": "g", "to": "j", "primitive": 6})));
+    assert!(!moves.iter().any(|m| hipless.contains(m)));
+    // b -> c in three primitives the robot can make (the map had g -> j, a turn without the
+    // hip, on the way before issue 24).
+    assert_eq!(
+        ok(&["plan", "b", "c"]),
+        "b (Yneg match) -> c (Zneg match): 3 primitive(s)\n  \
+         4 backExtend   -> h (Yneg Ypos stretch)\n  \
+         6 fwdTurnCCW   -> k (Zneg Ypos turn)\n  \
+         8 backTurnCCW  -> c (Zneg match)"
+    );
     // Every plan printed by the CLI follows the map's moves.
     for f in "abcdefghijklmno".chars() {
         for t in "abcdefghijklmno".chars() {
@@ -338,9 +351,10 @@ fn plan_and_map_commands() {
     let header = grid.lines().next().unwrap();
     for row in grid.lines().skip(1) {
         for (i, c) in row.char_indices().skip(7) {
-            if c.is_ascii_digit() || c == '.' {
-                // A primitive number sits one column left of its letter's column, `.` under it.
-                let col = if c == '.' { i } else { i + 1 };
+            if c.is_ascii_digit() || c == '.' || c == 'x' {
+                // A primitive number sits one column left of its letter's column, `.` and `x`
+                // under it.
+                let col = if c.is_ascii_digit() { i + 1 } else { i };
                 assert!(
                     header
                         .as_bytes()
@@ -351,7 +365,16 @@ fn plan_and_map_commands() {
             }
         }
     }
-    for code in ["4i", "2F", "*", ".", "--", "primitives: 1 fwdContract"] {
+    assert_eq!(grid.matches(" x").count(), 12);
+    for code in [
+        "4i",
+        "2F",
+        "*",
+        "x ",
+        ".",
+        "--",
+        "primitives: 1 fwdContract",
+    ] {
         assert!(legend.contains(code), "legend lacks {code:?}:\n{legend}");
     }
     let help = ok(&["map", "--help"]);

@@ -542,6 +542,24 @@ fn a_step_that_does_not_fit_the_state_is_refused_with_line_and_column() {
             ..
         }
     ));
+    // A turn between two right-angle states (g -> j by 6, fwdTurnCCW: A would swing about B's
+    // arm), named with its final state or without: refused by that name, the line of the step
+    // that put the robot in g given.
+    for step in ["primitive 6 -> j", "primitive 6"] {
+        let e = plan::parse(&format!("start b\nprimitive 7 -> g\n{step}\n")).unwrap_err();
+        assert_eq!((e.line, e.column), (3, 11), "{step}");
+        assert_eq!(
+            e.kind,
+            PlanErrorKind::TurnWithoutHip {
+                primitive: 6,
+                tracked: State::G,
+                target: State::J,
+                since: Some(2),
+            },
+            "{step}"
+        );
+        assert!(e.to_string().contains("turn_without_hip"), "{e}");
+    }
     // The header goes once, before the first step.
     assert_eq!(
         plan::parse("stop\nstart a\n").unwrap_err().kind,
@@ -633,11 +651,12 @@ fn a_primitive_step_names_its_final_state_or_the_plan_settles_it() {
 fn an_ambiguous_primitive_must_name_its_final_state() {
     let mut n = 0;
     for (from, p, first, second) in mmic::motion::map::ambiguous() {
-        // Reach `from` by primitives whose final state the parser fills in.
+        // Reach `from` by primitives, each naming its final state (some on the way are
+        // ambiguous themselves).
         let route = mmic::motion::route::lookup(State::A, from);
         let mut text = String::from("start a\nmode operational\n");
-        for q in route.primitives() {
-            text += &format!("primitive {}\n", q.number());
+        for (q, to) in route.primitives().iter().zip(route.states()) {
+            text += &format!("primitive {} -> {}\n", q.number(), to.letter());
         }
         let line = 3 + route.len();
         let e = err(&format!("{text}primitive {}  # which?\n", p.name()));
