@@ -14,7 +14,8 @@
 //! `PulseWidth::new`, `Reconfiguration::new`, `PrimitiveMove::new`, `Faults::from_wire`, …), so a strategy can only
 //! produce values the library itself would accept; nothing here bypasses a range check.
 //! Numeric ranges are drawn uniformly with their bounds over-weighted, because off-by-one
-//! mistakes live at the bounds (500 and 2500 µs, 0 and 35999 centidegrees, board 1 and 255).
+//! mistakes live at the bounds (500 and 2500 µs, an arm's 900 and 2100, 0 and 35999
+//! centidegrees, board 1 and 255).
 //! Sum types pick each variant with equal weight, so no variant is starved.
 //!
 //! Besides the [`Arbitrary`] impls, [`sealed_bytes`] draws byte strings with a packet's length,
@@ -30,6 +31,7 @@ use crate::command::{
     BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
     PrimitiveMove, Reconfiguration, ServoTarget,
 };
+use crate::control::interp::Travel;
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
 use crate::motion::{Primitive, State, StateKind};
@@ -192,6 +194,20 @@ arbitrary_boxed!(
         any::<PulseWidth>().prop_map(ServoTarget::Position),
     ]
 );
+/// A target of a servo with `travel`: contract, extend, or a position within the travel (its
+/// ends over-weighted), as the commands accept (`Travel::check`).
+pub fn servo_target(travel: Travel) -> impl Strategy<Value = ServoTarget> {
+    let (min, max) = (travel.min().micros(), travel.max().micros());
+    let position = prop_oneof![1 => Just(min), 1 => Just(max), 8 => min..=max]
+        .prop_filter_map("a pulse width", |us| PulseWidth::new(us).ok())
+        .prop_map(ServoTarget::Position);
+    prop_oneof![
+        Just(ServoTarget::Contract),
+        Just(ServoTarget::Extend),
+        position,
+    ]
+}
+
 arbitrary_boxed!(
     HipTarget,
     prop_oneof![
@@ -256,9 +272,9 @@ arbitrary_boxed!(
             Command::ClearFaults,
         ]),
         1 => any::<Mode>().prop_map(Command::Mode),
-        1 => (any::<Side>(), any::<ServoTarget>())
+        1 => (any::<Side>(), servo_target(Travel::ARM))
             .prop_map(|(side, target)| Command::Arm { side, target }),
-        1 => (any::<Side>(), any::<ServoTarget>())
+        1 => (any::<Side>(), servo_target(Travel::GRIPPER))
             .prop_map(|(side, target)| Command::Gripper { side, target }),
         1 => any::<HipTarget>().prop_map(Command::Hip),
         1 => any::<BolterCommand>().prop_map(Command::Bolter),

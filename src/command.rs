@@ -128,6 +128,26 @@ pub enum PowerTarget {
     All,
 }
 
+/// An arm target from JSON, refused outside the arms' travel.
+#[cfg(feature = "serde")]
+fn arm_target<'de, D: serde::Deserializer<'de>>(d: D) -> Result<ServoTarget, D::Error> {
+    use serde::Deserialize as _;
+    let t = ServoTarget::deserialize(d)?;
+    crate::control::interp::Travel::ARM
+        .check(t)
+        .map_err(|e| serde::de::Error::custom(format_args!("arm target: {e}")))
+}
+
+/// A gripper target from JSON, refused outside the grippers' travel.
+#[cfg(feature = "serde")]
+fn gripper_target<'de, D: serde::Deserializer<'de>>(d: D) -> Result<ServoTarget, D::Error> {
+    use serde::Deserialize as _;
+    let t = ServoTarget::deserialize(d)?;
+    crate::control::interp::Travel::GRIPPER
+        .check(t)
+        .map_err(|e| serde::de::Error::custom(format_args!("gripper target: {e}")))
+}
+
 /// A validated reconfiguration: the initial state and a different, matched target state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -337,18 +357,22 @@ pub enum Command {
     ClearFaults,
     /// Change operating mode.
     Mode(Mode),
-    /// Move one arm.
+    /// Move one arm. A position must lie within the arms' travel (`Travel::ARM`, 900..=2100 µs):
+    /// decoding and JSON refuse one outside it.
     Arm {
         /// Which arm.
         side: Side,
         /// Where to.
+        #[cfg_attr(feature = "serde", serde(deserialize_with = "arm_target"))]
         target: ServoTarget,
     },
-    /// Move one gripper.
+    /// Move one gripper. A position must lie within the grippers' travel (`Travel::GRIPPER`,
+    /// 1000..=2000 µs): decoding and JSON refuse one outside it.
     Gripper {
         /// Which gripper.
         side: Side,
         /// Where to.
+        #[cfg_attr(feature = "serde", serde(deserialize_with = "gripper_target"))]
         target: ServoTarget,
     },
     /// Rotate the hip.
@@ -565,16 +589,17 @@ pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl F
     }
 }
 
-/// Calls `visit` with every representable command: each variant class with every pulse width,
-/// every hip angle, every valid primitive command and every valid reconfiguration: 44,195
-/// calls.
+/// Calls `visit` with every representable command: each variant class, an arm or gripper
+/// with every pulse width of its travel, every hip angle, every valid primitive command and
+/// every valid reconfiguration: 40,595 calls.
 pub fn for_each_command(mut visit: impl FnMut(Command)) {
     for_each_variant_class(PulseWidth::CENTER, HipAngle::ZERO, |c| match c {
         Command::Arm {
             side,
             target: ServoTarget::Position(_),
         } => {
-            for us in PulseWidth::MIN_US..=PulseWidth::MAX_US {
+            let t = crate::control::interp::Travel::ARM;
+            for us in t.min().micros()..=t.max().micros() {
                 if let Ok(pw) = PulseWidth::new(us) {
                     visit(Command::Arm {
                         side,
@@ -587,7 +612,8 @@ pub fn for_each_command(mut visit: impl FnMut(Command)) {
             side,
             target: ServoTarget::Position(_),
         } => {
-            for us in PulseWidth::MIN_US..=PulseWidth::MAX_US {
+            let t = crate::control::interp::Travel::GRIPPER;
+            for us in t.min().micros()..=t.max().micros() {
                 if let Ok(pw) = PulseWidth::new(us) {
                     visit(Command::Gripper {
                         side,
@@ -633,9 +659,13 @@ mod tests {
             assert_eq!(Command::decode(id, p), Ok(c), "{c:?}");
             n += 1;
         });
-        // 61 classes; 4 positional servo classes × 2001 widths, 36000 angles, 60 primitive
-        // commands (8 classes), 84 reconfigurations.
-        assert_eq!(n, 61 - 4 - 1 - 8 - 1 + 4 * 2001 + 36000 + 60 + (15 * 6 - 6));
+        // 61 classes; 2 positional arm classes × 1201 widths (the arms' travel, 900..=2100),
+        // 2 gripper classes × 1001 (1000..=2000), 36000 angles, 60 primitive commands (8
+        // classes), 84 reconfigurations.
+        assert_eq!(
+            n,
+            61 - 4 - 1 - 8 - 1 + 2 * 1201 + 2 * 1001 + 36000 + 60 + (15 * 6 - 6)
+        );
     }
 
     #[test]
@@ -648,7 +678,7 @@ mod tests {
             assert_eq!((p[at], p[at + 1]), (0, 0), "{c:?}");
             n += 1;
         });
-        assert_eq!(n, 44_195);
+        assert_eq!(n, 40_595);
     }
 
     #[test]

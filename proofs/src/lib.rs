@@ -35,7 +35,8 @@ pub mod pus;
 
 use core::fmt::Debug;
 use mmic::bolter::{BolterDirection, BolterStep, MuxLines};
-use mmic::command::{for_each_variant_class, BolterPair, Command, PrimitiveMove};
+use mmic::command::{for_each_variant_class, BolterPair, Command, PrimitiveMove, ServoTarget};
+use mmic::control::interp::Travel;
 use mmic::faults::Faults;
 use mmic::mode::Mode;
 use mmic::motion::State;
@@ -229,6 +230,34 @@ impl<'a> Seed<'a> {
             }
             i += 1;
         });
+        // An arm or gripper position within its module's travel (the commands refuse others):
+        // the sampled pulse folded into it.
+        let fit = |travel: Travel| {
+            let (min, max) = (travel.min().micros(), travel.max().micros());
+            let off = (pw.micros() - PulseWidth::MIN_US) % (max - min + 1);
+            ServoTarget::Position(PulseWidth::new(min + off).expect("within the travel"))
+        };
+        match chosen {
+            Command::Arm {
+                side,
+                target: ServoTarget::Position(_),
+            } => {
+                chosen = Command::Arm {
+                    side,
+                    target: fit(Travel::ARM),
+                }
+            }
+            Command::Gripper {
+                side,
+                target: ServoTarget::Position(_),
+            } => {
+                chosen = Command::Gripper {
+                    side,
+                    target: fit(Travel::GRIPPER),
+                }
+            }
+            _ => {}
+        }
         if let Command::Primitive(m) = chosen {
             // Any final state the primitive reaches (3 for primitives 1-4, 12 for 5-8).
             let of_p = || PrimitiveMove::all().filter(move |o| o.primitive() == m.primitive());
@@ -279,7 +308,8 @@ fn sample_heartbeat(s: &mut Seed<'_>) -> HeartbeatRepr {
             let raw = s.u16() as u32 & Faults::DEFINED;
             Faults::from_wire([raw as u8, (raw >> 8) as u8]).expect("defined bits")
         },
-        refusal: Refusal::from_wire(s.u8() % 8),
+        // 0 (accepted) or any refusal code.
+        refusal: Refusal::from_wire(s.u8() % (Refusal::ALL.len() as u8 + 1)),
         mode: s.pick(&Mode::ALL),
         last_seq: s.u16(),
     }

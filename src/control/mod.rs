@@ -1,4 +1,5 @@
-//! Controllers (Section 5): open-loop interpolation for the arms and grippers.
+//! Controllers (Section 5): open-loop interpolation for the arms and grippers, the hip's PI
+//! controller, and the time budget of a single-module motion ([`deadline`]).
 //!
 //! ```
 //! use mmic::control::interp::{Interpolator, Rate};
@@ -10,5 +11,6 @@
 //! assert!(i.done());
 //! ```
 
+pub mod deadline;
 pub mod hip;
 pub mod interp;

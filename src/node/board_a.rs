@@ -35,6 +35,7 @@ use crate::bolter::{
     self as coordinator, BolterDirection, BolterSide, Coordinator, Drive, Job, MuxLines, Sensed,
 };
 use crate::command::{preset_angle, BolterCommand, Command, HipTarget, PrimitiveMove, ServoTarget};
+use crate::control::deadline;
 use crate::control::hip::{self, HipController};
 use crate::control::interp::{Interpolator, Rate, Travel};
 use crate::faults::{Fault, Faults};
@@ -49,7 +50,8 @@ use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use crate::safety::ModuleSet;
 use crate::sensors::frontend::Lost;
 use crate::units::{
-    BoardNumber, Electrical, Gravity, HipAngle, Instant, Module, PerSide, PulseWidth, Side,
+    BoardNumber, Duration, Electrical, Gravity, HipAngle, Instant, Module, PerSide, PulseWidth,
+    Side,
 };
 use crate::wire::b_command::{BCommandRepr, BPower, B_COMMAND_LEN};
 use crate::wire::command::{CommandPacket, CommandRepr, COMMAND_LEN};
@@ -79,6 +81,10 @@ pub struct Config {
     pub hip: hip::Config,
     /// A hip move is done within this distance of its target, 0.01°.
     pub hip_done_tolerance: u16,
+    /// The time budget of a module motion outside a primitive or a bolting job (arm, gripper
+    /// and hip commands, the move home): its size over the actuator's speed plus these margins
+    /// (spec/control/servos.toml).
+    pub deadline: deadline::Config,
     /// State estimation.
     pub estimate: estimate::Config,
     /// A→B command period, ms (sent sooner when its content changes).
@@ -104,6 +110,7 @@ impl Default for Config {
             gripper: Travel::GRIPPER,
             hip: hip::Config::default(),
             hip_done_tolerance: 150,
+            deadline: deadline::Config::default(),
             estimate: estimate::Config::default(),
             b_period_ms: 50,
             idle_settle_ms: 600,
@@ -322,6 +329,24 @@ pub struct BoardA {
     /// The last hip angle read: the heartbeat's "hip now" and the hold target of a Stop while
     /// the encoder is silent (the sensor-loss fault tells the ground it is stale).
     hip_seen: HipAngle,
+    /// The deadline of the module motion in progress outside a primitive or a bolting job.
+    watch: Watch,
+}
+
+/// The deadline of a module motion that has no step timeout of its own (arm, gripper and hip
+/// commands, the move home, a module pushed off its target): armed when modules start to move
+/// towards their targets with the budget of [`deadline::budget_ms`], disarmed when they are
+/// there ([`BoardA::watch_modules`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+enum Watch {
+    /// Nothing moves on its own account.
+    Idle,
+    /// Modules move; the motion times out at this instant.
+    Armed(Instant),
+    /// The motion timed out and was stopped; not armed again until the modules are at their
+    /// targets (an encoder that stays silent would otherwise time out again and again).
+    Expired,
 }
 
 /// A bolting job that waits for board B's bolter to report idle.
@@ -413,6 +438,7 @@ impl BoardA {
             paused: None,
             hold_b: false,
             hip_seen: cfg.safety.hip_home,
+            watch: Watch::Idle,
         }
     }
 
@@ -478,8 +504,15 @@ impl BoardA {
     }
 
     fn feedback(&self, hip_now: Option<HipAngle>, arm_a_switch: bool) -> Feedback {
-        let b_ok =
-            |now: PulseWidth, target: PulseWidth, want: PulseWidth| now == target && target == want;
+        // Side B's servo is done when B reports it at the target A wants. While B holds (a
+        // Stop, a mode change), B stops where it is when the hold reaches it, which is not
+        // where its last report put it (B moved on for up to a report and a command period):
+        // it is done when it reports itself at rest. Until issue 24 the hold was judged
+        // against the stale report, so a robot stopped with a side-B servo on its way stayed
+        // "in motion" for ever.
+        let b_ok = |now: PulseWidth, target: PulseWidth, want: PulseWidth| {
+            now == target && (self.hold_b || target == want)
+        };
         Feedback {
             arm_done: PerSide::new(
                 self.arm.done(),
@@ -620,6 +653,9 @@ impl BoardA {
             faults = faults.union(f);
         }
         self.bolting(now, out, &mut faults);
+        if self.watch_modules(now, fb) {
+            faults = faults.with(Fault::MotionTimeout);
+        }
         // Arm contraction check (Table 8), on both sides: after a commanded contraction ends,
         // the switch must close.
         for side in [Side::A, Side::B] {
@@ -628,6 +664,58 @@ impl BoardA {
             }
         }
         faults
+    }
+
+    /// The deadline of a module motion with no step timeout of its own (spec/decisions.toml,
+    /// `module-motion-deadline`): armed when the modules start moving towards their targets
+    /// outside a primitive, a bolting job or a job waiting for board B, in any mode but Standby
+    /// (nothing is driven there, and the robot may be moved by hand); when it passes, the
+    /// motion stops where the modules are ([`BoardA::stop_all`]) and true is returned: the
+    /// motion-timeout fault. A motion that was Stopped and Reset starts with a fresh budget.
+    fn watch_modules(&mut self, now: u32, fb: &Feedback) -> bool {
+        let modules = !fb.arm_done.all() || !fb.gripper_done.all() || !fb.hip_done;
+        let timed = self
+            .runner
+            .is_some_and(|r| r.status() == RunStatus::Running)
+            || self.coord.status() == coordinator::Status::Running
+            || self.waiting_job.is_some();
+        let own = modules && !timed && self.sup.mode() != Mode::Standby;
+        let t = Instant::from_millis(now);
+        match (self.watch, own) {
+            (Watch::Idle, true) => {
+                let budget = Duration::from_millis(self.module_budget_ms());
+                self.watch = Watch::Armed(t.after(budget));
+            }
+            (Watch::Armed(deadline), true) if t.reached(deadline) => {
+                self.watch = Watch::Expired;
+                self.stop_all(now, self.hip_seen);
+                return true;
+            }
+            (Watch::Armed(_), false) => self.watch = Watch::Idle,
+            (Watch::Expired, _) if !modules => self.watch = Watch::Idle,
+            _ => {}
+        }
+        false
+    }
+
+    /// The budget of the module motion towards the current targets, from where each module is
+    /// now (side B's servos as board B last reported them): the slowest servo's interpolation
+    /// time and the hip's time at its velocity-mode speed, with their margins.
+    fn module_budget_ms(&self) -> u32 {
+        let servo = |from: PulseWidth, to: PulseWidth| deadline::servo_ms(from, to, self.cfg.rate);
+        let (arm, gripper) = (self.cfg.arm, self.cfg.gripper);
+        let servos = [
+            servo(self.arm.now(), arm.resolve(self.targets.arm.a)),
+            servo(self.b.arm_b_now, arm.resolve(self.targets.arm.b)),
+            servo(self.gripper.now(), gripper.resolve(self.targets.gripper.a)),
+            servo(
+                self.b.gripper_b_now,
+                gripper.resolve(self.targets.gripper.b),
+            ),
+        ];
+        let servos = servos.into_iter().max().unwrap_or(0);
+        let hip = deadline::hip_ms(self.hip_seen, self.targets.hip, self.cfg.hip.speed);
+        deadline::budget_ms(&self.cfg.deadline, servos, hip)
     }
 
     /// Advances side `side`'s contraction check; true when it failed.
@@ -681,9 +769,11 @@ impl BoardA {
                 &inp.electrical,
                 b_over,
             ));
+            // Side B's battery only once B has reported it (Table 4 bytes 12-13).
+            let v_bat_b = self.b_heard.then_some(e_b.v_bat);
             if self
                 .battery
-                .update(&self.cfg.safety, now, inp.electrical.v_bat, e_b.v_bat)
+                .update(&self.cfg.safety, now, inp.electrical.v_bat, v_bat_b)
             {
                 conditions = conditions.with(Fault::LowBattery);
             }
@@ -888,9 +978,20 @@ impl BoardA {
             Err(r) => return Received::Run(seq, Incoming::Malformed(r)),
             Ok(c) => c,
         };
-        // Board-level checks the supervisor does not make: one motion at a time, and a
-        // primitive must be the map's move from the state the robot is in to the final state
-        // it names.
+        // Board-level checks the supervisor does not make. A position outside this robot's
+        // configured travel is a malformed command here, whatever the robot is doing (the
+        // packet's own check is against the library's travel): the servo would be driven
+        // against its end stop.
+        let travel = match c {
+            Command::Arm { target, .. } => self.cfg.arm.check(target).err(),
+            Command::Gripper { target, .. } => self.cfg.gripper.check(target).err(),
+            _ => None,
+        };
+        if travel.is_some() {
+            return Received::Refuse(seq, c, Refusal::InvalidParameter);
+        }
+        // One motion at a time, and a primitive must be the map's move from the state the
+        // robot is in to the final state it names.
         if c.kind().moves() && in_motion && self.sup.mode() == Mode::Operational {
             return Received::Refuse(seq, c, Refusal::Busy);
         }

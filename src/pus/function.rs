@@ -30,6 +30,7 @@ use crate::command::{
     BolterCommand, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove, PrimitiveMoveError,
     Reconfiguration, ReconfigurationError, ServoTarget,
 };
+use crate::control::interp::Travel;
 use crate::mode::Mode;
 use crate::motion::{Primitive, State};
 use crate::units::{HipAngle, Module, PulseWidth, Side};
@@ -208,7 +209,14 @@ fn side(f: FunctionId, b: u8) -> Result<Side, FunctionError> {
     })
 }
 
-fn servo(f: FunctionId, kind: u8, pulse: u16) -> Result<ServoTarget, FunctionError> {
+/// A servo target; a position within `travel` (the arms' or the grippers', which the command
+/// layer refuses to leave: spec/control/servos.toml).
+fn servo(
+    f: FunctionId,
+    kind: u8,
+    pulse: u16,
+    travel: Travel,
+) -> Result<ServoTarget, FunctionError> {
     Ok(match arg(f, "target", kind.into(), 0, SERVO_KINDS)? {
         0 | 1 => {
             arg(f, "pulse", pulse, 0, 0)?;
@@ -218,18 +226,13 @@ fn servo(f: FunctionId, kind: u8, pulse: u16) -> Result<ServoTarget, FunctionErr
                 ServoTarget::Extend
             }
         }
-        _ => ServoTarget::Position(match PulseWidth::new(pulse) {
-            Ok(p) => p,
-            Err(_) => {
-                return Err(range_err(
-                    f,
-                    "pulse",
-                    pulse,
-                    PulseWidth::MIN_US,
-                    PulseWidth::MAX_US,
-                ))
+        _ => {
+            let (min, max) = (travel.min().micros(), travel.max().micros());
+            match PulseWidth::new(arg(f, "pulse", pulse, min, max)?) {
+                Ok(p) => ServoTarget::Position(p),
+                Err(_) => return Err(range_err(f, "pulse", pulse, min, max)),
             }
-        }),
+        }
     })
 }
 
@@ -279,11 +282,11 @@ pub fn decode(data: &[u8]) -> Result<Command, FunctionError> {
     Ok(match f {
         FunctionId::Arm => Command::Arm {
             side: side(f, b(0))?,
-            target: servo(f, b(1), w(2))?,
+            target: servo(f, b(1), w(2), Travel::ARM)?,
         },
         FunctionId::Gripper => Command::Gripper {
             side: side(f, b(0))?,
-            target: servo(f, b(1), w(2))?,
+            target: servo(f, b(1), w(2), Travel::GRIPPER)?,
         },
         FunctionId::Hip => {
             let kind = arg(f, "target", b(0).into(), 0, HIP_KINDS)?;

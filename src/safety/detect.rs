@@ -11,9 +11,12 @@
 //! let cfg = Config::default();
 //! let mut lb = LowBattery::default();
 //! let t0 = u32::MAX - 100; // across the clock's wrap
-//! assert!(!lb.update(&cfg, t0, 9_900, 11_000));
-//! assert!(!lb.update(&cfg, t0.wrapping_add(500), 9_900, 11_000)); // 500 ms: not yet
-//! assert!(lb.update(&cfg, t0.wrapping_add(501), 9_900, 11_000)); // more than 0.5 s
+//! assert!(!lb.update(&cfg, t0, 9_900, Some(11_000)));
+//! assert!(!lb.update(&cfg, t0.wrapping_add(500), 9_900, Some(11_000))); // 500 ms: not yet
+//! assert!(lb.update(&cfg, t0.wrapping_add(501), 9_900, Some(11_000))); // more than 0.5 s
+//! // Side B not heard yet: only side A's battery is judged.
+//! let mut lb = LowBattery::default();
+//! assert!(!lb.update(&cfg, 0, 12_000, None) && !lb.update(&cfg, 2_000, 12_000, None));
 //! ```
 
 use crate::faults::{Fault, Faults};
@@ -126,14 +129,18 @@ pub struct LowBattery(Debounce);
 
 impl LowBattery {
     /// Feeds the filtered battery voltages of both sides; true while the fault condition holds.
+    /// Side B's is `None` until board B has reported one: a voltage nobody measured is not a
+    /// low battery (before issue 24 board A judged the 0 mV of an empty report, and a board B
+    /// powered more than `low_battery_ms` after A latched the fault at every start-up).
     pub fn update(
         &mut self,
         cfg: &Config,
         now: u32,
         v_bat_a: Millivolts,
-        v_bat_b: Millivolts,
+        v_bat_b: Option<Millivolts>,
     ) -> bool {
-        let below = v_bat_a < cfg.low_battery_mv || v_bat_b < cfg.low_battery_mv;
+        let low = |v: Millivolts| v < cfg.low_battery_mv;
+        let below = low(v_bat_a) || v_bat_b.is_some_and(low);
         self.0.update(now, below, cfg.low_battery_ms)
     }
 }
@@ -297,17 +304,23 @@ mod tests {
         // Exactly 10.0 V is not below; 9.999 V is.
         let mut lb = LowBattery::default();
         for t in (0..=2000).step_by(10) {
-            assert!(!lb.update(&cfg, t, 10_000, 10_000));
+            assert!(!lb.update(&cfg, t, 10_000, Some(10_000)));
         }
         let mut lb = LowBattery::default();
-        assert!(!lb.update(&cfg, 1000, 12_000, 9_999));
-        assert!(!lb.update(&cfg, 1500, 12_000, 9_999));
-        assert!(lb.update(&cfg, 1501, 12_000, 9_999));
+        assert!(!lb.update(&cfg, 1000, 12_000, Some(9_999)));
+        assert!(!lb.update(&cfg, 1500, 12_000, Some(9_999)));
+        assert!(lb.update(&cfg, 1501, 12_000, Some(9_999)));
         // One good sample resets the debounce.
-        assert!(!lb.update(&cfg, 1502, 12_000, 10_000));
-        assert!(!lb.update(&cfg, 1503, 9_000, 12_000));
-        assert!(!lb.update(&cfg, 2003, 9_000, 12_000));
-        assert!(lb.update(&cfg, 2004, 9_000, 12_000));
+        assert!(!lb.update(&cfg, 1502, 12_000, Some(10_000)));
+        assert!(!lb.update(&cfg, 1503, 9_000, Some(12_000)));
+        assert!(!lb.update(&cfg, 2003, 9_000, Some(12_000)));
+        assert!(lb.update(&cfg, 2004, 9_000, Some(12_000)));
+        // Side B unheard judges nothing of side B, and side A alone still counts.
+        let mut lb = LowBattery::default();
+        assert!(!lb.update(&cfg, 0, 12_000, None));
+        assert!(!lb.update(&cfg, 5_000, 12_000, None));
+        assert!(!lb.update(&cfg, 5_001, 9_000, None));
+        assert!(lb.update(&cfg, 5_502, 9_000, None));
     }
 
     #[test]

@@ -12,9 +12,10 @@
 //! ```
 
 use crate::command::{
-    BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove,
-    PrimitiveMoveError, Reconfiguration, ReconfigurationError, ServoTarget,
+    BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
+    PrimitiveMove, PrimitiveMoveError, Reconfiguration, ReconfigurationError, ServoTarget,
 };
+use crate::control::interp::Travel;
 use crate::mode::Mode;
 use crate::motion::{Primitive, State};
 use crate::units::{HipAngle, Module, PulseWidth, Side};
@@ -130,6 +131,21 @@ pub enum CommandError {
         /// Value found.
         found: u16,
     },
+    /// An arm or gripper position outside the module's travel (`Travel::ARM`, `Travel::GRIPPER`;
+    /// spec/control/servos.toml): it would drive the servo against its end stop.
+    #[error("bytes {index}-{}: {} target must be within its travel {min}..={max} us, found {found}", index + 1, kind.name())]
+    OutOfTravel {
+        /// Packet index of the low byte.
+        index: usize,
+        /// Arm or gripper.
+        kind: CommandKind,
+        /// Value found, µs.
+        found: u16,
+        /// The travel's smallest pulse, µs.
+        min: u16,
+        /// The travel's largest pulse, µs.
+        max: u16,
+    },
     /// A hip angle at or above 360°.
     #[error("bytes {index}-{}: hip angle must be < 36000 (0.01 deg), found {found}", index + 1)]
     HipAngle {
@@ -194,11 +210,25 @@ fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandErr
         1 => (ServoTarget::Extend, 0),
         _ => {
             let raw = get_u16(p, slot);
-            let pw = PulseWidth::new(raw).map_err(|_| CommandError::PulseWidth {
-                index: PARAM_OFFSET + slot.offset(),
-                found: raw,
-            })?;
-            (ServoTarget::Position(pw), 0b11 << slot.offset())
+            let index = PARAM_OFFSET + slot.offset();
+            let pw =
+                PulseWidth::new(raw).map_err(|_| CommandError::PulseWidth { index, found: raw })?;
+            let (kind, travel) = if base == ARM {
+                (CommandKind::Arm, Travel::ARM)
+            } else {
+                (CommandKind::Gripper, Travel::GRIPPER)
+            };
+            let target =
+                travel
+                    .check(ServoTarget::Position(pw))
+                    .map_err(|e| CommandError::OutOfTravel {
+                        index,
+                        kind,
+                        found: e.found,
+                        min: e.min,
+                        max: e.max,
+                    })?;
+            (target, 0b11 << slot.offset())
         }
     };
     let cmd = if base == ARM {

@@ -11,3 +11,4 @@ mod bolter_handshake;
 mod bolter_statistics;
 mod control_hip;
 mod sensors;
+mod servos_spec;

@@ -45,6 +45,9 @@ struct Rig {
     heard_b: Option<(InternalHeartbeatRepr, bool)>,
     /// Board B's heartbeats are lost on the serial line until this time, ms.
     b_lost_until: u32,
+    /// Board B reports arm B at this pulse whatever its servo does (a stalled arm, as a servo
+    /// that reports its position would say it).
+    b_arm_stuck: Option<PulseWidth>,
 }
 
 /// A bolter over a fastener, as its current sensor and home switch see it: driven down, it
@@ -126,8 +129,13 @@ struct Tick {
 impl Rig {
     /// Linked, Operational, at rest in state a.
     fn operational() -> Rig {
+        Rig::operational_with(board_a::Config::default())
+    }
+
+    /// The same with board A configured by `cfg`.
+    fn operational_with(cfg: board_a::Config) -> Rig {
         let mut r = Rig {
-            a: BoardA::in_state(board_a::Config::default(), State::A),
+            a: BoardA::in_state(cfg, State::A),
             b: BoardB::with_pose(
                 board_b::Config::default(),
                 board_a::Config::default().arm.contracted,
@@ -145,6 +153,7 @@ impl Rig {
             electrical: [Inputs::at_home().electrical; 2],
             heard_b: None,
             b_lost_until: 0,
+            b_arm_stuck: None,
         };
         r.send(Command::Mode(Mode::Operational));
         r.run(150);
@@ -206,6 +215,11 @@ impl Rig {
         );
         self.to_b = a.to_b;
         self.to_a = b.heartbeat.filter(|_| self.now >= self.b_lost_until);
+        if let (Some(stuck), Some(bytes)) = (self.b_arm_stuck, self.to_a) {
+            let mut hb = InternalHeartbeatRepr::parse(&bytes).unwrap();
+            hb.arm_b_now = stuck;
+            self.to_a = Some(hb.to_bytes());
+        }
         if let Some(bytes) = a.to_b {
             self.last_b = Some(BCommandRepr::parse(&bytes).unwrap());
         }
@@ -292,6 +306,10 @@ fn stop_mid_motion_freezes_both_arms_and_keeps_the_motion_for_reset() {
         assert!(r.a.paused(), "the stopped motion is kept for Reset");
         assert_frozen(&mut r, &at_stop, &format!("Stop, arm {side:?}"));
         assert_eq!(r.a.mode(), Mode::Operational);
+        // Paused, nothing moves: no longer in motion (side B held where the hold reached it,
+        // not where its last report before the Stop put it), and no motion timeout.
+        assert!(!r.a.in_motion(), "arm {side:?}: in motion while paused");
+        assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
         // Reset resumes it: the arm moves on to its target.
         r.send(Command::Reset);
         let after = r.run(300);
@@ -1203,4 +1221,245 @@ fn a_bolting_job_paused_longer_than_a_step_timeout_completes_after_reset() {
     assert_eq!(pairs(&events), [(BolterPair::P2, 1, true)]);
     assert_eq!(events.last(), Some(&Event::Bolting(None)));
     assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+}
+
+/// Issue 24, item 2: a module motion outside a primitive or a bolting job has a deadline, its
+/// size over the actuator's speed plus a margin (spec/control/servos.toml, `[deadline]`). The
+/// rig's hip reads 180° throughout, as a hip switched off by Power Control would: a quarter
+/// turn commanded to it runs 9 s nominal + 5 s margin, then raises the motion timeout (Safed),
+/// stops, and the robot is no longer in motion. With a low battery during the motion, the
+/// deferred Standby is not waited for forever either: the timeout's Safed wins (Safed over
+/// Standby). Before the fix the robot stayed in motion for ever.
+#[test]
+fn a_hip_that_cannot_move_times_out_after_its_budget() {
+    use mmic::command::{HipTarget, PowerTarget};
+    use mmic::units::Module;
+    for low_battery in [false, true] {
+        let mut r = Rig::operational();
+        r.send(Command::Power {
+            target: PowerTarget::Module(Module::Hip),
+            on: false,
+        });
+        let start = r.now;
+        r.send(Command::Hip(HipTarget::RightAngleCw));
+        if low_battery {
+            r.electrical[0].v_bat = 9_500;
+        }
+        let budget = 9_000 + board_a::Config::default().deadline.hip_margin_ms;
+        let mut ended = None;
+        while r.now - start < budget + 2_000 {
+            let t = r.tick(None);
+            let faults: Vec<Fault> =
+                t.a.events
+                    .iter()
+                    .filter_map(|e| match e {
+                        Event::Faults(f) => Some(f.iter().collect::<Vec<_>>()),
+                        _ => None,
+                    })
+                    .flatten()
+                    .collect();
+            if faults.contains(&Fault::MotionTimeout) {
+                ended = Some(r.now - start);
+                break;
+            }
+            assert!(r.a.in_motion(), "at {} ms", r.now - start);
+            assert_eq!(r.a.mode(), Mode::Operational, "at {} ms", r.now - start);
+        }
+        let at = ended.expect("no motion timeout: in motion for ever");
+        assert!((budget..=budget + 20).contains(&at), "timed out at {at} ms");
+        assert_eq!(r.a.mode(), Mode::Safed);
+        let hb = r.tick(Some(Command::Heartbeat)).hb.unwrap();
+        assert!(!hb.command_complete, "a timed-out move never completes");
+        r.run(10);
+        assert!(!r.a.in_motion(), "still in motion after the timeout");
+        assert_eq!(r.a.faults().contains(Fault::LowBattery), low_battery);
+        assert!(r.a.faults().contains(Fault::MotionTimeout));
+    }
+}
+
+/// The same for a servo: side B's arm, reported short of its target by board B (stalled), times
+/// out after its interpolation time (900 → 2100 µs at 10 µs per 20 ms: 2.4 s) + the 1 s servo
+/// margin, with or without a low battery meanwhile; a move that does arrive (side A's, or B's
+/// when its reports follow) never times out.
+#[test]
+fn a_stalled_arm_times_out_after_its_budget_and_a_free_one_does_not() {
+    let cfg = board_a::Config::default();
+    for low_battery in [false, true] {
+        let mut r = Rig::operational();
+        r.b_arm_stuck = Some(cfg.arm.contracted);
+        let start = r.now;
+        r.send(arm(Side::B, ServoTarget::Extend));
+        if low_battery {
+            r.electrical[0].v_bat = 9_500;
+        }
+        let budget = 2_400 + cfg.deadline.servo_margin_ms;
+        let mut at = None;
+        while r.now - start < budget + 2_000 {
+            r.tick(None);
+            if r.a.faults().contains(Fault::MotionTimeout) {
+                at = Some(r.now - start);
+                break;
+            }
+            assert!(r.a.in_motion());
+        }
+        let at = at.expect("no motion timeout: in motion for ever");
+        // Armed a tick after the command was taken, from where B last reported its arm.
+        assert!((budget..=budget + 60).contains(&at), "timed out at {at} ms");
+        assert_eq!(r.a.mode(), Mode::Safed);
+        assert_eq!(r.a.faults().contains(Fault::LowBattery), low_battery);
+        r.b_arm_stuck = None;
+        r.run(20);
+        assert!(!r.a.in_motion());
+    }
+    for side in [Side::A, Side::B] {
+        let mut r = Rig::operational();
+        r.send(arm(side, ServoTarget::Extend));
+        until_idle(&mut r);
+        r.run(600);
+        assert!(r.a.faults().is_empty(), "{side:?}: {:?}", r.a.faults());
+        assert_eq!(r.a.mode(), Mode::Operational);
+    }
+}
+
+/// Issue 24, item 3: board B powered 2 s after board A. Until B's first heartbeat board A has
+/// no side-B battery voltage, so it judges none: no low battery (before the fix it judged the
+/// 0 mV of an empty report and latched low_battery 0.5 s after start-up). What A does judge is
+/// B's silence: internal_comm_loss latches after 500 ms, as spec/decisions.toml
+/// (`comm-loss-at-start-up`) records; with B heard, clear_faults clears it and the robot enters
+/// Operational.
+#[test]
+fn board_b_powered_two_seconds_after_board_a_is_no_low_battery() {
+    let cfg = board_a::Config::default();
+    let mut a = BoardA::in_state(cfg, State::A);
+    let mut b = BoardB::with_pose(
+        board_b::Config::default(),
+        cfg.arm.contracted,
+        cfg.gripper.extended,
+    );
+    let (mut to_a, mut to_b) = (None, None);
+    let mut seq = 0;
+    let mut send = |c: Command| {
+        seq += 1;
+        Some(
+            CommandRepr {
+                board: BoardNumber::ONE,
+                command: c,
+                seq,
+            }
+            .to_bytes(),
+        )
+    };
+    let mut answers = vec![];
+    for t in (10..=4_000).step_by(10) {
+        let command = match t {
+            3_000 => send(Command::ClearFaults),
+            3_010 => send(Command::Mode(Mode::Operational)),
+            _ => None,
+        };
+        let out = a.tick(
+            t,
+            &Inputs {
+                command,
+                from_b: to_a.take(),
+                ..Inputs::at_home()
+            },
+        );
+        if let Some(h) = out.heartbeat {
+            answers.push(HeartbeatRepr::parse(&h).unwrap().refusal);
+        }
+        assert!(
+            !a.faults().contains(Fault::LowBattery),
+            "low battery latched at {t} ms"
+        );
+        if t >= 2_000 {
+            let o = b.tick(
+                t,
+                &board_b::Inputs {
+                    command: to_b.take(),
+                    electrical: Inputs::at_home().electrical,
+                    arm_contracted: true,
+                    bolter_at_home: true,
+                    ..board_b::Inputs::default()
+                },
+            );
+            to_a = o.heartbeat;
+            to_b = out.to_b;
+        }
+        if t == 2_000 {
+            assert_eq!(
+                a.faults().iter().collect::<Vec<_>>(),
+                [Fault::InternalCommLoss]
+            );
+        }
+    }
+    assert_eq!(answers, [None, None]);
+    assert_eq!(a.mode(), Mode::Operational);
+    assert!(a.faults().is_empty(), "{:?}", a.faults());
+}
+
+/// Issue 24, item 4: an arm or gripper position outside the module's travel would drive the
+/// servo against its end stop. The packet refuses one outside the library's travel (arm
+/// 900..=2100, gripper 1000..=2000 µs: `CommandError::OutOfTravel`, so board A answers
+/// invalid_parameter), and board A refuses one outside its own configured travel the same way;
+/// nothing moves. The ends of the travel are accepted.
+#[test]
+fn arm_and_gripper_targets_outside_their_travel_are_refused() {
+    use mmic::wire::checksum::crc16;
+    let mut r = Rig::operational();
+    // On the wire: arm A to 2101 µs (opcode 0x22, bytes 8-9), sealed by hand since the
+    // library's encoder is fed only commands within the travel by its users.
+    let cases = [(0x22u8, 8usize, 2101u16), (0x2a, 8, 999), (0x26, 10, 899)];
+    for (seq, (id, slot, us)) in (600u16..).zip(cases) {
+        let mut p = CommandRepr {
+            board: BoardNumber::ONE,
+            command: Command::Heartbeat,
+            seq,
+        }
+        .to_bytes();
+        p[5] = id;
+        p[slot..slot + 2].copy_from_slice(&us.to_le_bytes());
+        if slot == 10 {
+            // Arm B's position takes bytes 10-11; its sequence number moves to bytes 6-7.
+            p[6..8].copy_from_slice(&seq.to_le_bytes());
+        }
+        let crc = crc16(&p[..12]).to_le_bytes();
+        p[12..].copy_from_slice(&crc);
+        let e = CommandRepr::parse(&p).unwrap_err().to_string();
+        assert!(e.contains("travel"), "{id:#x} {us}: {e}");
+        let out = r.a.tick(
+            r.now + 10,
+            &Inputs {
+                command: Some(p),
+                ..Inputs::at_home()
+            },
+        );
+        r.now += 10;
+        let hb = HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
+        assert_eq!(
+            (hb.last_seq, hb.refusal),
+            (seq, Some(Refusal::InvalidParameter)),
+            "{id:#x} {us}"
+        );
+    }
+    // Board A's own travel, narrower than the library's: refused within the library's,
+    // accepted at its ends.
+    let cfg = board_a::Config {
+        arm: mmic::control::interp::Travel {
+            contracted: PulseWidth::new(1000).unwrap(),
+            extended: PulseWidth::new(2000).unwrap(),
+        },
+        ..board_a::Config::default()
+    };
+    let mut r = Rig::operational_with(cfg);
+    let at = |us| ServoTarget::Position(PulseWidth::new(us).unwrap());
+    for (side, us) in [(Side::B, 2050), (Side::A, 999)] {
+        let hb = r.tick(Some(arm(side, at(us)))).hb.unwrap();
+        assert_eq!(hb.refusal, Some(Refusal::InvalidParameter), "{side:?} {us}");
+        assert!(!r.a.in_motion(), "{side:?} {us}: moved");
+    }
+    r.send(arm(Side::A, at(2000)));
+    until_idle(&mut r);
+    r.send(arm(Side::B, at(1000)));
+    until_idle(&mut r);
+    assert!(r.a.faults().is_empty());
 }

@@ -6,6 +6,7 @@ use mmic::command::{
     BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove,
     Reconfiguration, ServoTarget,
 };
+use mmic::control::interp::Travel;
 use mmic::mode::Mode;
 use mmic::motion::State;
 use mmic::pus::function::{self, FunctionError, FunctionId, MAX_LEN};
@@ -19,14 +20,20 @@ fn every_command() -> Vec<Command> {
         Command::SystemFault,
         Command::ClearFaults,
     ];
-    let mut servo = vec![ServoTarget::Contract, ServoTarget::Extend];
-    servo.extend(
-        (PulseWidth::MIN_US..=PulseWidth::MAX_US)
-            .filter_map(|p| PulseWidth::new(p).ok().map(ServoTarget::Position)),
-    );
+    // Every target of each servo's travel (the commands refuse a position outside it).
+    let servo = |t: Travel| {
+        let mut v = vec![ServoTarget::Contract, ServoTarget::Extend];
+        v.extend(
+            (t.min().micros()..=t.max().micros())
+                .filter_map(|p| PulseWidth::new(p).ok().map(ServoTarget::Position)),
+        );
+        v
+    };
     for side in [Side::A, Side::B] {
-        for &target in &servo {
+        for target in servo(Travel::ARM) {
             all.push(Command::Arm { side, target });
+        }
+        for target in servo(Travel::GRIPPER) {
             all.push(Command::Gripper { side, target });
         }
     }
@@ -75,7 +82,8 @@ fn every_command_is_a_function_and_back() {
     let all = every_command();
     assert_eq!(
         all.len(),
-        4 + 2 * 2 * 2003 + 4 + 36_000 + 11 + 60 + (15 * 6 - 6) + 16 + 3
+        // Contract, extend and every position of the travel: arms 1201, grippers 1001.
+        4 + 2 * (1203 + 1003) + 4 + 36_000 + 11 + 60 + (15 * 6 - 6) + 16 + 3
     );
     let mut seen = std::collections::HashSet::new();
     for c in &all {
@@ -130,7 +138,7 @@ fn every_short_application_data_is_read_one_way_or_refused() {
 #[test]
 fn each_bad_input_is_refused_by_name() {
     use FunctionError::*;
-    let cases: [(&[u8], FunctionError); 12] = [
+    let cases: [(&[u8], FunctionError); 14] = [
         (&[], Empty),
         (&[0], UnknownFunction { id: 0 }),
         (&[13], UnknownFunction { id: 13 }),
@@ -170,14 +178,36 @@ fn each_bad_input_is_refused_by_name() {
                 max: 0,
             },
         ),
+        // A gripper position outside the grippers' travel (2001 µs), an arm's outside the
+        // arms' (899 µs), a pulse no servo takes (2501 µs): each named with its travel.
+        (
+            &[2, 0, 2, 0x07, 0xD1],
+            OutOfRange {
+                function: 2,
+                argument: "pulse",
+                value: 2001,
+                min: 1000,
+                max: 2000,
+            },
+        ),
+        (
+            &[1, 1, 2, 0x03, 0x83],
+            OutOfRange {
+                function: 1,
+                argument: "pulse",
+                value: 899,
+                min: 900,
+                max: 2100,
+            },
+        ),
         (
             &[2, 0, 2, 0x09, 0xC5],
             OutOfRange {
                 function: 2,
                 argument: "pulse",
                 value: 2501,
-                min: 500,
-                max: 2500,
+                min: 1000,
+                max: 2000,
             },
         ),
         (

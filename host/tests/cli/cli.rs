@@ -45,7 +45,8 @@ fn round_trip(kind: &str, value: &Value) {
 #[test]
 fn every_command_variant_class_round_trips_through_the_binary() {
     let mut n = 0;
-    for (pw, a) in [(500, 0), (2500, 35999), (1234, 9000)] {
+    // Pulse widths within both servos' travels (arm 900..=2100, gripper 1000..=2000 µs).
+    for (pw, a) in [(1000, 0), (2000, 35999), (1234, 9000)] {
         for_each_variant_class(
             PulseWidth::new(pw).unwrap(),
             HipAngle::new(a).unwrap(),
@@ -490,6 +491,23 @@ fn validated_values_are_refused_with_their_numbers() {
             "command",
             cmd(json!({"gripper": {"side": "b", "target": {"position": 499}}})),
             "500..=2500, found 499",
+        ),
+        // A servo pulse, but outside the module's travel (issue 24): the arm's and the
+        // gripper's ranges are named.
+        (
+            "command",
+            cmd(json!({"arm": {"side": "b", "target": {"position": 2101}}})),
+            "arm target: pulse width 2101 us is outside the travel 900..=2100 us",
+        ),
+        (
+            "command",
+            cmd(json!({"arm": {"side": "a", "target": {"position": 899}}})),
+            "arm target: pulse width 899 us is outside the travel 900..=2100 us",
+        ),
+        (
+            "command",
+            cmd(json!({"gripper": {"side": "a", "target": {"position": 2001}}})),
+            "gripper target: pulse width 2001 us is outside the travel 1000..=2000 us",
         ),
         (
             "command",

@@ -105,9 +105,10 @@ fn parameter_bytes_are_the_ones_the_decoder_reads_whatever_their_value() {
         target: ServoTarget::Position(pw(1536)),
     };
     assert_eq!(pages::param_bytes_used(arm_a), [8, 9]);
+    // 1792 µs = 0x0700, within the grippers' travel.
     let grip_b = Command::Gripper {
         side: Side::B,
-        target: ServoTarget::Position(pw(512)),
+        target: ServoTarget::Position(pw(1792)),
     };
     assert_eq!(pages::param_bytes_used(grip_b), [10, 11]);
     // 0°: both bytes zero, both used.
@@ -119,7 +120,8 @@ fn parameter_bytes_are_the_ones_the_decoder_reads_whatever_their_value() {
     };
     assert!(pages::param_bytes_used(contract).is_empty());
     // Over every class: the bytes a command uses are exactly the ones its encoding may set.
-    for (us, a) in [(500, 0), (1536, 256), (2500, 35999)] {
+    // Pulse widths within both servos' travels (a command outside them decodes to no command).
+    for (us, a) in [(1000, 0), (1536, 256), (2000, 35999)] {
         for_each_variant_class(pw(us), HipAngle::new(a).unwrap(), |c| {
             let (_, p) = c.encode();
             let used = pages::param_bytes_used(c);

@@ -53,7 +53,7 @@ fn the_readme_tc_encodes_to_its_golden_bytes_and_back() {
 
 fn example_args(f: &spec::Function) -> Value {
     let special = match f.name.as_str() {
-        "arm" => json!({"side": 1, "target": 2, "pulse": 2500}),
+        "arm" => json!({"side": 1, "target": 2, "pulse": 2100}),
         "gripper" => json!({"side": 0, "target": 1, "pulse": 0}),
         "hip" => json!({"target": 4, "angle": 35999}),
         "bolter" => json!({"operation": 1, "pair": 4}),

@@ -76,7 +76,7 @@ fn low_battery(start: u32, samples: &[(u16, bool, bool)]) {
             None
         };
         let expected = run_start.is_some_and(|s| abs - s > 500);
-        assert_eq!(lb.update(&cfg, now, va, vb), expected, "sample {i}");
+        assert_eq!(lb.update(&cfg, now, va, Some(vb)), expected, "sample {i}");
     }
 }
 
