@@ -170,7 +170,7 @@ pub const fn single_move(from: State, to: State) -> Option<(Side, Primitive)> {
 /// Whether the geometric move `from → to` is a turn between two right-angle (turn) states: the
 /// moving arm would swing about the holding arm's axis (g → j: arm A from −Y to −Z about arm B's
 /// +X). MMIC-I's only rotary joint is the hip, whose axis is perpendicular to both arms, and
-/// Table 6's caption says each turn "include[s] a rotation of the hip": no joint makes such a
+/// Table 6's caption says the turns "include a rotation of the hip": no joint makes such a
 /// move, so the robot has 12 fewer moves than the model (spec/decisions.toml,
 /// `turn-to-turn-moves`).
 pub const fn turns_without_hip(from: State, to: State) -> bool {
