@@ -1,5 +1,8 @@
 //! Board A's bolter coordinator: runs a bolt or unbolt job over one pair or all four, ordering
-//! both sides step by step and retrying a timed-out attempt up to three attempts in all.
+//! both sides step by step and retrying a timed-out attempt up to three attempts in all. A
+//! step that ends at home and times out fails the job at once, at any attempt: the next
+//! attempt would start from a home the bolter did not reach (Table 8 names only the three
+//! attempts; spec/decisions.toml, `bolting-failure-at-home`).
 
 use super::side::{ended, SideConfig};
 use super::{BolterDirection, BolterPair, BolterStep};
