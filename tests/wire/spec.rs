@@ -37,6 +37,8 @@ struct PacketSpec {
     #[allow(dead_code)]
     route: String,
     paper_cells: Option<Vec<String>>,
+    /// The decision that introduced a packet the paper does not have.
+    decision: Option<String>,
     field: Vec<FieldRow>,
 }
 
@@ -47,16 +49,32 @@ struct FieldRow {
     start: usize,
     len: usize,
     unit: String,
-    #[allow(dead_code)]
     meaning: String,
+    /// The decision that says what a field holds beyond the paper's label.
+    decision: Option<String>,
 }
 
 #[test]
 fn packets_match_spec_field_by_field_and_cell_by_cell() {
     let mut checked_fields = 0;
     let mut checked_cells = 0;
+    let decisions: Decisions = load("decisions.toml");
+    let ids: Vec<&str> = decisions.decision.iter().map(|d| d.id.as_str()).collect();
     for kind in PacketKind::ALL {
         let spec: PacketSpec = load(&format!("packets/{}.toml", kind.name()));
+        // A packet the paper has no table for is the project's, and says which decision.
+        assert_eq!(
+            spec.paper_cells.is_none(),
+            spec.decision.is_some(),
+            "{kind}"
+        );
+        for id in spec
+            .decision
+            .iter()
+            .chain(spec.field.iter().flat_map(|f| &f.decision))
+        {
+            assert!(ids.contains(&id.as_str()), "{kind}: no decision {id}");
+        }
         assert_eq!(spec.packet, kind.name());
         assert_eq!(spec.length, kind.len(), "{kind}: length");
         assert_eq!(spec.header.as_bytes(), kind.header(), "{kind}: header");
@@ -121,6 +139,7 @@ struct Extension {
     kind: String,
     #[allow(dead_code)]
     why: String,
+    decision: String,
 }
 
 #[derive(Deserialize)]
@@ -147,6 +166,18 @@ fn command_set_matches_spec() {
         .map(|k| k.name())
         .collect();
     assert_eq!(kinds, code);
+    // Each kind not in Table 1 names the decision that added it, and that decision names it.
+    let decisions: Decisions = load("decisions.toml");
+    for e in &spec.extension {
+        let d = decisions.decision.iter().find(|d| d.id == e.decision);
+        let d = d.unwrap_or_else(|| panic!("{}: no decision {}", e.kind, e.decision));
+        assert!(
+            d.decision.contains(&e.kind),
+            "decision {} names {}",
+            d.id,
+            e.kind
+        );
+    }
     let mut rows: BTreeMap<u8, &OpcodeRow> = BTreeMap::new();
     for r in &spec.opcode {
         assert!(
