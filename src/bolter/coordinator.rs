@@ -138,7 +138,7 @@ impl Coordinator {
     }
 
     /// Starts Table 1's "move bolters down" at `now`: both bolters of the pair the multiplexer
-    /// selects when idle (pair 1, lines low-low; spec/decisions.toml `bolters_down`) descend
+    /// selects when idle (pair 1, lines low-low; spec/decisions.toml `bolters-down`) descend
     /// until the current says they touch, and stop there. Nothing engages or rotates; the job
     /// ends Done when both sides touched or a descent timed out (the sides' reports tell
     /// which); a timeout is no (un)bolting failure, since nothing was bolted.
