@@ -2,10 +2,12 @@
 //!
 //! Byte 60 holds bits 0–7, byte 61 bits 8–15. One bit per Table 8 row; the overcurrent rows are
 //! split into the idle check and the operational check because the paper describes two checks
-//! with different thresholds and an operator needs to know which fired. Bit 13 is the
-//! project's own motion-step timeout, which no Table 8 row describes. Bits 14–15 are reserved
-//! and must be zero. The third fault byte (62) carries the last command's
-//! [`Refusal`](crate::refusal::Refusal).
+//! with different thresholds and an operator needs to know which fired (bits 0–12). Bits 13
+//! and 14 are the project's own causes, which no Table 8 row describes: the motion-step
+//! timeout and the sensor loss. Bit 15 is spare and must be zero. Table 3's third fault byte
+//! (62, "fault byte2") carries no fault bits but the outcome of the command the heartbeat
+//! reports on, as a [`Refusal`](crate::refusal::Refusal) code: so the map has 16 bits, not
+//! the 24 of Table 3's three fault bytes (spec/decisions.toml, `heartbeat-byte-62`).
 //!
 //! ```
 //! use mmic::faults::{Fault, Faults};
@@ -67,7 +69,7 @@ wire_enum! {
 
     /// Every fault, in bit order.
     const ALL;
-    /// Bit number in the 24-bit fault map.
+    /// Bit number in the 16-bit fault map (heartbeat bytes 60–61).
     pub const fn bit(self) -> u8;
     /// Stable snake_case name (spec/ and JSON).
     pub const fn name(self) -> &'static str;
@@ -227,7 +229,7 @@ impl Faults {
         self.0
     }
 
-    /// The two fault bytes, byte 60 first.
+    /// The two fault bytes, heartbeat byte 60 first.
     pub const fn to_wire(self) -> [u8; 2] {
         [self.0 as u8, (self.0 >> 8) as u8]
     }

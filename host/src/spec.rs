@@ -1,8 +1,11 @@
-//! The reviewable tables of spec/ that the PUS tools read: the ST\[8\] argument table
+//! The reviewable tables of spec/ that the host tools read: the ST\[8\] argument table
 //! (spec/ccsds/functions.toml), the services, failure codes and events
-//! (spec/ccsds/services.toml) and the fault names (spec/faults.toml). They are compiled in
-//! (`include_str!`) and parsed once, so the XTCE generator and the PUS codec have no second
-//! copy of any of them; tests/pus/spec.rs holds the library to the same files.
+//! (spec/ccsds/services.toml), the fault names (spec/faults.toml), and what of the paper's
+//! tables is the project's, with the decision that introduced it ([`origins`]: spec/faults.toml,
+//! spec/commands.toml, spec/modes.toml, spec/packets/), which the review pages mark. They are
+//! compiled in (`include_str!`) and parsed once, so the XTCE generator, the PUS codec and the
+//! pages have no second copy of any of them; tests/pus/spec.rs, tests/wire/spec.rs and
+//! tests/safety/safety_spec.rs hold the library to the same files.
 
 use mmic::faults::Fault;
 use mmic::pus::function::FunctionId;
@@ -10,6 +13,7 @@ use mmic::pus::request::RequestError;
 use mmic::pus::verification::{ABANDONED, KEY_REUSED, QUEUE_FULL, UNACKNOWLEDGED};
 use mmic::refusal::Refusal;
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::sync::OnceLock;
 
 /// spec/ccsds/functions.toml.
@@ -18,6 +22,26 @@ pub const FUNCTIONS_TOML: &str = include_str!("../../spec/ccsds/functions.toml")
 pub const SERVICES_TOML: &str = include_str!("../../spec/ccsds/services.toml");
 /// spec/faults.toml.
 pub const FAULTS_TOML: &str = include_str!("../../spec/faults.toml");
+/// spec/commands.toml.
+pub const COMMANDS_TOML: &str = include_str!("../../spec/commands.toml");
+/// spec/modes.toml.
+pub const MODES_TOML: &str = include_str!("../../spec/modes.toml");
+/// spec/packets/*.toml, by packet name.
+pub const PACKET_TOMLS: [(&str, &str); 4] = [
+    ("command", include_str!("../../spec/packets/command.toml")),
+    (
+        "heartbeat",
+        include_str!("../../spec/packets/heartbeat.toml"),
+    ),
+    (
+        "internal-heartbeat",
+        include_str!("../../spec/packets/internal-heartbeat.toml"),
+    ),
+    (
+        "b-command",
+        include_str!("../../spec/packets/b-command.toml"),
+    ),
+];
 
 /// One argument of an ST\[8\] function.
 #[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
@@ -139,6 +163,9 @@ pub struct FaultRow {
     pub bit: u8,
     /// Its name.
     pub name: String,
+    /// The decision that added it, for a bit no Table 8 row has.
+    #[serde(default)]
+    pub decision: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -287,4 +314,99 @@ pub fn event_ids() -> Result<Vec<(u16, String)>, String> {
 /// The fault of a bit, by the library.
 pub fn fault_of_bit(bit: u8) -> Option<Fault> {
     Fault::ALL.into_iter().find(|f| f.bit() == bit)
+}
+
+/// What of the paper's tables is the project's, and the decision that introduced each: read
+/// from spec/ for the review pages ([`crate::pages`]), which mark those rows.
+#[derive(Debug, Clone, Default)]
+pub struct Origins {
+    /// Table 1's kinds with their "Command Type" cell, in the table's order.
+    pub table1: Vec<(String, String)>,
+    /// Command kinds not in Table 1 → decision.
+    pub extensions: BTreeMap<String, String>,
+    /// Table 7's command availability as printed, mode → kinds.
+    pub table7_accepts: BTreeMap<String, Vec<String>>,
+    /// A kind accepted beyond Table 7 → decision.
+    pub accepts_decisions: BTreeMap<String, String>,
+    /// Refusal code name → decision.
+    pub refusal_decisions: BTreeMap<String, String>,
+    /// Packet name → (decision of a packet the paper does not have, field → decision).
+    pub packets: BTreeMap<String, (Option<String>, BTreeMap<String, String>)>,
+}
+
+#[derive(Deserialize)]
+struct CommandsFile {
+    table1: Vec<Table1Row>,
+    extension: Vec<ExtensionRow>,
+}
+
+#[derive(Deserialize)]
+struct Table1Row {
+    command_type: String,
+    kind: String,
+}
+
+#[derive(Deserialize)]
+struct ExtensionRow {
+    kind: String,
+    decision: String,
+}
+
+#[derive(Deserialize)]
+struct ModesFile {
+    table7_accepts: BTreeMap<String, Vec<String>>,
+    accepts_decisions: BTreeMap<String, String>,
+    refusal_decisions: BTreeMap<String, String>,
+}
+
+#[derive(Deserialize)]
+struct PacketFile {
+    #[serde(default)]
+    decision: Option<String>,
+    field: Vec<PacketField>,
+}
+
+#[derive(Deserialize)]
+struct PacketField {
+    name: String,
+    #[serde(default)]
+    decision: Option<String>,
+}
+
+fn read_origins() -> Result<Origins, toml::de::Error> {
+    let c: CommandsFile = toml::from_str(COMMANDS_TOML)?;
+    let m: ModesFile = toml::from_str(MODES_TOML)?;
+    let mut packets = BTreeMap::new();
+    for (name, text) in PACKET_TOMLS {
+        let p: PacketFile = toml::from_str(text)?;
+        let fields = p
+            .field
+            .into_iter()
+            .filter_map(|f| Some((f.name, f.decision?)))
+            .collect();
+        packets.insert(name.to_string(), (p.decision, fields));
+    }
+    Ok(Origins {
+        table1: c
+            .table1
+            .into_iter()
+            .map(|r| (r.kind, r.command_type))
+            .collect(),
+        extensions: c
+            .extension
+            .into_iter()
+            .map(|e| (e.kind, e.decision))
+            .collect(),
+        table7_accepts: m.table7_accepts,
+        accepts_decisions: m.accepts_decisions,
+        refusal_decisions: m.refusal_decisions,
+        packets,
+    })
+}
+
+/// The project's additions to the paper's tables, from spec/ (empty if a file does not parse:
+/// the pages then mark the project's rows with no decision, which their test refuses).
+pub fn origins() -> &'static Origins {
+    static O: OnceLock<Origins> = OnceLock::new();
+    O.get_or_init(|| read_origins().unwrap_or_default())
 }

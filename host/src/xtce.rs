@@ -359,7 +359,7 @@ pub fn generate() -> Result<String, String> {
         "refusal_type",
         8,
         &refusals,
-        "why the last command was refused (spec/modes.toml)",
+        "heartbeat byte 62: the outcome of the command the heartbeat reports on, 0 = accepted, else its refusal code (spec/modes.toml)",
     );
     let mut pairs = vec![(0, "NONE".to_string())];
     pairs.extend((1..=4).map(|p| (p, format!("PAIR_{p}"))));

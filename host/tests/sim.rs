@@ -1034,3 +1034,26 @@ fn inject_is_checked_and_summary_json_is_what_mmic_sim_returned() {
     );
     assert!(stdout.contains("injected: assembly-system@4.5"), "{stdout}");
 }
+
+/// The plant locks fasteners with Figure 10's per-attempt rates and starts with a full battery,
+/// both as spec/hardware.toml gives them (the paper's counts, in fastener pairs: decision
+/// figure-10-pairs).
+#[test]
+fn the_plant_takes_figure_10_and_the_battery_from_spec_hardware() {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../spec/hardware.toml");
+    let spec: toml::Table = toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+    let fig = spec["figure10"].as_table().unwrap();
+    let int = |v: &toml::Value| v.as_integer().unwrap() as f64;
+    let mut left = int(&fig["engaged"]);
+    let plant = mmic_host::sim::plant::PlantConfig::default();
+    let bolted = fig["bolted_after_attempt"].as_array().unwrap();
+    assert_eq!(bolted.len(), plant.lock_probability.len());
+    for (n, (count, p)) in bolted.iter().zip(plant.lock_probability).enumerate() {
+        // Attempt n + 1 locks count of the pairs still open.
+        let rate = int(count) / left;
+        assert!((p - rate).abs() < 1e-12, "attempt {}: {p} vs {rate}", n + 1);
+        left -= int(count);
+    }
+    assert_eq!(left, int(&fig["failed"]));
+    assert_eq!(plant.battery_mv, int(&spec["battery"]["max_mv"]));
+}

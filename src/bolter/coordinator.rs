@@ -1,5 +1,8 @@
 //! Board A's bolter coordinator: runs a bolt or unbolt job over one pair or all four, ordering
-//! both sides step by step and retrying a timed-out attempt up to three attempts in all.
+//! both sides step by step and retrying a timed-out attempt up to three attempts in all. A
+//! step that ends at home and times out fails the job at once, at any attempt: the next
+//! attempt would start from a home the bolter did not reach (Table 8 names only the three
+//! attempts; spec/decisions.toml, `bolting-failure-at-home`).
 
 use super::side::{ended, SideConfig};
 use super::{BolterDirection, BolterPair, BolterStep};
@@ -135,7 +138,7 @@ impl Coordinator {
     }
 
     /// Starts Table 1's "move bolters down" at `now`: both bolters of the pair the multiplexer
-    /// selects when idle (pair 1, lines low-low; spec/decisions.toml `bolters_down`) descend
+    /// selects when idle (pair 1, lines low-low; spec/decisions.toml `bolters-down`) descend
     /// until the current says they touch, and stop there. Nothing engages or rotates; the job
     /// ends Done when both sides touched or a descent timed out (the sides' reports tell
     /// which); a timeout is no (un)bolting failure, since nothing was bolted.

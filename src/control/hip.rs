@@ -1,6 +1,9 @@
 //! The hip's PI controller (Section 5): velocity mode at 10°/s while the hip is more than 3°
 //! from its target, position mode within 3°, velocity estimated from successive encoder
-//! readings with exponential smoothing. Fixed-point integers throughout (the ESP32-C3 has no
+//! readings with exponential smoothing. The estimate runs in both modes, but only the velocity
+//! law uses it: the position law is a PI on the angle error, which meets the settling and
+//! overshoot bounds of spec/control/hip.md without a velocity term (the paper's "again
+//! estimating velocity" read in spec/decisions.toml, `hip-position-law`). Fixed-point integers throughout (the ESP32-C3 has no
 //! FPU); the output is saturated to the configured pulse range and the integrator is clamped
 //! and frozen while the output saturates (anti-windup).
 //!

@@ -1,6 +1,10 @@
 //! State estimation: which of the 15 states agree with the sensors (both boards' gravity
 //! direction, the arm-contracted switches and the hip angle), given how the structure sits
-//! relative to gravity. Used by the initial-state-mismatch check (Table 8).
+//! relative to gravity. Used by the initial-state-mismatch check (Table 8). The paper computes
+//! that state from "IMU measurements and PWM values"; the PWM values are the firmware's own
+//! commands, which a robot positioned by hand in Standby does not change, so the switches and
+//! the encoder that measure what they set are read instead (spec/decisions.toml,
+//! `initial-state-sensors`).
 //!
 //! **Sensor model** (spec/motion/estimation.md). Each board's IMU frame is fixed to its side:
 //! x along that side's arm (hip → gripper), z along the hip axis, y = z × x. Gravity is one of

@@ -5,6 +5,9 @@
 //! 47-byte internal heartbeat of Table 4, whose byte 35 echoes the last command's sequence
 //! number (the acknowledgement). If A falls silent for `link_timeout_ms`, B holds its servos
 //! where they are and idles its bolter until A speaks again: B never moves on stale orders.
+//! The hold is this project's addition (the paper has B only execute A's commands); the
+//! period and the timeout are spec/boards.toml's (spec/decisions.toml,
+//! `board-b-heartbeat-and-hold`).
 //!
 //! ```
 //! use mmic::node::board_b::{BoardB, Config, Inputs};

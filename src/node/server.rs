@@ -7,6 +7,11 @@
 //! comes back, and disconnects, so one server serves several robots. This module is that
 //! bookkeeping; the shell does the connecting.
 //!
+//! The ground builds the whole packet (sequence number included) and the server forwards it
+//! unchanged after checking it, where the paper's server "identifies the command and fills the
+//! command packet" from a command ID: the number is the ground's to give, so the server must
+//! not rebuild the packet (spec/decisions.toml, `server-forwards-packet`).
+//!
 //! A pending command is never dropped silently: it leaves its slot only when delivered
 //! ([`Server::delivered`]) or when the ground replaces it with another command for the same
 //! robot, which [`Server::accept`] reports as [`Accepted::Superseded`]. The ground sends one

@@ -71,7 +71,7 @@ pub const FIELDS: [Field; 33] = [
         "refusal",
         1,
         "enum",
-        "why the last command was refused, 0 = accepted (spec/modes.toml)",
+        "heartbeat byte 62: the outcome of the command the heartbeat reports on, 0 = accepted, else its refusal code (spec/modes.toml; spec/decisions.toml heartbeat-byte-62)",
     ),
     f(
         "last_seq",

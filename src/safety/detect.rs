@@ -247,7 +247,7 @@ impl Over {
 
 /// Operational overcurrent check, performed at all times: any module above its absolute
 /// limit — side A judged here from A's currents, side B as board B judged it against its own
-/// limits (Table 4 bytes 41–43, spec/decisions.toml `b_overcurrent_flags`).
+/// limits (Table 4 bytes 41–43, spec/decisions.toml `b-overcurrent-flags`).
 pub fn operational_overcurrent(cfg: &Config, a: &Electrical, b: Over) -> Faults {
     use Fault::*;
     let f = (LocomotionOvercurrent, GripperOvercurrent, BolterOvercurrent);

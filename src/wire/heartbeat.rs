@@ -111,7 +111,7 @@ pub mod field {
     use super::*;
     use crate::wire::layout::span;
     use core::ops::Range;
-    /// `faults` (bytes 59–60).
+    /// `faults` (bytes 60–61).
     pub const FAULTS: Range<usize> = span!(HeartbeatPacket, faults, [u8; 2]);
     /// `last_seq` (bytes 57–58).
     pub const LAST_SEQ: Range<usize> = span!(
@@ -334,12 +334,16 @@ pub struct HeartbeatRepr {
     pub bolter_attempt: BolterAttempt,
     /// Latched faults.
     pub faults: Faults,
-    /// Why the command this heartbeat answers was refused; none when it was accepted.
+    /// Byte 62 (paper: "fault byte2"): the outcome of the command this heartbeat reports on —
+    /// the packet it answers, or, for a copy of a sequenced command board A does not judge
+    /// again (duplicate, stale), the command `last_seq` names; none = accepted, else why it
+    /// was refused (spec/decisions.toml, `heartbeat-byte-62`).
     pub refusal: Option<Refusal>,
     /// Operating mode.
     pub mode: Mode,
     /// Bytes 57–58 (paper: "empty"): sequence number of the last sequenced command board A
-    /// has taken (executed or refused), 0 before the first; `refusal` then tells its outcome.
+    /// has taken (executed or refused), 0 before the first; when the answered packet is
+    /// sequenced, `refusal` is this command's outcome.
     /// The ground's acknowledgement for exactly-once commanding (spec/protocol/README.md).
     #[cfg_attr(feature = "serde", serde(default))]
     #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq16"))]

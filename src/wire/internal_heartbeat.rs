@@ -406,7 +406,7 @@ impl InternalHeartbeatRepr {
     }
 }
 
-/// Bytes 25–33: board B's bolter progress (Table 4's "bolter aux").
+/// Table 4 bytes 26–34: board B's bolter progress ("bolter B operation auxiliary variables").
 fn bolter_aux(p: &InternalHeartbeatPacket) -> Result<BolterAux, WireError> {
     let b = |i: usize, name: &'static str, v: u8| get_bool(KIND, i, name, v);
     let step = optional(

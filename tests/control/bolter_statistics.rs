@@ -35,8 +35,6 @@ impl Rng {
     }
 }
 
-const DEMO: [u32; 4] = [2307, 103, 28, 86];
-
 /// A moving bolter's filtered current, mA: under both thresholds.
 const RUNNING_MA: u16 = 450;
 /// A bolter pushing its fastener: over the push threshold, under the lock threshold.
@@ -106,12 +104,15 @@ fn run_pair(cfg: &Config, succeeds: [bool; 3]) -> (u8, Status) {
 
 #[test]
 fn attempt_histogram_matches_figure_10() {
-    let total: u32 = DEMO.iter().sum();
-    assert_eq!(total, 2524);
+    // Figure 10's counts, from spec/hardware.toml (in fastener pairs: decision figure-10-pairs).
+    let figure = crate::hardware::figure10();
+    let demo = figure.histogram();
+    let total: u32 = demo.iter().sum();
+    assert_eq!(total, figure.engaged);
     // Conditional success probabilities implied by the demo.
-    let p1 = DEMO[0] as f64 / total as f64;
-    let p2 = DEMO[1] as f64 / (total - DEMO[0]) as f64;
-    let p3 = DEMO[2] as f64 / (total - DEMO[0] - DEMO[1]) as f64;
+    let p1 = demo[0] as f64 / total as f64;
+    let p2 = demo[1] as f64 / (total - demo[0]) as f64;
+    let p3 = demo[2] as f64 / (total - demo[0] - demo[1]) as f64;
     let cfg = Config::default();
     // The model's currents sit where the plant's do: running under both thresholds, pushing
     // between them, stalled over the lock threshold and under the overcurrent limit.
@@ -142,7 +143,7 @@ fn attempt_histogram_matches_figure_10() {
         "bolting statistics over {n} pairs: first {} second {} third {} failed {}",
         hist[0], hist[1], hist[2], hist[3]
     );
-    for (bin, (&got, &demo)) in hist.iter().zip(DEMO.iter()).enumerate() {
+    for (bin, (&got, &demo)) in hist.iter().zip(demo.iter()).enumerate() {
         let p = demo as f64 / total as f64;
         let sigma = (n as f64 * p * (1.0 - p)).sqrt();
         let expected = n as f64 * p;

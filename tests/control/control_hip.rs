@@ -194,3 +194,41 @@ fn sweep_reports_the_worst_case() {
     assert!(worst_overshoot <= OVERSHOOT_MAX);
     assert!(worst_detour <= DETOUR_MAX);
 }
+
+/// spec/control/hip.md's parameter table is the code's defaults: each row names one parameter
+/// (or two, "a / b") and gives its default first in the value column (likewise "x / y").
+#[test]
+fn the_defaults_equal_the_table_of_spec_control_hip_md() {
+    let md = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/spec/control/hip.md"))
+        .unwrap();
+    let c = Config::default();
+    let code: [(&str, i64); 9] = [
+        ("position_band", c.position_band.into()),
+        ("speed", c.speed.into()),
+        ("servo_gain", c.servo_gain.into()),
+        ("kp_velocity_q8", c.kp_velocity_q8.into()),
+        ("ki_velocity_q8", c.ki_velocity_q8.into()),
+        ("kp_position_q8", c.kp_position_q8.into()),
+        ("ki_position_q8", c.ki_position_q8.into()),
+        ("max_offset_us", c.max_offset_us.into()),
+        ("smoothing_shift", c.smoothing_shift.into()),
+    ];
+    let mut table = std::collections::BTreeMap::new();
+    for line in md.lines() {
+        let cells: Vec<&str> = line.split('|').map(str::trim).collect();
+        let [_, names, values, ..] = cells[..] else {
+            continue;
+        };
+        let values: Vec<i64> = values
+            .split(" / ")
+            .filter_map(|v| v.split_whitespace().next()?.parse().ok())
+            .collect();
+        for (name, value) in names.split(" / ").zip(values) {
+            table.insert(name.to_string(), value);
+        }
+    }
+    for (name, value) in &code {
+        assert_eq!(table.get(*name), Some(value), "spec/control/hip.md: {name}");
+    }
+    assert_eq!(table.len(), code.len(), "{table:?}");
+}

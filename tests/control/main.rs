@@ -1,5 +1,6 @@
 //! Sections 2 and 5, Figures 8 and 10: the hip controller, the sensor front end and the bolter
-//! (its current sensing, A/B handshake and statistics).
+//! (its current sensing, A/B handshake and statistics), and the paper's hardware facts
+//! (spec/hardware.toml).
 //!
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
@@ -10,5 +11,6 @@ mod bolter_current;
 mod bolter_handshake;
 mod bolter_statistics;
 mod control_hip;
+mod hardware;
 mod sensors;
 mod servos_spec;

@@ -8,3 +8,4 @@ mod node_boards;
 mod node_fidelity;
 mod node_handoff;
 mod node_primitives;
+mod node_spec;

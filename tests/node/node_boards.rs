@@ -208,6 +208,51 @@ fn every_command_class_in_every_starting_mode_runs_once_and_is_acknowledged() {
     assert_eq!(cases, 3 * 61);
 }
 
+/// Heartbeat byte 62 has one meaning (spec/decisions.toml, `heartbeat-byte-62`): the outcome of
+/// the command the heartbeat reports on — the packet it answers when board A judges that
+/// packet now (a new sequenced command, or an unsequenced one), and for a copy it does not
+/// judge again (duplicate, stale) the command bytes 57–58 name. So whenever the answered
+/// packet is sequenced, byte 62 is the outcome of the number in bytes 57–58, whatever
+/// unsequenced commands came in between.
+#[test]
+fn byte_62_reports_the_command_the_heartbeat_reports_on() {
+    let arm = Command::Arm {
+        side: mmic::units::Side::A,
+        target: mmic::command::ServoTarget::Extend,
+    };
+    let refused = Some(Refusal::NotAllowedInMode);
+    let mut a = BoardA::new(board_a::Config::default());
+    let mut t = 0;
+    let mut answer = |a: &mut BoardA, c: Command, seq: u16| {
+        t += 10;
+        let hb = send(a, t, c, seq).0.expect("answered");
+        (hb.last_seq, hb.refusal)
+    };
+    // Standby: a sequenced arm command is refused, and its heartbeat says so.
+    assert_eq!(answer(&mut a, arm, 10), (10, refused));
+    // Unsequenced packets report themselves: accepted, refused.
+    assert_eq!(answer(&mut a, Command::Heartbeat, 0), (10, None));
+    assert_eq!(answer(&mut a, arm, 0), (10, refused));
+    assert_eq!(answer(&mut a, Command::Heartbeat, 0), (10, None));
+    // Copies report the command bytes 57–58 name (10, refused), not the last packet judged
+    // (an accepted heartbeat request) nor what the copy itself would have earned.
+    assert_eq!(answer(&mut a, arm, 10), (10, refused));
+    assert_eq!(answer(&mut a, Command::Heartbeat, 0), (10, None));
+    assert_eq!(answer(&mut a, Command::Heartbeat, 9), (10, refused));
+    // A new sequenced command reports itself; an unsequenced one refused after it, itself;
+    // then a stale copy of 10 reports 11 (accepted), neither 10's refusal nor the last
+    // packet's.
+    assert_eq!(
+        answer(&mut a, Command::Mode(Mode::Operational), 11),
+        (11, None)
+    );
+    assert_eq!(
+        answer(&mut a, Command::Reset, 0),
+        (11, Some(Refusal::NothingToResume))
+    );
+    assert_eq!(answer(&mut a, arm, 10), (11, None));
+}
+
 #[test]
 fn packets_for_others_or_broken_get_no_answer_and_malformed_ones_a_refusal() {
     let mut a = BoardA::new(board_a::Config::default());

@@ -17,6 +17,9 @@ struct Spec {
     moving: Vec<String>,
     table7: BTreeMap<String, Vec<String>>,
     accepts: BTreeMap<String, Vec<String>>,
+    table7_accepts: BTreeMap<String, Vec<String>>,
+    accepts_decisions: BTreeMap<String, String>,
+    refusal_decisions: BTreeMap<String, String>,
     power: Power,
     fault: Vec<FaultRow>,
     refusals: BTreeMap<String, u8>,
@@ -200,4 +203,89 @@ fn refusal_codes_and_thresholds_equal_spec() {
         (c.absolute.locomotion, c.absolute.gripper, c.absolute.bolter),
         (t.absolute.locomotion, t.absolute.gripper, t.absolute.bolter)
     );
+}
+
+/// The decisions of spec/decisions.toml: id -> decision text.
+fn decisions() -> BTreeMap<String, String> {
+    #[derive(Deserialize)]
+    struct File {
+        decision: Vec<Entry>,
+    }
+    #[derive(Deserialize)]
+    struct Entry {
+        id: String,
+        decision: String,
+    }
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/decisions.toml");
+    let f: File = toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+    f.decision.into_iter().map(|e| (e.id, e.decision)).collect()
+}
+
+/// Asserts that decision `id` exists and names `what` (so it is the one that introduced it),
+/// in any case ("Reset" names `reset`).
+fn assert_introduces(decisions: &BTreeMap<String, String>, id: &str, what: &str) {
+    let text = decisions
+        .get(id)
+        .unwrap_or_else(|| panic!("{what}: no decision {id} in spec/decisions.toml"));
+    assert!(
+        text.to_lowercase().contains(what),
+        "decision {id} does not name {what}"
+    );
+}
+
+/// What the code accepts beyond Table 7 as printed is the project's, and each such kind names
+/// the decision that added it: the code takes every kind Table 7 lets a mode take (Operational:
+/// every Table 1 kind), and each kind taken beyond that has an entry in [accepts_decisions]
+/// whose decision names it. No entry is left over.
+#[test]
+fn acceptance_beyond_table7_is_a_recorded_decision() {
+    let s = spec();
+    let d = decisions();
+    #[derive(Deserialize)]
+    struct Commands {
+        table1: Vec<Row>,
+    }
+    #[derive(Deserialize)]
+    struct Row {
+        kind: String,
+    }
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/commands.toml");
+    let c: Commands = toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+    let table1: Vec<String> = c.table1.into_iter().map(|r| r.kind).collect();
+    assert_eq!(
+        s.table7_accepts["operational"], table1,
+        "Table 7: Operational takes all"
+    );
+    let mut used = std::collections::BTreeSet::new();
+    for mode in Mode::ALL {
+        let printed = &s.table7_accepts[mode.name()];
+        for k in CommandKind::ALL {
+            let in_table7 = printed.iter().any(|p| p == k.name());
+            if in_table7 {
+                assert!(
+                    accepts(mode, k),
+                    "{mode}: Table 7 takes {k}, the code refuses it"
+                );
+            } else if accepts(mode, k) {
+                let id = s.accepts_decisions.get(k.name());
+                let id = id.unwrap_or_else(|| panic!("{mode} takes {k}: no decision"));
+                assert_introduces(&d, id, k.name());
+                used.insert(k.name());
+            }
+        }
+    }
+    let listed: std::collections::BTreeSet<&str> =
+        s.accepts_decisions.keys().map(String::as_str).collect();
+    assert_eq!(listed, used, "[accepts_decisions] lists kinds no mode adds");
+}
+
+/// None of the refusal codes is the paper's: each names the decision that introduced it.
+#[test]
+fn every_refusal_code_names_the_decision_that_introduced_it() {
+    let s = spec();
+    let d = decisions();
+    assert_eq!(s.refusal_decisions.len(), Refusal::ALL.len());
+    for r in Refusal::ALL {
+        assert_introduces(&d, &s.refusal_decisions[r.name()], r.name());
+    }
 }

@@ -229,7 +229,7 @@ const HEARTBEAT: [u8; HEARTBEAT_LEN] = [
     0x34, 0x12, // 57-58 last sequenced command 0x1234 (paper: empty)
     0x00,       // 59 empty
     0x02, 0x08, // 60-61 faults: bit 1 (arm not contracted) | bit 11 (low battery)
-    0x05,       // 62 refusal of the last command: 5, invalid parameter
+    0x05,       // 62 outcome of the command reported on: 5, invalid parameter
     0x02,       // 63 mode: operational
     0x30, 0x72, // 64-65 CRC-16 0x7230
 ];

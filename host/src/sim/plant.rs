@@ -20,7 +20,8 @@
 //! model (`mmic::motion::estimate::predict`), so that the simulator tests the estimate; both sides'
 //! bolters share one lock roll per attempt (a face's fastener pair locks or does not);
 //! the lock probability of consecutive attempts on one pair follows Figure 10's demo
-//! (2307/2524, then 103/217, then 28/114); unbolting uses the same roll, "locked" then meaning
+//! (2307/2524, then 103/217, then 28/114: spec/hardware.toml `[figure10]`, checked by
+//! host/tests/sim.rs); unbolting uses the same roll, "locked" then meaning
 //! "released" (the head stalls at the end of the unlocking turn alike).
 
 use mmic::bolter::{Drive, MuxLines};

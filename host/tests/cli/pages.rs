@@ -56,7 +56,10 @@ fn every_grid_row_shows_seven_byte_indices_and_their_paper_labels() {
         }
         let ft = tables(fields);
         assert_eq!(ft.len(), 1);
-        assert_eq!(ft[0][0], ["bytes", "name (JSON)", "unit", "paper label"]);
+        assert_eq!(
+            ft[0][0],
+            ["bytes", "name (JSON)", "unit", "paper label", "origin"]
+        );
         assert_eq!(ft[0].len(), 2 + kind.fields().len());
         for (f, row) in kind.fields().iter().zip(&ft[0][2..]) {
             assert_eq!(row[1], format!("`{}`", f.name));
@@ -78,7 +81,8 @@ fn opcode_table_has_one_row_per_variant_class() {
             "opcode",
             "Table 1 kind",
             "command (JSON)",
-            "parameter bytes"
+            "parameter bytes",
+            "origin"
         ]
     );
     let mut rows = t[2..].iter();
@@ -87,7 +91,7 @@ fn opcode_table_has_one_row_per_variant_class() {
         let row = rows.next().expect("a row per class");
         let (id, _) = c.encode();
         assert_eq!(row[0], format!("`{id:#04x}`"));
-        assert_eq!(row[1], c.kind().name());
+        assert_eq!(row[1].trim_end_matches(pages::MARK).trim(), c.kind().name());
         let json = row[2].trim_matches('`');
         assert_eq!(serde_json::from_str::<Command>(json).unwrap(), c);
         n += 1;
@@ -141,5 +145,195 @@ fn parameter_bytes_are_the_ones_the_decoder_reads_whatever_their_value() {
                 "{c:?}: {used:?}"
             );
         });
+    }
+}
+
+/// spec/decisions.toml: id → the decision's text, lower case.
+fn decisions() -> std::collections::BTreeMap<String, String> {
+    let t: toml::Table = spec_file("decisions.toml");
+    t["decision"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| {
+            let d = d.as_table().unwrap();
+            let text = d["decision"].as_str().unwrap().to_lowercase();
+            (d["id"].as_str().unwrap().to_string(), text)
+        })
+        .collect()
+}
+
+fn spec_file(rel: &str) -> toml::Table {
+    let p = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../spec")
+        .join(rel);
+    toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+}
+
+/// The decision a row of a page cites: the `` `id` `` right after a mark.
+fn cited(row: &[String]) -> Option<String> {
+    row.iter().find_map(|c| {
+        let (_, after) = c.split_once(&format!("{} `", pages::MARK))?;
+        Some(after.split('`').next()?.to_string())
+    })
+}
+
+/// Whether a decision's text refers to byte `b` ("byte N" or "bytes N-M" with N ≤ b ≤ M).
+fn names_byte(text: &str, b: usize) -> bool {
+    text.match_indices("byte").any(|(at, _)| {
+        let rest = text[at + 4..].trim_start_matches('s');
+        let Some(rest) = rest.strip_prefix(' ') else {
+            return false;
+        };
+        let digits = |s: &str| -> Option<(usize, usize)> {
+            let n = s.len() - s.trim_start_matches(|c: char| c.is_ascii_digit()).len();
+            s[..n].parse().ok().map(|v| (v, n))
+        };
+        let Some((lo, n)) = digits(rest) else {
+            return false;
+        };
+        let hi = rest[n..]
+            .strip_prefix('-')
+            .and_then(digits)
+            .map_or(lo, |(hi, _)| hi);
+        (lo..=hi).contains(&b)
+    })
+}
+
+/// Item 5 of issue 24: every row of the review pages that is the project's, not the paper's,
+/// carries the mark and a decision of spec/decisions.toml that names what it introduced; no row
+/// of the paper carries the mark. What is the project's is decided here from the paper's side
+/// of spec/ (Table 8's rows in spec/faults.toml, Table 1 in spec/commands.toml, Table 7 as
+/// printed in spec/modes.toml, the paper's cells in spec/packets/) and the code's acceptance,
+/// not from the pages' own reading: a fault bit, command kind, accepted cell, refusal code or
+/// field the project adds without saying so fails here.
+#[test]
+fn project_rows_are_marked_with_the_decision_that_added_them() {
+    use mmic::command::CommandKind;
+    use mmic::mode::Mode;
+    use mmic::safety::policy::accepts;
+    let d = decisions();
+    let mark = pages::MARK;
+    let check = |page: &str, row: &[String], ours: bool, what: &str| {
+        let marked = row.iter().any(|c| c.contains(mark));
+        assert_eq!(marked, ours, "{page}: {row:?}");
+        if ours {
+            let id = cited(row).unwrap_or_else(|| panic!("{page}: {row:?} cites no decision"));
+            let text = d.get(&id);
+            let text = text.unwrap_or_else(|| panic!("{page}: {row:?}: no decision {id}"));
+            assert!(
+                text.contains(what),
+                "{page}: decision {id} does not name {what}"
+            );
+        }
+    };
+
+    // Faults: a bit is the project's when spec/faults.toml gives it no Table 8 row.
+    let faults = spec_file("faults.toml");
+    let page = pages::faults();
+    let rows = &tables(&page)[0];
+    let spec_rows = faults["fault"].as_array().unwrap();
+    assert_eq!(rows.len() - 2, spec_rows.len());
+    for (row, f) in rows[2..].iter().zip(spec_rows) {
+        let ours = f["table8"].as_str().unwrap().starts_with("none");
+        check("faults.md", row, ours, f["name"].as_str().unwrap());
+        if !ours {
+            assert!(row.last().unwrap().starts_with("Table 8: "), "{row:?}");
+        }
+    }
+
+    // Command kinds: the project's when not a Table 1 row.
+    let commands = spec_file("commands.toml");
+    let table1: Vec<&str> = commands["table1"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["kind"].as_str().unwrap())
+        .collect();
+    let page = pages::commands();
+    for row in &tables(&page)[0][2..] {
+        let kind = row[1].trim_end_matches(mark).trim();
+        check("commands.md", row, !table1.contains(&kind), kind);
+    }
+
+    // Table 7: a cell is the project's when the code takes a kind Table 7 as printed does not
+    // let that mode take (a kind not in Table 1 in every mode).
+    let modes = spec_file("modes.toml");
+    let printed = modes["table7_accepts"].as_table().unwrap();
+    let page = pages::modes();
+    let t = tables(&page);
+    let acceptance = &t[0];
+    assert_eq!(
+        acceptance[0],
+        ["command kind", "standby", "operational", "safed", "origin"]
+    );
+    assert_eq!(acceptance.len() - 2, CommandKind::ALL.len());
+    for (row, k) in acceptance[2..].iter().zip(CommandKind::ALL) {
+        let mut any = false;
+        for (col, m) in [Mode::Standby, Mode::Operational, Mode::Safed]
+            .into_iter()
+            .enumerate()
+        {
+            let in_table7 = printed[m.name()]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|x| x.as_str() == Some(k.name()));
+            let ours = accepts(m, k) && !in_table7;
+            any |= ours;
+            let want = match (accepts(m, k), ours) {
+                (true, true) => format!("accepted {mark}"),
+                (true, false) => "accepted".into(),
+                (false, _) => "refused".into(),
+            };
+            assert_eq!(row[col + 1], want, "modes.md: {k} in {m}");
+        }
+        check("modes.md", row, any, k.name());
+    }
+    // The refusal codes: none is the paper's.
+    let refusals = t.iter().find(|t| t[0][0] == "code").expect("refusal table");
+    assert_eq!(refusals.len() - 2, mmic::refusal::Refusal::ALL.len() + 1);
+    for row in &refusals[2..] {
+        let what = if row[0] == "0" { "byte 62" } else { &row[1] };
+        check("modes.md", row, true, what);
+    }
+
+    // Packets: a field is the project's where spec/packets says what it holds beyond the
+    // paper's label, or its packet is not in the paper; and, whatever spec/packets says, a
+    // field over bytes the paper calls "empty" that is not reserved, or over "fault byte2",
+    // which is not a fault byte here.
+    for kind in PacketKind::ALL {
+        let spec = spec_file(&format!("packets/{}.toml", kind.name()));
+        let cells = spec.get("paper_cells").and_then(|c| c.as_array());
+        let page = pages::packet(kind);
+        let (_, fields) = page.split_once("## Fields").unwrap();
+        let rows = &tables(fields)[0];
+        for (row, f) in rows[2..].iter().zip(spec["field"].as_array().unwrap()) {
+            let start = f["start"].as_integer().unwrap() as usize;
+            let len = f["len"].as_integer().unwrap() as usize;
+            let paper: Vec<&str> = cells.map_or(vec![], |c| {
+                c[start..start + len]
+                    .iter()
+                    .map(|c| c.as_str().unwrap())
+                    .collect()
+            });
+            let unit = f["unit"].as_str().unwrap();
+            let must = cells.is_none()
+                || (paper.contains(&"empty") && unit != "reserved")
+                || paper.contains(&"fault byte2");
+            let ours = cells.is_none() || f.get("decision").is_some();
+            assert!(ours || !must, "{kind}: {row:?} is the project's");
+            check(&format!("{kind}.md"), row, ours, "");
+            if ours && cells.is_some() {
+                let id = cited(row).unwrap();
+                assert!(
+                    names_byte(&d[&id], start),
+                    "{kind}: decision {id} names no byte {start}"
+                );
+            }
+        }
+        // A packet the paper does not have is marked in its title too.
+        let title = page.lines().find(|l| l.starts_with("# ")).unwrap();
+        assert_eq!(title.contains(mark), cells.is_none(), "{kind}: {title}");
     }
 }
