@@ -60,7 +60,7 @@ def test_spacepackets_decodes_the_tcs_we_encode(rust_fixtures):
 
 def example_args(f):
     """Arguments for a function from the table: the first value of each range that makes a command."""
-    special = {"arm": {"side": 1, "target": 2, "pulse": 2500}, "gripper": {"side": 0, "target": 0, "pulse": 0},
+    special = {"arm": {"side": 1, "target": 2, "pulse": 2100}, "gripper": {"side": 0, "target": 0, "pulse": 0},
                "hip": {"target": 4, "angle": 9000}, "bolter": {"operation": 0, "pair": 3},
                "primitive": {"primitive": 4, "final_state": ord("d")},
                "reconfiguration": {"initial": ord("a"), "target": ord("m")}}

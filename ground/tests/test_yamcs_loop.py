@@ -351,8 +351,9 @@ def test_reports_with_another_request_id_do_nothing_and_silence_times_out(robot,
 def test_out_of_range_argument_is_refused_by_yamcs(robot, commands):
     from yamcs.client import YamcsError
 
-    with pytest.raises(YamcsError, match=r"Value 2501 is not in the range \[500,2500\]"):
-        commands.issue("/MMIC/arm", args={"side": 0, "target": 2, "pulse": 2501})
+    # The arms' travel (spec/control/servos.toml), not just the servo range.
+    with pytest.raises(YamcsError, match=r"Value 2101 is not in the range \[900,2100\]"):
+        commands.issue("/MMIC/arm", args={"side": 0, "target": 2, "pulse": 2101})
     with pytest.raises(YamcsError, match=r"not in the range \[1,3\]"):
         commands.issue("/MMIC/mode", args={"mode": 4})
     with pytest.raises(YamcsError, match="cannot be found in enumeration list"):
