@@ -257,8 +257,8 @@ fn verifier(
             subservices.iter().map(u32::to_string).collect::<Vec<_>>().join("/")
         ),
     );
-    // Inputs not in the packet at hand come from the last value cache: hence `service == 1`, which
-    // makes every request-ID field one of this packet (the verification-report container).
+    // An input the packet at hand lacks keeps an earlier packet's value: hence `service == 1`,
+    // which makes every request-ID field one of this packet (the verification-report container).
     let matches = subservices
         .iter()
         .map(|s| format!("s == {s}"))
@@ -297,10 +297,25 @@ fn verifier(
     if ret {
         inputs.push(("/MMIC/failure_code", "failure_code"));
     }
+    // TM inputs are `instance="1"`: in 5.12.8 an input's instance 0 falls back to the last value
+    // cache when the delivery at hand lacks it, and YAMCS re-reads every input of the command's
+    // algorithms on each command-history update of the command, on the thread that published it
+    // (e.g. `Acknowledge_Sent`, by the TC link, while the TM thread handles the TM(1,1)): the cache's
+    // older values overwrote the report's between the algorithm's update and its run, and `Accepted`
+    // missed its report. An instance above 0 never reads the cache (`ProcessingContext.get`,
+    // PACKET_START_ACROSS_PACKETS) and, for a parameter the delivery has once, is that value
+    // (`ParameterValueList.get(p, n)` returns the last one found).
     for (p, i) in inputs {
+        let instance = if p.starts_with("/MMIC/") {
+            " instance=\"1\""
+        } else {
+            ""
+        };
         x.line(
             7,
-            &format!("<InputParameterInstanceRef parameterRef=\"{p}\" inputName=\"{i}\" />"),
+            &format!(
+                "<InputParameterInstanceRef parameterRef=\"{p}\"{instance} inputName=\"{i}\" />"
+            ),
         );
     }
     x.line(6, "</InputSet>");
