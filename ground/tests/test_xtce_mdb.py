@@ -75,3 +75,12 @@ def test_verifiers_are_tied_to_st1_and_fail_on_timeout():
                       ("CompleteVerifier", None), ("FailedVerifier", None)]
     for e in list(v)[:3]:
         assert e.find(".//x:AncillaryData[@name='yamcs.onTimeout']", NS).text == "FAIL"
+    # Algorithms reading TM as instance 1, not BooleanExpression: both race in YAMCS 5.12.8 (issue 24,
+    # ground/README.md "quirks").
+    for e in v:
+        assert e.find("x:CustomAlgorithm/x:AlgorithmText", NS).get("language") == "java-expression"
+        tm = {r.get("parameterRef"): r.get("instance")
+              for r in e.findall("x:CustomAlgorithm/x:InputSet/x:InputParameterInstanceRef", NS)
+              if r.get("parameterRef").startswith("/MMIC/")}
+        assert {"/MMIC/service", "/MMIC/subservice", "/MMIC/req_apid", "/MMIC/req_seq_count"} <= tm.keys()
+        assert set(tm.values()) == {"1"}, tm

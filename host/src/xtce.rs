@@ -224,6 +224,19 @@ fn arg_type_name(function: &str, a: &Arg) -> String {
     format!("{function}_{}_type", a.name)
 }
 
+/// One ST\[1\] verifier of `pus-tc`: a `java-expression` algorithm (compiled by YAMCS with its
+/// bundled Janino) that passes on a report of one of `subservices` whose request ID is the TC's
+/// (APID argument, sequence count the postprocessor published) and returns nothing on any other
+/// packet. Not a `BooleanExpression`: YAMCS 5.12.8 gives each such verifier its own subscription in
+/// `ParameterProcessorManager` and drops it on the timer thread when it matched, while the TM
+/// thread may be dispatching the next packet to it: `sendToProcessor(null)` throws
+/// (NullPointerException at ParameterProcessorManager.java:263) and every later verifier misses
+/// that packet. The gateway sends TM(1,1), (1,3), (1,7) back to back, so `Started` lost its (1,3)
+/// (issue 24). Algorithm verifiers get TM through the AlgorithmManager's one subscription, taken at
+/// start and never dropped, and their per-command contexts are copy-on-write lists.
+/// The failure verifier returns `failure_code` of that report as the return value (the command's
+/// error `Verifier Failed return: <code>`); a `ReturnParmRef` would read the last value cache,
+/// which YAMCS updates only after the algorithms ran: the previous failure's code.
 fn verifier(
     x: &mut Xml,
     element: &str,
@@ -234,33 +247,85 @@ fn verifier(
     ret: bool,
 ) {
     let n = name.map_or(String::new(), |n| format!(" name=\"{n}\""));
+    let stage = name.unwrap_or(element.trim_end_matches("Verifier"));
     x.line(4, &format!("<{element}{n}>"));
-    x.line(5, "<BooleanExpression>");
-    x.line(6, "<ANDedConditions>");
-    x.line(7, "<Condition><ParameterInstanceRef parameterRef=\"/yamcs/cmd/arg/apid\" /><ComparisonOperator>==</ComparisonOperator><ParameterInstanceRef parameterRef=\"/MMIC/req_apid\" /></Condition>");
-    x.line(7, "<Condition><ParameterInstanceRef parameterRef=\"/yamcs/cmdHist/ccsds-seqcount\" /><ComparisonOperator>==</ComparisonOperator><ParameterInstanceRef parameterRef=\"/MMIC/req_seq_count\" /></Condition>");
-    x.line(7, &cond("/MMIC/req_type", "==", 1));
-    x.line(7, &cond("/MMIC/service", "==", 1));
-    if let [one] = subservices {
-        x.line(7, &cond("/MMIC/subservice", "==", *one));
+    x.line(
+        5,
+        &format!(
+            "<CustomAlgorithm name=\"st1_{}\" shortDescription=\"TM(1,{}) with the TC's request ID\">",
+            stage.to_lowercase(),
+            subservices.iter().map(u32::to_string).collect::<Vec<_>>().join("/")
+        ),
+    );
+    // An input the packet at hand lacks keeps an earlier packet's value: hence `service == 1`,
+    // which makes every request-ID field one of this packet (the verification-report container).
+    let matches = subservices
+        .iter()
+        .map(|s| format!("s == {s}"))
+        .collect::<Vec<_>>()
+        .join(" || ");
+    let result = if ret {
+        "new org.yamcs.commanding.VerificationResult(true, null, failure_code.getEngValue())"
     } else {
-        x.line(7, "<ORedConditions>");
-        for s in subservices {
-            x.line(8, &cond("/MMIC/subservice", "==", *s));
-        }
-        x.line(7, "</ORedConditions>");
+        "Boolean.TRUE"
+    };
+    let text = format!(
+        "if (apid == null || seq_count == null || service == null || subservice == null || req_type == null || req_apid == null || req_seq_count == null{}) return null; \
+         if (service.getEngValue().toLong() != 1 || req_type.getEngValue().toLong() != 1 || req_apid.getEngValue().toLong() != apid.getEngValue().toLong() || req_seq_count.getEngValue().toLong() != seq_count.getEngValue().toLong()) return null; \
+         long s = subservice.getEngValue().toLong(); \
+         if ({matches}) return {result}; \
+         return null;",
+        if ret { " || failure_code == null" } else { "" },
+    );
+    x.line(
+        6,
+        &format!(
+            "<AlgorithmText language=\"java-expression\">{}</AlgorithmText>",
+            esc(&text)
+        ),
+    );
+    x.line(6, "<InputSet>");
+    let mut inputs = vec![
+        ("/yamcs/cmd/arg/apid", "apid"),
+        ("/yamcs/cmdHist/ccsds-seqcount", "seq_count"),
+        ("/MMIC/service", "service"),
+        ("/MMIC/subservice", "subservice"),
+        ("/MMIC/req_type", "req_type"),
+        ("/MMIC/req_apid", "req_apid"),
+        ("/MMIC/req_seq_count", "req_seq_count"),
+    ];
+    if ret {
+        inputs.push(("/MMIC/failure_code", "failure_code"));
     }
-    x.line(6, "</ANDedConditions>");
-    x.line(5, "</BooleanExpression>");
+    // TM inputs are `instance="1"`: in 5.12.8 an input's instance 0 falls back to the last value
+    // cache when the delivery at hand lacks it, and YAMCS re-reads every input of the command's
+    // algorithms on each command-history update of the command, on the thread that published it
+    // (e.g. `Acknowledge_Sent`, by the TC link, while the TM thread handles the TM(1,1)): the cache's
+    // older values overwrote the report's between the algorithm's update and its run, and `Accepted`
+    // missed its report. An instance above 0 never reads the cache (`ProcessingContext.get`,
+    // PACKET_START_ACROSS_PACKETS) and, for a parameter the delivery has once, is that value
+    // (`ParameterValueList.get(p, n)` returns the last one found).
+    for (p, i) in inputs {
+        let instance = if p.starts_with("/MMIC/") {
+            " instance=\"1\""
+        } else {
+            ""
+        };
+        x.line(
+            7,
+            &format!(
+                "<InputParameterInstanceRef parameterRef=\"{p}\"{instance} inputName=\"{i}\" />"
+            ),
+        );
+    }
+    x.line(6, "</InputSet>");
+    x.line(5, "</CustomAlgorithm>");
     x.line(
         5,
         &format!(
             "<CheckWindow timeToStopChecking=\"{window}\" timeWindowIsRelativeTo=\"commandRelease\" />"
         ),
     );
-    if ret {
-        x.line(5, "<ReturnParmRef parameterRef=\"/MMIC/failure_code\" />");
-    }
     if fail_on_timeout {
         x.line(5, "<AncillaryDataSet><AncillaryData name=\"yamcs.onTimeout\">FAIL</AncillaryData></AncillaryDataSet>");
     }
@@ -776,7 +841,7 @@ pub fn generate() -> Result<String, String> {
     }
     x.line(4, "</EntryList>");
     x.line(3, "</CommandContainer>");
-    x.line(3, "<!-- ST[1]: matched on the request ID (the TC's APID and sequence count); success reports need their ack flag (default 15: all) -->");
+    x.line(3, "<!-- ST[1]: matched on the request ID (the TC's APID and sequence count) by algorithms, not BooleanExpression (issue 24, host/src/xtce.rs); success reports need their ack flag (default 15: all) -->");
     x.line(3, "<VerifierSet>");
     verifier(
         &mut x,
