@@ -345,7 +345,8 @@ enum Watch {
     /// Modules move; the motion times out at this instant.
     Armed(Instant),
     /// The motion timed out and was stopped; not armed again until the modules are at their
-    /// targets (an encoder that stays silent would otherwise time out again and again).
+    /// targets or a new motion is commanded (a module that stays off its target, a silent
+    /// encoder, would otherwise time out again and again).
     Expired,
 }
 
@@ -1034,6 +1035,8 @@ impl BoardA {
 
     fn dispatch(&mut self, c: Command, now: u32) {
         if c.kind().moves() {
+            // A new motion gets a budget of its own, also after one that timed out.
+            self.watch = Watch::Idle;
             self.release_b_hold();
             if !matches!(c, Command::Primitive(_) | Command::Reconfigure(_)) {
                 self.complete = false;
@@ -1181,6 +1184,7 @@ impl BoardA {
     /// step timeouts (the time stopped is no stall).
     fn resume(&mut self, now: u32) {
         let Some(p) = self.paused.take() else { return };
+        self.watch = Watch::Idle;
         self.runner = p.runner;
         self.idle_check = p.idle_check;
         self.coord = p.coord;
@@ -1238,6 +1242,7 @@ impl BoardA {
 
     fn go_home(&mut self, now: u32) {
         let _ = now;
+        self.watch = Watch::Idle;
         self.hold_b = false;
         self.targets = Targets {
             hip: self.cfg.safety.hip_home,

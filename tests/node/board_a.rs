@@ -1450,16 +1450,168 @@ fn arm_and_gripper_targets_outside_their_travel_are_refused() {
         },
         ..board_a::Config::default()
     };
+    let cfg = board_a::Config {
+        gripper: mmic::control::interp::Travel {
+            contracted: PulseWidth::new(1100).unwrap(),
+            extended: PulseWidth::new(2000).unwrap(),
+        },
+        ..cfg
+    };
     let mut r = Rig::operational_with(cfg);
     let at = |us| ServoTarget::Position(PulseWidth::new(us).unwrap());
-    for (side, us) in [(Side::B, 2050), (Side::A, 999)] {
-        let hb = r.tick(Some(arm(side, at(us)))).hb.unwrap();
-        assert_eq!(hb.refusal, Some(Refusal::InvalidParameter), "{side:?} {us}");
-        assert!(!r.a.in_motion(), "{side:?} {us}: moved");
+    for c in [
+        arm(Side::B, at(2050)),
+        arm(Side::A, at(999)),
+        gripper(Side::A, at(1050)),
+    ] {
+        let hb = r.tick(Some(c)).hb.unwrap();
+        assert_eq!(hb.refusal, Some(Refusal::InvalidParameter), "{c:?}");
+        assert!(!r.a.in_motion(), "{c:?}: moved");
     }
     r.send(arm(Side::A, at(2000)));
     until_idle(&mut r);
     r.send(arm(Side::B, at(1000)));
     until_idle(&mut r);
     assert!(r.a.faults().is_empty());
+}
+
+/// The module budget is for motions without step timeouts of their own: a primitive's steps and
+/// a bolting job's are timed by the sequencer and the coordinator. Side B's arm reported stalled
+/// during a primitive's Move times out at the Move step's 15 s (the sequencer's motion timeout),
+/// not at the 3.4 s an arm command would get; during a bolting job a side-B servo reported off
+/// its target does not stop the job, and once the job has ended the module budget takes over.
+#[test]
+fn primitives_and_bolting_jobs_are_timed_by_their_steps_not_by_the_module_budget() {
+    let cfg = board_a::Config::default();
+    let mut r = Rig::operational();
+    let start = r.now;
+    r.send(extend_from_a());
+    r.b_arm_stuck = Some(cfg.arm.contracted);
+    let mut at = None;
+    while r.now - start < 30_000 {
+        r.tick(None);
+        if r.a.faults().contains(Fault::MotionTimeout) {
+            at = Some(r.now - start);
+            break;
+        }
+    }
+    let at = at.expect("the stalled primitive timed out");
+    assert!(
+        at > cfg.motion.move_ms,
+        "timed out at {at} ms, before the Move step's {} ms",
+        cfg.motion.move_ms
+    );
+    let mut r = Rig::operational();
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::from_number(1).unwrap(),
+    ))));
+    r.run(5);
+    // Side B's arm reported away from its target from now on.
+    r.b_arm_stuck = Some(PulseWidth::new(2000).unwrap());
+    let mut ended = None;
+    for i in 0..3_000 {
+        let t = r.tick(None);
+        assert!(
+            !r.a.faults().contains(Fault::MotionTimeout),
+            "motion timeout {} ms into the job",
+            i * 10
+        );
+        if let Some(e) = t.a.events.iter().find(|e| matches!(e, Event::Bolting(_))) {
+            ended = Some(*e);
+            break;
+        }
+    }
+    assert_eq!(ended, Some(Event::Bolting(None)), "the job completes");
+    // Then the report is a module off its target with no step timing it: 1100 µs of arm
+    // travel (2.2 s) + the 1 s margin.
+    let end = r.now;
+    while !r.a.faults().contains(Fault::MotionTimeout) {
+        r.tick(None);
+        assert!(r.now - end <= 3_300, "no timeout after the job");
+    }
+    assert!(r.now - end >= 3_200, "{} ms", r.now - end);
+}
+
+/// After a timeout the budget is not armed again while the module stays off its target (one
+/// fault, not one per budget); once the modules have come to rest, a module pushed off its
+/// target again is timed again.
+#[test]
+fn a_timed_out_motion_is_not_timed_again_until_the_modules_rest() {
+    let cfg = board_a::Config::default();
+    let mut r = Rig::operational();
+    r.b_arm_stuck = Some(cfg.arm.contracted);
+    r.send(arm(Side::B, ServoTarget::Extend));
+    r.run(400);
+    assert!(r.a.faults().contains(Fault::MotionTimeout));
+    assert_eq!(r.a.mode(), Mode::Safed);
+    // Still reported off target: cleared, it stays cleared.
+    r.send(Command::ClearFaults);
+    for _ in 0..1_000 {
+        r.tick(None);
+        assert!(
+            r.a.faults().is_empty(),
+            "timed out again: {:?}",
+            r.a.faults()
+        );
+    }
+    // At rest (the report follows the servo again), then off target again: timed again.
+    r.b_arm_stuck = None;
+    r.run(10);
+    assert!(!r.a.in_motion());
+    r.b_arm_stuck = Some(cfg.arm.contracted);
+    r.run(10);
+    assert!(r.a.in_motion());
+    let start = r.now;
+    while !r.a.faults().contains(Fault::MotionTimeout) {
+        r.tick(None);
+        assert!(r.now - start < 5_000, "not timed again");
+    }
+}
+
+/// Section 7: "When switching to 'opmode', actuators are set to go to their home position" —
+/// also when Operational is entered again after Safed held them where they were: arm B, held
+/// half-way out, goes back to contracted, within the module budget and with no fault.
+#[test]
+fn re_entering_operational_sends_the_servos_home_again() {
+    let cfg = board_a::Config::default();
+    let mut r = Rig::operational();
+    r.send(arm(Side::B, ServoTarget::Extend));
+    r.run(120);
+    r.send(Command::Mode(Mode::Safed));
+    r.run(50);
+    let held = r.heard_b.unwrap().0.arm_b_now;
+    assert!(held > cfg.arm.contracted, "arm B held out at {held:?}");
+    r.send(Command::Mode(Mode::Operational));
+    until_idle(&mut r);
+    let hb = r.heard_b.unwrap().0;
+    assert_eq!(
+        (hb.arm_b_now, hb.arm_b_target),
+        (cfg.arm.contracted, cfg.arm.contracted)
+    );
+    assert!(r.a.faults().is_empty(), "{:?}", r.a.faults());
+    assert_eq!(r.a.mode(), Mode::Operational);
+}
+
+/// The budget starts when the modules start to move: a side-B servo reported off its target
+/// long after the last motion ended gets its whole budget (2.4 s of travel + 1 s), not the
+/// deadline of the motion before.
+#[test]
+fn a_budget_starts_with_its_motion() {
+    let cfg = board_a::Config::default();
+    let mut r = Rig::operational();
+    r.send(arm(Side::B, ServoTarget::Extend));
+    until_idle(&mut r);
+    r.run(1_000);
+    assert!(r.a.faults().is_empty());
+    r.b_arm_stuck = Some(cfg.arm.contracted);
+    let start = r.now;
+    while !r.a.faults().contains(Fault::MotionTimeout) {
+        r.tick(None);
+        assert!(r.now - start < 5_000, "never timed out");
+    }
+    assert!(
+        r.now - start >= 3_400,
+        "timed out {} ms after",
+        r.now - start
+    );
 }
