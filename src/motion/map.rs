@@ -19,14 +19,20 @@ use core::fmt::Write as _;
 
 const N: usize = 15;
 
-const fn build() -> [[Option<Primitive>; N]; N] {
+/// The grid of [`robot_move`] (`robot`) or of the model's [`single_move`].
+const fn build(robot: bool) -> [[Option<Primitive>; N]; N] {
     let mut m = [[None; N]; N];
     let mut i = 0;
     while i < N {
         let mut j = 0;
         while j < N {
             if let (Some(from), Some(to)) = (State::from_index(i), State::from_index(j)) {
-                if let Some((_, p)) = robot_move(from, to) {
+                let mv = if robot {
+                    robot_move(from, to)
+                } else {
+                    single_move(from, to)
+                };
+                if let Some((_, p)) = mv {
                     m[i][j] = Some(p);
                 }
             }
@@ -39,7 +45,11 @@ const fn build() -> [[Option<Primitive>; N]; N] {
 
 /// Figure 9: the primitive that takes row state to column state, if the robot can make the
 /// move ([`robot_move`]: the model's 72 moves but the 12 turns without a hip rotation).
-pub const MAP: [[Option<Primitive>; N]; N] = build();
+pub const MAP: [[Option<Primitive>; N]; N] = build(true);
+
+/// The geometric model's moves ([`single_move`]: the map's 60 and the 12 turns without a hip
+/// rotation), for [`reaches`].
+const MODEL: [[Option<Primitive>; N]; N] = build(false);
 
 /// The primitive for a single-primitive reconfiguration from `from` to `to`.
 pub const fn primitive(from: State, to: State) -> Option<Primitive> {
@@ -74,11 +84,9 @@ pub fn targets(from: State, p: Primitive) -> impl Iterator<Item = State> {
 pub const fn reaches(p: Primitive, to: State) -> bool {
     let mut i = 0;
     while i < N {
-        if let Some(from) = State::from_index(i) {
-            if let Some((_, q)) = single_move(from, to) {
-                if q as u8 == p as u8 {
-                    return true;
-                }
+        if let Some(q) = MODEL[i][to.index()] {
+            if q as u8 == p as u8 {
+                return true;
             }
         }
         i += 1;
