@@ -149,6 +149,24 @@ pub enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// Replay a scenario recorded by `mmic sim --record` through one robot's nodes on this
+    /// host, and compare the outputs with another run's (the RV32 runner's under QEMU):
+    /// identical, or the first record and field that differ.
+    Replay {
+        /// The trace (`mmic sim --record FILE`).
+        #[arg(required_unless_present = "record_scenarios")]
+        trace: Option<PathBuf>,
+        /// Instead: record the scenarios CI replays on RV32 (the demo over both protocols,
+        /// every Table 8 fault, lossy links) as DIR/NAME.trace.
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["trace", "against", "out"])]
+        record_scenarios: Option<PathBuf>,
+        /// Compare with this output stream (the RV32 runner's); exit 1 on any difference.
+        #[arg(long, value_name = "FILE")]
+        against: Option<PathBuf>,
+        /// Write this host's output stream here.
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
     /// The reconfiguration map (Figure 9): which primitive takes one state to another.
     Map {
         /// Print {"moves":[{"from":..,"to":..,"primitive":..},..]}.
@@ -334,6 +352,21 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
                 motion::plan_text(from, to)
             };
             writeln!(out, "{text}").map_err(CliError::Output)?;
+        }
+        Cmd::Replay {
+            record_scenarios: Some(dir),
+            ..
+        } => crate::replay::cli_record(&dir, out)?,
+        Cmd::Replay {
+            trace: Some(trace),
+            against,
+            out: to,
+            ..
+        } => crate::replay::cli(&trace, against.as_deref(), to.as_deref(), out)?,
+        Cmd::Replay { .. } => {
+            return Err(CliError::Usage(
+                "mmic replay: give a TRACE or --record-scenarios DIR".into(),
+            ))
         }
         Cmd::Map { json } => {
             if json {

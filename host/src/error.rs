@@ -83,6 +83,9 @@ pub enum CliError {
     /// Options that do not go together.
     #[error("{0}")]
     Usage(String),
+    /// `mmic replay --against`: the two runs' outputs differ (where, in the message).
+    #[error("{0}")]
+    Replay(String),
     /// Standard output or error is closed.
     #[error("cannot write output: {0}")]
     Output(#[source] std::io::Error),
@@ -97,7 +100,10 @@ impl CliError {
             CliError::Spec(_) | CliError::Usage(_) => EXIT_INPUT,
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
             CliError::Plan { .. } | CliError::Inject(_) => EXIT_INPUT,
-            CliError::Incomplete(_) | CliError::Invariant(_) | CliError::Fleet(_) => 1,
+            CliError::Incomplete(_)
+            | CliError::Invariant(_)
+            | CliError::Fleet(_)
+            | CliError::Replay(_) => 1,
             CliError::HostBehind { .. } => EXIT_HOST,
             CliError::Write { .. }
             | CliError::Output(_)

@@ -13,6 +13,7 @@ pub mod pages;
 pub mod plan;
 pub mod plot;
 pub mod pus;
+pub mod replay;
 pub mod sim;
 pub mod simcli;
 pub mod spec;

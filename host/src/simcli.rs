@@ -201,6 +201,11 @@ pub struct SimArgs {
     /// a step that does not fit the state is reported with its line and column.
     #[arg(long)]
     pub check_plan: bool,
+    /// Virtual time: write robot 1's replay trace to FILE (every call of its nodes with its
+    /// time, sensor readings and bytes), for `mmic replay` and the bare-metal RV32 runner
+    /// (benches/rv32/README.md).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["realtime", "ground_tm_to"])]
+    pub record: Option<std::path::PathBuf>,
 }
 
 /// `--inject`'s value.
@@ -314,6 +319,7 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     cfg.links.wifi.reorder_us = 50_000;
     cfg.max_sim_ms = ms(Some(a.max_seconds)).unwrap_or(u32::MAX);
     cfg.log_path = Some(a.out.join("sim.jsonl"));
+    cfg.record = a.record.clone();
     cfg.progress = !a.quiet;
     if let (Some(tm_to), Some(tc_port)) = (a.ground_tm_to, a.ground_tc_port) {
         return external(cfg, tm_to, tc_port, out);

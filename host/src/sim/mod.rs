@@ -160,6 +160,10 @@ pub struct SimConfig {
     /// Virtual time: run on to [`SimConfig::max_sim_ms`] after every plan ended (the robots
     /// idle, still watched), instead of stopping there.
     pub run_to_end: bool,
+    /// Virtual time: write robot 1's replay trace here (`mmic sim --record`): every call of
+    /// its nodes with its time, readings and bytes, for `mmic replay` and the RV32 runner
+    /// (`benches/rv32`).
+    pub record: Option<PathBuf>,
 }
 
 /// An external ground on UDP (`mmic sim --protocol pus --ground-tm-to ADDR --ground-tc-port
@@ -237,6 +241,7 @@ impl SimConfig {
             log_events: true,
             planted_bug: engine::PlantedBug::None,
             run_to_end: false,
+            record: None,
         }
     }
 }

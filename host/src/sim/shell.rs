@@ -7,7 +7,7 @@
 
 use super::inject::{self, Scheduled};
 use super::log::Log;
-use super::plant::{Drives, Plant};
+use super::plant::{Drives, Plant, Senses};
 use super::progress::Progress;
 use super::steps::SimStep;
 use mmic::motion::State;
@@ -30,6 +30,8 @@ pub struct SideA {
     pub board: BoardA,
     /// Side A's front end (with the hip encoder).
     pub sensors: Frontend<WINDOW>,
+    /// What the last tick sensed (`mmic sim --record` writes it to the trace).
+    pub sensed: Option<Senses>,
 }
 
 impl SideA {
@@ -38,6 +40,7 @@ impl SideA {
         SideA {
             board,
             sensors: Frontend::new(frontend::Config::default()),
+            sensed: None,
         }
     }
 
@@ -52,14 +55,16 @@ impl SideA {
         command: Option<[u8; COMMAND_LEN]>,
         from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
     ) -> board_a::Outputs {
-        tick_a(
+        let (out, s) = tick_a_sensed(
             &mut self.board,
             &mut self.sensors,
             plant,
             now,
             command,
             from_b,
-        )
+        );
+        self.sensed = Some(s);
+        out
     }
 
     /// Board A's mode, faults, state and motion for a run's summary, at `now`.
@@ -78,6 +83,8 @@ pub struct SideB {
     pub board: BoardB,
     /// Side B's front end.
     pub sensors: Frontend<WINDOW>,
+    /// What the last tick sensed (`mmic sim --record` writes it to the trace).
+    pub sensed: Option<Senses>,
 }
 
 impl SideB {
@@ -89,6 +96,7 @@ impl SideB {
                 hip_encoder: false,
                 ..frontend::Config::default()
             }),
+            sensed: None,
         }
     }
 
@@ -101,7 +109,9 @@ impl SideB {
         now: u32,
         command: Option<[u8; B_COMMAND_LEN]>,
     ) -> board_b::Outputs {
-        tick_b(&mut self.board, &mut self.sensors, plant, now, command)
+        let (out, s) = tick_b_sensed(&mut self.board, &mut self.sensors, plant, now, command);
+        self.sensed = Some(s);
+        out
     }
 }
 
@@ -114,6 +124,18 @@ pub fn tick_a(
     command: Option<[u8; COMMAND_LEN]>,
     from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
 ) -> board_a::Outputs {
+    tick_a_sensed(board, sensors, plant, now, command, from_b).0
+}
+
+/// [`tick_a`], also returning what side A sensed.
+pub fn tick_a_sensed(
+    board: &mut BoardA,
+    sensors: &mut Frontend<WINDOW>,
+    plant: &mut Plant,
+    now: u32,
+    command: Option<[u8; COMMAND_LEN]>,
+    from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
+) -> (board_a::Outputs, Senses) {
     plant.advance(now);
     let s = plant.sense(0, now);
     let f = sensors.push(&s.raw);
@@ -145,7 +167,7 @@ pub fn tick_a(
             plant.set_state(*st);
         }
     }
-    out
+    (out, s)
 }
 
 /// [`SideB::tick`] on its parts.
@@ -156,6 +178,17 @@ pub fn tick_b(
     now: u32,
     command: Option<[u8; B_COMMAND_LEN]>,
 ) -> board_b::Outputs {
+    tick_b_sensed(board, sensors, plant, now, command).0
+}
+
+/// [`tick_b`], also returning what side B sensed.
+pub fn tick_b_sensed(
+    board: &mut BoardB,
+    sensors: &mut Frontend<WINDOW>,
+    plant: &mut Plant,
+    now: u32,
+    command: Option<[u8; B_COMMAND_LEN]>,
+) -> (board_b::Outputs, Senses) {
     let s = plant.sense(1, now);
     let f = sensors.push(&s.raw);
     let out = board.tick(
@@ -176,7 +209,7 @@ pub fn tick_b(
         bolter: out.bolter,
         mux: out.mux,
     });
-    out
+    (out, s)
 }
 
 /// The packets a deframer finds in `bytes` (a stream's next read).

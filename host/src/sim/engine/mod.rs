@@ -55,6 +55,7 @@ use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::deframer::Deframer;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 use mmic::wire::PacketKind;
+use mmic_replay::trace::{self, Record};
 use serde_json::{json, Value};
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, VecDeque};
@@ -244,6 +245,8 @@ struct Engine<'c, G: Ground> {
     tokens: u64,
     watch: Option<Watch>,
     status: Value,
+    /// Robot 1's replay trace, when recording.
+    trace: Option<Vec<u8>>,
 }
 
 /// Runs the simulation to the end of every robot's plan (or the time limit) in virtual time.
@@ -312,6 +315,11 @@ impl<'c, G: Ground> Engine<'c, G> {
             tokens: 0,
             watch: watched.then(|| Watch::new(cfg, n)),
             status: Value::Null,
+            trace: cfg.record.as_ref().map(|_| {
+                let mut t = Vec::new();
+                record_header(cfg).emit(&mut t);
+                t
+            }),
         };
         e.at(0, Ev::TickA);
         e.at(cfg.b_phase_us % 10_000, Ev::TickB);
@@ -337,6 +345,16 @@ impl<'c, G: Ground> Engine<'c, G> {
         (self.now / 1000) as u32
     }
 
+    /// Appends robot `i`'s call to the replay trace, if recording (robot 1 only).
+    fn record<'b>(&mut self, i: usize, r: impl FnOnce(u32) -> Record<'b>) {
+        if i == 0 {
+            let t = self.now_ms();
+            if let Some(trace) = &mut self.trace {
+                r(t).emit(trace);
+            }
+        }
+    }
+
     fn run(mut self) -> std::io::Result<(Summary, Option<Watch>)> {
         let wall = Instant::now();
         let max_us = (self.cfg.max_sim_ms as u64 + 1) * 1000;
@@ -357,6 +375,9 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
         if let Some(r) = self.robots.first() {
             self.status = r.a.status(now - now % TICK_MS);
+        }
+        if let (Some(p), Some(t)) = (&self.cfg.record, &self.trace) {
+            std::fs::write(p, t)?;
         }
         let (ends, stats) = self.ground.finish(now);
         let records = self.log.as_ref().map(Log::take).unwrap_or_default();
@@ -395,6 +416,7 @@ impl<'c, G: Ground> Engine<'c, G> {
                 let r = &mut self.robots[robot];
                 if r.wifi_open == Some(conn) {
                     r.wifi_open = None;
+                    self.record(robot, |t| Record::WifiClose { t });
                 }
             }
             Ev::VisitTimeout { robot, conn } => {
@@ -482,6 +504,7 @@ impl<'c, G: Ground> Engine<'c, G> {
     fn deliver(&mut self, i: usize, hop: Hop, conn: u64, bytes: Vec<u8>) {
         match hop {
             Hop::GroundToServer => {
+                self.record(i, |t| Record::ServerIn { t, bytes: &bytes });
                 let r = &mut self.robots[i];
                 match r.board {
                     Board::Relay(_) => {
@@ -511,6 +534,7 @@ impl<'c, G: Ground> Engine<'c, G> {
             Hop::ServerToA => self.wifi_bytes(i, conn, &bytes),
             Hop::AToServer => self.heartbeat_at_server(i, conn, &bytes),
             Hop::AToB => {
+                self.record(i, |t| Record::ToB { t, bytes: &bytes });
                 let r = &mut self.robots[i];
                 for f in frames(&mut r.b_reader, &bytes) {
                     if let Ok(p) = f.as_bytes().try_into() {
@@ -519,6 +543,7 @@ impl<'c, G: Ground> Engine<'c, G> {
                 }
             }
             Hop::BToA => {
+                self.record(i, |t| Record::ToA { t, bytes: &bytes });
                 let r = &mut self.robots[i];
                 for f in frames(&mut r.a_reader, &bytes) {
                     if let Ok(p) = f.as_bytes().try_into() {
@@ -536,6 +561,13 @@ impl<'c, G: Ground> Engine<'c, G> {
         let command = r.commands.split().1.pop();
         let from_b = r.a_from_b.pop_front();
         let out = r.a.tick(&mut r.plant, now, command, from_b);
+        if let Some(s) = r.a.sensed {
+            self.record(i, |t| Record::TickA {
+                t,
+                reading: reading(&s),
+            });
+        }
+        let r = &mut self.robots[i];
         if let Some(w) = &mut self.watch {
             w.tick_a(
                 i,
@@ -570,6 +602,13 @@ impl<'c, G: Ground> Engine<'c, G> {
         let r = &mut self.robots[i];
         let command = r.b_from_a.pop_front();
         let out = r.b.tick(&mut r.plant, now, command);
+        if let Some(s) = r.b.sensed {
+            self.record(i, |t| Record::TickB {
+                t,
+                reading: reading(&s),
+            });
+        }
+        let r = &mut self.robots[i];
         if let Some(w) = &mut self.watch {
             w.tick_b(i, now, &watch::SideMotion::of(&r.plant, 1));
         }
@@ -586,6 +625,7 @@ impl<'c, G: Ground> Engine<'c, G> {
     /// Board A's WiFi task takes a connection: heartbeats made while nobody was connected
     /// are discarded (the firmware's behaviour), then it serves this one.
     fn wifi_opened(&mut self, i: usize, conn: u64) {
+        self.record(i, |t| Record::WifiOpen { t });
         let r = &mut self.robots[i];
         r.wifi_open = Some(conn);
         r.wifi_reader = Deframer::new();
@@ -606,6 +646,7 @@ impl<'c, G: Ground> Engine<'c, G> {
 
     /// Board A's WiFi task writes the queued heartbeats to the open connection.
     fn wifi_drain(&mut self, i: usize) {
+        self.record(i, |t| Record::WifiDrain { t });
         let Some(conn) = self.robots[i].wifi_open else {
             self.wifi_discard(i);
             return;
@@ -623,6 +664,8 @@ impl<'c, G: Ground> Engine<'c, G> {
             self.node_event(i, 0, json!({"type": "wifi_closed", "hex": log::hex(bytes)}));
             return;
         }
+        self.record(i, |t| Record::WifiBytes { t, bytes });
+        let r = &mut self.robots[i];
         let mut packets: Vec<[u8; COMMAND_LEN]> = frames(&mut r.wifi_reader, bytes)
             .into_iter()
             .filter(|f| f.kind() == PacketKind::Command)
@@ -668,6 +711,8 @@ impl<'c, G: Ground> Engine<'c, G> {
             );
             return;
         }
+        self.record(i, |t| Record::ServerHeartbeat { t, bytes });
+        let r = &mut self.robots[i];
         let Some(v) = r.visit.as_mut() else { return };
         let Some(hb) = frames(&mut v.reader, bytes)
             .into_iter()
@@ -739,6 +784,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         if self.robots[i].visit.is_some() {
             return;
         }
+        self.record(i, |t| Record::ServerLoop { t });
         let now = self.now_ms();
         let inbox: Vec<Vec<u8>> = self.robots[i].inbox.drain(..).collect();
         let number = self.robots[i].number;
@@ -845,6 +891,28 @@ impl<'c, G: Ground> Engine<'c, G> {
                 }
             }
         }
+    }
+}
+
+/// The replay trace's header of a run (`mmic sim --record`).
+fn record_header(cfg: &SimConfig) -> trace::Header {
+    trace::Header {
+        protocol: match cfg.protocol {
+            Protocol::Legacy => trace::Protocol::Legacy,
+            Protocol::Pus => trace::Protocol::Pus,
+        },
+        board: board_number(0),
+        start: cfg.start_state,
+        gateway: cfg.gateway,
+    }
+}
+
+/// A side's senses as a trace reading.
+fn reading(s: &super::plant::Senses) -> trace::Reading {
+    trace::Reading {
+        raw: s.raw,
+        arm_contracted: s.arm_contracted,
+        bolter_at_home: s.bolter_at_home,
     }
 }
 

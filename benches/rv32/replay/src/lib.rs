@@ -1,0 +1,535 @@
+//! Replays a recorded scenario through one robot's nodes, on any target: the same library
+//! calls the virtual-time engine made (`mmic sim --record`), in the same order, with the same
+//! bytes, readings and times, each answered by one output record ([`out`]). Built for x86-64
+//! by `mmic replay` and for `riscv32imc-unknown-none-elf` by the bare-metal runner
+//! (`benches/rv32/runner`, under QEMU): the two outputs must be identical, byte for byte.
+//!
+//! What runs per record is the shells' glue around the library's pure nodes, as the engine
+//! (`host/src/sim/engine`) and the firmware (`firmware/support`) do it: board A's control tick
+//! (the hand-off queue's next command, the next internal heartbeat from the serial line, side
+//! A's [`Frontend`], [`BoardA::tick`], the heartbeat into the other hand-off queue), board A's
+//! WiFi task (commands deframed into the queue; heartbeats drained), board B's tick, and the
+//! server board (the legacy relay [`Server`] or the PUS [`Gateway`]). No `unsafe`, no
+//! allocation, no panic on any trace.
+//!
+//! ```
+//! use mmic_replay::{trace::{Header, Protocol, Reading, Record}, Replay};
+//! let mut r = Replay::new(&Header::demo(Protocol::Legacy));
+//! let mut out = Vec::new();
+//! r.step(&Record::TickA { t: 0, reading: Reading::default() }, &mut out, &mut ());
+//! let rec = mmic_replay::out::records(&out).next().unwrap();
+//! assert_eq!((rec.tag, rec.t), (1, 0));
+//! ```
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+#[cfg(feature = "std")]
+extern crate std;
+
+pub mod out;
+pub mod trace;
+
+use heapless::{Deque, Vec};
+use mmic::node::board_a::{self, BoardA};
+use mmic::node::board_b::{self, BoardB};
+use mmic::node::gateway::{self, Gateway, Out};
+use mmic::node::handoff::PacketQueue;
+use mmic::node::server::{Accepted, Server};
+use mmic::sensors::frontend::{self, Frontend, WINDOW};
+use mmic::units::PulseWidth;
+use mmic::wire::b_command::B_COMMAND_LEN;
+use mmic::wire::command::COMMAND_LEN;
+use mmic::wire::deframer::{Deframed, Deframer};
+use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
+use mmic::wire::internal_heartbeat::INTERNAL_HEARTBEAT_LEN;
+use mmic::wire::PacketKind;
+use out::{Field, RecordWriter};
+use trace::{Header, Protocol, Record};
+
+/// Where output bytes go (a file through semihosting, a `Vec` on the host).
+pub trait Sink {
+    /// Appends `bytes`.
+    fn put(&mut self, bytes: &[u8]);
+}
+
+#[cfg(feature = "std")]
+impl Sink for std::vec::Vec<u8> {
+    fn put(&mut self, bytes: &[u8]) {
+        self.extend_from_slice(bytes);
+    }
+}
+
+/// The parts of a call, for the cost tables: the runner reads the instruction counter at each.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// Moving packets: queues, deframers.
+    Glue = 0,
+    /// The sensor front end ([`Frontend::push`]).
+    FrontEnd = 1,
+    /// The node's own tick or call ([`BoardA::tick`], [`BoardB::tick`], the relay, the gateway).
+    Node = 2,
+    /// Writing the output record: not part of the node's cost.
+    Record = 3,
+}
+
+impl Phase {
+    /// Every phase, in table order.
+    pub const ALL: [Phase; 4] = [Phase::Glue, Phase::FrontEnd, Phase::Node, Phase::Record];
+
+    /// The phase's name in tables.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Phase::Glue => "glue",
+            Phase::FrontEnd => "front end",
+            Phase::Node => "node",
+            Phase::Record => "output record",
+        }
+    }
+}
+
+/// Told where a call's phases begin (the runner counts instructions; the host does nothing).
+pub trait Meter {
+    /// The call enters phase `p`.
+    fn enter(&mut self, p: Phase);
+}
+
+impl Meter for () {
+    fn enter(&mut self, _: Phase) {}
+}
+
+/// The gateway of the simulator: one robot, eight waiting telecommands, 64 remembered keys.
+pub type ReplayGateway = Gateway<1, 8, 64>;
+
+/// The largest telemetry packet the gateway writes, bytes.
+pub const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + gateway::MAX_TM_DATA;
+
+/// The largest packet from the ground the server board keeps, bytes (a longer datagram is
+/// reported in the output record and dropped).
+pub const MAX_GROUND_PACKET: usize = 256;
+
+/// Packets waiting in the engine's unbounded queues fit in these (a fuller one is reported).
+const QUEUE: usize = 32;
+
+// No allocator: the gateway lives in place (the replay holds one board).
+#[allow(clippy::large_enum_variant)]
+enum Board {
+    Relay(Server<4>),
+    Gateway(ReplayGateway),
+}
+
+/// One robot's nodes, and the glue between them.
+pub struct Replay {
+    header: Header,
+    a: BoardA,
+    front_a: Frontend<WINDOW>,
+    b: BoardB,
+    front_b: Frontend<WINDOW>,
+    commands: PacketQueue<COMMAND_LEN, 8>,
+    heartbeats: PacketQueue<HEARTBEAT_LEN, 8>,
+    a_reader: Deframer<256>,
+    a_from_b: Deque<[u8; INTERNAL_HEARTBEAT_LEN], QUEUE>,
+    b_reader: Deframer<256>,
+    b_from_a: Deque<[u8; B_COMMAND_LEN], QUEUE>,
+    wifi_open: bool,
+    wifi_reader: Deframer<256>,
+    board: Board,
+    visit: Deframer<256>,
+    inbox: Deque<Vec<u8, MAX_GROUND_PACKET>, QUEUE>,
+    server_reader: Deframer<256>,
+    w: RecordWriter,
+}
+
+/// A pulse as a number: µs, 0 for none.
+fn us(p: Option<PulseWidth>) -> u16 {
+    p.map_or(0, PulseWidth::micros)
+}
+
+/// The packets a deframer finds in `bytes`, handed to `f` one by one.
+fn frames(d: &mut Deframer<256>, bytes: &[u8], mut f: impl FnMut(mmic::wire::deframer::Frame)) {
+    d.feed(bytes, |e| {
+        if let Deframed::Frame(fr) = e {
+            f(fr);
+        }
+    });
+}
+
+impl Replay {
+    /// The nodes at the start of a scenario.
+    pub fn new(h: &Header) -> Replay {
+        let board = match h.protocol {
+            Protocol::Legacy => Board::Relay(Server::new()),
+            Protocol::Pus => {
+                let mut g = ReplayGateway::new(h.gateway);
+                g.add(h.board);
+                Board::Gateway(g)
+            }
+        };
+        Replay {
+            header: *h,
+            a: BoardA::in_state(
+                board_a::Config {
+                    board: h.board,
+                    ..board_a::Config::default()
+                },
+                h.start,
+            ),
+            front_a: Frontend::new(frontend::Config::default()),
+            b: BoardB::new(board_b::Config::default()),
+            front_b: Frontend::new(frontend::Config {
+                hip_encoder: false,
+                ..frontend::Config::default()
+            }),
+            commands: PacketQueue::new(),
+            heartbeats: PacketQueue::new(),
+            a_reader: Deframer::new(),
+            a_from_b: Deque::new(),
+            b_reader: Deframer::new(),
+            b_from_a: Deque::new(),
+            wifi_open: false,
+            wifi_reader: Deframer::new(),
+            board,
+            visit: Deframer::new(),
+            inbox: Deque::new(),
+            server_reader: Deframer::new(),
+            w: RecordWriter::new(),
+        }
+    }
+
+    /// Board A, as the replay left it.
+    pub fn board_a(&self) -> &BoardA {
+        &self.a
+    }
+
+    /// Runs one record and writes its output record to `out`; `m` is told the phases.
+    pub fn step(&mut self, r: &Record<'_>, out: &mut impl Sink, m: &mut impl Meter) {
+        m.enter(Phase::Glue);
+        self.w.begin(r.tag(), r.t());
+        match *r {
+            Record::TickA { t, reading } => {
+                let command = self.commands.split().1.pop();
+                let from_b = self.a_from_b.pop_front();
+                m.enter(Phase::FrontEnd);
+                let f = self.front_a.push(&reading.raw);
+                m.enter(Phase::Node);
+                let o = self.a.tick(
+                    t,
+                    &board_a::Inputs {
+                        command,
+                        from_b,
+                        electrical: f.electrical,
+                        hip: f.hip,
+                        gravity: f.gravity,
+                        arm_contracted: reading.arm_contracted,
+                        bolter_at_home: reading.bolter_at_home,
+                        lost: f.lost,
+                    },
+                );
+                m.enter(Phase::Glue);
+                let full = o
+                    .heartbeat
+                    .is_some_and(|hb| self.heartbeats.split().0.push(hb).is_err());
+                m.enter(Phase::Record);
+                tick_a_record(&mut self.w, command, from_b, &o, &self.a, full);
+            }
+            Record::TickB { t, reading } => {
+                let command = self.b_from_a.pop_front();
+                m.enter(Phase::FrontEnd);
+                let f = self.front_b.push(&reading.raw);
+                m.enter(Phase::Node);
+                let o = self.b.tick(
+                    t,
+                    &board_b::Inputs {
+                        command,
+                        electrical: f.electrical,
+                        gravity: f.gravity,
+                        arm_contracted: reading.arm_contracted,
+                        bolter_at_home: reading.bolter_at_home,
+                        lost: f.lost,
+                    },
+                );
+                m.enter(Phase::Record);
+                tick_b_record(&mut self.w, command, &o);
+            }
+            Record::ToA { bytes, .. } => {
+                let (mut n, mut over) = (0u32, 0u32);
+                let q = &mut self.a_from_b;
+                frames(&mut self.a_reader, bytes, |f| {
+                    if let Ok(p) = f.as_bytes().try_into() {
+                        n += 1;
+                        over += u32::from(q.push_back(p).is_err());
+                    }
+                });
+                m.enter(Phase::Record);
+                queued_record(&mut self.w, n, over);
+            }
+            Record::ToB { bytes, .. } => {
+                let (mut n, mut over) = (0u32, 0u32);
+                let q = &mut self.b_from_a;
+                frames(&mut self.b_reader, bytes, |f| {
+                    if let Ok(p) = f.as_bytes().try_into() {
+                        n += 1;
+                        over += u32::from(q.push_back(p).is_err());
+                    }
+                });
+                m.enter(Phase::Record);
+                queued_record(&mut self.w, n, over);
+            }
+            Record::WifiOpen { .. } => {
+                self.wifi_open = true;
+                self.wifi_reader = Deframer::new();
+                let n = self.discard();
+                m.enter(Phase::Record);
+                self.w.u32(Field::Discarded, n);
+            }
+            Record::WifiClose { .. } => {
+                self.wifi_open = false;
+                m.enter(Phase::Record);
+            }
+            Record::WifiBytes { bytes, .. } => {
+                let (mut n, mut full) = (0u32, 0u32);
+                let (mut p, _) = self.commands.split();
+                frames(&mut self.wifi_reader, bytes, |f| {
+                    if f.kind() != PacketKind::Command {
+                        return;
+                    }
+                    if let Ok(c) = <[u8; COMMAND_LEN]>::try_from(f.as_bytes()) {
+                        n += 1;
+                        full += u32::from(p.push(c).is_err());
+                    }
+                });
+                m.enter(Phase::Record);
+                queued_record(&mut self.w, n, full);
+            }
+            Record::WifiDrain { .. } => {
+                if !self.wifi_open {
+                    let n = self.discard();
+                    m.enter(Phase::Record);
+                    self.w.u32(Field::Discarded, n);
+                } else {
+                    m.enter(Phase::Record);
+                    while let Some(hb) = self.heartbeats.split().1.pop() {
+                        self.w.bytes(Field::Sent, &hb);
+                    }
+                }
+            }
+            Record::ServerIn { bytes, .. } => self.server_in(bytes, m),
+            Record::ServerLoop { t } => self.server_loop(t, m),
+            Record::ServerHeartbeat { t, bytes } => self.server_heartbeat(t, bytes, m),
+        }
+        m.enter(Phase::Record);
+        self.w.end(out);
+    }
+
+    /// Heartbeats made while nobody was connected: dropped (the firmware's behaviour).
+    fn discard(&mut self) -> u32 {
+        let mut n = 0;
+        while self.heartbeats.split().1.pop().is_some() {
+            n += 1;
+        }
+        n
+    }
+
+    fn server_in(&mut self, bytes: &[u8], m: &mut impl Meter) {
+        let (mut n, mut over) = (0u32, 0u32);
+        let inbox = &mut self.inbox;
+        let mut keep = |b: &[u8]| {
+            n += 1;
+            let ok = Vec::from_slice(b).map(|v| inbox.push_back(v).is_ok());
+            over += u32::from(!matches!(ok, Ok(true)));
+        };
+        match self.board {
+            Board::Relay(_) => {
+                m.enter(Phase::Node);
+                frames(&mut self.server_reader, bytes, |f| keep(f.as_bytes()));
+            }
+            Board::Gateway(_) => keep(bytes),
+        }
+        m.enter(Phase::Record);
+        queued_record(&mut self.w, n, over);
+    }
+
+    fn server_loop(&mut self, now: u32, m: &mut impl Meter) {
+        let number = self.header.board;
+        m.enter(Phase::Node);
+        match &mut self.board {
+            Board::Relay(srv) => {
+                while let Some(p) = self.inbox.pop_front() {
+                    let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(p.as_slice()) else {
+                        continue;
+                    };
+                    let r = srv.accept(&packet);
+                    m.enter(Phase::Record);
+                    match r {
+                        Ok(Accepted::Superseded(old)) => {
+                            self.w.debug(Field::Accepted, &"Superseded");
+                            self.w.bytes(Field::Accepted, &old);
+                        }
+                        Ok(a) => self.w.debug(Field::Accepted, &a),
+                        Err(e) => self.w.debug(Field::Refused, &e),
+                    }
+                    m.enter(Phase::Node);
+                }
+                if let Some((board, packet)) = srv.next_visit() {
+                    srv.delivered(board, &packet);
+                    if board == number {
+                        self.visit = Deframer::new();
+                    }
+                    m.enter(Phase::Record);
+                    self.w.u8(Field::Visit, board.get());
+                    self.w.bytes(Field::Visit, &packet);
+                }
+            }
+            Board::Gateway(g) => {
+                while let Some(p) = self.inbox.pop_front() {
+                    match g.tc_packet(&p) {
+                        Ok(o) => reports(&mut self.w, g, o, now, m),
+                        Err(e) => {
+                            m.enter(Phase::Record);
+                            self.w.debug(Field::Refused, &e);
+                            m.enter(Phase::Node);
+                        }
+                    }
+                }
+                let o = g.tick(now);
+                let visit = o
+                    .to_robots
+                    .iter()
+                    .find(|(b, _)| *b == number)
+                    .map(|(_, c)| c.to_bytes());
+                reports(&mut self.w, g, o, now, m);
+                if let Some(packet) = visit {
+                    self.visit = Deframer::new();
+                    m.enter(Phase::Record);
+                    self.w.u8(Field::Visit, number.get());
+                    self.w.bytes(Field::Visit, &packet);
+                } else {
+                    let d = g.next_deadline(now);
+                    m.enter(Phase::Record);
+                    self.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
+                }
+            }
+        }
+    }
+
+    fn server_heartbeat(&mut self, now: u32, bytes: &[u8], m: &mut impl Meter) {
+        let mut hb: Option<[u8; HEARTBEAT_LEN]> = None;
+        m.enter(Phase::Node);
+        frames(&mut self.visit, bytes, |f| {
+            if hb.is_none() && f.kind() == PacketKind::Heartbeat {
+                hb = f.as_bytes().try_into().ok();
+            }
+        });
+        let Some(hb) = hb else { return };
+        match &mut self.board {
+            Board::Relay(_) => {
+                m.enter(Phase::Record);
+                self.w.bytes(Field::Sent, &hb);
+            }
+            Board::Gateway(g) => {
+                if let Ok(h) = HeartbeatRepr::parse(&hb) {
+                    let o = g.heartbeat(now, &h);
+                    reports(&mut self.w, g, o, now, m);
+                }
+            }
+        }
+    }
+}
+
+/// The gateway's reports, encoded at `now`, into the record.
+fn reports<const M: usize>(
+    w: &mut RecordWriter,
+    g: &mut ReplayGateway,
+    o: Out<M>,
+    now: u32,
+    m: &mut impl Meter,
+) {
+    if o.overflow > 0 {
+        m.enter(Phase::Record);
+        w.u16(Field::Overflow, o.overflow);
+        m.enter(Phase::Node);
+    }
+    for tm in &o.reports {
+        let mut b = [0u8; MAX_TM_LEN];
+        let r = g.encode(tm, now, &mut b);
+        m.enter(Phase::Record);
+        match r {
+            Ok(n) => w.bytes(Field::Report, b.get(..n).unwrap_or(&[])),
+            Err(e) => w.debug(Field::Error, &e),
+        }
+        m.enter(Phase::Node);
+    }
+}
+
+/// Packets a read found (`n`), and those its queue could not take (`over`).
+pub fn queued_record(w: &mut RecordWriter, n: u32, over: u32) {
+    w.u32(Field::Queued, n);
+    if over > 0 {
+        w.u32(Field::Discarded, over);
+    }
+}
+
+/// Board A's control tick, as a record: what it took, what it drove and sent, where it is.
+pub fn tick_a_record(
+    w: &mut RecordWriter,
+    command: Option<[u8; COMMAND_LEN]>,
+    from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
+    o: &board_a::Outputs,
+    a: &BoardA,
+    handoff_full: bool,
+) {
+    if let Some(c) = command {
+        w.bytes(Field::Command, &c);
+    }
+    if let Some(b) = from_b {
+        w.bytes(Field::FromB, &b);
+    }
+    w.u16(Field::Hip, us(o.hip));
+    w.u16(Field::Arm, us(o.arm));
+    w.u16(Field::Gripper, us(o.gripper));
+    w.u8(Field::Regulator, o.regulator.into());
+    w.debug(Field::Bolter, &o.bolter);
+    w.u8(Field::Mux, u8::from(o.mux.a0) | u8::from(o.mux.a1) << 1);
+    if let Some(b) = o.to_b {
+        w.bytes(Field::ToB, &b);
+    }
+    if let Some(h) = o.heartbeat {
+        w.bytes(Field::Heartbeat, &h);
+    }
+    if !o.events.is_empty() {
+        w.debug(Field::Events, &o.events);
+    }
+    if o.events_lost > 0 {
+        w.u8(Field::EventsLost, o.events_lost);
+    }
+    w.debug(Field::Mode, &a.mode());
+    w.u32(Field::Faults, a.faults().bits());
+    w.debug(Field::State, &a.state());
+    w.u8(Field::InMotion, a.in_motion().into());
+    if handoff_full {
+        w.u8(Field::HandoffFull, 1);
+    }
+}
+
+/// Board B's tick, as a record.
+pub fn tick_b_record(
+    w: &mut RecordWriter,
+    command: Option<[u8; B_COMMAND_LEN]>,
+    o: &board_b::Outputs,
+) {
+    if let Some(c) = command {
+        w.bytes(Field::Command, &c);
+    }
+    w.u16(Field::Arm, us(o.arm));
+    w.u16(Field::Gripper, us(o.gripper));
+    w.u8(Field::Regulator, o.regulator.into());
+    w.debug(Field::Bolter, &o.bolter);
+    w.u8(Field::Mux, u8::from(o.mux.a0) | u8::from(o.mux.a1) << 1);
+    if let Some(h) = o.heartbeat {
+        w.bytes(Field::InternalHeartbeat, &h);
+    }
+    w.u8(Field::LinkLost, o.link_lost.into());
+    if let Some(e) = o.rejected {
+        w.debug(Field::Rejected, &e);
+    }
+}

@@ -1,0 +1,191 @@
+//! `mmic replay`: runs a recorded scenario (`mmic sim --record`) through one robot's nodes on
+//! this host ([`mmic_replay`]) and compares the output with another run's, such as the
+//! bare-metal RV32 runner's under QEMU (benches/rv32/README.md): any difference is named by
+//! its record, time and field.
+
+use crate::sim::{Protocol, SimConfig};
+use mmic_replay::out::{first_difference, Difference, Field};
+use mmic_replay::trace::{Trace, TraceError};
+use mmic_replay::Replay;
+
+/// Table 8's ten faults, each injected into its own run of the demo plan at a time it is
+/// detected (the run stops with the plan); the last two over PUS.
+pub const FAULTS: &[(&str, Protocol)] = &[
+    ("bolting-failure@5", Protocol::Legacy),
+    ("arm-not-contracted@28", Protocol::Legacy),
+    ("bolter-overcurrent@12", Protocol::Legacy),
+    ("gripper-overcurrent@15", Protocol::Legacy),
+    ("locomotion-overcurrent@3", Protocol::Legacy),
+    ("hip-mismatch@0", Protocol::Legacy),
+    ("initial-state-mismatch@5", Protocol::Legacy),
+    ("internal-comm-loss@5", Protocol::Legacy),
+    ("low-battery@5", Protocol::Pus),
+    ("assembly-system@5", Protocol::Pus),
+];
+
+/// The scenarios CI replays on RV32 (benches/rv32/README.md), by name: the demo plan over
+/// both protocols, the demo over lossy, duplicating and reordering links, and one run per
+/// Table 8 fault (`fault-NAME`). Each runs in virtual time, deterministically.
+pub fn scenarios() -> Vec<(String, SimConfig)> {
+    let demo = |protocol| {
+        let mut c = SimConfig::demo();
+        c.progress = false;
+        c.protocol = protocol;
+        c
+    };
+    let mut lossy = demo(Protocol::Pus);
+    lossy.seed = 7;
+    lossy.max_sim_ms = 400_000;
+    lossy.wifi_loss = 0.1;
+    lossy.serial_loss = 0.05;
+    lossy.ab_loss = 0.05;
+    lossy.links.wifi.duplicate = 0.05;
+    lossy.links.wifi.reorder = 0.05;
+    lossy.links.wifi.reorder_us = 50_000;
+    let mut all = vec![
+        ("demo-legacy".to_string(), demo(Protocol::Legacy)),
+        ("demo-pus".to_string(), demo(Protocol::Pus)),
+        ("lossy".to_string(), lossy),
+    ];
+    for (f, protocol) in FAULTS {
+        let mut c = demo(*protocol);
+        c.max_sim_ms = 60_000;
+        // The names and times above are fixed: the test of this list checks each is taken
+        // and raises its fault.
+        if let Ok(s) = f.parse() {
+            let _ = c.inject(s);
+        }
+        let name = f.split('@').next().unwrap_or(f);
+        all.push((format!("fault-{name}"), c));
+    }
+    all
+}
+
+/// Runs every scenario with its trace written to `dir`/NAME.trace; returns each path with the
+/// run's summary.
+pub fn record_scenarios(
+    dir: &std::path::Path,
+) -> Result<Vec<(std::path::PathBuf, crate::sim::Summary)>, CliError> {
+    std::fs::create_dir_all(dir).map_err(|source| CliError::Write {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut paths = Vec::new();
+    for (name, mut cfg) in scenarios() {
+        let p = dir.join(format!("{name}.trace"));
+        cfg.record = Some(p.clone());
+        let summary = crate::sim::run(&cfg).map_err(CliError::Sim)?;
+        paths.push((p, summary));
+    }
+    Ok(paths)
+}
+
+/// Runs `trace` on this host; returns the output stream and the number of records.
+pub fn run(trace: &[u8]) -> Result<(Vec<u8>, usize), TraceError> {
+    let t = Trace::parse(trace)?;
+    let mut r = Replay::new(&t.header);
+    let mut out = Vec::new();
+    let mut n = 0;
+    for rec in t.records() {
+        r.step(&rec?, &mut out, &mut ());
+        n += 1;
+    }
+    Ok((out, n))
+}
+
+/// The name of a trace record's tag.
+pub fn tag_name(tag: u8) -> &'static str {
+    match tag {
+        1 => "board A tick",
+        2 => "board B tick",
+        3 => "bytes to board A (serial)",
+        4 => "bytes to board B (serial)",
+        5 => "WiFi task: connection opened",
+        6 => "WiFi task: connection closed",
+        7 => "WiFi task: command bytes",
+        8 => "WiFi task: heartbeats drained",
+        9 => "server board: bytes from the ground",
+        10 => "server board: loop",
+        11 => "server board: heartbeat",
+        _ => "unknown record",
+    }
+}
+
+fn hex(b: &[u8]) -> String {
+    b.iter().map(|x| format!("{x:02x}")).collect()
+}
+
+/// A difference as one line: which record (index, kind, time), which field, both values.
+pub fn describe(d: &Difference<'_>, left: &str, right: &str) -> String {
+    let field = d.field.map_or("the record's shape or length", Field::name);
+    format!(
+        "first difference at output record {} ({}, t={} ms), field {field}: {left} {} | {right} {}",
+        d.index,
+        tag_name(d.tag),
+        d.t,
+        hex(d.left),
+        hex(d.right)
+    )
+}
+
+/// Compares two output streams: `None` when identical, else the description.
+pub fn compare(left: &[u8], right: &[u8], names: (&str, &str)) -> Option<String> {
+    first_difference(left, right).map(|d| describe(&d, names.0, names.1))
+}
+
+fn read(path: &std::path::Path) -> Result<Vec<u8>, CliError> {
+    std::fs::read(path).map_err(|source| CliError::Read {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// `mmic replay --record-scenarios DIR`.
+pub fn cli_record(dir: &std::path::Path, out: &mut dyn std::io::Write) -> Result<(), CliError> {
+    for (p, summary) in record_scenarios(dir)? {
+        let n = std::fs::metadata(&p).map(|m| m.len()).unwrap_or(0);
+        writeln!(out, "recorded {} ({n} bytes)", p.display()).map_err(CliError::Output)?;
+        for line in crate::sim::report::text(&summary).lines() {
+            if line.starts_with("injected:") || line.starts_with("robot:") {
+                writeln!(out, "  {line}").map_err(CliError::Output)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `mmic replay TRACE [--against FILE] [--out FILE]`.
+pub fn cli(
+    trace: &std::path::Path,
+    against: Option<&std::path::Path>,
+    to: Option<&std::path::Path>,
+    out: &mut dyn std::io::Write,
+) -> Result<(), CliError> {
+    let bytes = read(trace)?;
+    let (host, n) =
+        run(&bytes).map_err(|e| CliError::Usage(format!("{}: {e}", trace.display())))?;
+    if let Some(p) = to {
+        std::fs::write(p, &host).map_err(|source| CliError::Write {
+            path: p.to_path_buf(),
+            source,
+        })?;
+    }
+    writeln!(
+        out,
+        "replayed {n} records of {} on this host: {} output bytes",
+        trace.display(),
+        host.len()
+    )
+    .map_err(CliError::Output)?;
+    if let Some(p) = against {
+        let other = read(p)?;
+        let name = p.display().to_string();
+        if let Some(d) = compare(&host, &other, ("host", &name)) {
+            return Err(CliError::Replay(d));
+        }
+        writeln!(out, "identical to {name}: {} bytes", other.len()).map_err(CliError::Output)?;
+    }
+    Ok(())
+}
+
+use crate::error::CliError;

@@ -1,0 +1,184 @@
+//! The replay (`mmic replay`, `benches/rv32`) against the simulation it was recorded from: for
+//! every scenario CI runs on RV32, replaying the trace on this host must send exactly the
+//! packets the virtual-time engine sent (every link, in order, at the same milliseconds), and
+//! end with board A where the engine's ended. So the RV32 comparison checks the simulator's own
+//! ticks, not a look-alike. Also: a changed trace or output is found and named.
+
+use mmic_host::replay::{compare, run, scenarios, tag_name, FAULTS};
+use mmic_replay::out::{fields, records, Field};
+use mmic_replay::trace::{Record, Trace, TraceError};
+use serde_json::Value;
+
+type Streams = std::collections::BTreeMap<&'static str, Vec<(u32, String)>>;
+
+fn hex(b: &[u8]) -> String {
+    b.iter().map(|x| format!("{x:02x}")).collect()
+}
+
+/// Every packet the engine's log shows written, by stream (copies of duplicated packets and
+/// heartbeats discarded while unconnected are not writes).
+fn engine_streams(log: &[Value], pus: bool) -> Streams {
+    let mut s = Streams::new();
+    for r in log {
+        if r["kind"] != "packet" || r["fate"] == "duplicated" || r["fate"] == "unconnected" {
+            continue;
+        }
+        let stream = match (r["from"].as_str(), r["to"].as_str()) {
+            (Some("board_a1"), Some("board_b1")) => "A to B",
+            (Some("board_b1"), Some("board_a1")) => "B to A",
+            (Some("board_a1"), Some("server1")) => "A to server",
+            (Some("server1"), Some("board_a1")) => "server to A",
+            (Some("server1"), Some("ground")) => "server to ground",
+            _ => continue,
+        };
+        let _ = pus;
+        let t = r["t_ms"].as_u64().unwrap_or(u64::MAX) as u32;
+        let h = r["hex"].as_str().unwrap_or("").to_string();
+        s.entry(stream).or_default().push((t, h));
+    }
+    s
+}
+
+/// The same streams from the replay's output records.
+fn replay_streams(out: &[u8]) -> Streams {
+    let mut s = Streams::new();
+    for r in records(out) {
+        let mut visit_board = false;
+        for (id, v) in fields(r.fields) {
+            let stream = match (r.tag, Field::from_id(id)) {
+                (1, Some(Field::ToB)) => "A to B",
+                (2, Some(Field::InternalHeartbeat)) => "B to A",
+                (8, Some(Field::Sent)) => "A to server",
+                (11, Some(Field::Sent)) | (_, Some(Field::Report)) => "server to ground",
+                (_, Some(Field::Visit)) => {
+                    // The board number, then the command.
+                    visit_board = !visit_board;
+                    if visit_board {
+                        continue;
+                    }
+                    "server to A"
+                }
+                _ => continue,
+            };
+            s.entry(stream).or_default().push((r.t, hex(v)));
+        }
+    }
+    s
+}
+
+#[test]
+fn replay_sends_what_the_engine_sent_in_every_scenario() {
+    let dir = std::env::temp_dir().join(format!("mmic-replay-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let all = scenarios();
+    assert_eq!(all.len(), 3 + FAULTS.len());
+    for (name, mut cfg) in all {
+        let path = dir.join(format!("{name}.trace"));
+        cfg.record = Some(path.clone());
+        cfg.log_packets = true;
+        let pus = cfg.protocol == mmic_host::sim::Protocol::Pus;
+        let summary = mmic_host::sim::run(&cfg).unwrap();
+        let trace = std::fs::read(&path).unwrap();
+        let (out, n) = run(&trace).unwrap();
+        let (want, got) = (engine_streams(&summary.records, pus), replay_streams(&out));
+        assert_eq!(
+            want.keys().copied().collect::<Vec<_>>(),
+            [
+                "A to B",
+                "A to server",
+                "B to A",
+                "server to A",
+                "server to ground"
+            ],
+            "{name}"
+        );
+        for (stream, w) in &want {
+            let g = got.get(stream).map(Vec::as_slice).unwrap_or(&[]);
+            let first = w.iter().zip(g).position(|(a, b)| a != b);
+            assert!(
+                first.is_none() && w.len() == g.len(),
+                "{name}: {stream}: engine {} packets, replay {}; first difference at {first:?}: {:?} vs {:?}",
+                w.len(),
+                g.len(),
+                first.and_then(|i| w.get(i)),
+                first.and_then(|i| g.get(i)),
+            );
+        }
+        // Board A ends where the engine's did.
+        let t = Trace::parse(&trace).unwrap();
+        let mut r = mmic_replay::Replay::new(&t.header);
+        for rec in t.records() {
+            r.step(&rec.unwrap(), &mut Vec::new(), &mut ());
+        }
+        let status = &summary.status;
+        assert_eq!(
+            serde_json::to_value(r.board_a().mode()).unwrap(),
+            status["mode"],
+            "{name}"
+        );
+        assert_eq!(
+            serde_json::to_value(r.board_a().state()).unwrap(),
+            status["state"],
+            "{name}"
+        );
+        if let Some(f) = name.strip_prefix("fault-") {
+            let raised = mmic_host::sim::report::faults_raised(&summary);
+            assert!(raised.iter().any(|x| x == f), "{name}: raised {raised:?}");
+        }
+        assert!(n > 100, "{name}: {n} records");
+        std::fs::remove_file(&path).unwrap();
+    }
+    let _ = std::fs::remove_dir(&dir);
+}
+
+#[test]
+fn a_changed_output_is_named_by_record_and_field() {
+    let (name, cfg) = scenarios().swap_remove(0);
+    let mut cfg = cfg;
+    let path =
+        std::env::temp_dir().join(format!("mmic-replay-{name}-{}.trace", std::process::id()));
+    cfg.record = Some(path.clone());
+    cfg.log_packets = false;
+    mmic_host::sim::run(&cfg).unwrap();
+    let trace = std::fs::read(&path).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    let (out, _) = run(&trace).unwrap();
+    assert_eq!(compare(&out, &out, ("a", "b")), None);
+    // Flip one bit of the 500th record's arm pulse.
+    let r = records(&out).nth(500).unwrap();
+    assert_eq!(r.tag, 1, "the 500th record is a board A tick");
+    let offset = r.fields.as_ptr() as usize - out.as_ptr() as usize;
+    let (id, v) = fields(r.fields)
+        .find(|(id, _)| *id == Field::Arm as u8)
+        .unwrap();
+    assert_eq!(id, Field::Arm as u8);
+    let at = offset + (v.as_ptr() as usize - r.fields.as_ptr() as usize);
+    let mut bad = out.clone();
+    bad[at] ^= 1;
+    let d = compare(&out, &bad, ("host", "rv32")).unwrap();
+    assert!(
+        d.starts_with(&format!(
+            "first difference at output record 500 ({}, t={} ms), field arm pulse",
+            tag_name(1),
+            r.t
+        )),
+        "{d}"
+    );
+    // A missing tail is named too.
+    let cut = &out[..offset - 7];
+    let d = compare(&out, cut, ("host", "rv32")).unwrap();
+    assert!(d.contains("output record 500"), "{d}");
+    // A trace cut short is an error, not a shorter replay.
+    let err = run(&trace[..trace.len() - 3]).unwrap_err();
+    assert!(matches!(err, TraceError::Truncated { .. }), "{err}");
+    assert_eq!(run(b"not a trace at all!").unwrap_err(), TraceError::Magic);
+    // Every record parses back to what it was.
+    let t = Trace::parse(&trace).unwrap();
+    let mut again = Vec::new();
+    t.header.emit(&mut again);
+    for rec in t.records() {
+        let rec: Record<'_> = rec.unwrap();
+        rec.emit(&mut again);
+    }
+    assert_eq!(again, trace);
+}
