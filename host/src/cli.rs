@@ -167,6 +167,17 @@ pub enum Cmd {
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
     },
+    /// The RV32 runner's costs (benches/rv32): instructions and stack per node over the cost
+    /// files, as a Markdown table; with --budget, exit 1 if any call took more instructions.
+    #[command(name = "rv32-costs")]
+    Rv32Costs {
+        /// Cost files written by the runner.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// The most instructions any one call may take.
+        #[arg(long, value_name = "INSTRUCTIONS")]
+        budget: Option<u32>,
+    },
     /// The reconfiguration map (Figure 9): which primitive takes one state to another.
     Map {
         /// Print {"moves":[{"from":..,"to":..,"primitive":..},..]}.
@@ -363,6 +374,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
             out: to,
             ..
         } => crate::replay::cli(&trace, against.as_deref(), to.as_deref(), out)?,
+        Cmd::Rv32Costs { files, budget } => crate::replay::cli_costs(&files, budget, out)?,
         Cmd::Replay { .. } => {
             return Err(CliError::Usage(
                 "mmic replay: give a TRACE or --record-scenarios DIR".into(),

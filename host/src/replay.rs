@@ -189,3 +189,141 @@ pub fn cli(
 }
 
 use crate::error::CliError;
+
+/// One node's figures over the cost files.
+#[derive(Debug, Clone, Default)]
+pub struct NodeCost {
+    /// Calls measured.
+    pub calls: usize,
+    /// Instructions of each call (sorted by [`cost_table`]).
+    pub instructions: Vec<u32>,
+    /// The most expensive call: instructions, scenario, record tag, time.
+    pub worst: (u32, String, u8, u32),
+    /// The deepest stack before the output record, and with it, bytes.
+    pub stack: (u32, u32),
+    /// Per phase (glue, front end, node): the median and the largest, instructions.
+    pub phases: [Vec<u32>; 3],
+}
+
+/// The per-node figures of cost files, given as (scenario, bytes).
+pub fn node_costs(files: &[(String, Vec<u8>)]) -> Result<Vec<NodeCost>, CliError> {
+    use mmic_replay::cost::{Cost, COST_LEN};
+    let mut nodes = vec![NodeCost::default(); mmic_replay::trace::Node::ALL.len()];
+    for (name, b) in files {
+        if b.len() % COST_LEN != 0 {
+            return Err(CliError::Usage(format!(
+                "{name}: {} bytes is not a whole number of {COST_LEN}-byte cost records",
+                b.len()
+            )));
+        }
+        for c in b.chunks_exact(COST_LEN).filter_map(Cost::parse) {
+            let Some(n) = nodes.get_mut(usize::from(c.node)) else {
+                return Err(CliError::Usage(format!("{name}: node {} in a cost record", c.node)));
+            };
+            let i = c.instructions();
+            n.calls += 1;
+            n.instructions.push(i);
+            if i > n.worst.0 {
+                n.worst = (i, name.clone(), c.tag, c.t);
+            }
+            n.stack = (n.stack.0.max(c.stack_node), n.stack.1.max(c.stack_all));
+            for (p, v) in n.phases.iter_mut().zip(c.phases) {
+                p.push(v);
+            }
+        }
+    }
+    for n in &mut nodes {
+        n.instructions.sort_unstable();
+        for p in &mut n.phases {
+            p.sort_unstable();
+        }
+    }
+    Ok(nodes)
+}
+
+/// The value at quantile `q` (0..=1) of sorted `v` (nearest rank).
+pub fn quantile(v: &[u32], q: f64) -> u32 {
+    if v.is_empty() {
+        return 0;
+    }
+    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1]
+}
+
+/// The ESP32-C3's clock, Hz.
+pub const CLOCK_HZ: f64 = 160e6;
+/// The boards' tick, s.
+pub const TICK_S: f64 = 0.010;
+
+/// The cost table (Markdown) and the worst call's instructions.
+pub fn cost_table(nodes: &[NodeCost]) -> (String, u32) {
+    let mut s = String::from(
+        "| node | calls | instructions min / median / p99 / max | worst call | µs at 160 MHz, CPI 1 | share of the 10 ms tick | stack, bytes (node / with output record) |\n|---|---|---|---|---|---|---|\n",
+    );
+    let mut worst = 0;
+    for (n, node) in nodes.iter().zip(mmic_replay::trace::Node::ALL) {
+        let v = &n.instructions;
+        let max = v.last().copied().unwrap_or(0);
+        worst = worst.max(max);
+        let us = f64::from(max) / CLOCK_HZ * 1e6;
+        s.push_str(&format!(
+            "| {} | {} | {} / {} / {} / {} | {}, {} at {:.2} s | {us:.1} | {:.2} % | {} / {} |\n",
+            node.name(),
+            n.calls,
+            v.first().copied().unwrap_or(0),
+            quantile(v, 0.5),
+            quantile(v, 0.99),
+            max,
+            n.worst.1,
+            tag_name(n.worst.2),
+            f64::from(n.worst.3) / 1000.0,
+            us / (TICK_S * 1e6) * 100.0,
+            n.stack.0,
+            n.stack.1,
+        ));
+    }
+    s.push_str("\n| node | phase | median | max |\n|---|---|---|---|\n");
+    for (n, node) in nodes.iter().zip(mmic_replay::trace::Node::ALL) {
+        for (p, phase) in n.phases.iter().zip(mmic_replay::Phase::ALL) {
+            if p.last().copied().unwrap_or(0) == 0 {
+                continue;
+            }
+            s.push_str(&format!(
+                "| {} | {} | {} | {} |\n",
+                node.name(),
+                phase.name(),
+                quantile(p, 0.5),
+                p.last().copied().unwrap_or(0)
+            ));
+        }
+    }
+    (s, worst)
+}
+
+/// `mmic rv32-costs [--budget N] COST...`.
+pub fn cli_costs(
+    files: &[std::path::PathBuf],
+    budget: Option<u32>,
+    out: &mut dyn std::io::Write,
+) -> Result<(), CliError> {
+    let mut all = Vec::new();
+    for f in files {
+        let name = f
+            .file_stem()
+            .map_or_else(|| f.display().to_string(), |s| s.to_string_lossy().into_owned());
+        all.push((name, read(f)?));
+    }
+    let nodes = node_costs(&all)?;
+    let (table, worst) = cost_table(&nodes);
+    write!(out, "{table}").map_err(CliError::Output)?;
+    if let Some(b) = budget {
+        if worst > b {
+            return Err(CliError::Replay(format!(
+                "the worst call took {worst} instructions, over the budget of {b}"
+            )));
+        }
+        writeln!(out, "\nworst call: {worst} instructions, within the budget of {b}")
+            .map_err(CliError::Output)?;
+    }
+    Ok(())
+}

@@ -27,6 +27,7 @@
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod cost;
 pub mod out;
 pub mod trace;
 
@@ -202,123 +203,156 @@ impl Replay {
     }
 
     /// Runs one record and writes its output record to `out`; `m` is told the phases.
+    ///
+    /// Each kind of record runs in a function of its own that is never inlined, so that a
+    /// call's stack holds only what its node needs (the RV32 runner measures it).
     pub fn step(&mut self, r: &Record<'_>, out: &mut impl Sink, m: &mut impl Meter) {
         m.enter(Phase::Glue);
         self.w.begin(r.tag(), r.t());
         match *r {
-            Record::TickA { t, reading } => {
-                let command = self.commands.split().1.pop();
-                let from_b = self.a_from_b.pop_front();
-                m.enter(Phase::FrontEnd);
-                let f = self.front_a.push(&reading.raw);
-                m.enter(Phase::Node);
-                let o = self.a.tick(
-                    t,
-                    &board_a::Inputs {
-                        command,
-                        from_b,
-                        electrical: f.electrical,
-                        hip: f.hip,
-                        gravity: f.gravity,
-                        arm_contracted: reading.arm_contracted,
-                        bolter_at_home: reading.bolter_at_home,
-                        lost: f.lost,
-                    },
-                );
-                m.enter(Phase::Glue);
-                let full = o
-                    .heartbeat
-                    .is_some_and(|hb| self.heartbeats.split().0.push(hb).is_err());
-                m.enter(Phase::Record);
-                tick_a_record(&mut self.w, command, from_b, &o, &self.a, full);
-            }
-            Record::TickB { t, reading } => {
-                let command = self.b_from_a.pop_front();
-                m.enter(Phase::FrontEnd);
-                let f = self.front_b.push(&reading.raw);
-                m.enter(Phase::Node);
-                let o = self.b.tick(
-                    t,
-                    &board_b::Inputs {
-                        command,
-                        electrical: f.electrical,
-                        gravity: f.gravity,
-                        arm_contracted: reading.arm_contracted,
-                        bolter_at_home: reading.bolter_at_home,
-                        lost: f.lost,
-                    },
-                );
-                m.enter(Phase::Record);
-                tick_b_record(&mut self.w, command, &o);
-            }
-            Record::ToA { bytes, .. } => {
-                let (mut n, mut over) = (0u32, 0u32);
-                let q = &mut self.a_from_b;
-                frames(&mut self.a_reader, bytes, |f| {
-                    if let Ok(p) = f.as_bytes().try_into() {
-                        n += 1;
-                        over += u32::from(q.push_back(p).is_err());
-                    }
-                });
-                m.enter(Phase::Record);
-                queued_record(&mut self.w, n, over);
-            }
-            Record::ToB { bytes, .. } => {
-                let (mut n, mut over) = (0u32, 0u32);
-                let q = &mut self.b_from_a;
-                frames(&mut self.b_reader, bytes, |f| {
-                    if let Ok(p) = f.as_bytes().try_into() {
-                        n += 1;
-                        over += u32::from(q.push_back(p).is_err());
-                    }
-                });
-                m.enter(Phase::Record);
-                queued_record(&mut self.w, n, over);
-            }
-            Record::WifiOpen { .. } => {
-                self.wifi_open = true;
-                self.wifi_reader = Deframer::new();
-                let n = self.discard();
-                m.enter(Phase::Record);
-                self.w.u32(Field::Discarded, n);
-            }
+            Record::TickA { t, reading } => self.tick_a(t, &reading, m),
+            Record::TickB { t, reading } => self.tick_b(t, &reading, m),
+            Record::ToA { bytes, .. } => self.to_a(bytes, m),
+            Record::ToB { bytes, .. } => self.to_b(bytes, m),
+            Record::WifiOpen { .. } => self.wifi_open(m),
             Record::WifiClose { .. } => {
                 self.wifi_open = false;
                 m.enter(Phase::Record);
             }
-            Record::WifiBytes { bytes, .. } => {
-                let (mut n, mut full) = (0u32, 0u32);
-                let (mut p, _) = self.commands.split();
-                frames(&mut self.wifi_reader, bytes, |f| {
-                    if f.kind() != PacketKind::Command {
-                        return;
-                    }
-                    if let Ok(c) = <[u8; COMMAND_LEN]>::try_from(f.as_bytes()) {
-                        n += 1;
-                        full += u32::from(p.push(c).is_err());
-                    }
-                });
-                m.enter(Phase::Record);
-                queued_record(&mut self.w, n, full);
-            }
-            Record::WifiDrain { .. } => {
-                if !self.wifi_open {
-                    let n = self.discard();
-                    m.enter(Phase::Record);
-                    self.w.u32(Field::Discarded, n);
-                } else {
-                    m.enter(Phase::Record);
-                    while let Some(hb) = self.heartbeats.split().1.pop() {
-                        self.w.bytes(Field::Sent, &hb);
-                    }
-                }
-            }
+            Record::WifiBytes { bytes, .. } => self.wifi_bytes(bytes, m),
+            Record::WifiDrain { .. } => self.wifi_drain(m),
             Record::ServerIn { bytes, .. } => self.server_in(bytes, m),
             Record::ServerLoop { t } => self.server_loop(t, m),
             Record::ServerHeartbeat { t, bytes } => self.server_heartbeat(t, bytes, m),
         }
         m.enter(Phase::Record);
         self.w.end(out);
+    }
+
+    /// Board A's control task: the next command and internal heartbeat, the front end, the
+    /// tick, the heartbeat into the WiFi task's queue.
+    #[inline(never)]
+    fn tick_a(&mut self, t: u32, reading: &trace::Reading, m: &mut impl Meter) {
+        let command = self.commands.split().1.pop();
+        let from_b = self.a_from_b.pop_front();
+        m.enter(Phase::FrontEnd);
+        let f = self.front_a.push(&reading.raw);
+        m.enter(Phase::Node);
+        let o = self.a.tick(
+            t,
+            &board_a::Inputs {
+                command,
+                from_b,
+                electrical: f.electrical,
+                hip: f.hip,
+                gravity: f.gravity,
+                arm_contracted: reading.arm_contracted,
+                bolter_at_home: reading.bolter_at_home,
+                lost: f.lost,
+            },
+        );
+        m.enter(Phase::Glue);
+        let full = o
+            .heartbeat
+            .is_some_and(|hb| self.heartbeats.split().0.push(hb).is_err());
+        m.enter(Phase::Record);
+        tick_a_record(&mut self.w, command, from_b, &o, &self.a, full);
+    }
+
+    /// Board B: the next command, the front end, the tick.
+    #[inline(never)]
+    fn tick_b(&mut self, t: u32, reading: &trace::Reading, m: &mut impl Meter) {
+        let command = self.b_from_a.pop_front();
+        m.enter(Phase::FrontEnd);
+        let f = self.front_b.push(&reading.raw);
+        m.enter(Phase::Node);
+        let o = self.b.tick(
+            t,
+            &board_b::Inputs {
+                command,
+                electrical: f.electrical,
+                gravity: f.gravity,
+                arm_contracted: reading.arm_contracted,
+                bolter_at_home: reading.bolter_at_home,
+                lost: f.lost,
+            },
+        );
+        m.enter(Phase::Record);
+        tick_b_record(&mut self.w, command, &o);
+    }
+
+    /// Board A's serial line: internal heartbeats deframed into the control task's queue.
+    #[inline(never)]
+    fn to_a(&mut self, bytes: &[u8], m: &mut impl Meter) {
+        let (mut n, mut over) = (0u32, 0u32);
+        let q = &mut self.a_from_b;
+        frames(&mut self.a_reader, bytes, |f| {
+            if let Ok(p) = f.as_bytes().try_into() {
+                n += 1;
+                over += u32::from(q.push_back(p).is_err());
+            }
+        });
+        m.enter(Phase::Record);
+        queued_record(&mut self.w, n, over);
+    }
+
+    /// Board B's serial line: B commands deframed into its queue.
+    #[inline(never)]
+    fn to_b(&mut self, bytes: &[u8], m: &mut impl Meter) {
+        let (mut n, mut over) = (0u32, 0u32);
+        let q = &mut self.b_from_a;
+        frames(&mut self.b_reader, bytes, |f| {
+            if let Ok(p) = f.as_bytes().try_into() {
+                n += 1;
+                over += u32::from(q.push_back(p).is_err());
+            }
+        });
+        m.enter(Phase::Record);
+        queued_record(&mut self.w, n, over);
+    }
+
+    /// Board A's WiFi task takes a connection: a fresh deframer, stale heartbeats dropped.
+    #[inline(never)]
+    fn wifi_open(&mut self, m: &mut impl Meter) {
+        self.wifi_open = true;
+        self.wifi_reader = Deframer::new();
+        let n = self.discard();
+        m.enter(Phase::Record);
+        self.w.u32(Field::Discarded, n);
+    }
+
+    /// Board A's WiFi task: command packets deframed into the control task's queue.
+    #[inline(never)]
+    fn wifi_bytes(&mut self, bytes: &[u8], m: &mut impl Meter) {
+        let (mut n, mut full) = (0u32, 0u32);
+        let (mut p, _) = self.commands.split();
+        frames(&mut self.wifi_reader, bytes, |f| {
+            if f.kind() != PacketKind::Command {
+                return;
+            }
+            if let Ok(c) = <[u8; COMMAND_LEN]>::try_from(f.as_bytes()) {
+                n += 1;
+                full += u32::from(p.push(c).is_err());
+            }
+        });
+        m.enter(Phase::Record);
+        queued_record(&mut self.w, n, full);
+    }
+
+    /// Board A's WiFi task writes the queued heartbeats (or drops them, unconnected).
+    #[inline(never)]
+    fn wifi_drain(&mut self, m: &mut impl Meter) {
+        if !self.wifi_open {
+            let n = self.discard();
+            m.enter(Phase::Record);
+            self.w.u32(Field::Discarded, n);
+        } else {
+            while let Some(hb) = self.heartbeats.split().1.pop() {
+                m.enter(Phase::Record);
+                self.w.bytes(Field::Sent, &hb);
+                m.enter(Phase::Glue);
+            }
+        }
     }
 
     /// Heartbeats made while nobody was connected: dropped (the firmware's behaviour).
@@ -330,6 +364,7 @@ impl Replay {
         n
     }
 
+    #[inline(never)]
     fn server_in(&mut self, bytes: &[u8], m: &mut impl Meter) {
         let (mut n, mut over) = (0u32, 0u32);
         let inbox = &mut self.inbox;
@@ -349,6 +384,7 @@ impl Replay {
         queued_record(&mut self.w, n, over);
     }
 
+    #[inline(never)]
     fn server_loop(&mut self, now: u32, m: &mut impl Meter) {
         let number = self.header.board;
         m.enter(Phase::Node);
@@ -412,6 +448,7 @@ impl Replay {
         }
     }
 
+    #[inline(never)]
     fn server_heartbeat(&mut self, now: u32, bytes: &[u8], m: &mut impl Meter) {
         let mut hb: Option<[u8; HEARTBEAT_LEN]> = None;
         m.enter(Phase::Node);

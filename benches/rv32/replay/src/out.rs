@@ -154,16 +154,27 @@ impl RecordWriter {
         self.bytes(f, &v.to_le_bytes());
     }
 
-    /// A field holding `v`'s `Debug` text (cut at 512 bytes, which no text of the library's
-    /// reaches).
+    /// A field holding `v`'s `Debug` text, written in place (the record is cut if it does
+    /// not fit).
     pub fn debug(&mut self, f: Field, v: &dyn fmt::Debug) {
+        let start = self.len;
+        self.raw(&[f as u8, 0, 0]);
+        if self.cut {
+            return;
+        }
         let mut t = Text {
-            buf: [0; 512],
+            buf: self.buf.get_mut(start + 3..RECORD_MAX - 4).unwrap_or(&mut []),
             len: 0,
+            full: false,
         };
         let _ = write!(t, "{v:?}");
-        let n = t.len;
-        self.bytes(f, t.buf.get(..n).unwrap_or(&[]));
+        let (n, full) = (t.len, t.full);
+        self.cut |= full;
+        self.len += n;
+        let n = u16::try_from(n).unwrap_or(u16::MAX);
+        if let Some(l) = self.buf.get_mut(start + 1..start + 3) {
+            l.copy_from_slice(&n.to_le_bytes());
+        }
     }
 
     /// Ends the record and writes it to `out`.
@@ -182,19 +193,27 @@ impl RecordWriter {
     }
 }
 
-struct Text {
-    buf: [u8; 512],
+/// Text written into the rest of the record's buffer.
+struct Text<'b> {
+    buf: &'b mut [u8],
     len: usize,
+    full: bool,
 }
 
-impl Write for Text {
+impl Write for Text<'_> {
     fn write_str(&mut self, s: &str) -> fmt::Result {
         let b = s.as_bytes();
-        let room = self.buf.len() - self.len;
-        let n = b.len().min(room);
-        self.buf[self.len..self.len + n].copy_from_slice(&b[..n]);
-        self.len += n;
-        Ok(())
+        match self.buf.get_mut(self.len..self.len + b.len()) {
+            Some(d) => {
+                d.copy_from_slice(b);
+                self.len += b.len();
+                Ok(())
+            }
+            None => {
+                self.full = true;
+                Err(fmt::Error)
+            }
+        }
     }
 }
 

@@ -1,0 +1,264 @@
+//! The bare-metal RV32IMC runner: replays a trace (`mmic sim --record`) through
+//! [`mmic_replay`] on QEMU's `virt` machine, and writes, through semihosting, the output stream
+//! (to compare with the host's, `mmic replay --against`) and each call's cost: instructions per
+//! phase from `minstret` (exact under `-icount shift=0`) and its stack depth from a painted
+//! stack.
+//!
+//! ```text
+//! qemu-system-riscv32 -M virt -m 64M -bios none -nographic -icount shift=0 \
+//!   -semihosting-config enable=on,target=native,arg=mmic-rv32,arg=TRACE,arg=OUT,arg=COST \
+//!   -kernel target/riscv32imc-unknown-none-elf/release/mmic-rv32
+//! ```
+//!
+//! This is a shell: file I/O, the instruction counter and the stack paint. The stack paint
+//! writes and reads memory below the stack pointer, which needs `unsafe`; nothing else does.
+#![no_std]
+#![no_main]
+
+use core::ffi::CStr;
+use mmic_replay::cost::{Cost, COST_LEN};
+use mmic_replay::trace::{Record, Trace};
+use mmic_replay::{Meter, Phase, Replay, Sink};
+use riscv::register::minstret;
+use semihosting::fs::File;
+use semihosting::io::{Read, Write};
+use semihosting::{eprintln, println};
+
+/// The largest trace, bytes.
+const TRACE_MAX: usize = 4 << 20;
+/// How far below the replay loop's frame the stack is painted, bytes: a call that reaches the
+/// bottom is reported, not measured.
+const PAINT: usize = 32 * 1024;
+/// The paint.
+const PAINT_WORD: u32 = 0x5ac3_5ac3;
+
+#[riscv_rt::entry]
+fn main() -> ! {
+    let code = match run() {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("mmic-rv32: {e}");
+            1
+        }
+    };
+    semihosting::process::exit(code)
+}
+
+/// A path argument as a C string, in `buf`.
+fn c_path<'b>(arg: &str, buf: &'b mut [u8; 512]) -> Result<&'b CStr, &'static str> {
+    let b = arg.as_bytes();
+    let d = buf.get_mut(..b.len()).ok_or("a path is longer than 511 bytes")?;
+    d.copy_from_slice(b);
+    buf[b.len()] = 0;
+    CStr::from_bytes_until_nul(&buf[..=b.len()]).map_err(|_| "a path holds a NUL byte")
+}
+
+/// A file written through a buffer (a semihosting call per 64 KiB, not per record).
+struct Buffered {
+    file: File,
+    buf: [u8; 64 * 1024],
+    len: usize,
+    bytes: usize,
+    failed: bool,
+}
+
+impl Buffered {
+    fn flush(&mut self) {
+        if self.len > 0 && self.file.write_all(&self.buf[..self.len]).is_err() {
+            self.failed = true;
+        }
+        self.len = 0;
+    }
+}
+
+impl Sink for Buffered {
+    fn put(&mut self, mut bytes: &[u8]) {
+        self.bytes += bytes.len();
+        while !bytes.is_empty() {
+            if self.len == self.buf.len() {
+                self.flush();
+            }
+            let n = bytes.len().min(self.buf.len() - self.len);
+            self.buf[self.len..self.len + n].copy_from_slice(&bytes[..n]);
+            self.len += n;
+            bytes = &bytes[n..];
+        }
+    }
+}
+
+fn run() -> Result<(), &'static str> {
+    let args = semihosting::experimental::env::args::<1024>().map_err(|_| "no arguments")?;
+    let mut it = &args;
+    let _program = it.next();
+    let mut next = || -> Result<&str, &'static str> {
+        it.next()
+            .ok_or("usage: mmic-rv32 TRACE OUT COST")?
+            .map_err(|_| "an argument is not UTF-8")
+    };
+    let (trace_path, out_path, cost_path) = (next()?, next()?, next()?);
+
+    let mut p = [0u8; 512];
+    let mut trace = [0u8; TRACE_MAX];
+    let mut f = File::open(c_path(trace_path, &mut p)?).map_err(|_| "cannot open the trace")?;
+    let mut n = 0;
+    loop {
+        let room = trace.get_mut(n..).unwrap_or(&mut []);
+        if room.is_empty() {
+            return Err("the trace is larger than 4 MiB");
+        }
+        match f.read(room) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(_) => return Err("cannot read the trace"),
+        }
+    }
+    let t = Trace::parse(&trace[..n]).map_err(|_| "not a replay trace")?;
+    let create = |path: &str, p: &mut [u8; 512]| -> Result<Buffered, &'static str> {
+        Ok(Buffered {
+            file: File::create(c_path(path, p)?).map_err(|_| "cannot create an output file")?,
+            buf: [0; 64 * 1024],
+            len: 0,
+            bytes: 0,
+            failed: false,
+        })
+    };
+    let mut out = create(out_path, &mut p)?;
+    let mut costs = create(cost_path, &mut p)?;
+    let mut replay = Replay::new(&t.header);
+    let records = drive(&t, &mut replay, &mut out, &mut costs)?;
+    out.flush();
+    costs.flush();
+    if out.failed || costs.failed {
+        return Err("cannot write an output file");
+    }
+    println!(
+        "mmic-rv32: {records} records, {} output bytes, {} cost bytes",
+        out.bytes, costs.bytes
+    );
+    Ok(())
+}
+
+/// The stack pointer.
+#[inline(always)]
+fn sp() -> usize {
+    let sp: usize;
+    // SAFETY: reads a register into a local.
+    unsafe { core::arch::asm!("mv {0}, sp", out(reg) sp, options(nomem, nostack)) };
+    sp
+}
+
+/// Paints the words of `[from, to)`.
+///
+/// # Safety
+/// The range must lie in RAM below every live stack frame.
+#[inline(always)]
+unsafe fn paint(from: usize, to: usize) {
+    let mut a = from;
+    while a < to {
+        // SAFETY: the caller's range is unused stack.
+        unsafe { core::ptr::write_volatile(a as *mut u32, PAINT_WORD) };
+        a += 4;
+    }
+}
+
+/// The lowest word of `[bottom, top)` that is no longer paint (`top` if none).
+fn lowest_dirty(bottom: usize, top: usize) -> usize {
+    let mut a = bottom;
+    while a < top {
+        // SAFETY: the range is the painted stack area, in RAM and word-aligned; reading it
+        // has no effect.
+        if unsafe { core::ptr::read_volatile(a as *const u32) } != PAINT_WORD {
+            return a;
+        }
+        a += 4;
+    }
+    top
+}
+
+/// Counts instructions per phase and takes the stack depth when the output record starts.
+struct Counter {
+    bottom: usize,
+    top: usize,
+    phase: Phase,
+    last: u32,
+    acc: [u32; 4],
+    stack_node: Option<usize>,
+}
+
+impl Meter for Counter {
+    #[inline(never)]
+    fn enter(&mut self, p: Phase) {
+        let now = minstret::read() as u32;
+        let i = self.phase as usize;
+        self.acc[i] = self.acc[i].wrapping_add(now.wrapping_sub(self.last));
+        if p == Phase::Record && self.stack_node.is_none() {
+            self.stack_node = Some(self.top - lowest_dirty(self.bottom, self.top));
+        }
+        self.phase = p;
+        self.last = minstret::read() as u32;
+    }
+}
+
+/// Runs every record, each measured; returns how many ran.
+#[inline(never)]
+fn drive(
+    t: &Trace<'_>,
+    replay: &mut Replay,
+    out: &mut Buffered,
+    costs: &mut Buffered,
+) -> Result<usize, &'static str> {
+    // Every call below starts its frames at this stack pointer.
+    let top = sp() & !3;
+    let bottom = top - PAINT;
+    // SAFETY: [bottom, top - 64) is below this function's frame and unused: the stack is 64 MiB
+    // minus the program, far more than PAINT (riscv-rt's memory.x gives the stack the rest of
+    // RAM), and nothing else runs (one hart, no interrupts enabled).
+    unsafe { paint(bottom, top - 64) };
+    let mut n = 0;
+    for rec in t.records() {
+        let rec = rec.map_err(|_| "a trace record is malformed")?;
+        let mut m = Counter {
+            bottom,
+            top,
+            phase: Phase::Glue,
+            last: 0,
+            acc: [0; 4],
+            stack_node: None,
+        };
+        m.last = minstret::read() as u32;
+        step(replay, &rec, out, &mut m);
+        m.enter(Phase::Record);
+        let low = lowest_dirty(bottom, top - 64);
+        if low == bottom {
+            return Err("a call used more than the painted 32 KiB of stack");
+        }
+        let c = Cost {
+            tag: rec.tag(),
+            node: rec.node() as u8,
+            t: rec.t(),
+            phases: m.acc,
+            stack_node: m.stack_node.unwrap_or(top - low) as u32,
+            stack_all: (top - low) as u32,
+        };
+        let mut b = [0u8; COST_LEN];
+        c.emit(&mut b);
+        costs.put(&b);
+        // SAFETY: as above; the words below `low` are still paint.
+        unsafe { paint(low, top - 64) };
+        n += 1;
+    }
+    Ok(n)
+}
+
+/// One call, in a frame of its own below `drive`'s stack pointer, so that the call's own
+/// locals (whatever is inlined into it) are counted in its stack depth.
+#[inline(never)]
+fn step(replay: &mut Replay, rec: &Record<'_>, out: &mut Buffered, m: &mut Counter) {
+    replay.step(rec, out, m);
+}
+
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo<'_>) -> ! {
+    eprintln!("mmic-rv32: panic");
+    semihosting::process::exit(101)
+}
