@@ -47,7 +47,9 @@ fn main() -> ! {
 /// A path argument as a C string, in `buf`.
 fn c_path<'b>(arg: &str, buf: &'b mut [u8; 512]) -> Result<&'b CStr, &'static str> {
     let b = arg.as_bytes();
-    let d = buf.get_mut(..b.len()).ok_or("a path is longer than 511 bytes")?;
+    let d = buf
+        .get_mut(..b.len())
+        .ok_or("a path is longer than 511 bytes")?;
     d.copy_from_slice(b);
     buf[b.len()] = 0;
     CStr::from_bytes_until_nul(&buf[..=b.len()]).map_err(|_| "a path holds a NUL byte")
