@@ -29,6 +29,7 @@ extern crate std;
 
 pub mod cost;
 pub mod out;
+pub mod parsers;
 pub mod trace;
 
 use heapless::{Deque, Vec};
