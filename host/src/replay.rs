@@ -218,7 +218,10 @@ pub fn node_costs(files: &[(String, Vec<u8>)]) -> Result<Vec<NodeCost>, CliError
         }
         for c in b.chunks_exact(COST_LEN).filter_map(Cost::parse) {
             let Some(n) = nodes.get_mut(usize::from(c.node)) else {
-                return Err(CliError::Usage(format!("{name}: node {} in a cost record", c.node)));
+                return Err(CliError::Usage(format!(
+                    "{name}: node {} in a cost record",
+                    c.node
+                )));
             };
             let i = c.instructions();
             n.calls += 1;
@@ -308,9 +311,10 @@ pub fn cli_costs(
 ) -> Result<(), CliError> {
     let mut all = Vec::new();
     for f in files {
-        let name = f
-            .file_stem()
-            .map_or_else(|| f.display().to_string(), |s| s.to_string_lossy().into_owned());
+        let name = f.file_stem().map_or_else(
+            || f.display().to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        );
         all.push((name, read(f)?));
     }
     let nodes = node_costs(&all)?;
@@ -322,8 +326,11 @@ pub fn cli_costs(
                 "the worst call took {worst} instructions, over the budget of {b}"
             )));
         }
-        writeln!(out, "\nworst call: {worst} instructions, within the budget of {b}")
-            .map_err(CliError::Output)?;
+        writeln!(
+            out,
+            "\nworst call: {worst} instructions, within the budget of {b}"
+        )
+        .map_err(CliError::Output)?;
     }
     Ok(())
 }

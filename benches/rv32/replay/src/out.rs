@@ -163,7 +163,10 @@ impl RecordWriter {
             return;
         }
         let mut t = Text {
-            buf: self.buf.get_mut(start + 3..RECORD_MAX - 4).unwrap_or(&mut []),
+            buf: self
+                .buf
+                .get_mut(start + 3..RECORD_MAX - 4)
+                .unwrap_or(&mut []),
             len: 0,
             full: false,
         };

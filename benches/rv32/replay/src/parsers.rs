@@ -128,7 +128,11 @@ impl Sample {
             Kind::PusTc => {
                 // Both are in range: a failure leaves an empty packet, which `parse` refuses.
                 let (Ok(apid), Ok(seq_count)) = (Apid::new(APID), SeqCount::new(7)) else {
-                    return Sample { kind, bytes, len: 0 };
+                    return Sample {
+                        kind,
+                        bytes,
+                        len: 0,
+                    };
                 };
                 let tc = TcRepr {
                     apid,
