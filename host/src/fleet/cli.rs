@@ -3,6 +3,7 @@
 
 use super::{realtime, run_virtual, FleetConfig, FleetResult};
 use crate::error::CliError;
+use crate::sim::nodes::OVERRUN_MS;
 use crate::sim::Protocol;
 use std::io::Write;
 use std::path::PathBuf;
@@ -33,7 +34,9 @@ Examples:
              --plot target/fleet.svg --json target/fleet.json
 
 Exit codes: 0 every poll answered within 0.7 s; 1 not (the line says which figure missed);
-2 bad arguments; 3 an output could not be written or a socket opened.";
+2 bad arguments; 3 an output could not be written or a socket opened; 4 (--realtime) a poll was
+missed while the boards' ticks ran 100 ms or more late: the host fell behind, so the run measured
+the host, not the protocol.";
 
 /// Arguments of `mmic fleet`.
 #[derive(Debug, clap::Args)]
@@ -163,13 +166,19 @@ fn write_json(path: &Option<PathBuf>, v: &serde_json::Value) -> Result<(), CliEr
     Ok(())
 }
 
+/// Every run answered every poll in time; or which did not. A realtime run whose board ticks
+/// started [`OVERRUN_MS`] or more late measured the host, not the robots' protocol: it is
+/// reported as the host falling behind (exit 4, as `mmic sim`), not as a missed window.
 fn verdict(all: &[FleetResult]) -> Result<(), CliError> {
     match all.iter().find(|r| !r.all_answered_in_time()) {
         None => Ok(()),
-        Some(r) => Err(CliError::Fleet(format!(
-            "not every poll answered within 0.7 s: {}",
-            r.line()
-        ))),
+        Some(r) => match r.max_tick_lateness_ms {
+            Some(late_ms) if late_ms >= OVERRUN_MS => Err(CliError::HostBehind { late_ms }),
+            _ => Err(CliError::Fleet(format!(
+                "not every poll answered within 0.7 s: {}",
+                r.line()
+            ))),
+        },
     }
 }
 
@@ -265,4 +274,37 @@ fn stack(charts: &[&str]) -> String {
     format!(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{y}\">\n{body}</svg>\n"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::CliError;
+    use std::time::Duration;
+
+    fn run(answered: u64, late: Option<u32>) -> FleetResult {
+        FleetResult {
+            robots: 2,
+            sim_seconds: 10.0,
+            wall: Duration::from_secs(10),
+            attempts: (answered, 16),
+            max_latency_ms: 300,
+            ends: (0, 2),
+            threads: late.map(|_| 3),
+            max_tick_lateness_ms: late,
+        }
+    }
+
+    #[test]
+    fn a_missed_window_is_the_hosts_only_when_ticks_ran_late() {
+        assert!(verdict(&[run(16, Some(500))]).is_ok());
+        assert!(matches!(verdict(&[run(15, None)]), Err(CliError::Fleet(_))));
+        assert!(matches!(
+            verdict(&[run(15, Some(OVERRUN_MS - 1))]),
+            Err(CliError::Fleet(_))
+        ));
+        let e = verdict(&[run(15, Some(OVERRUN_MS))]).unwrap_err();
+        assert!(matches!(e, CliError::HostBehind { late_ms } if late_ms == OVERRUN_MS));
+        assert_eq!(e.exit_code(), crate::exit::EXIT_HOST);
+    }
 }
