@@ -213,8 +213,8 @@ impl Replay {
         match *r {
             Record::TickA { t, reading } => self.tick_a(t, &reading, m),
             Record::TickB { t, reading } => self.tick_b(t, &reading, m),
-            Record::ToA { bytes, .. } => self.to_a(bytes, m),
-            Record::ToB { bytes, .. } => self.to_b(bytes, m),
+            Record::ToA { bytes, .. } => self.serial_a(bytes, m),
+            Record::ToB { bytes, .. } => self.serial_b(bytes, m),
             Record::WifiOpen { .. } => self.wifi_open(m),
             Record::WifiClose { .. } => {
                 self.wifi_open = false;
@@ -284,7 +284,7 @@ impl Replay {
 
     /// Board A's serial line: internal heartbeats deframed into the control task's queue.
     #[inline(never)]
-    fn to_a(&mut self, bytes: &[u8], m: &mut impl Meter) {
+    fn serial_a(&mut self, bytes: &[u8], m: &mut impl Meter) {
         let (mut n, mut over) = (0u32, 0u32);
         let q = &mut self.a_from_b;
         frames(&mut self.a_reader, bytes, |f| {
@@ -299,7 +299,7 @@ impl Replay {
 
     /// Board B's serial line: B commands deframed into its queue.
     #[inline(never)]
-    fn to_b(&mut self, bytes: &[u8], m: &mut impl Meter) {
+    fn serial_b(&mut self, bytes: &[u8], m: &mut impl Meter) {
         let (mut n, mut over) = (0u32, 0u32);
         let q = &mut self.b_from_a;
         frames(&mut self.b_reader, bytes, |f| {
