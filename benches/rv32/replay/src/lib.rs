@@ -156,6 +156,23 @@ fn frames(d: &mut Deframer<256>, bytes: &[u8], mut f: impl FnMut(mmic::wire::def
     });
 }
 
+/// A serial line's bytes through its deframer: every packet of the queue's length queued (as
+/// the engine does, whatever its kind); returns the packets found and those the queue refused.
+fn serial<const L: usize>(
+    d: &mut Deframer<256>,
+    bytes: &[u8],
+    q: &mut Deque<[u8; L], QUEUE>,
+) -> (u32, u32) {
+    let (mut n, mut over) = (0u32, 0u32);
+    frames(d, bytes, |f| {
+        if let Ok(p) = f.as_bytes().try_into() {
+            n += 1;
+            over += u32::from(q.push_back(p).is_err());
+        }
+    });
+    (n, over)
+}
+
 impl Replay {
     /// The nodes at the start of a scenario.
     pub fn new(h: &Header) -> Replay {
@@ -285,14 +302,7 @@ impl Replay {
     /// Board A's serial line: internal heartbeats deframed into the control task's queue.
     #[inline(never)]
     fn serial_a(&mut self, bytes: &[u8], m: &mut impl Meter) {
-        let (mut n, mut over) = (0u32, 0u32);
-        let q = &mut self.a_from_b;
-        frames(&mut self.a_reader, bytes, |f| {
-            if let Ok(p) = f.as_bytes().try_into() {
-                n += 1;
-                over += u32::from(q.push_back(p).is_err());
-            }
-        });
+        let (n, over) = serial(&mut self.a_reader, bytes, &mut self.a_from_b);
         m.enter(Phase::Record);
         queued_record(&mut self.w, n, over);
     }
@@ -300,14 +310,7 @@ impl Replay {
     /// Board B's serial line: B commands deframed into its queue.
     #[inline(never)]
     fn serial_b(&mut self, bytes: &[u8], m: &mut impl Meter) {
-        let (mut n, mut over) = (0u32, 0u32);
-        let q = &mut self.b_from_a;
-        frames(&mut self.b_reader, bytes, |f| {
-            if let Ok(p) = f.as_bytes().try_into() {
-                n += 1;
-                over += u32::from(q.push_back(p).is_err());
-            }
-        });
+        let (n, over) = serial(&mut self.b_reader, bytes, &mut self.b_from_a);
         m.enter(Phase::Record);
         queued_record(&mut self.w, n, over);
     }
