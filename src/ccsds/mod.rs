@@ -60,6 +60,7 @@ pub const PEC_LEN: usize = 2;
 /// ```
 /// assert_eq!(mmic::ccsds::pec(b"123456789"), 0x29b1);
 /// ```
+#[inline]
 pub fn pec(bytes: &[u8]) -> u16 {
     crate::wire::checksum::crc16(bytes)
 }

@@ -37,6 +37,7 @@ pub(crate) struct Checked<'a, H> {
 
 /// Runs the checks of [`PacketError`] in their order on `bytes` as a packet with fixed header
 /// `H`, accepting the APIDs in `accepted`.
+#[inline]
 pub(crate) fn check<'a, H: FixedHeader>(
     bytes: &'a [u8],
     accepted: &[u16],
@@ -104,7 +105,11 @@ pub(crate) fn check<'a, H: FixedHeader>(
             computed,
         });
     }
-    if !accepted.contains(&primary.apid) {
+    // A loop rather than `contains`, whose slice specialisation is an out-of-line call: 0.8 ns
+    // of a 15-ns TC parse (issue 25).
+    #[allow(clippy::manual_contains)]
+    let known = accepted.iter().any(|&a| a == primary.apid);
+    if !known {
         return Err(PacketError::Apid {
             kind,
             found: primary.apid,

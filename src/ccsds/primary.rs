@@ -156,6 +156,7 @@ impl PrimaryHeader {
     }
 
     /// Decodes the first six octets of `bytes`; `None` if there are fewer.
+    #[inline]
     pub fn read(bytes: &[u8]) -> Option<PrimaryHeader> {
         let (l, _) = PrimaryLayout::ref_from_prefix(bytes).ok()?;
         Some(PrimaryHeader::from(l))
@@ -182,6 +183,7 @@ impl PrimaryHeader {
 }
 
 impl From<&PrimaryLayout> for PrimaryHeader {
+    #[inline]
     fn from(l: &PrimaryLayout) -> PrimaryHeader {
         let id = l.packet_id.get();
         let seq = l.sequence.get();

@@ -85,11 +85,13 @@ impl<'a> Tc<'a> {
 
     /// Checks `bytes` as one whole telecommand (see [`PacketError`] for the checks and their
     /// order) whose APID is one of `accepted`.
+    #[inline]
     pub fn new_checked(bytes: &'a [u8], accepted: &[u16]) -> Result<Tc<'a>, PacketError> {
         check::<TcHeaderLayout>(bytes, accepted).map(Tc)
     }
 
     /// The secondary header.
+    #[inline]
     pub fn secondary(&self) -> TcSecondaryHeader {
         TcSecondaryHeader::from(&self.0.header.secondary)
     }
@@ -105,6 +107,7 @@ impl<'a> Tc<'a> {
     }
 
     /// The packet's fields.
+    #[inline]
     pub fn repr(&self) -> TcRepr<'a> {
         TcRepr {
             apid: self.apid(),
@@ -135,6 +138,7 @@ pub struct TcRepr<'a> {
 
 impl<'a> TcRepr<'a> {
     /// Checks `bytes` (see [`Tc::new_checked`]) and returns the fields.
+    #[inline]
     pub fn parse(bytes: &'a [u8], accepted: &[u16]) -> Result<TcRepr<'a>, PacketError> {
         Tc::new_checked(bytes, accepted).map(|tc| tc.repr())
     }

@@ -123,6 +123,7 @@ impl TcSecondaryLayout {
 }
 
 impl From<&TcSecondaryLayout> for TcSecondaryHeader {
+    #[inline]
     fn from(l: &TcSecondaryLayout) -> TcSecondaryHeader {
         TcSecondaryHeader {
             ack: AckFlags::from_bits(l.version_ack),

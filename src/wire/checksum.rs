@@ -11,6 +11,14 @@
 //! short of flash enables the feature `small-crc-table` and gets the 512-byte table; the
 //! bitwise variant (no table) is about 7× slower again and is not offered.
 //!
+//! **The loop.** The `crc` crate builds the tables (at compile time); the library runs its own
+//! loop over them, because the crate's handles the octets after the last whole 16-octet block
+//! one at a time, each lookup waiting on the previous one, and that serial remainder was most
+//! of the time of a 16-octet telecommand's or a 66-octet heartbeat's parse (issue 25,
+//! `benches/README.md`). The CRC is linear, so the register after `n` octets is the xor of one
+//! lookup per octet in table `n - 1 - i` (the register xored into the first two octets): the
+//! remainder takes one step, as a whole block does.
+//!
 //! Every packet's header is fixed, so the CRC register after the four header bytes is a
 //! constant: [`packet_crc`] starts from it and only processes the bytes after the header.
 //!
@@ -26,19 +34,104 @@
 use super::{PacketKind, HEADER_LEN};
 
 #[cfg(not(feature = "small-crc-table"))]
-type Tables = crc::Table<16>;
+const LANES: usize = 16;
 #[cfg(feature = "small-crc-table")]
-type Tables = crc::Table<1>;
+const LANES: usize = 1;
+type Tables = crc::Table<LANES>;
 
-/// The CRC engine.
+/// The CRC engine. The library's loop runs its tables (`CRC.table()`: `table[k][b]` is the
+/// register after octet `b` and `k` zero octets, from a zero register); they stay inside the
+/// engine, so that an identical engine of another crate (spacepackets has the 256-entry one)
+/// shares them in a linked image.
 pub const CRC: crc::Crc<u16, Tables> = crc::Crc::<u16, Tables>::new(&crc::CRC_16_IBM_3740);
 
 /// Flash taken by the CRC tables, in bytes.
 pub const TABLE_BYTES: usize = core::mem::size_of::<<Tables as crc::Implementation>::Data<u16>>();
 
 /// CRC-16/CCITT-FALSE of `bytes`.
+#[inline]
 pub fn crc16(bytes: &[u8]) -> u16 {
-    CRC.checksum(bytes)
+    update(crc::CRC_16_IBM_3740.init, bytes)
+}
+
+/// The register after `bytes`, from register `crc` (the algorithm has no reflection and no
+/// final xor, so the register is the CRC so far): 16 octets at a time as the `crc` crate
+/// does, then the remaining 0–15 octets in one step too (module docs, "The loop"). Never
+/// inlined: one copy serves every packet (inlined, each caller had its own, 460 octets more
+/// flash per copy on the ESP32-C3, and no faster on the host).
+#[cfg(not(feature = "small-crc-table"))]
+#[inline(never)]
+fn update(mut crc: u16, bytes: &[u8]) -> u16 {
+    let t = CRC.table();
+    let blocks = bytes.chunks_exact(16);
+    let tail = blocks.remainder();
+    for block in blocks {
+        // The fourteen lookups that do not depend on the register first, so that they run
+        // ahead; the register's two last, the only ones on the path from block to block.
+        let mut r = 0;
+        for (k, &x) in block.iter().rev().take(14).enumerate() {
+            r ^= t[k][x as usize];
+        }
+        let (x0, x1) = (block[0] ^ (crc >> 8) as u8, block[1] ^ crc as u8);
+        crc = r ^ t[14][x1 as usize] ^ t[15][x0 as usize];
+    }
+    let n = tail.len();
+    let mut r = match n {
+        0 => return crc,
+        1 => return (crc << 8) ^ t[0][(tail[0] ^ (crc >> 8) as u8) as usize],
+        // The tables are linear in their index, so the register's share is two lookups of
+        // its own, and the octets' shares do not wait for it.
+        _ => t[(n - 1) & 15][(crc >> 8) as usize] ^ t[(n - 2) & 15][crc as u8 as usize],
+    };
+    // The octets in pieces of 8, 4, 2 and 1, each piece unrolled; `k` octets are left, so
+    // the next octet's table is `k - 1`.
+    let mut rest = tail;
+    let mut k = n;
+    if let Some((p, more)) = rest.split_first_chunk::<8>() {
+        k -= 8;
+        r ^= piece(&t[k..], p);
+        rest = more;
+    }
+    if let Some((p, more)) = rest.split_first_chunk::<4>() {
+        k -= 4;
+        r ^= piece(&t[k..], p);
+        rest = more;
+    }
+    if let Some((p, more)) = rest.split_first_chunk::<2>() {
+        k -= 2;
+        r ^= piece(&t[k..], p);
+        rest = more;
+    }
+    if let [x] = rest {
+        r ^= t[0][*x as usize];
+    }
+    r
+}
+
+/// The share of the `N` octets `p` in the register, when `lanes` starts at the table of
+/// `p`'s last octet (the number of octets after it).
+#[cfg(not(feature = "small-crc-table"))]
+#[inline(always)]
+fn piece<const N: usize>(lanes: &[[u16; 256]], p: &[u8; N]) -> u16 {
+    let Some(lanes) = lanes.first_chunk::<N>() else {
+        return 0; // never: a piece and the octets after it are fewer than 16
+    };
+    let mut r = 0;
+    for (i, &x) in p.iter().enumerate() {
+        r ^= lanes[N - 1 - i][x as usize];
+    }
+    r
+}
+
+/// The register after `bytes`, from register `crc`: one octet at a time (`small-crc-table`).
+#[cfg(feature = "small-crc-table")]
+#[inline]
+fn update(mut crc: u16, bytes: &[u8]) -> u16 {
+    let t = &CRC.table()[0];
+    for &x in bytes {
+        crc = (crc << 8) ^ t[(x ^ (crc >> 8) as u8) as usize];
+    }
+    crc
 }
 
 const HEADER_CRC: [u16; 4] = [
@@ -50,8 +143,16 @@ const HEADER_CRC: [u16; 4] = [
 
 /// CRC-16/CCITT-FALSE of a packet body (`body` = every byte before the checksum) whose first
 /// four bytes are `kind`'s header, which the caller has already checked. Equal to
-/// `crc16(body)`, with the header's share precomputed.
+/// `crc16(body)`, with the header's share precomputed (unless the body is whole 16-octet
+/// blocks, the 66-octet heartbeat's).
+#[inline]
 pub fn packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
+    // A body of whole 16-octet blocks (the heartbeat's 64) is faster from the start than as
+    // three blocks and a 12-octet remainder after the header.
+    #[cfg(not(feature = "small-crc-table"))]
+    if body.len() % 16 == 0 {
+        return crc16(body);
+    }
     // The algorithm has no reflection and no final xor, so the register after the header is
     // the header's CRC and the computation can resume from it.
     let start = match kind {
@@ -60,14 +161,34 @@ pub fn packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
         PacketKind::InternalHeartbeat => HEADER_CRC[2],
         PacketKind::BCommand => HEADER_CRC[3],
     };
-    let mut d = CRC.digest_with_initial(start);
-    d.update(body.get(HEADER_LEN..).unwrap_or(&[]));
-    d.finalize()
+    update(start, body.get(HEADER_LEN..).unwrap_or(&[]))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_length_and_start_equals_the_crc_crate() {
+        // Every length 0..=80 (so every remainder after whole 16-octet blocks), from the
+        // algorithm's start and from other registers, against the `crc` crate's own loop.
+        for pattern in [0u8, 0x5a, 0xff] {
+            let mut bytes = [0u8; 80];
+            for (i, b) in bytes.iter_mut().enumerate() {
+                *b = (i as u8).wrapping_mul(151).wrapping_mul(pattern & 1) ^ pattern;
+            }
+            for len in 0..=bytes.len() {
+                let b = &bytes[..len];
+                assert_eq!(crc16(b), CRC.checksum(b), "{len}");
+                for start in [0u16, 1, 0x8000, 0x1d0f, 0xffff, 0xa5c3] {
+                    let mut d = CRC.digest_with_initial(start);
+                    d.update(b);
+                    assert_eq!(update(start, b), d.finalize(), "{len} from {start:#06x}");
+                }
+            }
+        }
+        assert_eq!(crc16(b"123456789"), 0x29b1);
+    }
 
     #[test]
     fn resuming_after_the_header_equals_the_full_crc() {
