@@ -106,3 +106,64 @@ impl<const L: usize, const N: usize> Consumer<'_, L, N> {
         self.c.len() == 0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Full, PacketQueue};
+
+    /// Packet `i`: its number and its complement, so a torn or stale slot shows.
+    fn packet(i: u32) -> [u8; 14] {
+        let mut p = [0u8; 14];
+        p[..4].copy_from_slice(&i.to_le_bytes());
+        p[4..8].copy_from_slice(&(!i).to_le_bytes());
+        p[8..].copy_from_slice(&[i as u8; 6]);
+        p
+    }
+
+    /// One core's view of many laps of the ring (every index wraps many times): each packet
+    /// comes out once, in order, byte for byte; a full queue (N − 1 = 3) hands the packet back
+    /// and keeps what it holds; a packet given up is counted. Under Miri (.ci/miri) this walks
+    /// heapless's `unsafe` slot accesses at every position of the ring.
+    #[test]
+    fn packets_come_out_in_order_over_many_laps_and_a_full_queue_hands_back() {
+        let mut q: PacketQueue<14, 4> = PacketQueue::default();
+        let (mut tx, mut rx) = q.split();
+        assert!(rx.is_empty() && rx.pop().is_none());
+        let (mut sent, mut received) = (0u32, 0u32);
+        for round in 0..40u32 {
+            while tx.push(packet(sent)).is_ok() {
+                sent += 1;
+            }
+            assert_eq!(rx.len(), 3, "round {round}");
+            assert_eq!(tx.push(packet(sent)), Err(Full(packet(sent))));
+            // Take 1, 2 or 3 so that the next fill starts at another slot.
+            for _ in 0..1 + round % 3 {
+                assert_eq!(rx.pop(), Some(packet(received)));
+                received += 1;
+            }
+        }
+        while let Some(p) = rx.pop() {
+            assert_eq!(p, packet(received));
+            received += 1;
+        }
+        // 79 taken in the rounds (1 + round mod 3 each: 40 + 39), 2 left after the last.
+        assert_eq!((sent, received), (81, 81));
+        assert!(rx.is_empty());
+        assert_eq!(tx.dropped(), 0);
+        assert_eq!(
+            tx.push(packet(sent)),
+            Ok(()),
+            "an empty queue takes the packet"
+        );
+        for i in 1..=3 {
+            if let Err(back) = tx.push(packet(sent + i)) {
+                tx.give_up(back);
+            }
+        }
+        assert_eq!(
+            (rx.len(), tx.dropped()),
+            (3, 1),
+            "the fourth packet was given up"
+        );
+    }
+}

@@ -10,6 +10,9 @@
 //! sequence count, secondary header, data or CRC, must be refused as `checksum` (the APID check
 //! runs after the CRC). The test does not rely on that argument: it runs every corruption through
 //! the real parser and compares with the prediction.
+//!
+//! Under Miri (.ci/miri), which interprets some 100x slower, only the 1-bit errors run (296 of
+//! 1,140,044 corruptions): each bit of both packets through the parser once.
 
 use super::{alive, tc_bytes, tm_bytes, APID};
 use mmic::ccsds::primary::{Apid, SeqCount};
@@ -18,6 +21,9 @@ use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::ccsds::tm::TmRepr;
 use mmic::ccsds::PacketError;
 use std::collections::BTreeMap;
+
+/// The heaviest error weight flipped: 3, or 1 under Miri.
+const MAX_WEIGHT: u64 = if cfg!(miri) { 1 } else { 3 };
 
 fn choose(n: u64, k: u64) -> u64 {
     (0..k).fold(1, |acc, i| acc * (n - i) / (i + 1))
@@ -49,8 +55,8 @@ fn flip(bytes: &mut [u8], bit: usize) {
     bytes[bit / 8] ^= 0x80 >> (bit % 8);
 }
 
-/// Flips every combination of 1–3 bits of `packet`, asserts each is refused as predicted, and
-/// returns the refusals per check name.
+/// Flips every combination of 1–3 bits of `packet` (1 under Miri), asserts each is refused as
+/// predicted, and returns the refusals per check name.
 fn corrupt_all(
     name: &str,
     packet: &[u8],
@@ -69,10 +75,10 @@ fn corrupt_all(
     for i in 0..n {
         flip(&mut buf, i);
         judge(&buf, &[i]);
-        for j in i + 1..n {
+        for j in (i + 1..n).filter(|_| MAX_WEIGHT >= 2) {
             flip(&mut buf, j);
             judge(&buf, &[i, j]);
-            for k in j + 1..n {
+            for k in (j + 1..n).filter(|_| MAX_WEIGHT >= 3) {
                 flip(&mut buf, k);
                 judge(&buf, &[i, j, k]);
                 flip(&mut buf, k);
@@ -104,14 +110,19 @@ fn every_1_2_3_bit_error_of_a_tc_is_refused() {
     let tally = corrupt_all("TC(8,1)", &bytes, |b| TcRepr::parse(b, &[APID]).map(|_| ()));
     let total: u64 = tally.values().sum();
     // C(128,1) + C(128,2) + C(128,3), by hand: 128 + 8,128 + 341,376.
-    assert_eq!(total, 349_632);
+    assert_eq!(total, if cfg!(miri) { 128 } else { 349_632 });
     // Errors touching none of the 27 fixed bits: all caught by the CRC.
     let free = 128 - 27;
     assert_eq!(
         tally["checksum"],
-        choose(free, 1) + choose(free, 2) + choose(free, 3)
+        (1..=MAX_WEIGHT).map(|w| choose(free, w)).sum::<u64>()
     );
-    assert_eq!(tally["checksum"], 101 + 5_050 + 166_650);
+    let by_hand = if cfg!(miri) {
+        101
+    } else {
+        101 + 5_050 + 166_650
+    };
+    assert_eq!(tally["checksum"], by_hand);
     assert!(
         !tally.contains_key("apid"),
         "a corrupted APID is corruption"
@@ -127,10 +138,10 @@ fn every_1_2_3_bit_error_of_a_tm_is_refused() {
     });
     let total: u64 = tally.values().sum();
     // C(168,1) + C(168,2) + C(168,3) = 168 + 14,028 + 776,216.
-    assert_eq!(total, 790_412);
+    assert_eq!(total, if cfg!(miri) { 168 } else { 790_412 });
     let free = 168 - 27;
     assert_eq!(
         tally["checksum"],
-        choose(free, 1) + choose(free, 2) + choose(free, 3)
+        (1..=MAX_WEIGHT).map(|w| choose(free, w)).sum::<u64>()
     );
 }

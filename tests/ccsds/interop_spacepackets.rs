@@ -41,7 +41,7 @@ fn tm_parts() -> impl Strategy<Value = (Apid, SeqCount, TmSecondaryHeader, Vec<u
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+    #![proptest_config(crate::common::prop::config(512))]
 
     /// Our telecommands read in spacepackets with the same fields.
     #[test]

@@ -4,6 +4,9 @@
 //!
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
+#[path = "../common/mod.rs"]
+mod common;
+
 mod bad_inputs;
 mod corruption;
 mod golden;

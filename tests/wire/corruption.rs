@@ -12,6 +12,9 @@
 //! refused by the checksum check, since the CRC catches it before any field is looked at. The
 //! expected counts follow from that by counting combinations: C(n, w) − C(n − 32, w) errors of
 //! weight w touch the 32 header bits.
+//!
+//! Under Miri (.ci/miri), which interprets some 100x slower, only the 1-bit errors run (488 of
+//! 9,094,124 corruptions): each bit of both packets through `parse` once.
 
 use mmic::command::Command;
 use mmic::units::BoardNumber;
@@ -19,6 +22,9 @@ use mmic::wire::command::CommandRepr;
 use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
 use mmic::wire::{WireError, HEADER_LEN};
 use std::time::Instant;
+
+/// The heaviest error weight flipped: 3, or 1 under Miri.
+const MAX_WEIGHT: usize = if cfg!(miri) { 1 } else { 3 };
 
 /// C(n, k).
 fn choose(n: u64, k: u64) -> u64 {
@@ -36,8 +42,8 @@ fn flip(bytes: &mut [u8], bit: usize) {
     bytes[bit / 8] ^= 0x80 >> (bit % 8);
 }
 
-/// Flips every combination of 1, 2 and 3 bits of `packet`, asserts that `parse` refuses each
-/// one by the header or checksum check, and returns the refusals per weight.
+/// Flips every combination of 1, 2 and 3 bits of `packet` (1 under Miri), asserts that `parse`
+/// refuses each one by the header or checksum check, and returns the refusals per weight.
 fn corrupt_all<T: std::fmt::Debug>(
     name: &str,
     packet: &[u8],
@@ -59,10 +65,10 @@ fn corrupt_all<T: std::fmt::Debug>(
     for i in 0..n {
         flip(&mut buf, i);
         judge(&buf, 1);
-        for j in i + 1..n {
+        for j in (i + 1..n).filter(|_| MAX_WEIGHT >= 2) {
             flip(&mut buf, j);
             judge(&buf, 2);
-            for k in j + 1..n {
+            for k in (j + 1..n).filter(|_| MAX_WEIGHT >= 3) {
                 flip(&mut buf, k);
                 judge(&buf, 3);
                 flip(&mut buf, k);
@@ -80,12 +86,18 @@ fn corrupt_all<T: std::fmt::Debug>(
     out
 }
 
-/// The counts the header/checksum argument predicts for an `n`-bit packet.
+/// The counts the header/checksum argument predicts for an `n`-bit packet (none above
+/// `MAX_WEIGHT`).
 fn expected(n: u64) -> [Refusals; 3] {
     let h = (HEADER_LEN * 8) as u64;
-    [1, 2, 3].map(|w| Refusals {
-        header: choose(n, w) - choose(n - h, w),
-        checksum: choose(n - h, w),
+    [1, 2, 3].map(|w| {
+        if w as usize > MAX_WEIGHT {
+            return Refusals::default();
+        }
+        Refusals {
+            header: choose(n, w) - choose(n - h, w),
+            checksum: choose(n - h, w),
+        }
     })
 }
 
@@ -100,8 +112,12 @@ fn every_1_2_3_bit_error_in_a_command_packet_is_refused() {
     let got = corrupt_all("command", &packet, CommandRepr::parse);
     assert_eq!(got, expected(112));
     let total: u64 = got.iter().map(|r| r.header + r.checksum).sum();
-    assert_eq!(total, 112 + choose(112, 2) + choose(112, 3));
-    assert_eq!(total, 234_248);
+    if MAX_WEIGHT == 3 {
+        assert_eq!(total, 112 + choose(112, 2) + choose(112, 3));
+        assert_eq!(total, 234_248);
+    } else {
+        assert_eq!(total, 112);
+    }
 }
 
 #[test]
@@ -114,6 +130,10 @@ fn every_1_2_3_bit_error_in_an_internal_heartbeat_is_refused() {
     let got = corrupt_all("internal heartbeat", &packet, InternalHeartbeatRepr::parse);
     assert_eq!(got, expected(376));
     let total: u64 = got.iter().map(|r| r.header + r.checksum).sum();
-    assert_eq!(total, 376 + choose(376, 2) + choose(376, 3));
-    assert_eq!(total, 8_859_876);
+    if MAX_WEIGHT == 3 {
+        assert_eq!(total, 376 + choose(376, 2) + choose(376, 3));
+        assert_eq!(total, 8_859_876);
+    } else {
+        assert_eq!(total, 376);
+    }
 }

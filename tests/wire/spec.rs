@@ -55,6 +55,10 @@ struct FieldRow {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "spec/ text through toml and string scans: no library path Miri adds to; tens of minutes under Miri"
+)]
 fn packets_match_spec_field_by_field_and_cell_by_cell() {
     let mut checked_fields = 0;
     let mut checked_cells = 0;
@@ -152,6 +156,10 @@ struct OpcodeRow {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "spec/ text through toml and string scans: no library path Miri adds to; tens of minutes under Miri"
+)]
 fn command_set_matches_spec() {
     let spec: Commands = load("commands.toml");
     // Table 1's rows, in order, then the extension, are the code's command kinds.
@@ -230,6 +238,10 @@ struct FaultRow {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "spec/ text through toml and string scans: no library path Miri adds to; tens of minutes under Miri"
+)]
 fn fault_bits_match_spec() {
     let spec: Faults = load("faults.toml");
     let decisions: Decisions = load("decisions.toml");
@@ -295,6 +307,10 @@ struct Decision {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "spec/ text through toml and string scans: no library path Miri adds to; tens of minutes under Miri"
+)]
 fn decisions_match_code() {
     let d: Decisions = load("decisions.toml");
     for kind in PacketKind::ALL {
@@ -390,6 +406,10 @@ fn decisions_match_code() {
 
 /// Each packet's `field` module names the same byte ranges as its `FIELDS` table.
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "spec/ text through toml and string scans: no library path Miri adds to; tens of minutes under Miri"
+)]
 fn field_modules_agree_with_the_field_tables() {
     use mmic::wire::{b_command, heartbeat, internal_heartbeat};
     let range = |fields: &[mmic::wire::FieldSpec], name: &str| {
@@ -667,6 +687,10 @@ fn prose_about_bytes() -> Vec<(String, String, Option<&'static str>, bool)> {
 /// "fault bit N" must be a fault whose name the text also gives. What it cannot see: a
 /// reference written another way ("the third fault byte", "bytes 6..=11").
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "spec/ text through toml and string scans: no library path Miri adds to; tens of minutes under Miri"
+)]
 fn prose_names_bytes_and_bits_as_the_packet_tables_do() {
     let packets: BTreeMap<&str, PacketSpec> = PacketKind::ALL
         .iter()
