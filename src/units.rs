@@ -507,6 +507,23 @@ impl HipAngle {
     pub const fn centidegrees(self) -> u16 {
         self.0
     }
+
+    /// The circular distance to `other`, in 0.01°, 0..=18000: the shorter way round.
+    ///
+    /// ```
+    /// use mmic::units::HipAngle;
+    /// let a = HipAngle::wrapping;
+    /// assert_eq!(a(100).distance(a(35900)), 200);
+    /// assert_eq!(a(0).distance(a(18000)), 18000);
+    /// ```
+    pub const fn distance(self, other: HipAngle) -> u16 {
+        let d = self.0.abs_diff(other.0);
+        if d > Self::TURN / 2 {
+            Self::TURN - d
+        } else {
+            d
+        }
+    }
 }
 
 impl TryFrom<u16> for HipAngle {

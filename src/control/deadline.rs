@@ -67,7 +67,7 @@ pub const fn servo_ms(from: PulseWidth, to: PulseWidth, rate: Rate) -> u32 {
 /// The time the hip takes from `from` to `to` the short way round at `speed` (0.01°/s, the hip
 /// controller's velocity-mode speed; at least 1).
 pub const fn hip_ms(from: HipAngle, to: HipAngle, speed: i32) -> u32 {
-    let d = crate::safety::detect::hip_distance(from, to) as u32;
+    let d = from.distance(to) as u32;
     let speed = if speed < 1 { 1 } else { speed as u32 };
     (d * 1000).div_ceil(speed)
 }

@@ -191,7 +191,7 @@ pub fn predict(cfg: &Config, s: State) -> impl Iterator<Item = Readings> {
 }
 
 fn hip_close(cfg: &Config, a: HipAngle, b: HipAngle) -> bool {
-    crate::safety::detect::hip_distance(a, b) <= cfg.hip_tolerance
+    a.distance(b) <= cfg.hip_tolerance
 }
 
 /// The states consistent with `r`: those for which some hidden hip-axis choice predicts the

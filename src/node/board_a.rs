@@ -45,7 +45,7 @@ use crate::motion::runner::{RunStatus, Runner};
 use crate::motion::sequencer::{self, Feedback, Targets};
 use crate::motion::State;
 use crate::refusal::Refusal;
-use crate::safety::detect::{self, hip_distance, CommMonitor, LowBattery};
+use crate::safety::detect::{self, CommMonitor, LowBattery};
 use crate::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use crate::safety::ModuleSet;
 use crate::sensors::frontend::Lost;
@@ -533,7 +533,7 @@ impl BoardA {
             ),
             // An unread hip is not at its target: the motion waits (and times out).
             hip_done: hip_now
-                .is_some_and(|h| hip_distance(h, self.targets.hip) <= self.cfg.hip_done_tolerance),
+                .is_some_and(|h| h.distance(self.targets.hip) <= self.cfg.hip_done_tolerance),
             arm_switch: PerSide::new(arm_a_switch, self.b.arm_contracted),
         }
     }

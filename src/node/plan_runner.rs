@@ -48,7 +48,6 @@ use crate::faults::Faults;
 use crate::mode::Mode;
 use crate::motion::State;
 use crate::refusal::Refusal;
-use crate::safety::detect::hip_distance;
 use crate::units::BoardNumber;
 use crate::units::Instant;
 use crate::wire::command::CommandRepr;
@@ -340,7 +339,7 @@ pub fn settled(hb: &HeartbeatRepr) -> bool {
         && hb.arm_b_now == hb.arm_b_target
         && hb.gripper_a_now == hb.gripper_a_target
         && hb.gripper_b_now == hb.gripper_b_target
-        && hip_distance(hb.hip_now, hb.hip_target) <= 300
+        && hb.hip_now.distance(hb.hip_target) <= 300
 }
 
 impl PlanRunner {

@@ -271,21 +271,10 @@ pub fn idle_overcurrent(cfg: &Config, a: &Electrical, b: Over) -> Faults {
         .union(b.faults(f.0, f.1, f.2))
 }
 
-/// Circular distance between two hip angles, in 0.01°, 0..=18000.
-pub const fn hip_distance(a: HipAngle, b: HipAngle) -> u16 {
-    let (x, y) = (a.centidegrees(), b.centidegrees());
-    let d = x.abs_diff(y);
-    if d > HipAngle::TURN / 2 {
-        HipAngle::TURN - d
-    } else {
-        d
-    }
-}
-
 /// Hip mismatch check when entering Operational: true when the reading is within tolerance of
 /// the contracted-gripped angle.
 pub const fn hip_at_home(cfg: &Config, hip_now: HipAngle) -> bool {
-    hip_distance(hip_now, cfg.hip_home) <= cfg.hip_tolerance
+    hip_now.distance(cfg.hip_home) <= cfg.hip_tolerance
 }
 
 /// (Un)bolting failure (Table 8): the bolter state machine has failed this many consecutive
@@ -388,8 +377,8 @@ mod tests {
     #[test]
     fn hip_distance_is_circular() {
         let a = HipAngle::wrapping; // all test values are below 36000
-        assert_eq!(hip_distance(a(100), a(35900)), 200);
-        assert_eq!(hip_distance(a(0), a(18000)), 18000);
+        assert_eq!(a(100).distance(a(35900)), 200);
+        assert_eq!(a(0).distance(a(18000)), 18000);
         let cfg = Config::default();
         assert!(hip_at_home(&cfg, a(17000)) && hip_at_home(&cfg, a(19000)));
         assert!(!hip_at_home(&cfg, a(16999)) && !hip_at_home(&cfg, a(19001)));
