@@ -1,7 +1,7 @@
 //! `mmic plan` and `mmic map`: the motion library's plans and map, as text and JSON.
 
 use crate::error::CliError;
-use mmic::motion::{map, route, State};
+use mmic::motion::{figure9, map, route, State};
 use serde::Serialize;
 
 #[derive(Serialize)]
@@ -82,14 +82,14 @@ pub fn map_json() -> String {
 /// The Figure 9 grid as text, followed by its legend.
 pub fn map_text() -> String {
     let mut s = String::new();
-    let _ = map::render(&mut s);
+    let _ = figure9::render(&mut s);
     s.push('\n');
     s + &map_legend()
 }
 
-/// What the grid's codes mean ([`map::write_legend`]).
+/// What the grid's codes mean ([`figure9::write_legend`]).
 pub fn map_legend() -> String {
     let mut s = String::new();
-    let _ = map::write_legend(&mut s);
+    let _ = figure9::write_legend(&mut s);
     s
 }

@@ -11,6 +11,7 @@
 //! ```
 
 pub mod estimate;
+pub mod figure9;
 pub mod geometry;
 pub mod map;
 mod primitive;

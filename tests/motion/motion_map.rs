@@ -223,7 +223,7 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
 #[test]
 fn rendered_grid_is_current_in_spec() {
     let mut grid = String::new();
-    map::render(&mut grid).unwrap();
+    mmic::motion::figure9::render(&mut grid).unwrap();
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/motion/map.txt");
     let on_disk = std::fs::read_to_string(path).unwrap_or_default();
     if std::env::var_os("MMIC_REGENERATE").is_some() {
@@ -233,7 +233,7 @@ fn rendered_grid_is_current_in_spec() {
     assert_eq!(on_disk, grid, "spec/motion/map.txt is stale; regenerate with: MMIC_REGENERATE=1 cargo test --test motion motion_map");
     // 60 move cells, 15 diagonal cells; the asterisks are exactly the moves no matched plan uses.
     let used = map::moves()
-        .filter(|(f, t, _)| map::used_between_matched(*f, *t))
+        .filter(|(f, t, _)| mmic::motion::figure9::used_between_matched(*f, *t))
         .count();
     assert_eq!(grid.matches('*').count(), 60 - used);
 }

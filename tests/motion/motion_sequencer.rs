@@ -278,6 +278,6 @@ fn turns_without_the_hip_are_no_primitive() {
             Sequencer::start(Config::default(), f, t, Targets::home(), 0),
             Err(NotAMove { from: f, to: t })
         );
-        assert!(!map::used_between_matched(f, t));
+        assert!(!mmic::motion::figure9::used_between_matched(f, t));
     }
 }
