@@ -33,6 +33,7 @@ pub mod board_b;
 pub mod exactly_once;
 pub mod gateway;
 pub mod ground;
+pub mod ground_link;
 #[cfg(any(
     target_has_atomic = "ptr",
     feature = "portable-atomic-critical-section",

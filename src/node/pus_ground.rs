@@ -41,7 +41,7 @@
 //! ```
 
 use super::ground::{Done, Efficiency, Outcome};
-use super::plan_runner::{Link, LinkTick, MotionEnd};
+use super::ground_link::{Link, LinkTick, MotionEnd};
 use crate::ccsds::primary::{Apid, SeqCount};
 use crate::ccsds::tc::{TcRepr, TC_MIN_LEN};
 use crate::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
