@@ -600,12 +600,15 @@ mod tests {
                 ..HeartbeatRepr::default()
             },
         ];
+        // Under Miri (about 100x slower) every 51st value of each octet, both edges among them:
+        // 0, 51, 102, 153, 204, 255; natively all 256.
+        let step = if cfg!(miri) { 51 } else { 1 };
         let mut checked = 0u32;
         for repr in samples {
             let good = repr.to_bytes();
             assert_eq!(HeartbeatRepr::parse(&good), Ok(repr));
             for at in field::BOARD.start..field::CHECKSUM.start {
-                for v in 0..=255u8 {
+                for v in (0..=255u8).step_by(step) {
                     let mut b = good;
                     b[at] = v;
                     let crc = crc16(&b[..field::CHECKSUM.start]).to_le_bytes();
@@ -620,6 +623,6 @@ mod tests {
                 }
             }
         }
-        assert_eq!(checked, 2 * 60 * 256);
+        assert_eq!(checked, 2 * 60 * 256_u32.div_ceil(step as u32));
     }
 }
