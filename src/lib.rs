@@ -71,7 +71,7 @@ const _: () = {
     format::<motion::Primitive>();
     format::<command::PrimitiveMove>();
     format::<bolter::BolterPair>();
-    format::<node::board_a::Event>();
+    format::<node::robot::board_a::Event>();
     format::<units::PulseWidth>();
     format::<units::HipAngle>();
     format::<ccsds::tc::TcRepr<'static>>();

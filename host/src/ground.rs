@@ -1,5 +1,5 @@
 //! `mmic ground`: the Rust side of the ground interop tests (ground/): packets made by the real
-//! PUS gateway ([`mmic::node::gateway::Gateway`]) for Python `spacepackets`, `ccsdspy` and
+//! PUS gateway ([`mmic::node::server::gateway::Gateway`]) for Python `spacepackets`, `ccsdspy` and
 //! YAMCS to read, and a UDP stand-in robot for the YAMCS loop.
 //!
 //! Both put a trivial stand-in for board A ([`StubBoardA`]) behind the gateway: it takes every
@@ -14,7 +14,7 @@ use mmic::command::Command;
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
 use mmic::motion::State;
-use mmic::node::gateway::{Config, Gateway, Out};
+use mmic::node::server::gateway::{Config, Gateway, Out};
 use mmic::refusal::Refusal;
 use mmic::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use mmic::wire::command::CommandRepr;

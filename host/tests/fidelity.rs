@@ -7,7 +7,7 @@ use mmic::command::{BolterCommand, Command, Reconfiguration, ServoTarget};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
 use mmic::motion::State;
-use mmic::node::board_a::Event;
+use mmic::node::robot::board_a::Event;
 use mmic::refusal::Refusal;
 use mmic::units::Side;
 use mmic_host::sim::lockstep::Robot;
@@ -253,7 +253,7 @@ fn command_complete_follows_the_idle_check_at_the_end() {
     assert!(r.run_until(3_000, |r| !r.a.in_motion()));
     let hb = r.command(Command::Heartbeat).expect("answered");
     assert!(hb.command_complete);
-    let settle = mmic::node::board_a::Config::default().idle_settle_ms;
+    let settle = mmic::node::robot::board_a::Config::default().idle_settle_ms;
     assert!(r.now - reached >= settle, "{} ms", r.now - reached);
 }
 

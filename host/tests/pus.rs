@@ -1,7 +1,7 @@
 //! The PUS path on the whole simulated robot (issue 15): the gateway
-//! ([`mmic::node::gateway`]) in lock-step with boards A and B and the plant
+//! ([`mmic::node::server::gateway`]) in lock-step with boards A and B and the plant
 //! (`mmic_host::sim::lockstep`, deterministic), the ground's PUS plan runner
-//! ([`mmic::node::pus_ground`]) through the packets' bytes, and `mmic sim --protocol pus` end
+//! ([`mmic::node::ground::pus`]) through the packets' bytes, and `mmic sim --protocol pus` end
 //! to end (threads, UDP and TCP on loopback).
 
 use mmic::ccsds::tm::TmRepr;
@@ -9,10 +9,10 @@ use mmic::command::{Command, Reconfiguration};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
 use mmic::motion::State;
-use mmic::node::board_a::Event;
-use mmic::node::gateway::{Config, Gateway, Out, Tc};
-use mmic::node::plan_runner::{PlanEnd, PlanRunner, PlanStep};
-use mmic::node::pus_ground::{self, MAX_TC_LEN};
+use mmic::node::ground::plan_runner::{PlanEnd, PlanRunner, PlanStep};
+use mmic::node::ground::pus::{self, MAX_TC_LEN};
+use mmic::node::robot::board_a::Event;
+use mmic::node::server::gateway::{Config, Gateway, Out, Tc};
 use mmic::pus::request::Request;
 use mmic::pus::verification::{Report, RequestId, Stage};
 use mmic::refusal::Refusal;
@@ -82,7 +82,7 @@ impl Loop {
 
     /// A telecommand packet (ack: every report) from the ground; returns the reports it got.
     fn tc(&mut self, seq: u16, c: Command) -> Vec<Tm> {
-        let tc = pus_ground::TcOut {
+        let tc = pus::TcOut {
             request: RequestId {
                 apid: APID,
                 seq_count: seq,
@@ -335,7 +335,7 @@ fn run_plan(
     lose: impl Fn(usize) -> bool,
 ) -> (Option<PlanEnd>, Loop, Vec<Vec<u8>>) {
     let mut l = Loop::new(start);
-    let mut run = PlanRunner::pus(pus_ground::Config::default(), BoardNumber::ONE);
+    let mut run = PlanRunner::pus(pus::Config::default(), BoardNumber::ONE);
     let mut sent = Vec::new();
     let mut k = 0;
     let end = l.r.now + max_ms;

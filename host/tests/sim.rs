@@ -4,7 +4,7 @@
 //! (threads, pipes, TCP and UDP on loopback) are in `host/tests/realtime.rs`.
 
 use mmic::mode::Mode;
-use mmic::node::plan_runner::PlanEnd;
+use mmic::node::ground::plan_runner::PlanEnd;
 use mmic_host::plan;
 use mmic_host::sim::{report, run, SimConfig, Summary};
 use serde_json::Value;
@@ -270,7 +270,7 @@ fn low_battery_during_a_motion_enters_standby_only_after_the_motion_completes() 
     assert!(standby >= reached, "Standby only once the motion completed");
     // The reconfiguration ends with Section 7's idle check, once the robot has been still for
     // `idle_settle_ms`; Standby comes at once after it.
-    let settle = u64::from(mmic::node::board_a::Config::default().idle_settle_ms);
+    let settle = u64::from(mmic::node::robot::board_a::Config::default().idle_settle_ms);
     assert!(
         standby - reached <= settle + 100,
         "and at once after the idle check at its end ({} ms after the target was reached)",
@@ -823,7 +823,7 @@ fn check_case(c: &Case, s: &Summary, records: &[Value], json: &report::SummaryJs
         );
         // The reconfiguration ends with its idle check once the robot has been still for
         // `idle_settle_ms` (Section 7); Standby follows at once.
-        let settle = u64::from(mmic::node::board_a::Config::default().idle_settle_ms);
+        let settle = u64::from(mmic::node::robot::board_a::Config::default().idle_settle_ms);
         expect(
             changed >= reached && changed - reached <= settle + 100,
             format!("Standby at {changed} ms, m reached at {reached} ms"),

@@ -4,7 +4,7 @@
 //! The robot has no absolute clock, only each board's millisecond counter since power-on
 //! ([`crate::units::Instant`], a `u32` that wraps after 2³² ms ≈ 49.7 days). So the epoch is
 //! **the power-on of the node that makes the telemetry** — the server board as PUS gateway
-//! (`crate::node::gateway`) — mission elapsed time: an agency-defined epoch, level 2. The
+//! (`crate::node::server::gateway`) — mission elapsed time: an agency-defined epoch, level 2. The
 //! P-field is implicit (not in the packet, as ECSS-E-ST-70-41C §7.4.3.1 allows when the time
 //! format is fixed per mission); were it sent it would be [`P_FIELD`] = `0x2E`: no extension
 //! (bit 0 = 0), time code ID `010` (agency-defined epoch), 4 coarse octets (`11`), 2 fine

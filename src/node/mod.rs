@@ -4,19 +4,19 @@
 //! Every node is a value stepped with the time and what arrived; it returns what to send and
 //! what to drive. The shells (ESP32 firmware, the host simulator in `host/`) move bytes and
 //! read sensors, nothing else. Commanding is exactly-once: the ground numbers its commands
-//! ([`ground`]), board A runs each number once ([`exactly_once`]) and acknowledges it in every
+//! ([`exactly_once::uplink`]), board A runs each number once ([`exactly_once::log`]) and acknowledges it in every
 //! heartbeat; spec/protocol/README.md has the design and what stateright checked.
 //!
 //! ```
 //! use mmic::command::Command;
 //! use mmic::mode::Mode;
-//! use mmic::node::board_a::{self, BoardA};
-//! use mmic::node::ground::{self, Outcome, Uplink};
+//! use mmic::node::robot::board_a::{self, BoardA};
+//! use mmic::node::exactly_once::uplink::{self, Outcome, Uplink};
 //! use mmic::units::BoardNumber;
 //! use mmic::wire::heartbeat::HeartbeatRepr;
 //!
 //! // The ground asks for Operational; the packet reaches board A, whose heartbeat comes back.
-//! let mut up = Uplink::new(ground::Config::default(), BoardNumber::ONE);
+//! let mut up = Uplink::new(uplink::Config::default(), BoardNumber::ONE);
 //! let mut a = BoardA::new(board_a::Config::default());
 //! up.submit(Command::Mode(Mode::Operational)).unwrap();
 //! let packet = up.tick(0).send.unwrap().to_bytes();
@@ -27,19 +27,7 @@
 //! assert_eq!(a.mode(), Mode::Operational);
 //! ```
 
-pub mod b_link;
-pub mod board_a;
-pub mod board_b;
 pub mod exactly_once;
-pub mod gateway;
 pub mod ground;
-pub mod ground_link;
-#[cfg(any(
-    target_has_atomic = "ptr",
-    feature = "portable-atomic-critical-section",
-    feature = "portable-atomic"
-))]
-pub mod handoff;
-pub mod plan_runner;
-pub mod pus_ground;
+pub mod robot;
 pub mod server;

@@ -129,8 +129,8 @@ fn bolter_defaults_equal_spec() {
     );
     assert_eq!(cfg.max_attempts, spec.attempts.max);
     // Board B runs the same executor with the same defaults.
-    assert_eq!(mmic::node::board_b::Config::default().bolter, side);
-    assert_eq!(mmic::node::board_a::Config::default().bolter, cfg);
+    assert_eq!(mmic::node::robot::board_b::Config::default().bolter, side);
+    assert_eq!(mmic::node::robot::board_a::Config::default().bolter, cfg);
 
     // Both thresholds lie strictly between the bolter's idle limit and its absolute limit, as
     // spec/modes.toml states them and as the fault detectors use them: a push or a lock is

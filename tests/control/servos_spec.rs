@@ -3,7 +3,7 @@
 //! done tolerance and speed, and the module-motion deadline's margins.
 
 use mmic::control::{deadline, hip, interp};
-use mmic::node::{board_a, board_b};
+use mmic::node::robot::{board_a, board_b};
 use serde::Deserialize;
 
 #[derive(Deserialize)]

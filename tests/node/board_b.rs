@@ -1,7 +1,7 @@
 //! Board B on its own: it follows A's targets for each servo separately, holds on A's stop
 //! flag, and judges the A→B link silent exactly past its timeout.
 
-use mmic::node::board_b::{BoardB, Config, Inputs};
+use mmic::node::robot::board_b::{BoardB, Config, Inputs};
 use mmic::units::{Electrical, PulseWidth};
 use mmic::wire::b_command::{BCommandRepr, BPower};
 

@@ -1,8 +1,8 @@
 //! The two-core hand-off (Section 3) under real concurrency: one OS thread produces numbered,
-//! checksummed packets into an 8-slot `node::handoff` queue, another consumes them. Every
+//! checksummed packets into an 8-slot `node::robot::handoff` queue, another consumes them. Every
 //! packet must arrive exactly once, in order, byte for byte (no loss, duplication or tearing).
 
-use mmic::node::handoff::PacketQueue;
+use mmic::node::robot::handoff::PacketQueue;
 use mmic::wire::checksum::crc16;
 
 /// Two million packets; under Miri (.ci/miri), which interprets some 100x slower but checks

@@ -8,8 +8,8 @@
 use mmic::command::{Command, PrimitiveMove};
 use mmic::mode::Mode;
 use mmic::motion::{map, route, Primitive, State};
-use mmic::node::board_a::{self, BoardA, Event, Inputs};
-use mmic::node::board_b::{self, BoardB};
+use mmic::node::robot::board_a::{self, BoardA, Event, Inputs};
+use mmic::node::robot::board_b::{self, BoardB};
 use mmic::refusal::Refusal;
 use mmic::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};

@@ -3,8 +3,9 @@
 //! once board A has been silent past the timeout.
 
 use mmic::motion::estimate;
-use mmic::node::board_b::{self, BoardB};
-use mmic::node::{board_a, ground};
+use mmic::node::exactly_once::uplink;
+use mmic::node::robot::board_a;
+use mmic::node::robot::board_b::{self, BoardB};
 use mmic::sensors::frontend;
 use mmic::units::{Axis, PulseWidth, Sign};
 use mmic::wire::b_command::{BCommandRepr, BPower};
@@ -75,7 +76,7 @@ fn the_nodes_defaults_equal_spec_boards() {
         (b.heartbeat_period_ms, b.link_timeout_ms),
         (s.board_b.heartbeat_period_ms, s.board_b.link_timeout_ms)
     );
-    let g = ground::Config::default();
+    let g = uplink::Config::default();
     assert_eq!(
         (g.period_ms, g.timeout_ms, g.max_attempts),
         (
@@ -84,7 +85,7 @@ fn the_nodes_defaults_equal_spec_boards() {
             s.ground.max_attempts
         )
     );
-    assert_eq!(ground::Efficiency::WINDOW, s.ground.efficiency_window);
+    assert_eq!(uplink::Efficiency::WINDOW, s.ground.efficiency_window);
     assert_eq!(
         frontend::Config::default().loss_ticks,
         s.sensor_frontend.loss_ticks

@@ -6,7 +6,7 @@ use mmic::command::{Command, Reconfiguration};
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
 use mmic::motion::State;
-use mmic::node::gateway::{Config, Gateway, Out, Tc, TmOut};
+use mmic::node::server::gateway::{Config, Gateway, Out, Tc, TmOut};
 use mmic::pus::request::Request;
 use mmic::pus::verification::{Report, RequestId, Stage};
 use mmic::refusal::Refusal;

@@ -320,12 +320,12 @@ struct PusTiming {
 fn pus_timing_is_the_decision() {
     let t: TimingDoc = load("decisions.toml");
     let t = t.pus_timing;
-    let g = mmic::node::pus_ground::Config::default();
+    let g = mmic::node::ground::pus::Config::default();
     assert_eq!(
         (g.timeout_ms, g.query_ms, g.max_attempts),
         (t.tc_timeout_ms, t.tc_query_ms, t.tc_max_attempts)
     );
-    let w = mmic::node::gateway::Config::default();
+    let w = mmic::node::server::gateway::Config::default();
     assert_eq!(
         (w.poll_ms, w.uplink.timeout_ms),
         (t.gateway_poll_ms, t.gateway_visit_timeout_ms)

@@ -631,10 +631,10 @@ fn prose_about_bytes() -> Vec<(String, String, Option<&'static str>, bool)> {
             }
         }
     }
-    // The Markdown of spec/ and the README, a paragraph at a time.
+    // The Markdown of spec/, docs/ and the README, a paragraph at a time.
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     let mut md = vec![root.join("README.md")];
-    let mut dirs = vec![root.join("spec")];
+    let mut dirs = vec![root.join("spec"), root.join("docs")];
     while let Some(d) = dirs.pop() {
         for e in std::fs::read_dir(&d).unwrap() {
             let p = e.unwrap().path();

@@ -1,5 +1,5 @@
 //! The server board (Figure 4): commands from the opsUI on the USB serial line go into the
-//! library's pending slots (`mmic::node::server`); each loop visits one robot with a pending
+//! library's pending slots (`mmic::node::server::relay`); each loop visits one robot with a pending
 //! command: connect, send, forward the heartbeat that comes back, disconnect.
 //!
 //! The USB serial line carries the opsUI's packets only: this binary prints nothing after
@@ -19,7 +19,7 @@ use esp_hal::timer::timg::TimerGroup;
 use esp_hal::usb::usb_serial_jtag::{UsbSerialJtag, UsbSerialJtagRx, UsbSerialJtagTx};
 use esp_hal::Blocking;
 use esp_radio::wifi::{self, sta::StationConfig, AuthenticationMethodConfig, Interface};
-use mmic::node::server::{Accepted, Server, ServerError};
+use mmic::node::server::relay::{Accepted, Server, ServerError};
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::HEARTBEAT_LEN;
 use mmic::wire::PacketKind;

@@ -4,8 +4,8 @@
 
 use crate::link::{ByteSink, ByteSource, Link};
 use mmic::bolter::{Drive, MuxLines};
-use mmic::node::board_a::{self, BoardA};
-use mmic::node::handoff::{Consumer, Producer};
+use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::PulseWidth;
 use mmic::wire::command::COMMAND_LEN;

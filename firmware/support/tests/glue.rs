@@ -11,8 +11,8 @@ use embedded_hal_mock::eh1::i2c::{Mock, Transaction as Tx};
 use mmic::bolter::MuxLines;
 use mmic::command::Command;
 use mmic::mode::Mode;
-use mmic::node::board_a;
-use mmic::node::handoff::PacketQueue;
+use mmic::node::robot::board_a;
+use mmic::node::robot::handoff::PacketQueue;
 use mmic::sensors::frontend;
 use mmic::units::{BoardNumber, PulseWidth};
 use mmic::wire::command::CommandRepr;
@@ -170,7 +170,7 @@ fn board_a_command_to_heartbeat_through_the_glue() {
 #[test]
 fn garbage_on_the_b_line_resyncs_and_the_link_holds() {
     use mmic::faults::Fault;
-    use mmic::node::board_b::{self, BoardB};
+    use mmic::node::robot::board_b::{self, BoardB};
     let mut rx: PacketQueue<14, QUEUE> = PacketQueue::new();
     let mut tx: PacketQueue<HEARTBEAT_LEN, QUEUE> = PacketQueue::new();
     let (_wifi_in, control_in) = rx.split();

@@ -24,7 +24,7 @@ pub mod cli;
 pub mod realtime;
 
 use crate::sim::{self, engine, Protocol, SimConfig, SimStep};
-use mmic::node::plan_runner::{PlanEnd, PlanStep};
+use mmic::node::ground::plan_runner::{PlanEnd, PlanStep};
 use std::time::Duration;
 
 /// What fleet to run.

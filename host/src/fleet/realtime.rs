@@ -22,12 +22,12 @@
 use super::{FleetConfig, FleetResult};
 use crate::sim::shell::{Ground, GroundSide, LegacyGround, SideA, SideB};
 use crate::sim::{plant::Plant, Protocol, SimConfig};
-use mmic::node::board_a::{self, BoardA};
-use mmic::node::board_b::{self, BoardB};
-use mmic::node::gateway::Gateway;
-use mmic::node::handoff::{Consumer, PacketQueue, Producer};
-use mmic::node::plan_runner::PlanRunner;
-use mmic::node::server::Server;
+use mmic::node::ground::plan_runner::PlanRunner;
+use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::robot::board_b::{self, BoardB};
+use mmic::node::robot::handoff::{Consumer, PacketQueue, Producer};
+use mmic::node::server::gateway::Gateway;
+use mmic::node::server::relay::Server;
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::deframer::{Deframed, Deframer};
@@ -72,7 +72,7 @@ pub fn run(cfg: &FleetConfig) -> std::io::Result<FleetResult> {
     rt.shutdown_timeout(Duration::from_secs(2));
     let completed = ends
         .iter()
-        .filter(|e| **e == Some(mmic::node::plan_runner::PlanEnd::Completed))
+        .filter(|e| **e == Some(mmic::node::ground::plan_runner::PlanEnd::Completed))
         .count() as u32;
     let ended = ends.iter().filter(|e| e.is_some()).count() as u32;
     Ok(FleetResult {
@@ -88,7 +88,7 @@ pub fn run(cfg: &FleetConfig) -> std::io::Result<FleetResult> {
     })
 }
 
-type Ends = Vec<Option<mmic::node::plan_runner::PlanEnd>>;
+type Ends = Vec<Option<mmic::node::ground::plan_runner::PlanEnd>>;
 
 async fn fleet(cfg: SimConfig) -> std::io::Result<(Ends, crate::sim::shell::GroundStats, u32)> {
     let n = cfg.robots.max(1) as usize;
@@ -362,10 +362,10 @@ async fn send_reports<const M: usize>(
     sock: &UdpSocket,
     ground: SocketAddr,
     g: &mut Gateway<1, 8, 64>,
-    out: mmic::node::gateway::Out<M>,
+    out: mmic::node::server::gateway::Out<M>,
     now: u32,
 ) {
-    const MAX: usize = mmic::ccsds::tm::TM_MIN_LEN + mmic::node::gateway::MAX_TM_DATA;
+    const MAX: usize = mmic::ccsds::tm::TM_MIN_LEN + mmic::node::server::gateway::MAX_TM_DATA;
     for tm in &out.reports {
         let mut b = [0u8; MAX];
         if let Ok(k) = g.encode(tm, now, &mut b) {

@@ -4,7 +4,7 @@
 //! attempt of every robot was answered within the 0.7 s timeout.
 
 use super::{run, SimConfig, SimStep};
-use mmic::node::plan_runner::PlanStep;
+use mmic::node::ground::plan_runner::PlanStep;
 
 /// One trial's result.
 #[derive(Debug, Clone, Copy, PartialEq)]

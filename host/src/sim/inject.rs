@@ -7,7 +7,7 @@
 //! gripper or the arm, an encoder that reads off, a sagging battery, a cut A–B line. The rest
 //! come from the ground: a reconfiguration command that carries a wrong initial state, and
 //! the System fault, Stop and Reset commands of Table 1, sent out of band through the plan
-//! runner ([`mmic::node::plan_runner::PlanRunner::interject`]).
+//! runner ([`mmic::node::ground::plan_runner::PlanRunner::interject`]).
 //!
 //! ```
 //! use mmic_host::sim::inject::{Injection, Scheduled};

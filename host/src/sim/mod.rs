@@ -28,8 +28,8 @@
 //! from the ground (a misstated reconfiguration, out-of-band commands).
 //!
 //! [`Protocol::Pus`] runs the same plans over CCSDS/PUS: the ground's plan runner sends PUS-C
-//! telecommands ([`mmic::node::pus_ground`]) to the server board (UDP on loopback in the
-//! realtime engine), which runs the PUS gateway ([`mmic::node::gateway`]) instead of the legacy
+//! telecommands ([`mmic::node::ground::pus`]) to the server board (UDP on loopback in the
+//! realtime engine), which runs the PUS gateway ([`mmic::node::server::gateway`]) instead of the legacy
 //! relay and sends its ST\[1\], ST\[3\], ST\[5\] and ST\[17\] telemetry back; the server board
 //! and board A talk as before.
 
@@ -48,10 +48,10 @@ pub mod shell;
 pub mod steps;
 
 use mmic::motion::State;
-use mmic::node::gateway;
-use mmic::node::ground;
-use mmic::node::plan_runner::PlanEnd;
-use mmic::node::pus_ground;
+use mmic::node::exactly_once::uplink;
+use mmic::node::ground::plan_runner::PlanEnd;
+use mmic::node::ground::pus;
+use mmic::node::server::gateway;
 use mmic::wire::heartbeat::HeartbeatRepr;
 pub use plant::PlantConfig;
 use serde_json::Value;
@@ -98,7 +98,7 @@ pub struct SimConfig {
     /// How the ground and the server board talk.
     pub protocol: Protocol,
     /// The ground's telecommand link with [`Protocol::Pus`].
-    pub pus: pus_ground::Config,
+    pub pus: pus::Config,
     /// The server board's gateway with [`Protocol::Pus`] (its uplink to board A, polls,
     /// housekeeping interval).
     pub gateway: gateway::Config,
@@ -127,7 +127,7 @@ pub struct SimConfig {
     /// The state the robot starts in (and board A knows it is in).
     pub start_state: State,
     /// The ground's uplink timing.
-    pub ground: ground::Config,
+    pub ground: uplink::Config,
     /// Stop after this much simulated time, ms.
     pub max_sim_ms: u32,
     /// How long the server waits for a heartbeat before disconnecting, ms.
@@ -208,7 +208,7 @@ impl SimConfig {
     pub fn with_steps(steps: Vec<SimStep>) -> SimConfig {
         SimConfig {
             protocol: Protocol::Legacy,
-            pus: pus_ground::Config::default(),
+            pus: pus::Config::default(),
             gateway: gateway::Config::default(),
             steps,
             robots: 1,
@@ -224,9 +224,9 @@ impl SimConfig {
             // The paper resends until acknowledged; 20 attempts make an unacknowledged command
             // unlikely even at 30 % loss each way (0.51^20 < 2e-6) while still ending a run
             // whose link is gone.
-            ground: ground::Config {
+            ground: uplink::Config {
                 max_attempts: 20,
-                ..ground::Config::default()
+                ..uplink::Config::default()
             },
             max_sim_ms: 900_000,
             visit_ms: 250,

@@ -97,7 +97,7 @@ impl Default for PlantConfig {
             adc_silent_at: [None; 2],
             encoder_silent_at: None,
             seed: 1,
-            arm_contracted: mmic::node::board_a::Config::default().arm.contracted,
+            arm_contracted: mmic::node::robot::board_a::Config::default().arm.contracted,
         }
     }
 }
@@ -203,7 +203,7 @@ fn within(at: Option<u32>, now: u32, ms: u32) -> bool {
 impl Plant {
     /// The robot at rest in `state`, arms contracted, grippers closed, hip at 180°.
     pub fn new(cfg: PlantConfig, state: State) -> Plant {
-        let a = mmic::node::board_a::Config::default();
+        let a = mmic::node::robot::board_a::Config::default();
         let mut p = Plant {
             rng: fastrand::Rng::with_seed(cfg.seed),
             noise: fastrand::Rng::with_seed(cfg.seed ^ 0x5eed_5e45),

@@ -2,7 +2,7 @@
 
 use super::steps::SimStep;
 use mmic::motion::State;
-use mmic::node::ground::Efficiency;
+use mmic::node::exactly_once::uplink::Efficiency;
 use mmic::wire::heartbeat::HeartbeatRepr;
 
 /// Live progress on stderr: a line when a step starts or the robot's mode, state or faults

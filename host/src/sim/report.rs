@@ -4,7 +4,7 @@ use super::inject::Injection;
 use super::Summary;
 use crate::plot::{bar_chart, line_chart_with, LineOptions, Series};
 use mmic::faults::Fault;
-use mmic::node::plan_runner::PlanEnd;
+use mmic::node::ground::plan_runner::PlanEnd;
 use mmic::refusal::Refusal;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -291,9 +291,9 @@ fn sent_initial(s: &Summary) -> Option<mmic::motion::State> {
 /// What the refused step expected and what the robot last reported.
 fn mismatch(s: &Summary, step: usize) -> String {
     let expected = match s.plan.get(step).map(|st| st.step) {
-        Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Reconfigure(
-            r,
-        ))) => match sent_initial(s).filter(|i| *i != r.initial()) {
+        Some(mmic::node::ground::plan_runner::PlanStep::Command(
+            mmic::command::Command::Reconfigure(r),
+        )) => match sent_initial(s).filter(|i| *i != r.initial()) {
             // An injected initial-state-mismatch: the ground sent another initial state.
             Some(sent) => format!(
                 "the plan expected the robot in {}, but the ground sent the reconfiguration \
@@ -302,7 +302,9 @@ fn mismatch(s: &Summary, step: usize) -> String {
             ),
             None => format!("the plan expected the robot in {}", r.initial()),
         },
-        Some(mmic::node::plan_runner::PlanStep::Command(mmic::command::Command::Primitive(m))) => {
+        Some(mmic::node::ground::plan_runner::PlanStep::Command(
+            mmic::command::Command::Primitive(m),
+        )) => {
             format!(
                 "primitive {} does not take the robot from the state it is in to {}",
                 m.primitive().number(),

@@ -11,11 +11,11 @@ use super::plant::{Drives, Plant, Senses};
 use super::progress::Progress;
 use super::steps::SimStep;
 use mmic::motion::State;
-use mmic::node::board_a::{self, BoardA, Event};
-use mmic::node::board_b::{self, BoardB};
-use mmic::node::ground::Efficiency;
-use mmic::node::plan_runner::{Link, PlanEnd, PlanRunner, PlanStep, PlanTick};
-use mmic::node::pus_ground::{self, TcLink, TcOut};
+use mmic::node::exactly_once::uplink::Efficiency;
+use mmic::node::ground::plan_runner::{Link, PlanEnd, PlanRunner, PlanStep, PlanTick};
+use mmic::node::ground::pus::{self, TcLink, TcOut};
+use mmic::node::robot::board_a::{self, BoardA, Event};
+use mmic::node::robot::board_b::{self, BoardB};
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::wire::b_command::B_COMMAND_LEN;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
@@ -359,7 +359,7 @@ impl Ground for PlanRunner<TcLink> {
     }
 
     fn bytes(p: &TcOut) -> Vec<u8> {
-        let mut b = [0u8; pus_ground::MAX_TC_LEN];
+        let mut b = [0u8; pus::MAX_TC_LEN];
         match p.emit(&mut b) {
             Ok(n) => b.get(..n).unwrap_or(&[]).to_vec(),
             Err(_) => Vec::new(),

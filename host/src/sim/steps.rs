@@ -1,7 +1,7 @@
 //! The steps a simulation runs: the plan's steps with the line each came from, and the
 //! built-in demo plan.
 
-use mmic::node::plan_runner::PlanStep;
+use mmic::node::ground::plan_runner::PlanStep;
 
 /// A step of the plan with where it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,8 +34,12 @@ pub fn steps_of(p: &crate::plan::Plan) -> Vec<SimStep> {
             line: s.line,
             text: s.text.clone(),
             step: match s.action {
-                crate::plan::Action::Command(c) => mmic::node::plan_runner::PlanStep::Command(c),
-                crate::plan::Action::Wait { ms } => mmic::node::plan_runner::PlanStep::Wait { ms },
+                crate::plan::Action::Command(c) => {
+                    mmic::node::ground::plan_runner::PlanStep::Command(c)
+                }
+                crate::plan::Action::Wait { ms } => {
+                    mmic::node::ground::plan_runner::PlanStep::Wait { ms }
+                }
             },
         })
         .collect()

@@ -6,7 +6,7 @@ mod protocol_exactly_once;
 mod protocol_paper;
 mod protocol_pus;
 
-use mmic::node::board_a::{self, BoardA, Event};
+use mmic::node::robot::board_a::{self, BoardA, Event};
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::HEARTBEAT_LEN;
 

@@ -19,10 +19,10 @@
 
 use mmic::command::Command;
 use mmic::mode::Mode;
-use mmic::node::board_a::{self, BoardA};
-use mmic::node::board_b::{self, BoardB};
-use mmic::node::ground::{self, Outcome, Uplink};
-use mmic::node::server::{Accepted, Server};
+use mmic::node::exactly_once::uplink::{self, Outcome, Uplink};
+use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::robot::board_b::{self, BoardB};
+use mmic::node::server::relay::{Accepted, Server};
 use mmic::units::{BoardNumber, Electrical};
 use mmic::wire::b_command::B_COMMAND_LEN;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
@@ -106,7 +106,7 @@ fn index_of(seq: u16) -> Option<usize> {
 }
 
 impl GroundModel {
-    fn uplink_step(&self, n: &mut Ground, t: ground::Tick) {
+    fn uplink_step(&self, n: &mut Ground, t: uplink::Tick) {
         if let Some(p) = t.send {
             match n.server.accept(&p.to_bytes()) {
                 Ok(Accepted::Superseded(old)) => {
@@ -134,9 +134,9 @@ impl Model for GroundModel {
     type Action = GroundAction;
 
     fn init_states(&self) -> Vec<Ground> {
-        let cfg = ground::Config {
+        let cfg = uplink::Config {
             max_attempts: self.max_attempts,
-            ..ground::Config::default()
+            ..uplink::Config::default()
         };
         vec![Ground {
             up: Uplink::new(cfg, BoardNumber::ONE),

@@ -13,9 +13,9 @@
 
 use mmic::command::Command;
 use mmic::mode::Mode;
-use mmic::node::board_a::{self, BoardA};
-use mmic::node::gateway::{Config, Gateway, Tc};
-use mmic::node::ground;
+use mmic::node::exactly_once::uplink;
+use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::server::gateway::{Config, Gateway, Tc};
 use mmic::pus::request::Request;
 use mmic::pus::verification::{Report, RequestId, Stage, UNACKNOWLEDGED};
 use mmic::units::BoardNumber;
@@ -108,7 +108,7 @@ fn tc(i: u8) -> Tc {
 
 impl PusModel {
     /// The gateway's output: legacy commands onto the WiFi link, final reports downlink.
-    fn out(&self, n: &mut State, out: mmic::node::gateway::Out<16>) {
+    fn out(&self, n: &mut State, out: mmic::node::server::gateway::Out<16>) {
         for (_, c) in out.to_robots {
             if let Some(i) = TCS.iter().position(|t| *t == c.command) {
                 n.seq_of[i] = Some(c.seq);
@@ -154,7 +154,7 @@ impl Model for PusModel {
 
     fn init_states(&self) -> Vec<State> {
         let cfg = Config {
-            uplink: ground::Config {
+            uplink: uplink::Config {
                 max_attempts: 3,
                 ..Config::default().uplink
             },
@@ -367,7 +367,7 @@ fn pus_exactly_once() {
          \n\
          ground (sends each TC once, may send one again with the same key) <-> server board:\n\
          a link losing, reordering and duplicating TCs and final ST[1] reports; the PUS gateway\n\
-         (node::gateway, legacy uplink with 3 attempts); the WiFi link losing, reordering and\n\
+         (node::server::gateway, legacy uplink with 3 attempts); the WiFi link losing, reordering and\n\
          duplicating legacy packets; BoardA. At most {MAX_IN_FLIGHT} packets in flight per link,\n\
          {MAX_DUPLICATES} duplication in all. Telecommands {TCS:?}\n\
          {unique} unique states ({total} visited), breadth-first, exhaustive:\n\

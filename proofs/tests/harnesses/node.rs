@@ -4,10 +4,10 @@
 //! proofs over all inputs of the fixed length (Kani not run here).
 
 use mmic::command::Command;
+use mmic::node::exactly_once::uplink::{Config, Outcome, Uplink};
 use mmic::node::exactly_once::{newer, Admission, CommandLog};
-use mmic::node::ground::{Config, Outcome, Uplink};
-use mmic::node::handoff::PacketQueue;
-use mmic::node::server::{Accepted, Server};
+use mmic::node::robot::handoff::PacketQueue;
+use mmic::node::server::relay::{Accepted, Server};
 use mmic::refusal::Refusal;
 use mmic::units::BoardNumber;
 use mmic::wire::command::CommandRepr;

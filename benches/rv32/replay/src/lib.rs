@@ -33,11 +33,11 @@ pub mod parsers;
 pub mod trace;
 
 use heapless::{Deque, Vec};
-use mmic::node::board_a::{self, BoardA};
-use mmic::node::board_b::{self, BoardB};
-use mmic::node::gateway::{self, Gateway, Out};
-use mmic::node::handoff::PacketQueue;
-use mmic::node::server::{Accepted, Server};
+use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::robot::board_b::{self, BoardB};
+use mmic::node::robot::handoff::PacketQueue;
+use mmic::node::server::gateway::{self, Gateway, Out};
+use mmic::node::server::relay::{Accepted, Server};
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::PulseWidth;
 use mmic::wire::b_command::B_COMMAND_LEN;

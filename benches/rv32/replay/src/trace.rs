@@ -26,8 +26,8 @@
 
 use crate::Sink;
 use mmic::motion::State;
-use mmic::node::gateway;
-use mmic::node::ground;
+use mmic::node::exactly_once::uplink;
+use mmic::node::server::gateway;
 use mmic::sensors::frontend::Raw;
 use mmic::units::BoardNumber;
 
@@ -71,9 +71,9 @@ pub enum TraceError {
 /// How the ground talks to the server board.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Protocol {
-    /// The paper's packets: the server board relays (`mmic::node::server`).
+    /// The paper's packets: the server board relays (`mmic::node::server::relay`).
     Legacy = 0,
-    /// PUS-C: the server board is the gateway (`mmic::node::gateway`).
+    /// PUS-C: the server board is the gateway (`mmic::node::server::gateway`).
     Pus = 1,
 }
 
@@ -131,7 +131,7 @@ impl Header {
         let board = BoardNumber::new(b).map_err(|_| header("board", b.into()))?;
         let s = r.u8()?;
         let start = State::from_index(s.into()).ok_or(header("state", s.into()))?;
-        let uplink = ground::Config {
+        let uplink = uplink::Config {
             period_ms: r.u32()?,
             timeout_ms: r.u32()?,
             max_attempts: r.u8()?,

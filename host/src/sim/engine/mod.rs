@@ -44,12 +44,12 @@ use super::plant::Plant;
 use super::shell::{frames, Ground, GroundSide, LegacyGround, SideA, SideB};
 use super::{Protocol, SimConfig, Summary};
 use link::{Fate, Link, LinkModel};
-use mmic::node::board_a::{self, BoardA};
-use mmic::node::board_b::{self, BoardB};
-use mmic::node::gateway::{Gateway, Out};
-use mmic::node::handoff::PacketQueue;
-use mmic::node::plan_runner::PlanRunner;
-use mmic::node::server::{Accepted, Server};
+use mmic::node::ground::plan_runner::PlanRunner;
+use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::robot::board_b::{self, BoardB};
+use mmic::node::robot::handoff::PacketQueue;
+use mmic::node::server::gateway::{Gateway, Out};
+use mmic::node::server::relay::{Accepted, Server};
 use mmic::units::BoardNumber;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::deframer::Deframer;
@@ -186,7 +186,7 @@ impl Ord for Queued {
 type SimGateway = Gateway<1, 8, 64>;
 
 /// The largest telemetry packet the gateway writes, bytes.
-const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + mmic::node::gateway::MAX_TM_DATA;
+const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + mmic::node::server::gateway::MAX_TM_DATA;
 
 /// The server board's logic: the legacy relay, or the PUS gateway.
 enum Board {

@@ -36,7 +36,7 @@ use mmic::bolter::Drive;
 use mmic::control::interp::Travel;
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
-use mmic::node::board_a::{self, BoardA, Event};
+use mmic::node::robot::board_a::{self, BoardA, Event};
 use mmic::safety::policy::fault_action;
 use mmic::wire::command::COMMAND_LEN;
 use std::collections::HashMap;

@@ -10,7 +10,7 @@
 //! `board-b-heartbeat-and-hold`).
 //!
 //! ```
-//! use mmic::node::board_b::{BoardB, Config, Inputs};
+//! use mmic::node::robot::board_b::{BoardB, Config, Inputs};
 //! use mmic::wire::b_command::{BCommandRepr, BPower};
 //! use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
 //! use mmic::units::PulseWidth;
@@ -169,28 +169,7 @@ impl BoardB {
 
     /// One tick at `now` (ms).
     pub fn tick(&mut self, now: u32, inp: &Inputs) -> Outputs {
-        let mut rejected = None;
-        if let Some(bytes) = inp.command {
-            match BCommandRepr::parse(&bytes) {
-                Ok(c) => {
-                    self.heard = Some(Instant::from_millis(now));
-                    self.holding = false;
-                    if c.stop {
-                        self.hold(now);
-                    } else {
-                        if self.arm.target() != c.arm_target {
-                            self.arm.set_target(c.arm_target, now);
-                        }
-                        if self.gripper.target() != c.gripper_target {
-                            self.gripper.set_target(c.gripper_target, now);
-                        }
-                        self.bolter.order(c.seq, c.bolter, now);
-                    }
-                    self.last = Some(c);
-                }
-                Err(e) => rejected = Some(e),
-            }
-        }
+        let rejected = inp.command.and_then(|bytes| self.take(now, &bytes));
         let silent = match self.heard {
             Some(t) => Instant::from_millis(now).since(t).millis() > self.cfg.link_timeout_ms,
             None => false,
@@ -209,19 +188,6 @@ impl BoardB {
         let gripper_now = self.gripper.tick(now);
         let power = self.last.map(|c| c.power).unwrap_or_default();
         let live = power.regulator && !self.holding;
-        let heartbeat = match self.sent {
-            Some(t)
-                if Instant::from_millis(now).since(t).millis() < self.cfg.heartbeat_period_ms =>
-            {
-                None
-            }
-            // Blind: say nothing rather than report stale currents as B's own verdicts.
-            _ if blind => None,
-            _ => {
-                self.sent = Some(Instant::from_millis(now));
-                Some(self.report(inp).to_bytes())
-            }
-        };
         Outputs {
             arm: (power.regulator && power.arm).then_some(arm_now),
             gripper: (power.regulator && power.gripper).then_some(gripper_now),
@@ -232,9 +198,52 @@ impl BoardB {
                 Drive::Idle
             },
             mux: self.bolter.mux(),
-            heartbeat,
+            heartbeat: self.heartbeat_due(now, inp, blind),
             link_lost: silent,
             rejected,
+        }
+    }
+
+    /// Board A's command packet: adopted (a stop flag holds everything where it is), or the
+    /// reason it was rejected.
+    fn take(&mut self, now: u32, bytes: &[u8; B_COMMAND_LEN]) -> Option<WireError> {
+        let c = match BCommandRepr::parse(bytes) {
+            Ok(c) => c,
+            Err(e) => return Some(e),
+        };
+        self.heard = Some(Instant::from_millis(now));
+        self.holding = false;
+        if c.stop {
+            self.hold(now);
+        } else {
+            if self.arm.target() != c.arm_target {
+                self.arm.set_target(c.arm_target, now);
+            }
+            if self.gripper.target() != c.gripper_target {
+                self.gripper.set_target(c.gripper_target, now);
+            }
+            self.bolter.order(c.seq, c.bolter, now);
+        }
+        self.last = Some(c);
+        None
+    }
+
+    /// The internal heartbeat, once a period; none while blind: B says nothing rather than
+    /// report stale currents as its own verdicts.
+    fn heartbeat_due(
+        &mut self,
+        now: u32,
+        inp: &Inputs,
+        blind: bool,
+    ) -> Option<[u8; INTERNAL_HEARTBEAT_LEN]> {
+        let period = self.cfg.heartbeat_period_ms;
+        match self.sent {
+            Some(t) if Instant::from_millis(now).since(t).millis() < period => None,
+            _ if blind => None,
+            _ => {
+                self.sent = Some(Instant::from_millis(now));
+                Some(self.report(inp).to_bytes())
+            }
         }
     }
 

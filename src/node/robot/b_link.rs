@@ -16,7 +16,7 @@
 //! force, which is how board A matches B's report to its coordinator's order.
 //!
 //! ```
-//! use mmic::node::b_link::BLink;
+//! use mmic::node::robot::b_link::BLink;
 //! use mmic::wire::b_command::{BCommandRepr, BPower};
 //! use mmic::units::PulseWidth;
 //! let mut link = BLink::new();

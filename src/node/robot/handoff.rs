@@ -3,7 +3,7 @@
 //! lock-free single-producer single-consumer queues (`heapless::spsc`).
 //!
 //! ```
-//! use mmic::node::handoff::{Full, PacketQueue};
+//! use mmic::node::robot::handoff::{Full, PacketQueue};
 //! let mut q: PacketQueue<14, 4> = PacketQueue::new();
 //! let (mut wifi, mut control) = q.split();
 //! for i in 0..3u8 {

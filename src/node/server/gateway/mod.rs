@@ -16,7 +16,7 @@
 //!
 //! ```
 //! use mmic::command::Command;
-//! use mmic::node::gateway::{Gateway, Tc};
+//! use mmic::node::server::gateway::{Gateway, Tc};
 //! use mmic::pus::request::Request;
 //! use mmic::pus::verification::{RequestId, Stage};
 //! use mmic::units::BoardNumber;
@@ -42,27 +42,25 @@
 //! assert_eq!(stages, [(Stage::Completion, true)]); // start success not asked (ack 0b1001)
 //! ```
 
+mod robot;
+
 use crate::ccsds::cuc::Cuc;
 use crate::ccsds::primary::{Apid, SeqCount};
 use crate::ccsds::tc::TcRepr;
 use crate::ccsds::tm::TmRepr;
 use crate::ccsds::tm_header::TmSecondaryHeader;
 use crate::ccsds::{EmitError, PacketError};
-use crate::command::Command;
-use crate::faults::Faults;
-use crate::node::ground::{self, Done, Outcome, Uplink};
+use crate::node::exactly_once::uplink::{self, Uplink};
 use crate::pus::event;
-use crate::pus::housekeeping::{self, DEFAULT_INTERVAL_MS, REPORT_LEN};
-use crate::pus::request::{Request, RequestError, ST_HOUSEKEEPING, ST_TEST, ST_VERIFICATION};
-use crate::pus::verification::{
-    Failure, Report, RequestId, Stage, ABANDONED, FAILURE_LEN, KEY_REUSED, QUEUE_FULL,
-    UNACKNOWLEDGED,
-};
+use crate::pus::housekeeping::{DEFAULT_INTERVAL_MS, REPORT_LEN};
+use crate::pus::request::{Request, RequestError, ST_VERIFICATION};
+use crate::pus::verification::{Failure, Report, RequestId, Stage};
 use crate::pus::{robot_apid, robot_of_apid};
 use crate::units::{BoardNumber, Instant};
 use crate::wire::command::CommandRepr;
 use crate::wire::heartbeat::HeartbeatRepr;
 use heapless::Vec;
+use robot::Robot;
 
 /// A telecommand the CCSDS layer accepted (header, CRC and APID checked), with its request
 /// already read ([`Request::parse`]) or refused.
@@ -137,7 +135,7 @@ impl TmOut {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Config {
     /// The legacy uplink's resend timing towards board A.
-    pub uplink: ground::Config,
+    pub uplink: uplink::Config,
     /// A heartbeat is asked for this often while nothing else is sent, ms; 0: never (then
     /// motions are not seen to complete: for models of the command path alone).
     pub poll_ms: u32,
@@ -152,7 +150,7 @@ impl Default for Config {
     /// housekeeping every second, on.
     fn default() -> Config {
         Config {
-            uplink: ground::Config {
+            uplink: uplink::Config {
                 period_ms: 250,
                 timeout_ms: 200,
                 max_attempts: 10,
@@ -181,50 +179,6 @@ impl<const M: usize> Out<M> {
             self.overflow = self.overflow.saturating_add(1);
         }
     }
-}
-
-/// What the key log remembers of a telecommand.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-struct Entry {
-    key: (u16, u16),
-    request: Request,
-    /// The latest report made for it (sent again for a copy).
-    last: Option<Report>,
-}
-
-/// A telecommand on its way: queued, sent to board A, or running there.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-struct Job {
-    request: RequestId,
-    source_id: u16,
-    ack: u8,
-    command: Command,
-    /// Are-you-alive: answer TM(17,2) when board A answers.
-    alive: bool,
-}
-
-/// One robot's side of the gateway.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-struct Robot<const Q: usize, const K: usize> {
-    board: BoardNumber,
-    uplink: Uplink,
-    queue: Vec<Job, Q>,
-    sent: Option<(u16, Job)>,
-    /// The motions board A accepted (with the legacy number it accepted each under), until
-    /// "command complete", a fault or a mode change. Several at once only where board A runs
-    /// them together (single-module moves in Safed); "command complete" ends them all.
-    running: Vec<(u16, Job), Q>,
-    log: Vec<Entry, K>,
-    last: Option<HeartbeatRepr>,
-    stopped: bool,
-    hk_enabled: bool,
-    hk_interval_ms: u32,
-    hk_next: Option<Instant>,
-    next_poll: Option<Instant>,
-    /// Telemetry: the APID's packet sequence count, and a message type counter per report type
-    /// ([`TmOut::type_index`]).
-    tm_seq: SeqCount,
-    counters: [u16; 16],
 }
 
 /// The gateway for up to `R` robots, `Q` waiting telecommands and `K` remembered keys each.
@@ -370,91 +324,13 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
     /// A telecommand from the ground.
     pub fn tc(&mut self, tc: &Tc) -> Out<M> {
         let mut out = Out::default();
-        let apid = tc.request.apid;
-        let Some(r) =
-            robot_of_apid(apid).and_then(|b| self.robots.iter_mut().find(|r| r.board == b))
-        else {
-            // The CCSDS layer admits only the APIDs of robots served; nothing to answer.
-            return out;
-        };
-        let key = (tc.source_id, tc.request.seq_count);
-        let send = |r: &mut Robot<Q, K>, out: &mut Out<M>, rep: Report, ack: u8| {
-            r.remember(key, rep);
-            r.verify(out, rep, ack, tc.source_id);
-        };
-        let request = match tc.request_of {
-            Ok(q) => q,
-            Err(e) => {
-                let f = Failure {
-                    code: e.code(),
-                    data: 0,
-                };
-                r.verify(
-                    &mut out,
-                    report(Stage::Acceptance, tc.request, Some(f)),
-                    tc.ack,
-                    tc.source_id,
-                );
-                return out;
+        let robot = robot_of_apid(tc.request.apid)
+            .and_then(|b| self.robots.iter_mut().find(|r| r.board == b));
+        // The CCSDS layer admits only the APIDs of robots served; nothing to answer otherwise.
+        if let Some(r) = robot {
+            if let Some(request) = r.admit(tc, &mut out) {
+                r.run(tc, request, &mut out);
             }
-        };
-        if let Some(e) = r.log.iter().find(|e| e.key == key).copied() {
-            if e.request == request {
-                // A copy: not run again; its latest report again, for a ground that lost it.
-                if let Some(rep) = e.last {
-                    r.verify(&mut out, rep, 0xF, tc.source_id);
-                }
-            } else {
-                let f = Failure {
-                    code: KEY_REUSED,
-                    data: u32::from(tc.request.seq_count),
-                };
-                r.verify(
-                    &mut out,
-                    report(Stage::Acceptance, tc.request, Some(f)),
-                    tc.ack,
-                    tc.source_id,
-                );
-            }
-            return out;
-        }
-        if r.log.is_full() {
-            r.log.remove(0);
-        }
-        let _ = r.log.push(Entry {
-            key,
-            request,
-            last: None,
-        });
-        let accepted = report(Stage::Acceptance, tc.request, None);
-        let done = |r: &mut Robot<Q, K>, out: &mut Out<M>| {
-            send(r, out, accepted, tc.ack);
-            send(r, out, report(Stage::Start, tc.request, None), tc.ack);
-            send(r, out, report(Stage::Completion, tc.request, None), tc.ack);
-        };
-        let job = |command, alive| Job {
-            request: tc.request,
-            source_id: tc.source_id,
-            ack: tc.ack,
-            command,
-            alive,
-        };
-        match request {
-            Request::HkEnable => {
-                r.hk_enabled = true;
-                done(r, &mut out);
-            }
-            Request::HkDisable => {
-                r.hk_enabled = false;
-                done(r, &mut out);
-            }
-            Request::HkInterval { ms } => {
-                r.hk_interval_ms = ms;
-                r.hk_next = None;
-                done(r, &mut out);
-            }
-            Request::Function(c) => r.enqueue(&mut out, job(c, false), key),
-            Request::AreYouAlive => r.enqueue(&mut out, job(Command::Heartbeat, true), key),
         }
         out
     }
@@ -503,187 +379,5 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
             r.finished(&mut out, d);
         }
         out
-    }
-}
-
-impl<const Q: usize, const K: usize> Robot<Q, K> {
-    fn apid(&self) -> u16 {
-        robot_apid(self.board)
-    }
-
-    /// Records `rep` as the latest report of the telecommand keyed `key`.
-    fn remember(&mut self, key: (u16, u16), rep: Report) {
-        if let Some(e) = self.log.iter_mut().find(|e| e.key == key) {
-            e.last = Some(rep);
-        }
-    }
-
-    /// Sends an ST\[1\] report: failures always, successes when `ack` asks for the stage.
-    fn verify<const M2: usize>(&self, out: &mut Out<M2>, rep: Report, ack: u8, dest: u16) {
-        let bit = match rep.stage {
-            Stage::Acceptance => 0,
-            Stage::Start => 1,
-            Stage::Completion => 3,
-        };
-        if rep.failure.is_some() || ack & (1 << bit) != 0 {
-            let mut b = [0u8; FAILURE_LEN];
-            let n = rep.emit(&mut b);
-            out.push(TmOut::new(
-                self.apid(),
-                ST_VERIFICATION,
-                rep.subservice(),
-                dest,
-                b.get(..n).unwrap_or(&[]),
-            ));
-        }
-    }
-
-    fn report<const M2: usize>(&mut self, out: &mut Out<M2>, job: &Job, rep: Report) {
-        self.remember((job.source_id, job.request.seq_count), rep);
-        self.verify(out, rep, job.ack, job.source_id);
-    }
-
-    fn enqueue<const M2: usize>(&mut self, out: &mut Out<M2>, job: Job, key: (u16, u16)) {
-        match self.queue.push(job) {
-            Ok(()) => {
-                let rep = report(Stage::Acceptance, job.request, None);
-                self.remember(key, rep);
-                self.verify(out, rep, job.ack, job.source_id);
-            }
-            Err(_) => {
-                let f = Failure {
-                    code: QUEUE_FULL,
-                    data: Q as u32,
-                };
-                let rep = report(Stage::Acceptance, job.request, Some(f));
-                self.remember(key, rep);
-                self.verify(out, rep, job.ack, job.source_id);
-            }
-        }
-    }
-
-    /// The uplink is idle: the next telecommand, else a poll when one is due. Until board A's
-    /// first heartbeat came, telecommands wait in the queue and the gateway polls: ST\[5\]
-    /// events are what changed between two heartbeats, so a command answered by the very
-    /// first one (entering Operational, a fault raised on the way) would change nothing the
-    /// gateway could report (spec/decisions.toml, `pus-gateway`).
-    fn submit_next(&mut self, now: u32, cfg: &Config) {
-        let t = Instant::from_millis(now);
-        if self.last.is_none() && !self.queue.is_empty() {
-            if self.uplink.submit(Command::Heartbeat).is_ok() {
-                self.next_poll = Some(Instant::from_millis(now.wrapping_add(cfg.poll_ms)));
-            }
-            return;
-        }
-        if !self.queue.is_empty() {
-            let job = self.queue.remove(0);
-            if let Ok(seq) = self.uplink.submit(job.command) {
-                if job.command == Command::Stop {
-                    self.stopped = true;
-                }
-                self.sent = Some((seq, job));
-            }
-            return;
-        }
-        let due = cfg.poll_ms > 0 && self.next_poll.is_none_or(|p| t.reached(p));
-        if due && self.uplink.submit(Command::Heartbeat).is_ok() {
-            self.next_poll = Some(Instant::from_millis(now.wrapping_add(cfg.poll_ms)));
-        }
-    }
-
-    /// The uplink finished a command: start (or failure) reports, completion for what does
-    /// not move.
-    fn finished<const M2: usize>(&mut self, out: &mut Out<M2>, d: Done) {
-        let Some((seq, job)) = self.sent else { return };
-        if seq != d.seq {
-            return;
-        }
-        self.sent = None;
-        let req = job.request;
-        match d.outcome {
-            Outcome::Accepted => {
-                self.report(out, &job, report(Stage::Start, req, None));
-                if job.alive {
-                    out.push(TmOut::new(self.apid(), ST_TEST, 2, job.source_id, &[]));
-                }
-                if job.command.kind().moves() {
-                    if self.running.push((seq, job)).is_err() {
-                        // More motions at once than the queue holds: say so, never lose one.
-                        let f = Failure {
-                            code: QUEUE_FULL,
-                            data: Q as u32,
-                        };
-                        self.report(out, &job, report(Stage::Completion, req, Some(f)));
-                    }
-                } else {
-                    self.report(out, &job, report(Stage::Completion, req, None));
-                }
-            }
-            Outcome::Refused(r) => {
-                self.report(
-                    out,
-                    &job,
-                    report(Stage::Start, req, Some(Failure::refused(r))),
-                );
-            }
-            Outcome::Unacknowledged => {
-                let f = Failure {
-                    code: UNACKNOWLEDGED,
-                    data: u32::from(d.attempts),
-                };
-                self.report(out, &job, report(Stage::Start, req, Some(f)));
-            }
-        }
-    }
-
-    /// The running motions: complete, failed by a fault, or abandoned by a mode change. Only a
-    /// heartbeat that answers a command sent after the latest of them counts: one delayed from
-    /// before (or the answer to a copy, numbered 0) says nothing of them.
-    fn progress<const M2: usize>(
-        &mut self,
-        out: &mut Out<M2>,
-        prev: &HeartbeatRepr,
-        hb: &HeartbeatRepr,
-    ) {
-        let Some(&(newest, _)) = self.running.last() else {
-            return;
-        };
-        if hb.last_seq == 0 || hb.last_seq.wrapping_sub(newest) >= 0x8000 {
-            return;
-        }
-        let raised = Faults::from_iter(hb.faults.iter().filter(|f| !prev.faults.contains(*f)));
-        // A fault deferred to the motion's end (Table 8: low battery, assembly system) lets
-        // the motion complete; its ST[5] event reports it. Any other fails the motion.
-        let stopping = raised
-            .iter()
-            .find(|f| !crate::safety::policy::fault_action(*f).deferred);
-        // "Command complete" before the mode: a deferred fault takes the robot to its mode in
-        // the very tick the motion completes, so the completing heartbeat shows both.
-        let failure = match stopping {
-            Some(f) => Some(Failure::fault(f, hb.faults)),
-            None if hb.command_complete => None,
-            None if hb.mode != prev.mode => Some(Failure {
-                code: ABANDONED,
-                data: u32::from(hb.mode.to_wire()),
-            }),
-            None => return,
-        };
-        for (_, job) in core::mem::take(&mut self.running) {
-            self.report(out, &job, report(Stage::Completion, job.request, failure));
-        }
-    }
-
-    fn housekeeping<const M2: usize>(&mut self, now: u32, out: &mut Out<M2>) {
-        let t = Instant::from_millis(now);
-        let due = self.hk_next.is_none_or(|n| t.reached(n));
-        if !self.hk_enabled || !due {
-            return;
-        }
-        if let Some(hb) = self.last {
-            let mut b = [0u8; REPORT_LEN];
-            housekeeping::emit(&hb, &mut b);
-            out.push(TmOut::new(self.apid(), ST_HOUSEKEEPING, 25, 0, &b));
-            self.hk_next = Some(Instant::from_millis(now.wrapping_add(self.hk_interval_ms)));
-        }
     }
 }

@@ -1,13 +1,13 @@
 //! What the ground's plan runner ([`plan_runner`](super::plan_runner)) sends its commands
 //! through: one command outstanding at a time, numbered, resent until answered. The legacy
 //! [`Uplink`] (the paper's 14-byte commands, heartbeats back) is one [`Link`]; the PUS
-//! [`TcLink`](super::pus_ground::TcLink) (telecommands to the gateway) is the other. The
+//! [`TcLink`](super::pus::TcLink) (telecommands to the gateway) is the other. The
 //! trait lives apart from both links and from the runner, so that each imports it and none
 //! imports another.
 //!
 //! ```
-//! use mmic::node::ground::{Config, Uplink};
-//! use mmic::node::ground_link::Link;
+//! use mmic::node::exactly_once::uplink::{Config, Uplink};
+//! use mmic::node::ground::link::Link;
 //! use mmic::command::Command;
 //! use mmic::mode::Mode;
 //! use mmic::units::BoardNumber;
@@ -17,10 +17,10 @@
 //! assert_eq!(Link::tick(&mut up, 0).send.map(|c| c.seq), Some(seq));
 //! ```
 
-use super::ground::{Done, Uplink};
 use crate::command::Command;
 use crate::faults::Faults;
 use crate::mode::Mode;
+use crate::node::exactly_once::uplink::{Done, Uplink};
 use crate::wire::command::CommandRepr;
 
 /// How a started motion ended, as a link that reports it says ([`Link::POLLS`] false: the
@@ -68,7 +68,7 @@ impl<P> Default for LinkTick<P> {
 
 /// What the plan runner sends its commands through: one command outstanding at a time,
 /// numbered, resent until answered. The legacy [`Uplink`] (14-byte commands, heartbeats back)
-/// and the PUS [`TcLink`](super::pus_ground::TcLink) (telecommands to the gateway, ST\[1\]/ST\[3\]/ST\[5\] back).
+/// and the PUS [`TcLink`](super::pus::TcLink) (telecommands to the gateway, ST\[1\]/ST\[3\]/ST\[5\] back).
 pub trait Link {
     /// What goes out for one command.
     type Packet: Copy;

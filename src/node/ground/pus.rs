@@ -1,7 +1,7 @@
 //! The ground's telecommand link over PUS: the plan runner's commands as PUS-C telecommands
-//! to the server board acting as gateway ([`super::gateway`]), and its telemetry read back
+//! to the server board acting as gateway ([`gateway`](crate::node::server::gateway)), and its telemetry read back
 //! into what the runner waits for — the start of each command, the completion of each
-//! motion, the robot's status. The PUS counterpart of the legacy [`super::ground::Uplink`];
+//! motion, the robot's status. The PUS counterpart of the legacy [`Uplink`](crate::node::exactly_once::uplink::Uplink);
 //! [`super::plan_runner::PlanRunner`] drives either ([`super::plan_runner::Link`]).
 //!
 //! Each command becomes a TC(8,1) function (TC(17,1) are-you-alive for a heartbeat request)
@@ -21,9 +21,9 @@
 //!
 //! ```
 //! use mmic::command::Command;
-//! use mmic::node::ground::Outcome;
-//! use mmic::node::plan_runner::Link;
-//! use mmic::node::pus_ground::{Config, TcLink};
+//! use mmic::node::exactly_once::uplink::Outcome;
+//! use mmic::node::ground::plan_runner::Link;
+//! use mmic::node::ground::pus::{Config, TcLink};
 //! use mmic::pus::verification::{Report, Stage};
 //! use mmic::units::BoardNumber;
 //!
@@ -31,7 +31,7 @@
 //! let seq = link.submit(Command::Stop).unwrap();
 //! let tc = link.tick(0).send.unwrap();
 //! assert_eq!((tc.request.apid, tc.request.seq_count, tc.command), (0x101, seq, Command::Stop));
-//! let mut bytes = [0u8; mmic::node::pus_ground::MAX_TC_LEN];
+//! let mut bytes = [0u8; mmic::node::ground::pus::MAX_TC_LEN];
 //! let n = tc.emit(&mut bytes).unwrap();
 //! assert_eq!(mmic::pus::read_tc(&bytes[..n], &[0x101]).unwrap().0.header.service, 8);
 //! let start = Report { stage: Stage::Start, request: tc.request, failure: None };
@@ -40,8 +40,7 @@
 //! assert!(link.is_idle());
 //! ```
 
-use super::ground::{Done, Efficiency, Outcome};
-use super::ground_link::{Link, LinkTick, MotionEnd};
+use super::link::{Link, LinkTick, MotionEnd};
 use crate::ccsds::primary::{Apid, SeqCount};
 use crate::ccsds::tc::{TcRepr, TC_MIN_LEN};
 use crate::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
@@ -49,6 +48,7 @@ use crate::ccsds::EmitError;
 use crate::command::Command;
 use crate::faults::Faults;
 use crate::mode::Mode;
+use crate::node::exactly_once::uplink::{Done, Efficiency, Outcome};
 use crate::pus::function::{self, FunctionError};
 use crate::pus::housekeeping;
 use crate::pus::request::{ST_EVENT, ST_FUNCTION, ST_HOUSEKEEPING, ST_TEST, ST_VERIFICATION};

@@ -21,7 +21,7 @@
 //!
 //! ```
 //! use mmic::command::Command;
-//! use mmic::node::server::{Accepted, Server};
+//! use mmic::node::server::relay::{Accepted, Server};
 //! use mmic::units::BoardNumber;
 //! use mmic::wire::command::CommandRepr;
 //!

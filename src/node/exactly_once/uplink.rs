@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use mmic::command::Command;
-//! use mmic::node::ground::{Config, Outcome, Uplink};
+//! use mmic::node::exactly_once::uplink::{Config, Outcome, Uplink};
 //! use mmic::units::BoardNumber;
 //! use mmic::wire::heartbeat::HeartbeatRepr;
 //!
