@@ -335,7 +335,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
             let text = if ccsdspy {
                 xtce::ccsdspy_csv()
             } else {
-                xtce::generate().map_err(CliError::Spec)?
+                xtce::generate()?
             };
             write!(out, "{text}").map_err(CliError::Output)?;
         }

@@ -27,9 +27,9 @@ pub enum CliError {
     /// A PUS-C packet was refused, or its JSON is bad.
     #[error(transparent)]
     Pus(#[from] crate::pus::PusCodecError),
-    /// A table of spec/ could not be turned into the XTCE (a row without a name).
-    #[error("spec/: {0}")]
-    Spec(String),
+    /// spec/ could not be turned into the XTCE mission database.
+    #[error(transparent)]
+    Xtce(#[from] crate::xtce::XtceError),
     /// A page could not be written.
     #[error("cannot write {}: {source}", path.display())]
     Write {
@@ -97,7 +97,7 @@ impl CliError {
         match self {
             CliError::Codec(e) => e.exit_code(),
             CliError::Pus(e) => e.exit_code(),
-            CliError::Spec(_) | CliError::Usage(_) => EXIT_INPUT,
+            CliError::Xtce(_) | CliError::Usage(_) => EXIT_INPUT,
             CliError::UnknownKind { .. } | CliError::UnknownState { .. } => EXIT_INPUT,
             CliError::Plan { .. } | CliError::Inject(_) => EXIT_INPUT,
             CliError::Incomplete(_)

@@ -277,69 +277,79 @@ pub fn hk_stream() -> Vec<(Vec<u8>, Value)> {
 /// Packets, each with a line saying what it is.
 pub type Labelled = Vec<(String, Vec<u8>)>;
 
+/// The session's first TCs, each given its second to be answered: (time ms, what, TC JSON).
+const COMMANDS: [(u32, &str, &str); 7] = [
+    (
+        1000,
+        "are-you-alive",
+        r#"{"seq_count":1,"source_id":7,"service":17,"subservice":1}"#,
+    ),
+    (
+        3000,
+        "reconfiguration refused in standby",
+        r#"{"seq_count":2,"source_id":7,"function":"reconfiguration","args":{"initial":"a","target":"m"}}"#,
+    ),
+    (
+        5000,
+        "mode operational",
+        r#"{"seq_count":3,"source_id":7,"function":"mode","args":{"mode":2}}"#,
+    ),
+    (
+        7000,
+        "reconfiguration",
+        r#"{"seq_count":4,"source_id":7,"function":"reconfiguration","args":{"initial":"a","target":"m"}}"#,
+    ),
+    (
+        9000,
+        "hk interval",
+        r#"{"seq_count":5,"source_id":7,"service":3,"subservice":31,"interval_ms":500}"#,
+    ),
+    (
+        11000,
+        "hk disable",
+        r#"{"seq_count":6,"source_id":7,"service":3,"subservice":6}"#,
+    ),
+    (
+        13000,
+        "hk enable",
+        r#"{"seq_count":7,"source_id":7,"service":3,"subservice":5}"#,
+    ),
+];
+
+/// A motion that a fault ends (TM(1,8)), with the fault (5,4) and mode change events.
+const PRIMITIVE: &str = r#"{"seq_count":9,"source_id":7,"function":"primitive","args":{"primitive":4,"final_state":"d"}}"#;
+
+/// Sends `json` at `now` (recorded in `tcs` as `what`) and runs the bench for a second.
+fn step(b: &mut Bench, now: u32, what: &str, json: &str, tcs: &mut Labelled) {
+    let p = tc(json);
+    let _ = b.tc(now, &p);
+    tcs.push((what.to_string(), p));
+    b.run(now, now + 1000);
+}
+
 /// Every kind of TM the gateway emits, from one scripted session: TM(1,1/2/3/4/7/8), (3,25),
 /// (5,1..4), (17,2). Returns (what, packet) in order.
 pub fn session() -> (Labelled, Labelled) {
     let mut b = Bench::new(1000, 300);
     let mut tcs = Vec::new();
-    let step =
-        |b: &mut Bench, now: u32, what: &str, json: &str, tcs: &mut Vec<(String, Vec<u8>)>| {
-            let p = tc(json);
-            let _ = b.tc(now, &p);
-            tcs.push((what.to_string(), p));
-            b.run(now, now + 1000);
-        };
     b.run(0, 500);
-    step(
-        &mut b,
-        1000,
-        "are-you-alive",
-        r#"{"seq_count":1,"source_id":7,"service":17,"subservice":1}"#,
-        &mut tcs,
-    );
-    step(
-        &mut b,
-        3000,
-        "reconfiguration refused in standby",
-        r#"{"seq_count":2,"source_id":7,"function":"reconfiguration","args":{"initial":"a","target":"m"}}"#,
-        &mut tcs,
-    );
-    step(
-        &mut b,
-        5000,
-        "mode operational",
-        r#"{"seq_count":3,"source_id":7,"function":"mode","args":{"mode":2}}"#,
-        &mut tcs,
-    );
-    step(
-        &mut b,
-        7000,
-        "reconfiguration",
-        r#"{"seq_count":4,"source_id":7,"function":"reconfiguration","args":{"initial":"a","target":"m"}}"#,
-        &mut tcs,
-    );
-    step(
-        &mut b,
-        9000,
-        "hk interval",
-        r#"{"seq_count":5,"source_id":7,"service":3,"subservice":31,"interval_ms":500}"#,
-        &mut tcs,
-    );
-    step(
-        &mut b,
-        11000,
-        "hk disable",
-        r#"{"seq_count":6,"source_id":7,"service":3,"subservice":6}"#,
-        &mut tcs,
-    );
-    step(
-        &mut b,
-        13000,
-        "hk enable",
-        r#"{"seq_count":7,"source_id":7,"service":3,"subservice":5}"#,
-        &mut tcs,
-    );
-    // A TC whose function does not exist: refused at acceptance (TM(1,2)).
+    for (now, what, json) in COMMANDS {
+        step(&mut b, now, what, json, &mut tcs);
+    }
+    unknown_function(&mut b, &mut tcs);
+    step(&mut b, 16000, "primitive", PRIMITIVE, &mut tcs);
+    bolting_attempts(&mut b);
+    motion_ended_by_fault(&mut b, &mut tcs);
+    let tms =
+        b.tm.iter()
+            .map(|(t, p)| (format!("t={t} ms"), p.clone()))
+            .collect();
+    (tms, tcs)
+}
+
+/// A TC whose function does not exist (its ID patched, its CRC redone): refused at acceptance
+/// (TM(1,2)).
+fn unknown_function(b: &mut Bench, tcs: &mut Labelled) {
     let mut bad = tc(r#"{"seq_count":8,"source_id":7,"function":"stop"}"#);
     if let Some(id) = bad.get_mut(11) {
         *id = 13;
@@ -350,43 +360,29 @@ pub fn session() -> (Labelled, Labelled) {
     let _ = b.tc(15000, &bad);
     tcs.push(("unknown function (refused)".into(), bad));
     b.run(15000, 15500);
-    // A motion that a fault ends (TM(1,8)), with the fault (5,4) and mode change events.
-    step(
-        &mut b,
-        16000,
-        "primitive",
-        r#"{"seq_count":9,"source_id":7,"function":"primitive","args":{"primitive":4,"final_state":"d"}}"#,
-        &mut tcs,
-    );
+}
+
+/// Bolting attempts on pair 2: attempt 1 running, then 2 (1 failed: (5,2)), then done ((5,1)).
+fn bolting_attempts(b: &mut Bench) {
     let hb = b.board.hb;
-    // Bolting attempts on pair 2: attempt 1 running, then 2 (1 failed: (5,2)), then done ((5,1)).
     let attempt = |n| BolterAttempt::new(n).unwrap_or(BolterAttempt::NONE);
     let pair = BolterPair::ALL.get(1).copied();
-    b.set(
-        18000,
-        HeartbeatRepr {
-            active_bolter: pair,
-            bolter_attempt: attempt(1),
-            ..hb
-        },
-    );
-    b.set(
-        18100,
-        HeartbeatRepr {
-            active_bolter: pair,
-            bolter_attempt: attempt(2),
-            ..hb
-        },
-    );
-    b.set(
-        18200,
-        HeartbeatRepr {
-            active_bolter: None,
-            bolter_attempt: attempt(0),
-            ..hb
-        },
-    );
-    // A motion accepted, then a high-severity fault safes the robot: (5,4), (5,1), (1,8).
+    for (now, active_bolter, n) in [(18000, pair, 1), (18100, pair, 2), (18200, None, 0)] {
+        let bolter_attempt = attempt(n);
+        b.set(
+            now,
+            HeartbeatRepr {
+                active_bolter,
+                bolter_attempt,
+                ..hb
+            },
+        );
+    }
+}
+
+/// A motion accepted, then a high-severity fault safes the robot: (5,4), (5,1), (1,8); then a
+/// deferred fault (medium severity, (5,3)), and every fault cleared ((5,1)).
+fn motion_ended_by_fault(b: &mut Bench, tcs: &mut Labelled) {
     let p = tc(
         r#"{"seq_count":10,"source_id":7,"function":"reconfiguration","args":{"initial":"m","target":"a"}}"#,
     );
@@ -418,11 +414,6 @@ pub fn session() -> (Labelled, Labelled) {
         },
     );
     b.run(20300, 21500);
-    let tms =
-        b.tm.iter()
-            .map(|(t, p)| (format!("t={t} ms"), p.clone()))
-            .collect();
-    (tms, tcs)
 }
 
 /// Writes the fixtures into `dir`: `tm.jsonl` and `tc.jsonl` (each line `{"what","hex",

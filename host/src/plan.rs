@@ -988,6 +988,7 @@ const PRIMITIVE: &str = "a primitive number 1..=8 or a Table 6 name";
 const STATE: &str = "a state letter a..o (Table 5)";
 const DURATION: &str = "a duration with unit ms or s (e.g. 500ms, 1.5s)";
 
+/// One step of a plan: its keyword `first`, then its arguments from `cur`.
 fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Parsed, PlanError> {
     let kw = first.text.to_ascii_lowercase();
     let cmd = match kw.as_str() {
@@ -996,110 +997,16 @@ fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Parsed, PlanError
         "reset" => Command::Reset,
         "system-fault" => Command::SystemFault,
         "clear-faults" => Command::ClearFaults,
-        "mode" => {
-            const MODES: &str = "a mode: standby, operational or safed";
-            let t = cur.next("mode", MODES)?;
-            let m = Mode::ALL
-                .into_iter()
-                .find(|m| m.name().eq_ignore_ascii_case(t.text))
-                .ok_or_else(|| cur.bad(t, MODES))?;
-            Command::Mode(m)
-        }
-        "arm" | "gripper" => {
-            let step = if kw == "arm" { "arm" } else { "gripper" };
-            let side = side(cur, step)?;
-            let target = servo_target(cur, step)?;
-            if step == "arm" {
-                Command::Arm { side, target }
-            } else {
-                Command::Gripper { side, target }
-            }
-        }
+        "mode" => mode_step(cur)?,
+        "arm" => servo_step(cur, "arm")?,
+        "gripper" => servo_step(cur, "gripper")?,
         "hip" => Command::Hip(hip_target(cur)?),
-        "bolt" | "unbolt" => {
-            let step = if kw == "bolt" { "bolt" } else { "unbolt" };
-            let t = cur.next(step, PAIR)?;
-            let which = if t.text.eq_ignore_ascii_case("all") {
-                Fasteners::All
-            } else {
-                let n = cur.integer(t, PAIR)?;
-                u8::try_from(n)
-                    .ok()
-                    .and_then(BolterPair::from_number)
-                    .map(Fasteners::Pair)
-                    .ok_or_else(|| cur.out_of_range(t, "bolter pair", "1", "4"))?
-            };
-            Command::Bolter(if step == "bolt" {
-                BolterCommand::Bolt(which)
-            } else {
-                BolterCommand::Unbolt(which)
-            })
-        }
-        "bolters" => {
-            let t = cur.next("bolters", "down")?;
-            if !t.text.eq_ignore_ascii_case("down") {
-                return Err(cur.bad(t, "down"));
-            }
-            Command::Bolter(BolterCommand::Down)
-        }
-        "primitive" => {
-            let t = cur.next("primitive", PRIMITIVE)?;
-            let by_name = Primitive::ALL
-                .into_iter()
-                .find(|p| p.name().eq_ignore_ascii_case(t.text));
-            let p = match by_name {
-                Some(p) => p,
-                None => {
-                    let n = cur.integer(t, PRIMITIVE)?;
-                    u8::try_from(n)
-                        .ok()
-                        .and_then(Primitive::from_number)
-                        .ok_or_else(|| cur.out_of_range(t, "primitive", "1", "8"))?
-                }
-            };
-            // The final state: `-> s` or `s`; none, to be filled in from the plan's state.
-            if cur.tokens.get(cur.next).is_some_and(|t| t.text == "->") {
-                cur.next += 1;
-            } else if cur.tokens.get(cur.next).is_none() {
-                return Ok(Parsed::BarePrimitive(p));
-            }
-            let target_tok = cur.tokens.get(cur.next).copied();
-            let target = state_token(cur, "primitive")?;
-            Command::primitive(p, target).map_err(|e| {
-                let at = target_tok.unwrap_or(t);
-                cur.error_at(&at, PlanErrorKind::Primitive(e))
-            })?
-        }
-        "reconfigure" => {
-            let initial = state(cur)?;
-            let arrow = cur.next("reconfigure", "`->` and a target state")?;
-            if arrow.text != "->" {
-                return Err(cur.bad(arrow, "`->`"));
-            }
-            let target_tok = cur.tokens.get(cur.next).copied();
-            let target = state(cur)?;
-            Command::reconfigure(initial, target).map_err(|e| {
-                let at = target_tok.unwrap_or(arrow);
-                cur.error_at(&at, PlanErrorKind::Reconfiguration(e))
-            })?
-        }
-        "power" => {
-            let t = cur.next("power", "on or off")?;
-            let on = match t.text.to_ascii_lowercase().as_str() {
-                "on" => true,
-                "off" => false,
-                _ => return Err(cur.bad(t, "on or off")),
-            };
-            let t = cur.next("power", POWER_TARGETS)?;
-            let target = if t.text.eq_ignore_ascii_case("all") {
-                PowerTarget::All
-            } else {
-                PowerTarget::Module(
-                    module_from_keyword(t.text).ok_or_else(|| cur.bad(t, POWER_TARGETS))?,
-                )
-            };
-            Command::Power { target, on }
-        }
+        "bolt" => bolt_step(cur, "bolt")?,
+        "unbolt" => bolt_step(cur, "unbolt")?,
+        "bolters" => bolters_step(cur)?,
+        "primitive" => return primitive_step(cur),
+        "reconfigure" => reconfigure_step(cur)?,
+        "power" => power_step(cur)?,
         "wait" => return wait(cur).map(Parsed::Action),
         _ => {
             return Err(cur.error_at(
@@ -1111,6 +1018,121 @@ fn step(cur: &mut Cursor<'_, '_>, first: &Token<'_>) -> Result<Parsed, PlanError
         }
     };
     Ok(Parsed::Action(Action::Command(cmd)))
+}
+
+/// `mode standby|operational|safed`.
+fn mode_step(cur: &mut Cursor<'_, '_>) -> Result<Command, PlanError> {
+    const MODES: &str = "a mode: standby, operational or safed";
+    let t = cur.next("mode", MODES)?;
+    let m = Mode::ALL
+        .into_iter()
+        .find(|m| m.name().eq_ignore_ascii_case(t.text))
+        .ok_or_else(|| cur.bad(t, MODES))?;
+    Ok(Command::Mode(m))
+}
+
+/// `arm|gripper SIDE TARGET` (`step` is which).
+fn servo_step(cur: &mut Cursor<'_, '_>, step: &'static str) -> Result<Command, PlanError> {
+    let side = side(cur, step)?;
+    let target = servo_target(cur, step)?;
+    Ok(if step == "arm" {
+        Command::Arm { side, target }
+    } else {
+        Command::Gripper { side, target }
+    })
+}
+
+/// `bolt|unbolt PAIR|all` (`step` is which).
+fn bolt_step(cur: &mut Cursor<'_, '_>, step: &'static str) -> Result<Command, PlanError> {
+    let t = cur.next(step, PAIR)?;
+    let which = if t.text.eq_ignore_ascii_case("all") {
+        Fasteners::All
+    } else {
+        let n = cur.integer(t, PAIR)?;
+        u8::try_from(n)
+            .ok()
+            .and_then(BolterPair::from_number)
+            .map(Fasteners::Pair)
+            .ok_or_else(|| cur.out_of_range(t, "bolter pair", "1", "4"))?
+    };
+    Ok(Command::Bolter(if step == "bolt" {
+        BolterCommand::Bolt(which)
+    } else {
+        BolterCommand::Unbolt(which)
+    }))
+}
+
+/// `bolters down`.
+fn bolters_step(cur: &mut Cursor<'_, '_>) -> Result<Command, PlanError> {
+    let t = cur.next("bolters", "down")?;
+    if !t.text.eq_ignore_ascii_case("down") {
+        return Err(cur.bad(t, "down"));
+    }
+    Ok(Command::Bolter(BolterCommand::Down))
+}
+
+/// `primitive N|NAME [->] STATE`, or without the state: a bare primitive whose final state the
+/// plan's state fills in.
+fn primitive_step(cur: &mut Cursor<'_, '_>) -> Result<Parsed, PlanError> {
+    let t = cur.next("primitive", PRIMITIVE)?;
+    let by_name = Primitive::ALL
+        .into_iter()
+        .find(|p| p.name().eq_ignore_ascii_case(t.text));
+    let p = match by_name {
+        Some(p) => p,
+        None => {
+            let n = cur.integer(t, PRIMITIVE)?;
+            u8::try_from(n)
+                .ok()
+                .and_then(Primitive::from_number)
+                .ok_or_else(|| cur.out_of_range(t, "primitive", "1", "8"))?
+        }
+    };
+    // The final state: `-> s` or `s`; none, to be filled in from the plan's state.
+    if cur.tokens.get(cur.next).is_some_and(|t| t.text == "->") {
+        cur.next += 1;
+    } else if cur.tokens.get(cur.next).is_none() {
+        return Ok(Parsed::BarePrimitive(p));
+    }
+    let target_tok = cur.tokens.get(cur.next).copied();
+    let target = state_token(cur, "primitive")?;
+    let cmd = Command::primitive(p, target).map_err(|e| {
+        let at = target_tok.unwrap_or(t);
+        cur.error_at(&at, PlanErrorKind::Primitive(e))
+    })?;
+    Ok(Parsed::Action(Action::Command(cmd)))
+}
+
+/// `reconfigure STATE -> STATE`.
+fn reconfigure_step(cur: &mut Cursor<'_, '_>) -> Result<Command, PlanError> {
+    let initial = state(cur)?;
+    let arrow = cur.next("reconfigure", "`->` and a target state")?;
+    if arrow.text != "->" {
+        return Err(cur.bad(arrow, "`->`"));
+    }
+    let target_tok = cur.tokens.get(cur.next).copied();
+    let target = state(cur)?;
+    Command::reconfigure(initial, target).map_err(|e| {
+        let at = target_tok.unwrap_or(arrow);
+        cur.error_at(&at, PlanErrorKind::Reconfiguration(e))
+    })
+}
+
+/// `power on|off MODULE|all`.
+fn power_step(cur: &mut Cursor<'_, '_>) -> Result<Command, PlanError> {
+    let t = cur.next("power", "on or off")?;
+    let on = match t.text.to_ascii_lowercase().as_str() {
+        "on" => true,
+        "off" => false,
+        _ => return Err(cur.bad(t, "on or off")),
+    };
+    let t = cur.next("power", POWER_TARGETS)?;
+    let target = if t.text.eq_ignore_ascii_case("all") {
+        PowerTarget::All
+    } else {
+        PowerTarget::Module(module_from_keyword(t.text).ok_or_else(|| cur.bad(t, POWER_TARGETS))?)
+    };
+    Ok(Command::Power { target, on })
 }
 
 fn side(cur: &mut Cursor<'_, '_>, step: &'static str) -> Result<Side, PlanError> {

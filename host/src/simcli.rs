@@ -43,6 +43,19 @@ slowest node, so a busy host slows the run down instead of making the firmware's
 Before anything is sent, the plan is checked against the robot's state, from its `start` line
 (`a` if none).";
 
+/// `mmic sim --help`'s part on `--summary-json`; [`summary_json_help`] puts the library's
+/// refusal names in place of `REFUSALS`.
+const SUMMARY_JSON_HELP: &str = r#"--summary-json FILE writes one JSON object when the run ends:
+  {"completed": false, "mode": "safed", "faults": ["bolter-overcurrent"],
+   "refusals": ["not_allowed_in_mode"], "exit": 1}
+completed: every step of the plan done. mode: standby, safed or operational, as the robot
+last reported it (the last heartbeat the ground received). faults: the Table 8 faults board A
+raised, in the order raised, each once, by their --inject names (a module's idle-check and
+operational-check overcurrent bits are both that module's name). refusals: every command
+board A refused, in order, by the names of spec/modes.toml [refusals]:
+  REFUSALS.
+exit: the exit code this run of mmic sim returns."#;
+
 /// `mmic sim --help`'s part on `--summary-json`, with the refusal names of the library
 /// (spec/modes.toml `[refusals]`).
 pub fn summary_json_help() -> String {
@@ -50,20 +63,7 @@ pub fn summary_json_help() -> String {
         .iter()
         .map(|r| r.name())
         .collect();
-    format!(
-        "\
---summary-json FILE writes one JSON object when the run ends:
-  {{\"completed\": false, \"mode\": \"safed\", \"faults\": [\"bolter-overcurrent\"],
-   \"refusals\": [\"not_allowed_in_mode\"], \"exit\": 1}}
-completed: every step of the plan done. mode: standby, safed or operational, as the robot
-last reported it (the last heartbeat the ground received). faults: the Table 8 faults board A
-raised, in the order raised, each once, by their --inject names (a module's idle-check and
-operational-check overcurrent bits are both that module's name). refusals: every command
-board A refused, in order, by the names of spec/modes.toml [refusals]:
-  {}.
-exit: the exit code this run of mmic sim returns.",
-        refusals.join(", ")
-    )
+    SUMMARY_JSON_HELP.replace("REFUSALS", &refusals.join(", "))
 }
 
 /// `mmic sim --help`'s description, with every injection and what it does.

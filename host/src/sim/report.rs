@@ -327,10 +327,38 @@ fn mismatch(s: &Summary, step: usize) -> String {
     format!("{expected}; {reported}")
 }
 
-/// The summary as text.
+/// The summary as text: one line per aspect of the run, each from a function below.
 pub fn text(s: &Summary) -> String {
     let mut t = String::new();
     let _ = writeln!(t, "{}", plan_line(s));
+    time_line(&mut t, s);
+    if s.protocol == super::Protocol::Pus {
+        pus_lines(&mut t, s);
+    }
+    attempts_lines(&mut t, s);
+    clock_line(&mut t, s);
+    commands_line(&mut t, s);
+    injected_line(&mut t, s);
+    let b = bolting(s);
+    let _ = writeln!(
+        t,
+        "bolting: {} pairs; first attempt {}, second {}, third {}, failed {}",
+        b.iter().sum::<u64>(),
+        b[0],
+        b[1],
+        b[2],
+        b[3]
+    );
+    let _ = writeln!(
+        t,
+        "robot: mode {}, state {}, faults {}",
+        s.status["mode"], s.status["state"], s.status["faults"]
+    );
+    t
+}
+
+/// Simulated against wall time, and their ratio.
+fn time_line(t: &mut String, s: &Summary) {
     let _ = writeln!(
         t,
         "time: {:.1} s simulated in {:.1} s wall ({:.1}x)",
@@ -338,27 +366,34 @@ pub fn text(s: &Summary) -> String {
         s.wall.as_secs_f64(),
         s.sim_ms as f64 / 1000.0 / s.wall.as_secs_f64().max(1e-9)
     );
-    let (ok, n) = s.attempts;
-    if s.protocol == super::Protocol::Pus {
+}
+
+/// With `--protocol pus`: the ground link, and how many packets of each service crossed it.
+fn pus_lines(t: &mut String, s: &Summary) {
+    let _ = writeln!(
+        t,
+        "protocol: pus -- PUS-C telecommands and telemetry {} between the ground and the \
+         server board (the PUS gateway); legacy commands to board A",
+        if s.realtime {
+            "over UDP on loopback"
+        } else {
+            "over a simulated datagram link"
+        }
+    );
+    if let Some(c) = pus_counts(s) {
         let _ = writeln!(
             t,
-            "protocol: pus -- PUS-C telecommands and telemetry {} between the ground and the \
-             server board (the PUS gateway); legacy commands to board A",
-            if s.realtime {
-                "over UDP on loopback"
-            } else {
-                "over a simulated datagram link"
-            }
+            "pus: {} TC sent ({} telecommands, the rest resends and queries; {} lost), \
+             {} TM ({} lost): {} ST[1], {} ST[3] housekeeping, {} ST[5] events, {} ST[17]",
+            c.tc, c.tc_keys, c.tc_lost, c.tm, c.tm_lost, c.st1, c.st3, c.st5, c.st17
         );
-        if let Some(c) = pus_counts(s) {
-            let _ = writeln!(
-                t,
-                "pus: {} TC sent ({} telecommands, the rest resends and queries; {} lost), \
-                 {} TM ({} lost): {} ST[1], {} ST[3] housekeeping, {} ST[5] events, {} ST[17]",
-                c.tc, c.tc_keys, c.tc_lost, c.tm, c.tm_lost, c.st1, c.st3, c.st5, c.st17
-            );
-        }
     }
+}
+
+/// How many attempts were answered in time, and, with WiFi loss, what loss predicts and what
+/// this run lost.
+fn attempts_lines(t: &mut String, s: &Summary) {
+    let (ok, n) = s.attempts;
     let _ = writeln!(
         t,
         "{}: {ok}/{n} attempts answered within the timeout ({:.1}%), longest answer {} ms",
@@ -404,6 +439,10 @@ pub fn text(s: &Summary) -> String {
             s.visit_ms
         );
     }
+}
+
+/// Virtual time's guarantee, or how late the real-time run's ticks started.
+fn clock_line(t: &mut String, s: &Summary) {
     let held = if s.held_ms > 0 {
         format!("; the clock waited {} ms for slow nodes", s.held_ms)
     } else {
@@ -430,6 +469,10 @@ pub fn text(s: &Summary) -> String {
             }
         );
     }
+}
+
+/// How many commands board A executed, answered as copies, or (wrongly) executed twice.
+fn commands_line(t: &mut String, s: &Summary) {
     let executed = s.events("executed").count();
     let dups = s.events("duplicate").count() + s.events("stale").count();
     let twice = executed_twice(s);
@@ -438,6 +481,10 @@ pub fn text(s: &Summary) -> String {
         "commands: {executed} executed by board A, {dups} copies answered without running, {} executed twice",
         twice.len()
     );
+}
+
+/// The injections into robot 1 and the Table 8 faults they raised (nothing when none).
+fn injected_line(t: &mut String, s: &Summary) {
     let injected: Vec<String> = s
         .events("inject")
         .filter(|e| e["event"]["robot"] == 1)
@@ -460,22 +507,6 @@ pub fn text(s: &Summary) -> String {
             }
         );
     }
-    let b = bolting(s);
-    let _ = writeln!(
-        t,
-        "bolting: {} pairs; first attempt {}, second {}, third {}, failed {}",
-        b.iter().sum::<u64>(),
-        b[0],
-        b[1],
-        b[2],
-        b[3]
-    );
-    let _ = writeln!(
-        t,
-        "robot: mode {}, state {}, faults {}",
-        s.status["mode"], s.status["state"], s.status["faults"]
-    );
-    t
 }
 
 /// The Figure 11 analogue: robot 1's efficiency over its last 100 attempts against simulated

@@ -8,3 +8,4 @@ mod pages;
 mod plan;
 mod plot;
 mod pus;
+mod xtce;

@@ -537,3 +537,113 @@ fn a_time_series_ends_at_its_data_with_headroom_and_a_legend() {
     );
     assert!(texts(&svg).contains(&"robot 1"));
 }
+
+/// (element name, its direct text) of every element of `svg`, read by quick-xml (a full XML
+/// parser: end tags must match, attributes must be well-formed, entities known).
+fn parsed(svg: &str) -> Vec<(String, String)> {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_str(svg);
+    let (mut out, mut open): (Vec<(String, String)>, Vec<usize>) = (Vec::new(), Vec::new());
+    loop {
+        match reader.read_event().unwrap_or_else(|e| panic!("{e}: {svg}")) {
+            Event::Start(e) => {
+                open.push(out.len());
+                out.push((
+                    String::from_utf8_lossy(e.name().as_ref()).into(),
+                    String::new(),
+                ));
+            }
+            Event::Empty(e) => {
+                for a in e.attributes() {
+                    a.unwrap_or_else(|err| panic!("{err}: {svg}"));
+                }
+                out.push((
+                    String::from_utf8_lossy(e.name().as_ref()).into(),
+                    String::new(),
+                ));
+            }
+            Event::End(_) => {
+                open.pop().expect("balanced");
+            }
+            Event::Text(t) => {
+                let text = t.decode().unwrap();
+                match open.last() {
+                    Some(&i) => out[i].1 += &text,
+                    None => assert!(text.trim().is_empty(), "text outside the root: {text:?}"),
+                }
+            }
+            Event::GeneralRef(r) => {
+                let name = r.decode().unwrap();
+                let c = quick_xml::escape::resolve_predefined_entity(&name).expect("known entity");
+                let i = *open.last().expect("entity inside the root");
+                out[i].1 += c;
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    assert!(open.is_empty(), "unclosed elements");
+    out
+}
+
+/// Every chart, whatever its input, is XML a real parser takes; its root is `svg`, its first
+/// child the `<title>` with the chart's title (unescaped back), and the title, axis labels and
+/// series names are texts of it.
+#[test]
+fn charts_parse_as_xml_with_their_title_labels_and_series() {
+    let nasty = "a < b && c > \"d\" 'e'";
+    let gaps = [
+        (0.0, 1.0),
+        (f64::NAN, 2.0),
+        (3.0, 3.0),
+        (4.0, f64::INFINITY),
+    ];
+    let ramp: Vec<(f64, f64)> = (0..20).map(|i| (f64::from(i), f64::from(i * i))).collect();
+    let series = [
+        Series {
+            name: nasty,
+            points: &gaps,
+        },
+        Series {
+            name: "ramp",
+            points: &ramp,
+        },
+    ];
+    let labels: Vec<String> = (0..12).map(|i| format!("category {i}")).collect();
+    let crowded: Vec<(&str, f64)> = labels.iter().map(|l| (l.as_str(), -1.5)).collect();
+    let charts = [
+        (line_chart(nasty, "x <s>", "y & z", None, &series), true),
+        (
+            line_chart(nasty, "x <s>", "y & z", Some((0.0, 5.0)), &series),
+            true,
+        ),
+        (line_chart(nasty, "x <s>", "y & z", None, &[]), false),
+        (bar_chart(nasty, "y & z", &crowded), false),
+        (bar_chart(nasty, "y & z", &[]), false),
+    ];
+    for (svg, has_series) in &charts {
+        let elements = parsed(svg);
+        assert_eq!(elements[0].0, "svg");
+        assert_eq!(elements[1], ("title".to_string(), nasty.to_string()));
+        let texts: Vec<&str> = elements
+            .iter()
+            .filter(|e| e.0 == "text")
+            .map(|e| e.1.as_str())
+            .collect();
+        assert!(
+            texts.contains(&nasty) && texts.contains(&"y & z"),
+            "{texts:?}"
+        );
+        if *has_series {
+            assert!(
+                texts.contains(&"x <s>") && texts.contains(&"ramp"),
+                "{texts:?}"
+            );
+            assert_eq!(elements.iter().filter(|e| e.0 == "polyline").count(), 3);
+        }
+    }
+    let bar_labels = parsed(&charts[3].0);
+    for l in &labels {
+        assert!(bar_labels.iter().any(|e| e.0 == "text" && e.1 == *l), "{l}");
+    }
+}
