@@ -43,3 +43,5 @@ pub mod handoff;
 pub mod plan_runner;
 pub mod pus_ground;
 pub mod server;
+pub mod visit;
+pub mod wifi_session;
