@@ -42,6 +42,7 @@ pub mod ground_link;
 pub mod handoff;
 pub mod plan_runner;
 pub mod pus_ground;
+pub mod sensed;
 pub mod server;
 pub mod visit;
 pub mod wifi_session;

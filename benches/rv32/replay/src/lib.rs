@@ -256,19 +256,10 @@ impl Replay {
         m.enter(Phase::FrontEnd);
         let f = self.front_a.push(&reading.raw);
         m.enter(Phase::Node);
-        let o = self.a.tick(
-            t,
-            &board_a::Inputs {
-                command,
-                from_b,
-                electrical: f.electrical,
-                hip: f.hip,
-                gravity: f.gravity,
-                arm_contracted: reading.arm_contracted,
-                bolter_at_home: reading.bolter_at_home,
-                lost: f.lost,
-            },
-        );
+        let (arm, home) = (reading.arm_contracted, reading.bolter_at_home);
+        let o = self
+            .a
+            .tick(t, &board_a::Inputs::sensed(&f, arm, home, command, from_b));
         m.enter(Phase::Glue);
         let full = o
             .heartbeat
@@ -284,17 +275,10 @@ impl Replay {
         m.enter(Phase::FrontEnd);
         let f = self.front_b.push(&reading.raw);
         m.enter(Phase::Node);
-        let o = self.b.tick(
-            t,
-            &board_b::Inputs {
-                command,
-                electrical: f.electrical,
-                gravity: f.gravity,
-                arm_contracted: reading.arm_contracted,
-                bolter_at_home: reading.bolter_at_home,
-                lost: f.lost,
-            },
-        );
+        let (arm, home) = (reading.arm_contracted, reading.bolter_at_home);
+        let o = self
+            .b
+            .tick(t, &board_b::Inputs::sensed(&f, arm, home, command));
         m.enter(Phase::Record);
         tick_b_record(&mut self.w, command, &o);
     }
