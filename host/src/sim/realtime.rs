@@ -187,86 +187,120 @@ fn spawn_robot<'scope, 'env>(
     scope.spawn(move || wifi.run(nodes.0));
     scope.spawn(move || control.run(nodes.1));
     scope.spawn(move || b.run(nodes.2));
+    let server = ServerEnds {
+        name: &name_s,
+        board,
+        addr: robot.addr,
+        seed,
+    };
     match cfg.protocol {
-        Protocol::Legacy => {
-            let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
-            let server = nodes::ServerTask {
-                from_ground: ground_to_server.read,
-                to_ground: env.lossy(
-                    server_to_ground.write,
-                    "serial_ground",
-                    (&name_s, "ground"),
-                    cfg.serial_loss,
-                    None,
-                    seed,
-                    3,
-                ),
-                robots: vec![(board, robot.addr)],
-                visit_ms: cfg.visit_ms,
-            };
-            scope.spawn(move || server.run(nodes.3));
-            let to_server = env.lossy(
-                ground_to_server.write,
-                "serial_ground",
-                ("ground", &name_s),
-                cfg.serial_loss,
-                None,
-                seed,
-                4,
-            );
-            Ok((to_server.boxed(), server_to_ground.read, board))
-        }
-        Protocol::Pus => {
-            // UDP on loopback: one socket at the ground, one at the server board.
-            let ground = UdpSocket::bind("127.0.0.1:0")?;
-            let server =
-                UdpSocket::bind(("127.0.0.1", cfg.external.as_ref().map_or(0, |x| x.tc_port)))?;
-            let (mut ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
-            if let Some(x) = &cfg.external {
-                ground_addr = x.tm_to;
-                x.wire
-                    .line(json!({"ready": true, "tc_port": server_addr.port()}));
-            }
-            server.set_nonblocking(true)?;
-            let to_ground = nodes::UdpOut {
-                sock: server.try_clone()?,
-                peer: ground_addr,
-            };
-            let to_server = nodes::UdpOut {
-                sock: ground.try_clone()?,
-                peer: server_addr,
-            };
-            let gw = nodes::GatewayTask {
-                from_ground: server,
-                to_ground: env.lossy(
-                    to_ground,
-                    "udp_ground",
-                    (&name_s, "ground"),
-                    cfg.serial_loss,
-                    None,
-                    seed,
-                    3,
-                ),
-                robot: (board, robot.addr),
-                config: cfg.gateway,
-                wire: cfg.external.as_ref().map(|x| x.wire.clone()),
-            };
-            scope.spawn(move || gw.run(nodes.3));
-            let (tx, rx) = std::sync::mpsc::channel();
-            let stop = env.stop;
-            scope.spawn(move || nodes::udp_reader(ground, tx, stop));
-            let to_server = env.lossy(
-                to_server,
-                "udp_ground",
-                ("ground", &name_s),
-                cfg.serial_loss,
-                None,
-                seed,
-                4,
-            );
-            Ok((to_server.boxed(), rx, board))
-        }
+        Protocol::Legacy => spawn_relay(scope, env, server, nodes.3),
+        Protocol::Pus => spawn_gateway(scope, env, server, nodes.3),
     }
+}
+
+/// What a robot's server board is to the rest: its name in the log, the robot it serves,
+/// where that robot's board A listens, and the robot's seed (of the links' loss draws).
+struct ServerEnds<'n> {
+    name: &'n str,
+    board: BoardNumber,
+    addr: std::net::SocketAddr,
+    seed: u64,
+}
+
+/// Starts the legacy relay ([`nodes::ServerTask`]) on its serial line to the ground; returns
+/// the ground's end of that line.
+fn spawn_relay<'scope, 'env>(
+    scope: &'scope std::thread::Scope<'scope, 'env>,
+    env: &RunEnv<'env>,
+    s: ServerEnds<'_>,
+    node: nodes::Node<'env>,
+) -> std::io::Result<GroundLink> {
+    let cfg = env.cfg;
+    let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
+    let server = nodes::ServerTask {
+        from_ground: ground_to_server.read,
+        to_ground: env.lossy(
+            server_to_ground.write,
+            "serial_ground",
+            (s.name, "ground"),
+            cfg.serial_loss,
+            None,
+            s.seed,
+            3,
+        ),
+        robots: vec![(s.board, s.addr)],
+        visit_ms: cfg.visit_ms,
+    };
+    scope.spawn(move || server.run(node));
+    let to_server = env.lossy(
+        ground_to_server.write,
+        "serial_ground",
+        ("ground", s.name),
+        cfg.serial_loss,
+        None,
+        s.seed,
+        4,
+    );
+    Ok((to_server.boxed(), server_to_ground.read, s.board))
+}
+
+/// Starts the PUS gateway ([`nodes::GatewayTask`]) on a UDP socket on loopback (the ground's
+/// own, or an external ground's); returns the ground's end of the link.
+fn spawn_gateway<'scope, 'env>(
+    scope: &'scope std::thread::Scope<'scope, 'env>,
+    env: &RunEnv<'env>,
+    s: ServerEnds<'_>,
+    node: nodes::Node<'env>,
+) -> std::io::Result<GroundLink> {
+    let cfg = env.cfg;
+    // UDP on loopback: one socket at the ground, one at the server board.
+    let ground = UdpSocket::bind("127.0.0.1:0")?;
+    let server = UdpSocket::bind(("127.0.0.1", cfg.external.as_ref().map_or(0, |x| x.tc_port)))?;
+    let (mut ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
+    if let Some(x) = &cfg.external {
+        ground_addr = x.tm_to;
+        x.wire
+            .line(json!({"ready": true, "tc_port": server_addr.port()}));
+    }
+    server.set_nonblocking(true)?;
+    let to_ground = nodes::UdpOut {
+        sock: server.try_clone()?,
+        peer: ground_addr,
+    };
+    let to_server = nodes::UdpOut {
+        sock: ground.try_clone()?,
+        peer: server_addr,
+    };
+    let gw = nodes::GatewayTask {
+        from_ground: server,
+        to_ground: env.lossy(
+            to_ground,
+            "udp_ground",
+            (s.name, "ground"),
+            cfg.serial_loss,
+            None,
+            s.seed,
+            3,
+        ),
+        robot: (s.board, s.addr),
+        config: cfg.gateway,
+        wire: cfg.external.as_ref().map(|x| x.wire.clone()),
+    };
+    scope.spawn(move || gw.run(node));
+    let (tx, rx) = std::sync::mpsc::channel();
+    let stop = env.stop;
+    scope.spawn(move || nodes::udp_reader(ground, tx, stop));
+    let to_server = env.lossy(
+        to_server,
+        "udp_ground",
+        ("ground", s.name),
+        cfg.serial_loss,
+        None,
+        s.seed,
+        4,
+    );
+    Ok((to_server.boxed(), rx, s.board))
 }
 
 /// Runs the simulation on the wall clock to the end of every robot's plan (or the time limit).
