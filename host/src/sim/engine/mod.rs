@@ -33,6 +33,9 @@
 //! * the server board visits its robot as the firmware does (open a connection, send the
 //!   command, wait up to `visit_ms` for the heartbeat, forward it, close) and reads the ground's
 //!   line only between visits; the PUS gateway wakes at its own next deadline;
+//! * what board A's WiFi task and the server board's visit do with their bytes is the
+//!   library's, as in every other shell ([`mmic::node::wifi_session`], [`mmic::node::visit`]);
+//!   the engine only carries those bytes and times them;
 //! * the ground ticks its plan runners every [`GROUND_TICK_MS`] and takes each packet from a
 //!   server board when it arrives.
 
