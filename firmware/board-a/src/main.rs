@@ -1,38 +1,33 @@
 //! Board A (Figures 5 and 6): the robot's primary board. Two embassy tasks stand for the
 //! paper's two cores, joined by the library's hand-off queues: the WiFi task (accepts the
-//! server board's TCP connection, deframes command packets into the rx queue, sends the
-//! heartbeats of the tx queue back) and the 10 ms control task (sensors, `BoardA::tick`,
-//! servos, bolter, regulator, the serial line to board B).
+//! server board's TCP connection and does what the library's `WifiSession` says: command
+//! packets into the rx queue, the heartbeats of the tx queue back) and the 10 ms control task
+//! (sensors, `BoardA::tick`, servos, bolter, regulator, the serial line to board B).
 #![no_std]
 #![no_main]
 
 use core::cell::RefCell;
 use embassy_executor::Spawner;
 use embassy_net::tcp::TcpSocket;
-use embassy_net::{Ipv4Address, Ipv4Cidr, Runner, Stack, StackResources, StaticConfigV4};
+use embassy_net::Stack;
 use embassy_time::{with_timeout, Duration, Instant, Ticker, Timer};
 use esp_backtrace as _;
-use esp_hal::clock::CpuClock;
 use esp_hal::gpio::Input;
 use esp_hal::i2c::master::{Config as I2cConfig, I2c};
-use esp_hal::rng::Rng;
 use esp_hal::time::Rate;
-use esp_hal::timer::timg::TimerGroup;
 use esp_hal::uart::{Config as UartConfig, Uart};
-use esp_hal::{ram, Blocking};
+use esp_hal::Blocking;
 use esp_println::println;
-use esp_radio::wifi::{self, sta::StationConfig, AuthenticationMethodConfig, Interface};
 use mmic::node::robot::board_a;
 use mmic::node::robot::handoff::{Consumer, PacketQueue, Producer};
+use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::sensors::frontend;
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::HEARTBEAT_LEN;
-use mmic::wire::PacketKind;
 use static_cell::StaticCell;
 use support::control::{commands_in, ControlA, QUEUE, TICK_MS};
 use support::hw::{self, Serial};
-use support::link::Link;
 use support::net;
 use support::sensors::Side;
 
@@ -50,15 +45,10 @@ type Bus = RefCell<I2c<'static, Blocking>>;
 static BUS: StaticCell<Bus> = StaticCell::new();
 static RX: StaticCell<PacketQueue<COMMAND_LEN, QUEUE>> = StaticCell::new();
 static TX: StaticCell<PacketQueue<HEARTBEAT_LEN, QUEUE>> = StaticCell::new();
-static NET: StaticCell<StackResources<3>> = StaticCell::new();
 
 #[esp_rtos::main]
 async fn main(spawner: Spawner) -> ! {
-    let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
-    esp_alloc::heap_allocator!(#[ram(reclaimed)] size: 64 * 1024);
-    esp_alloc::heap_allocator!(size: 36 * 1024);
-    let timg0 = TimerGroup::new(p.TIMG0);
-    esp_rtos::start(timg0.timer0, p.FROM_CPU_INTR0);
+    wifi::boot!(p);
     println!("mmic board A{BOARD} on {}", support::chip::CHIP);
 
     // Start-up: a peripheral that cannot be configured is a build or wiring error.
@@ -86,30 +76,7 @@ async fn main(spawner: Spawner) -> ! {
     spawner.spawn(control(ctl, side, outs, serial).expect("control task"));
 
     // WiFi: station on the lab's access point, board A at its fixed address.
-    let auth =
-        AuthenticationMethodConfig::Wpa2Personal(net::PASSWORD.try_into().expect("password"));
-    let sta = StationConfig::default()
-        .with_ssid(net::SSID.try_into().expect("SSID"))
-        .with_authentication(auth);
-    let radio_cfg =
-        wifi::ControllerConfig::default().with_initial_config(wifi::Config::Station(sta));
-    let controller = wifi::WifiController::new(p.WIFI, radio_cfg).expect("WiFi");
-    let ip = StaticConfigV4 {
-        address: Ipv4Cidr::new(Ipv4Address::from(net::robot(n)), 24),
-        gateway: None,
-        dns_servers: Default::default(),
-    };
-    let rng = Rng::new();
-    let seed = (u64::from(rng.random()) << 32) | u64::from(rng.random());
-    let resources = NET.init(StackResources::new());
-    let (stack, runner) = embassy_net::new(
-        Interface::station(),
-        embassy_net::Config::ipv4_static(ip),
-        resources,
-        seed,
-    );
-    spawner.spawn(connection(controller).expect("connection task"));
-    spawner.spawn(net_task(runner).expect("net task"));
+    let stack = wifi::start(&spawner, p.WIFI, net::robot(n));
     wifi_task(stack, cmd_in, hb_out).await
 }
 
@@ -145,13 +112,14 @@ async fn control(
 }
 
 /// The WiFi task: one server connection at a time; a dropped connection is accepted again.
+/// What to do with each connection's bytes and each heartbeat is the library's session's.
 async fn wifi_task(
     stack: Stack<'static>,
     mut commands: Producer<'static, COMMAND_LEN, QUEUE>,
     mut heartbeats: Consumer<'static, HEARTBEAT_LEN, QUEUE>,
 ) -> ! {
     let (mut rx_buf, mut tx_buf) = ([0u8; 256], [0u8; 256]);
-    let mut unconnected = 0u32;
+    let mut session = WifiSession::new(WifiConfig::default());
     loop {
         let mut sock = TcpSocket::new(stack, &mut rx_buf, &mut tx_buf);
         sock.set_timeout(Some(Duration::from_secs(5)));
@@ -159,56 +127,38 @@ async fn wifi_task(
             Timer::after_millis(10).await;
             continue;
         }
-        // Heartbeats made while no server was connected cannot be delivered (as in the host
-        // simulator's WiFi task): counted, not sent to the next connection.
-        while heartbeats.pop().is_some() {
-            unconnected = unconnected.wrapping_add(1);
-        }
-        let mut link = Link::new(PacketKind::Command);
+        // Heartbeats made while no server was connected are dropped (counted by the session).
+        session.open(
+            wifi::now_ms(),
+            core::iter::from_fn(|| heartbeats.pop()),
+            drop,
+        );
         let mut buf = [0u8; 128];
         'conn: loop {
             match with_timeout(Duration::from_millis(2), sock.read(&mut buf)).await {
                 Ok(Ok(0)) | Ok(Err(_)) => break 'conn,
-                Ok(Ok(n)) => commands_in(&mut link, &buf[..n], &mut commands),
+                Ok(Ok(n)) => commands_in(&mut session, wifi::now_ms(), &buf[..n], &mut commands),
+                Err(_) if session.expired(wifi::now_ms()) => break 'conn,
                 Err(_) => {}
             }
             while let Some(hb) = heartbeats.pop() {
-                if !write_all(&mut sock, &hb).await {
-                    break 'conn;
+                if let Outgoing::Send(hb) = session.heartbeat(hb) {
+                    if !wifi::write_all(&mut sock, &hb).await {
+                        break 'conn;
+                    }
                 }
             }
         }
+        session.close();
+        let c = session.counts();
         println!(
-            "server gone: discarded={} unconnected={unconnected}",
-            link.discarded()
+            "server gone: discarded={} unconnected={} commands={} sent={}",
+            session.discarded(),
+            c.unconnected,
+            c.commands,
+            c.sent
         );
         sock.abort();
         let _ = with_timeout(Duration::from_millis(100), sock.flush()).await;
     }
-}
-
-async fn write_all(sock: &mut TcpSocket<'_>, mut bytes: &[u8]) -> bool {
-    while !bytes.is_empty() {
-        match sock.write(bytes).await {
-            Ok(0) | Err(_) => return false,
-            Ok(n) => bytes = &bytes[n..],
-        }
-    }
-    true
-}
-
-/// Keeps the station associated: reconnects after a drop.
-#[embassy_executor::task]
-async fn connection(mut controller: wifi::WifiController<'static>) {
-    loop {
-        if controller.connect_async().await.is_ok() {
-            let _ = controller.wait_for_disconnect_async().await;
-        }
-        Timer::after_millis(1000).await;
-    }
-}
-
-#[embassy_executor::task]
-async fn net_task(mut runner: Runner<'static, Interface>) {
-    runner.run().await
 }

@@ -112,14 +112,8 @@ impl ControlB {
     ) -> board_b::Outputs {
         let r = sensors.read();
         let f = self.front.push(&r.raw);
-        let inputs = board_b::Inputs {
-            command: self.from_a.next(uart),
-            electrical: f.electrical,
-            gravity: f.gravity,
-            arm_contracted: r.arm_contracted,
-            bolter_at_home: r.bolter_at_home,
-            lost: f.lost,
-        };
+        let command = self.from_a.next(uart);
+        let inputs = board_b::Inputs::sensed(&f, r.arm_contracted, r.bolter_at_home, command);
         let o = self.b.tick(now, &inputs);
         out.servos([o.arm, o.gripper, None]);
         out.regulator(o.regulator);

@@ -6,6 +6,7 @@ use crate::link::{ByteSink, ByteSource, Link};
 use mmic::bolter::{Drive, MuxLines};
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::handoff::{Consumer, Producer};
+use mmic::node::robot::wifi_session::WifiSession;
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::PulseWidth;
 use mmic::wire::command::COMMAND_LEN;
@@ -111,16 +112,9 @@ impl<'q> ControlA<'q> {
     ) -> board_a::Outputs {
         let r = sensors.read();
         let f = self.front.push(&r.raw);
-        let inputs = board_a::Inputs {
-            command: self.commands.pop(),
-            from_b: self.from_b.next(uart),
-            electrical: f.electrical,
-            hip: f.hip,
-            gravity: f.gravity,
-            arm_contracted: r.arm_contracted,
-            bolter_at_home: r.bolter_at_home,
-            lost: f.lost,
-        };
+        let (command, from_b) = (self.commands.pop(), self.from_b.next(uart));
+        let inputs =
+            board_a::Inputs::sensed(&f, r.arm_contracted, r.bolter_at_home, command, from_b);
         let o = self.a.tick(now, &inputs);
         out.servos([o.arm, o.gripper, o.hip]);
         out.regulator(o.regulator);
@@ -139,10 +133,16 @@ impl<'q> ControlA<'q> {
     }
 }
 
-/// Board A's WiFi task, receive side: command packets from the server's TCP stream into the
-/// control task's queue (a full queue gives the packet up, counted by the library).
-pub fn commands_in(link: &mut Link, bytes: &[u8], q: &mut Producer<'_, COMMAND_LEN, QUEUE>) {
-    link.feed(bytes, |p| {
+/// Board A's WiFi task, receive side: the command packets the library's session finds in
+/// bytes read from the server's TCP stream at `now`, into the control task's queue (a full
+/// queue gives the packet up, counted by the library).
+pub fn commands_in(
+    session: &mut WifiSession,
+    now: u32,
+    bytes: &[u8],
+    q: &mut Producer<'_, COMMAND_LEN, QUEUE>,
+) {
+    session.received(now, bytes, |p| {
         if let Err(full) = q.push(p) {
             q.give_up(full);
         }

@@ -13,6 +13,7 @@ use mmic::command::Command;
 use mmic::mode::Mode;
 use mmic::node::robot::board_a;
 use mmic::node::robot::handoff::PacketQueue;
+use mmic::node::robot::wifi_session::{WifiConfig, WifiSession};
 use mmic::sensors::frontend;
 use mmic::units::{BoardNumber, PulseWidth};
 use mmic::wire::command::CommandRepr;
@@ -138,11 +139,12 @@ fn board_a_command_to_heartbeat_through_the_glue() {
         seq: 1,
     }
     .to_bytes();
-    let mut tcp = Link::new(PacketKind::Command);
-    commands_in(&mut tcp, b"junk\x4d", &mut wifi_in);
-    commands_in(&mut tcp, &cmd[..6], &mut wifi_in);
-    commands_in(&mut tcp, &cmd[6..], &mut wifi_in);
-    assert_eq!((tcp.frames(), tcp.discarded()), (1, 5));
+    let mut tcp = WifiSession::new(WifiConfig::default());
+    tcp.open(0, core::iter::empty(), drop);
+    commands_in(&mut tcp, 1, b"junk\x4d", &mut wifi_in);
+    commands_in(&mut tcp, 2, &cmd[..6], &mut wifi_in);
+    commands_in(&mut tcp, 3, &cmd[6..], &mut wifi_in);
+    assert_eq!((tcp.counts().commands, tcp.discarded()), (1, 5));
 
     // Tick 2: the ADC answers, so no condition holds: the command runs and its heartbeat
     // reaches the WiFi task's queue, still reporting the latched sensor loss.

@@ -26,13 +26,13 @@ use mmic::node::ground::plan_runner::PlanRunner;
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::{Consumer, PacketQueue, Producer};
+use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::node::server::gateway::Gateway;
 use mmic::node::server::relay::Server;
+use mmic::node::server::visit::Visit;
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
-use mmic::wire::deframer::{Deframed, Deframer};
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
-use mmic::wire::PacketKind;
 use std::collections::{HashMap, VecDeque};
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -237,6 +237,7 @@ async fn wifi_task(
 ) {
     let mut rng = fastrand::Rng::with_seed(seed);
     let mut lost = move || loss > 0.0 && rng.f64() < loss;
+    let mut session = WifiSession::new(WifiConfig::default());
     while !shared.stop.load(Ordering::Relaxed) {
         let accepted = tokio::time::timeout(Duration::from_millis(200), listener.accept()).await;
         let Ok(Ok((mut sock, _))) = accepted else {
@@ -244,8 +245,11 @@ async fn wifi_task(
         };
         let _ = sock.set_nodelay(true);
         // Heartbeats made while nobody was connected are not sent to the next connection.
-        while heartbeats.pop().is_some() {}
-        let mut d = Deframer::<256>::new();
+        session.open(
+            shared.now_ms(),
+            std::iter::from_fn(|| heartbeats.pop()),
+            drop,
+        );
         let mut buf = [0u8; 256];
         loop {
             tokio::select! {
@@ -254,25 +258,17 @@ async fn wifi_task(
                     if k == 0 {
                         break;
                     }
-                    let mut frames = Vec::new();
-                    d.feed(&buf[..k], |e| {
-                        if let Deframed::Frame(f) = e {
-                            frames.push(f);
-                        }
-                    });
-                    for f in frames {
-                        if f.kind() != PacketKind::Command || lost() {
-                            continue;
-                        }
-                        if let Ok(p) = <[u8; COMMAND_LEN]>::try_from(f.as_bytes()) {
+                    session.received(shared.now_ms(), &buf[..k], |p| {
+                        if !lost() {
                             if let Err(full) = commands.push(p) {
                                 commands.give_up(full);
                             }
                         }
-                    }
+                    });
                 }
                 _ = notify.notified() => {
                     while let Some(hb) = heartbeats.pop() {
+                        let Outgoing::Send(hb) = session.heartbeat(hb) else { continue };
                         if !lost() && sock.write_all(&hb).await.is_err() {
                             break;
                         }
@@ -280,6 +276,7 @@ async fn wifi_task(
                 }
             }
         }
+        session.close();
     }
 }
 
@@ -309,12 +306,14 @@ async fn server_task(
                         let _ = srv.accept(&p);
                     }
                 }
-                while let Some((b, packet)) = srv.next_visit() {
-                    srv.delivered(b, &packet);
-                    if b != board {
+                while let Some(mut v) = Visit::next(&mut srv, shared.now_ms(), cfg.visit_ms) {
+                    // Marked delivered before the write, as before: a robot of another
+                    // server board's fleet, or a visit that fails, is not retried.
+                    v.written(&mut srv);
+                    if v.board() != board {
                         continue;
                     }
-                    if let Some(hb) = visit(a_addr, &packet, cfg.visit_ms).await {
+                    if let Some(hb) = visit(a_addr, &mut v, &shared).await {
                         let _ = sock.send_to(&hb, ground).await;
                     }
                 }
@@ -344,7 +343,8 @@ async fn server_task(
                     if b != board {
                         continue;
                     }
-                    let hb = visit(a_addr, &c.to_bytes(), wait)
+                    let mut v = Visit::new(shared.now_ms(), b, c.to_bytes(), wait);
+                    let hb = visit(a_addr, &mut v, &shared)
                         .await
                         .and_then(|h| HeartbeatRepr::parse(&h).ok());
                     if let Some(hb) = hb {
@@ -374,19 +374,19 @@ async fn send_reports<const M: usize>(
     }
 }
 
-/// One visit of board A: connect, send, the first heartbeat within `wait_ms`, disconnect (with
-/// an abortive close, so that a thousand visits a second leave no TIME_WAIT sockets behind).
-async fn visit(a: SocketAddr, packet: &[u8], wait_ms: u32) -> Option<Vec<u8>> {
-    let wait = Duration::from_millis(wait_ms as u64);
-    let deadline = tokio::time::Instant::now() + wait;
-    let mut sock = tokio::time::timeout(wait, TcpStream::connect(a))
+/// One visit of board A: connect, send, the first heartbeat by the visit's deadline (the
+/// library's [`Visit`] decides), disconnect (with an abortive close, so that a thousand visits
+/// a second leave no TIME_WAIT sockets behind).
+async fn visit(a: SocketAddr, v: &mut Visit, shared: &Shared) -> Option<[u8; HEARTBEAT_LEN]> {
+    let left = v.left_ms(shared.now_ms())?;
+    let deadline = tokio::time::Instant::now() + Duration::from_millis(left as u64);
+    let mut sock = tokio::time::timeout_at(deadline, TcpStream::connect(a))
         .await
         .ok()?
         .ok()?;
     let _ = sock.set_nodelay(true);
     let _ = sock.set_zero_linger();
-    sock.write_all(packet).await.ok()?;
-    let mut d = Deframer::<256>::new();
+    sock.write_all(v.packet()).await.ok()?;
     let mut buf = [0u8; 256];
     loop {
         let k = tokio::time::timeout_at(deadline, sock.read(&mut buf))
@@ -396,16 +396,8 @@ async fn visit(a: SocketAddr, packet: &[u8], wait_ms: u32) -> Option<Vec<u8>> {
         if k == 0 {
             return None;
         }
-        let mut hb = None;
-        d.feed(&buf[..k], |e| {
-            if let Deframed::Frame(f) = e {
-                if f.kind() == PacketKind::Heartbeat && hb.is_none() {
-                    hb = Some(f.as_bytes().to_vec());
-                }
-            }
-        });
-        if hb.is_some() {
-            return hb;
+        if let Some(hb) = v.received(&buf[..k]) {
+            return Some(hb);
         }
     }
 }

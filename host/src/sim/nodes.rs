@@ -7,15 +7,16 @@
 use super::clock::{Clock, NodeClock};
 use super::log::Log;
 use super::plant::Plant;
-use super::shell::{frames, SideA, SideB};
+use super::shell::{SideA, SideB};
 use mmic::node::robot::handoff::{Consumer, Producer};
+use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::node::server::gateway::{self, Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
+use mmic::node::server::visit::Visit;
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::deframer::{Deframed, Deframer};
 use mmic::wire::heartbeat::HEARTBEAT_LEN;
-use mmic::wire::PacketKind;
 use serde_json::{json, Value};
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, UdpSocket};
@@ -179,7 +180,8 @@ impl Node<'_> {
 pub use super::shell::event_json;
 
 /// Board A's WiFi task (core 0): accepts the server's connections, deframes command packets
-/// into the hand-off queue, writes heartbeats from the other queue back.
+/// into the hand-off queue, writes heartbeats from the other queue back, as the library's
+/// [`WifiSession`] says.
 pub struct WifiTask<'q> {
     /// Where the server board connects.
     pub listener: TcpListener,
@@ -197,16 +199,21 @@ impl WifiTask<'_> {
     /// Runs until the run stops.
     pub fn run(mut self, node: Node<'_>) {
         let mut rng = fastrand::Rng::with_seed(self.seed);
+        let mut session = WifiSession::new(WifiConfig::default());
         let _ = self.listener.set_nonblocking(true);
         while node.running() {
-            node.poll();
+            let now = node.poll();
             match self.listener.accept() {
-                Ok((sock, _)) => self.serve(&node, sock, &mut rng),
+                Ok((sock, _)) => {
+                    let queued = std::iter::from_fn(|| self.heartbeats.pop());
+                    session.open(now, queued, |hb| unconnected(&node, &hb));
+                    self.serve(&node, sock, &mut rng, &mut session);
+                    session.close();
+                }
                 Err(_) => {
                     while let Some(hb) = self.heartbeats.pop() {
-                        if let Some(l) = &node.log {
-                            let now = node.clock.now_ms();
-                            l.packet(now, "wifi", &node.name, "server", "unconnected", &hb);
+                        if let Outgoing::Drop(hb) = session.heartbeat(hb) {
+                            unconnected(&node, &hb);
                         }
                     }
                     std::thread::sleep(Duration::from_micros(300));
@@ -219,33 +226,40 @@ impl WifiTask<'_> {
         self.loss > 0.0 && rng.f64() < self.loss
     }
 
-    /// One connection of the server board, until it disconnects.
-    fn serve(&mut self, node: &Node<'_>, mut sock: TcpStream, rng: &mut fastrand::Rng) {
+    /// One connection of the server board, until it disconnects (or idles out).
+    fn serve(
+        &mut self,
+        node: &Node<'_>,
+        mut sock: TcpStream,
+        rng: &mut fastrand::Rng,
+        session: &mut WifiSession,
+    ) {
         let _ = sock.set_nonblocking(true);
         let _ = sock.set_nodelay(true);
-        let mut d = Deframer::<256>::new();
         let mut buf = [0u8; 256];
         while node.running() {
-            node.poll();
+            let now = node.poll();
             match sock.read(&mut buf) {
                 Ok(0) => return,
                 Ok(n) => {
-                    for f in frames(&mut d, &buf[..n]) {
-                        if f.kind() == PacketKind::Command {
-                            self.take_command(node, f.as_bytes(), rng);
-                        }
+                    let mut commands = Vec::new();
+                    session.received(now, &buf[..n], |c| commands.push(c));
+                    for c in commands {
+                        self.take_command(node, c, rng);
                     }
                 }
                 Err(e) if e.kind() == ErrorKind::WouldBlock => {}
                 Err(_) => return,
             }
+            if session.expired(now) {
+                return;
+            }
             while let Some(hb) = self.heartbeats.pop() {
-                let fate = if self.lost(rng) {
-                    "lost"
-                } else if sock.write_all(&hb).is_ok() {
-                    "delivered"
-                } else {
-                    "closed"
+                let fate = match session.heartbeat(hb) {
+                    Outgoing::Drop(_) => "unconnected",
+                    Outgoing::Send(_) if self.lost(rng) => "lost",
+                    Outgoing::Send(hb) if sock.write_all(&hb).is_ok() => "delivered",
+                    Outgoing::Send(_) => "closed",
                 };
                 if let Some(l) = &node.log {
                     l.packet(node.clock.now_ms(), "wifi", &node.name, "server", fate, &hb);
@@ -257,15 +271,12 @@ impl WifiTask<'_> {
 
     /// A command packet off the link: lost, or handed to the control task (a full queue hands
     /// it back, and that is logged).
-    fn take_command(&mut self, node: &Node<'_>, bytes: &[u8], rng: &mut fastrand::Rng) {
+    fn take_command(&mut self, node: &Node<'_>, p: [u8; COMMAND_LEN], rng: &mut fastrand::Rng) {
         let now = node.clock.now_ms();
         let fate = if self.lost(rng) { "lost" } else { "delivered" };
         if let Some(l) = &node.log {
-            l.packet(now, "wifi", "server", &node.name, fate, bytes);
+            l.packet(now, "wifi", "server", &node.name, fate, &p);
         }
-        let Ok(p) = <[u8; COMMAND_LEN]>::try_from(bytes) else {
-            return;
-        };
         if fate == "delivered" {
             if let Err(full) = self.commands.push(p) {
                 node.event(
@@ -275,6 +286,20 @@ impl WifiTask<'_> {
                 self.commands.give_up(full);
             }
         }
+    }
+}
+
+/// Logs a heartbeat board A's WiFi task dropped with no server connected.
+fn unconnected(node: &Node<'_>, hb: &[u8]) {
+    if let Some(l) = &node.log {
+        l.packet(
+            node.clock.now_ms(),
+            "wifi",
+            &node.name,
+            "server",
+            "unconnected",
+            hb,
+        );
     }
 }
 
@@ -383,28 +408,26 @@ impl ServerTask {
         while node.running() {
             node.poll();
             self.take_from_ground(&node, &mut srv);
-            let Some((robot, packet)) = srv.next_visit() else {
+            let now = node.clock.now_ms();
+            let Some(mut visit) = Visit::next(&mut srv, now, self.visit_ms) else {
                 std::thread::sleep(Duration::from_micros(300));
                 continue;
             };
             let Some(addr) = self
                 .robots
                 .iter()
-                .find(|(b, _)| *b == robot)
+                .find(|(b, _)| *b == visit.board())
                 .map(|(_, a)| *a)
             else {
                 continue;
             };
-            let Ok(mut sock) = TcpStream::connect_timeout(&addr, Duration::from_millis(200)) else {
-                std::thread::sleep(Duration::from_millis(1));
+            let Some(sock) = connect(&addr, visit.packet()) else {
                 continue;
             };
-            let _ = sock.set_nodelay(true);
-            if sock.write_all(&packet).is_err() {
-                continue;
+            visit.written(&mut srv);
+            if let Some(hb) = await_heartbeat(&node, sock, &mut visit) {
+                self.to_ground.send(node.clock.now_ms(), &hb);
             }
-            srv.delivered(robot, &packet);
-            self.await_heartbeat(&node, sock);
         }
     }
 
@@ -425,33 +448,34 @@ impl ServerTask {
             node.event(now, what);
         }
     }
-
-    /// Waits up to `visit_ms` for the robot's heartbeat and forwards it; then disconnects (one
-    /// robot per loop).
-    fn await_heartbeat(&mut self, node: &Node<'_>, sock: TcpStream) {
-        if let Some(hb) = await_heartbeat(node, sock, self.visit_ms) {
-            self.to_ground.send(node.clock.now_ms(), &hb);
-        }
-    }
 }
 
-/// Waits up to `wait_ms` on a visit's connection for board A's heartbeat. Polled without
-/// blocking: a socket read timeout is rounded up to the kernel's tick (4–8 ms here), and a
-/// blocked server would hold the paced clock back.
-fn await_heartbeat(node: &Node<'_>, mut sock: TcpStream, wait_ms: u32) -> Option<Vec<u8>> {
+/// Connects to board A at `addr` and writes the visit's packet; `None` if either failed.
+fn connect(addr: &SocketAddr, packet: &[u8]) -> Option<TcpStream> {
+    let Ok(mut sock) = TcpStream::connect_timeout(addr, Duration::from_millis(200)) else {
+        std::thread::sleep(Duration::from_millis(1));
+        return None;
+    };
+    let _ = sock.set_nodelay(true);
+    sock.write_all(packet).ok().map(|_| sock)
+}
+
+/// Waits on a visit's connection for board A's heartbeat until the visit's deadline (the
+/// library's [`Visit`] decides). Polled without blocking: a socket read timeout is rounded up
+/// to the kernel's tick (4–8 ms here), and a blocked server would hold the paced clock back.
+fn await_heartbeat(
+    node: &Node<'_>,
+    mut sock: TcpStream,
+    visit: &mut Visit,
+) -> Option<[u8; HEARTBEAT_LEN]> {
     let _ = sock.set_nonblocking(true);
-    let until = node.clock.now_ms().saturating_add(wait_ms);
-    let mut d = Deframer::<256>::new();
     let mut buf = [0u8; 256];
-    while node.running() && node.poll() < until {
+    while node.running() && visit.left_ms(node.poll()).is_some() {
         match sock.read(&mut buf) {
             Ok(0) => return None,
             Ok(n) => {
-                if let Some(f) = frames(&mut d, &buf[..n])
-                    .into_iter()
-                    .find(|f| f.kind() == PacketKind::Heartbeat)
-                {
-                    return Some(f.as_bytes().to_vec());
+                if let Some(hb) = visit.received(&buf[..n]) {
+                    return Some(hb);
                 }
             }
             Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {
@@ -608,17 +632,12 @@ impl GatewayTask {
     /// One visit of board A: connect, send the command, wait up to the gateway's uplink
     /// timeout for the heartbeat and hand it to the gateway, disconnect.
     fn visit(&mut self, node: &Node<'_>, g: &mut SimGateway, packet: [u8; COMMAND_LEN]) {
-        let Ok(mut sock) = TcpStream::connect_timeout(&self.robot.1, Duration::from_millis(200))
-        else {
-            std::thread::sleep(Duration::from_millis(1));
+        let (now, wait) = (node.clock.now_ms(), self.config.uplink.timeout_ms);
+        let mut visit = Visit::new(now, self.robot.0, packet, wait);
+        let Some(sock) = connect(&self.robot.1, visit.packet()) else {
             return;
         };
-        let _ = sock.set_nodelay(true);
-        if sock.write_all(&packet).is_err() {
-            return;
-        }
-        let wait = self.config.uplink.timeout_ms;
-        let hb = await_heartbeat(node, sock, wait)
+        let hb = await_heartbeat(node, sock, &mut visit)
             .and_then(|b| mmic::wire::heartbeat::HeartbeatRepr::parse(&b).ok());
         if let Some(hb) = hb {
             let out = g.heartbeat(node.clock.now_ms(), &hb);

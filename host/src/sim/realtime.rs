@@ -187,84 +187,106 @@ fn spawn_robot<'scope, 'env>(
     scope.spawn(move || wifi.run(nodes.0));
     scope.spawn(move || control.run(nodes.1));
     scope.spawn(move || b.run(nodes.2));
+    let server = ServerEnds {
+        name: &name_s,
+        board,
+        addr: robot.addr,
+        seed,
+    };
+    spawn_server(scope, env, server, nodes.3)
+}
+
+/// What a robot's server board is to the rest: its name in the log, the robot it serves,
+/// where that robot's board A listens, and the robot's seed (of the links' loss draws).
+struct ServerEnds<'n> {
+    name: &'n str,
+    board: BoardNumber,
+    addr: std::net::SocketAddr,
+    seed: u64,
+}
+
+impl ServerEnds<'_> {
+    /// The lossy writer of the ground link's direction `k` (3: to the ground, 4: from it).
+    fn lossy<W: Write>(&self, env: &RunEnv<'_>, out: W, link: &'static str, k: u64) -> Lossy<W> {
+        let ends = if k == 3 {
+            (self.name, "ground")
+        } else {
+            ("ground", self.name)
+        };
+        env.lossy(out, link, ends, env.cfg.serial_loss, None, self.seed, k)
+    }
+
+    /// The PUS gateway's task on a UDP socket on loopback (the ground's own, or an external
+    /// ground's), with the ground's socket and its writer to the gateway.
+    fn gateway(&self, env: &RunEnv<'_>) -> std::io::Result<(nodes::GatewayTask, GroundUdp)> {
+        let cfg = env.cfg;
+        // UDP on loopback: one socket at the ground, one at the server board.
+        let ground = UdpSocket::bind("127.0.0.1:0")?;
+        let port = cfg.external.as_ref().map_or(0, |x| x.tc_port);
+        let server = UdpSocket::bind(("127.0.0.1", port))?;
+        let (mut ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
+        if let Some(x) = &cfg.external {
+            ground_addr = x.tm_to;
+            x.wire
+                .line(json!({"ready": true, "tc_port": server_addr.port()}));
+        }
+        server.set_nonblocking(true)?;
+        let to_ground = nodes::UdpOut {
+            sock: server.try_clone()?,
+            peer: ground_addr,
+        };
+        let to_server = nodes::UdpOut {
+            sock: ground.try_clone()?,
+            peer: server_addr,
+        };
+        let gw = nodes::GatewayTask {
+            from_ground: server,
+            to_ground: self.lossy(env, to_ground, "udp_ground", 3),
+            robot: (self.board, self.addr),
+            config: cfg.gateway,
+            wire: cfg.external.as_ref().map(|x| x.wire.clone()),
+        };
+        Ok((gw, GroundUdp { ground, to_server }))
+    }
+}
+
+/// The ground's end of a gateway's UDP link: its socket, and its writer to the gateway.
+struct GroundUdp {
+    ground: UdpSocket,
+    to_server: nodes::UdpOut,
+}
+
+/// Starts robot `i`'s server board — the legacy relay ([`nodes::ServerTask`]) on a serial line
+/// or the PUS gateway ([`nodes::GatewayTask`]) on UDP — and returns the ground's end of its
+/// link.
+fn spawn_server<'scope, 'env>(
+    scope: &'scope std::thread::Scope<'scope, 'env>,
+    env: &RunEnv<'env>,
+    s: ServerEnds<'_>,
+    node: nodes::Node<'env>,
+) -> std::io::Result<GroundLink> {
+    let cfg = env.cfg;
     match cfg.protocol {
         Protocol::Legacy => {
             let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
             let server = nodes::ServerTask {
                 from_ground: ground_to_server.read,
-                to_ground: env.lossy(
-                    server_to_ground.write,
-                    "serial_ground",
-                    (&name_s, "ground"),
-                    cfg.serial_loss,
-                    None,
-                    seed,
-                    3,
-                ),
-                robots: vec![(board, robot.addr)],
+                to_ground: s.lossy(env, server_to_ground.write, "serial_ground", 3),
+                robots: vec![(s.board, s.addr)],
                 visit_ms: cfg.visit_ms,
             };
-            scope.spawn(move || server.run(nodes.3));
-            let to_server = env.lossy(
-                ground_to_server.write,
-                "serial_ground",
-                ("ground", &name_s),
-                cfg.serial_loss,
-                None,
-                seed,
-                4,
-            );
-            Ok((to_server.boxed(), server_to_ground.read, board))
+            scope.spawn(move || server.run(node));
+            let to_server = s.lossy(env, ground_to_server.write, "serial_ground", 4);
+            Ok((to_server.boxed(), server_to_ground.read, s.board))
         }
         Protocol::Pus => {
-            // UDP on loopback: one socket at the ground, one at the server board.
-            let ground = UdpSocket::bind("127.0.0.1:0")?;
-            let server =
-                UdpSocket::bind(("127.0.0.1", cfg.external.as_ref().map_or(0, |x| x.tc_port)))?;
-            let (mut ground_addr, server_addr) = (ground.local_addr()?, server.local_addr()?);
-            if let Some(x) = &cfg.external {
-                ground_addr = x.tm_to;
-                x.wire
-                    .line(json!({"ready": true, "tc_port": server_addr.port()}));
-            }
-            server.set_nonblocking(true)?;
-            let to_ground = nodes::UdpOut {
-                sock: server.try_clone()?,
-                peer: ground_addr,
-            };
-            let to_server = nodes::UdpOut {
-                sock: ground.try_clone()?,
-                peer: server_addr,
-            };
-            let gw = nodes::GatewayTask {
-                from_ground: server,
-                to_ground: env.lossy(
-                    to_ground,
-                    "udp_ground",
-                    (&name_s, "ground"),
-                    cfg.serial_loss,
-                    None,
-                    seed,
-                    3,
-                ),
-                robot: (board, robot.addr),
-                config: cfg.gateway,
-                wire: cfg.external.as_ref().map(|x| x.wire.clone()),
-            };
-            scope.spawn(move || gw.run(nodes.3));
+            let (gw, udp) = s.gateway(env)?;
+            scope.spawn(move || gw.run(node));
             let (tx, rx) = std::sync::mpsc::channel();
             let stop = env.stop;
-            scope.spawn(move || nodes::udp_reader(ground, tx, stop));
-            let to_server = env.lossy(
-                to_server,
-                "udp_ground",
-                ("ground", &name_s),
-                cfg.serial_loss,
-                None,
-                seed,
-                4,
-            );
-            Ok((to_server.boxed(), rx, board))
+            scope.spawn(move || nodes::udp_reader(udp.ground, tx, stop));
+            let to_server = s.lossy(env, udp.to_server, "udp_ground", 4);
+            Ok((to_server.boxed(), rx, s.board))
         }
     }
 }

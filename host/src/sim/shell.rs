@@ -139,19 +139,8 @@ pub fn tick_a_sensed(
     plant.advance(now);
     let s = plant.sense(0, now);
     let f = sensors.push(&s.raw);
-    let out = board.tick(
-        now,
-        &board_a::Inputs {
-            command,
-            from_b,
-            electrical: f.electrical,
-            hip: f.hip,
-            gravity: f.gravity,
-            arm_contracted: s.arm_contracted,
-            bolter_at_home: s.bolter_at_home,
-            lost: f.lost,
-        },
-    );
+    let inputs = board_a::Inputs::sensed(&f, s.arm_contracted, s.bolter_at_home, command, from_b);
+    let out = board.tick(now, &inputs);
     plant.drive_a(
         Drives {
             arm: out.arm,
@@ -191,17 +180,8 @@ pub fn tick_b_sensed(
 ) -> (board_b::Outputs, Senses) {
     let s = plant.sense(1, now);
     let f = sensors.push(&s.raw);
-    let out = board.tick(
-        now,
-        &board_b::Inputs {
-            command,
-            electrical: f.electrical,
-            gravity: f.gravity,
-            arm_contracted: s.arm_contracted,
-            bolter_at_home: s.bolter_at_home,
-            lost: f.lost,
-        },
-    );
+    let inputs = board_b::Inputs::sensed(&f, s.arm_contracted, s.bolter_at_home, command);
+    let out = board.tick(now, &inputs);
     plant.drive_b(Drives {
         arm: out.arm,
         gripper: out.gripper,

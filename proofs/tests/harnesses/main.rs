@@ -16,6 +16,7 @@ mod pus;
 mod safety_timers;
 mod sensors_frontend;
 mod sensors_moving_average;
+mod transport;
 
 /// Every harness lands with its ledger row: each `#[test]` function of the harness files (the
 /// packet harnesses as `<packet>::<name>`, one per `packet_harnesses!` instance) has a row in

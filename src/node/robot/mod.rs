@@ -11,3 +11,5 @@ pub mod board_b;
     feature = "portable-atomic"
 ))]
 pub mod handoff;
+pub mod sensed;
+pub mod wifi_session;

@@ -36,8 +36,10 @@ use heapless::{Deque, Vec};
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
+use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::node::server::gateway::{self, Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
+use mmic::node::server::visit::Visit;
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::PulseWidth;
 use mmic::wire::b_command::B_COMMAND_LEN;
@@ -45,7 +47,6 @@ use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::deframer::{Deframed, Deframer};
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 use mmic::wire::internal_heartbeat::INTERNAL_HEARTBEAT_LEN;
-use mmic::wire::PacketKind;
 use out::{Field, RecordWriter};
 use trace::{Header, Protocol, Record};
 
@@ -133,10 +134,9 @@ pub struct Replay {
     a_from_b: Deque<[u8; INTERNAL_HEARTBEAT_LEN], QUEUE>,
     b_reader: Deframer<256>,
     b_from_a: Deque<[u8; B_COMMAND_LEN], QUEUE>,
-    wifi_open: bool,
-    wifi_reader: Deframer<256>,
+    wifi: WifiSession,
     board: Board,
-    visit: Deframer<256>,
+    visit: Option<Visit>,
     inbox: Deque<Vec<u8, MAX_GROUND_PACKET>, QUEUE>,
     server_reader: Deframer<256>,
     w: RecordWriter,
@@ -205,10 +205,9 @@ impl Replay {
             a_from_b: Deque::new(),
             b_reader: Deframer::new(),
             b_from_a: Deque::new(),
-            wifi_open: false,
-            wifi_reader: Deframer::new(),
+            wifi: WifiSession::new(WifiConfig::default()),
             board,
-            visit: Deframer::new(),
+            visit: None,
             inbox: Deque::new(),
             server_reader: Deframer::new(),
             w: RecordWriter::new(),
@@ -232,12 +231,12 @@ impl Replay {
             Record::TickB { t, reading } => self.tick_b(t, &reading, m),
             Record::ToA { bytes, .. } => self.serial_a(bytes, m),
             Record::ToB { bytes, .. } => self.serial_b(bytes, m),
-            Record::WifiOpen { .. } => self.wifi_open(m),
+            Record::WifiOpen { t } => self.wifi_open(t, m),
             Record::WifiClose { .. } => {
-                self.wifi_open = false;
+                self.wifi.close();
                 m.enter(Phase::Record);
             }
-            Record::WifiBytes { bytes, .. } => self.wifi_bytes(bytes, m),
+            Record::WifiBytes { t, bytes } => self.wifi_bytes(t, bytes, m),
             Record::WifiDrain { .. } => self.wifi_drain(m),
             Record::ServerIn { bytes, .. } => self.server_in(bytes, m),
             Record::ServerLoop { t } => self.server_loop(t, m),
@@ -256,19 +255,10 @@ impl Replay {
         m.enter(Phase::FrontEnd);
         let f = self.front_a.push(&reading.raw);
         m.enter(Phase::Node);
-        let o = self.a.tick(
-            t,
-            &board_a::Inputs {
-                command,
-                from_b,
-                electrical: f.electrical,
-                hip: f.hip,
-                gravity: f.gravity,
-                arm_contracted: reading.arm_contracted,
-                bolter_at_home: reading.bolter_at_home,
-                lost: f.lost,
-            },
-        );
+        let (arm, home) = (reading.arm_contracted, reading.bolter_at_home);
+        let o = self
+            .a
+            .tick(t, &board_a::Inputs::sensed(&f, arm, home, command, from_b));
         m.enter(Phase::Glue);
         let full = o
             .heartbeat
@@ -284,17 +274,10 @@ impl Replay {
         m.enter(Phase::FrontEnd);
         let f = self.front_b.push(&reading.raw);
         m.enter(Phase::Node);
-        let o = self.b.tick(
-            t,
-            &board_b::Inputs {
-                command,
-                electrical: f.electrical,
-                gravity: f.gravity,
-                arm_contracted: reading.arm_contracted,
-                bolter_at_home: reading.bolter_at_home,
-                lost: f.lost,
-            },
-        );
+        let (arm, home) = (reading.arm_contracted, reading.bolter_at_home);
+        let o = self
+            .b
+            .tick(t, &board_b::Inputs::sensed(&f, arm, home, command));
         m.enter(Phase::Record);
         tick_b_record(&mut self.w, command, &o);
     }
@@ -315,57 +298,51 @@ impl Replay {
         queued_record(&mut self.w, n, over);
     }
 
-    /// Board A's WiFi task takes a connection: a fresh deframer, stale heartbeats dropped.
+    /// Board A's WiFi task takes a connection (the library's session): a fresh deframer,
+    /// stale heartbeats dropped.
     #[inline(never)]
-    fn wifi_open(&mut self, m: &mut impl Meter) {
-        self.wifi_open = true;
-        self.wifi_reader = Deframer::new();
-        let n = self.discard();
+    fn wifi_open(&mut self, t: u32, m: &mut impl Meter) {
+        let mut n = 0u32;
+        let (_, mut queued) = self.heartbeats.split();
+        self.wifi
+            .open(t, core::iter::from_fn(|| queued.pop()), |_| n += 1);
         m.enter(Phase::Record);
         self.w.u32(Field::Discarded, n);
     }
 
-    /// Board A's WiFi task: command packets deframed into the control task's queue.
+    /// Board A's WiFi task: the session's command packets into the control task's queue.
     #[inline(never)]
-    fn wifi_bytes(&mut self, bytes: &[u8], m: &mut impl Meter) {
+    fn wifi_bytes(&mut self, t: u32, bytes: &[u8], m: &mut impl Meter) {
         let (mut n, mut full) = (0u32, 0u32);
         let (mut p, _) = self.commands.split();
-        frames(&mut self.wifi_reader, bytes, |f| {
-            if f.kind() != PacketKind::Command {
-                return;
-            }
-            if let Ok(c) = <[u8; COMMAND_LEN]>::try_from(f.as_bytes()) {
-                n += 1;
-                full += u32::from(p.push(c).is_err());
-            }
+        self.wifi.received(t, bytes, |c| {
+            n += 1;
+            full += u32::from(p.push(c).is_err());
         });
         m.enter(Phase::Record);
         queued_record(&mut self.w, n, full);
     }
 
-    /// Board A's WiFi task writes the queued heartbeats (or drops them, unconnected).
+    /// Board A's WiFi task writes the queued heartbeats (or drops them, unconnected), as the
+    /// session says.
     #[inline(never)]
     fn wifi_drain(&mut self, m: &mut impl Meter) {
-        if !self.wifi_open {
-            let n = self.discard();
-            m.enter(Phase::Record);
-            self.w.u32(Field::Discarded, n);
-        } else {
-            while let Some(hb) = self.heartbeats.split().1.pop() {
-                m.enter(Phase::Record);
-                self.w.bytes(Field::Sent, &hb);
-                m.enter(Phase::Glue);
+        let open = self.wifi.is_open();
+        let mut dropped = 0u32;
+        while let Some(hb) = self.heartbeats.split().1.pop() {
+            match self.wifi.heartbeat(hb) {
+                Outgoing::Send(hb) => {
+                    m.enter(Phase::Record);
+                    self.w.bytes(Field::Sent, &hb);
+                    m.enter(Phase::Glue);
+                }
+                Outgoing::Drop(_) => dropped += 1,
             }
         }
-    }
-
-    /// Heartbeats made while nobody was connected: dropped (the firmware's behaviour).
-    fn discard(&mut self) -> u32 {
-        let mut n = 0;
-        while self.heartbeats.split().1.pop().is_some() {
-            n += 1;
+        if !open {
+            m.enter(Phase::Record);
+            self.w.u32(Field::Discarded, dropped);
         }
-        n
     }
 
     #[inline(never)]
@@ -410,10 +387,13 @@ impl Replay {
                     }
                     m.enter(Phase::Node);
                 }
-                if let Some((board, packet)) = srv.next_visit() {
-                    srv.delivered(board, &packet);
+                // The replay keeps no deadline: the trace has a heartbeat record only while
+                // the engine's visit was current.
+                if let Some(visit) = Visit::next(srv, now, u32::MAX / 2) {
+                    visit.written(srv);
+                    let (board, packet) = (visit.board(), *visit.packet());
                     if board == number {
-                        self.visit = Deframer::new();
+                        self.visit = Some(visit);
                     }
                     m.enter(Phase::Record);
                     self.w.u8(Field::Visit, board.get());
@@ -439,7 +419,7 @@ impl Replay {
                     .map(|(_, c)| c.to_bytes());
                 reports(&mut self.w, g, o, now, m);
                 if let Some(packet) = visit {
-                    self.visit = Deframer::new();
+                    self.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
                     m.enter(Phase::Record);
                     self.w.u8(Field::Visit, number.get());
                     self.w.bytes(Field::Visit, &packet);
@@ -454,14 +434,10 @@ impl Replay {
 
     #[inline(never)]
     fn server_heartbeat(&mut self, now: u32, bytes: &[u8], m: &mut impl Meter) {
-        let mut hb: Option<[u8; HEARTBEAT_LEN]> = None;
         m.enter(Phase::Node);
-        frames(&mut self.visit, bytes, |f| {
-            if hb.is_none() && f.kind() == PacketKind::Heartbeat {
-                hb = f.as_bytes().try_into().ok();
-            }
-        });
-        let Some(hb) = hb else { return };
+        let Some(hb) = self.visit.as_mut().and_then(|v| v.received(bytes)) else {
+            return;
+        };
         match &mut self.board {
             Board::Relay(_) => {
                 m.enter(Phase::Record);

@@ -33,6 +33,9 @@
 //! * the server board visits its robot as the firmware does (open a connection, send the
 //!   command, wait up to `visit_ms` for the heartbeat, forward it, close) and reads the ground's
 //!   line only between visits; the PUS gateway wakes at its own next deadline;
+//! * what board A's WiFi task and the server board's visit do with their bytes is the
+//!   library's, as in every other shell ([`mmic::node::robot::wifi_session`], [`mmic::node::server::visit`]);
+//!   the engine only carries those bytes and times them;
 //! * the ground ticks its plan runners every [`GROUND_TICK_MS`] and takes each packet from a
 //!   server board when it arrives.
 
@@ -48,13 +51,14 @@ use mmic::node::ground::plan_runner::PlanRunner;
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
+use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::node::server::gateway::{Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
+use mmic::node::server::visit::Visit;
 use mmic::units::BoardNumber;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::deframer::Deframer;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
-use mmic::wire::PacketKind;
 use mmic_replay::trace::{self, Record};
 use serde_json::{json, Value};
 use std::cmp::Reverse;
@@ -194,12 +198,6 @@ enum Board {
     Gateway(Box<SimGateway>),
 }
 
-/// A visit of board A in progress: the connection, where its bytes are deframed.
-struct Visit {
-    conn: u64,
-    reader: Deframer<256>,
-}
-
 /// One robot's nodes and links.
 struct Robot {
     number: BoardNumber,
@@ -216,11 +214,12 @@ struct Robot {
     b_reader: Deframer<256>,
     b_from_a: VecDeque<[u8; mmic::wire::b_command::B_COMMAND_LEN]>,
     b_lost: bool,
-    /// Board A's WiFi task: the open connection, its reader.
-    wifi_open: Option<u64>,
-    wifi_reader: Deframer<256>,
+    /// Board A's WiFi task (the library's session) and its open connection's number.
+    wifi: WifiSession,
+    wifi_conn: u64,
     board: Board,
-    visit: Option<Visit>,
+    /// The server board's visit in progress: its connection's number, the library's visit.
+    visit: Option<(u64, Visit)>,
     /// Packets from the ground waiting for the server board's loop.
     inbox: VecDeque<Vec<u8>>,
     server_reader: Deframer<256>,
@@ -414,13 +413,14 @@ impl<'c, G: Ground> Engine<'c, G> {
             Ev::Open { robot, conn } => self.wifi_opened(robot, conn),
             Ev::Close { robot, conn } => {
                 let r = &mut self.robots[robot];
-                if r.wifi_open == Some(conn) {
-                    r.wifi_open = None;
+                if r.wifi_conn == conn && r.wifi.close() {
                     self.record(robot, |t| Record::WifiClose { t });
                 }
             }
             Ev::VisitTimeout { robot, conn } => {
-                if self.robots[robot].visit.as_ref().map(|v| v.conn) == Some(conn) {
+                let now = self.now_ms();
+                let due = |(c, v): &(u64, Visit)| *c == conn && v.left_ms(now).is_none();
+                if self.robots[robot].visit.as_ref().is_some_and(due) {
                     self.end_visit(robot);
                     self.server_loop(robot);
                 }
@@ -623,36 +623,52 @@ impl<'c, G: Ground> Engine<'c, G> {
     }
 
     /// Board A's WiFi task takes a connection: heartbeats made while nobody was connected
-    /// are discarded (the firmware's behaviour), then it serves this one.
+    /// are discarded (the library's session says so), then it serves this one.
     fn wifi_opened(&mut self, i: usize, conn: u64) {
         self.record(i, |t| Record::WifiOpen { t });
+        let now = self.now_ms();
         let r = &mut self.robots[i];
-        r.wifi_open = Some(conn);
-        r.wifi_reader = Deframer::new();
-        self.wifi_discard(i);
+        r.wifi_conn = conn;
+        let (_, mut queued) = r.heartbeats.split();
+        let mut stale = Vec::new();
+        r.wifi.open(now, std::iter::from_fn(|| queued.pop()), |hb| {
+            stale.push(hb)
+        });
+        for hb in stale {
+            self.unconnected(i, &hb);
+        }
     }
 
-    fn wifi_discard(&mut self, i: usize) {
-        let now = self.now_ms();
-        while let Some(hb) = self.robots[i].heartbeats.split().1.pop() {
-            if self.packet_log {
-                if let Some(l) = &self.log {
-                    let r = &self.robots[i];
-                    l.packet(now, "wifi", &r.names[0], &r.names[2], "unconnected", &hb);
-                }
+    /// Logs a heartbeat board A's WiFi task dropped with no server connected.
+    fn unconnected(&self, i: usize, hb: &[u8]) {
+        if self.packet_log {
+            if let Some(l) = &self.log {
+                let r = &self.robots[i];
+                l.packet(
+                    self.now_ms(),
+                    "wifi",
+                    &r.names[0],
+                    &r.names[2],
+                    "unconnected",
+                    hb,
+                );
             }
         }
     }
 
-    /// Board A's WiFi task writes the queued heartbeats to the open connection.
+    /// Board A's WiFi task writes the queued heartbeats to the open connection (or drops
+    /// them, unconnected).
     fn wifi_drain(&mut self, i: usize) {
         self.record(i, |t| Record::WifiDrain { t });
-        let Some(conn) = self.robots[i].wifi_open else {
-            self.wifi_discard(i);
-            return;
-        };
         while let Some(hb) = self.robots[i].heartbeats.split().1.pop() {
-            self.send(i, Hop::AToServer, conn, &hb);
+            let r = &mut self.robots[i];
+            match r.wifi.heartbeat(hb) {
+                Outgoing::Send(hb) => {
+                    let conn = r.wifi_conn;
+                    self.send(i, Hop::AToServer, conn, &hb);
+                }
+                Outgoing::Drop(hb) => self.unconnected(i, &hb),
+            }
         }
     }
 
@@ -660,17 +676,15 @@ impl<'c, G: Ground> Engine<'c, G> {
     fn wifi_bytes(&mut self, i: usize, conn: u64, bytes: &[u8]) {
         let copy = conn & DUPLICATE != 0;
         let r = &mut self.robots[i];
-        if r.wifi_open != Some(conn & !DUPLICATE) {
+        if !r.wifi.is_open() || r.wifi_conn != conn & !DUPLICATE {
             self.node_event(i, 0, json!({"type": "wifi_closed", "hex": log::hex(bytes)}));
             return;
         }
         self.record(i, |t| Record::WifiBytes { t, bytes });
+        let now = self.now_ms();
         let r = &mut self.robots[i];
-        let mut packets: Vec<[u8; COMMAND_LEN]> = frames(&mut r.wifi_reader, bytes)
-            .into_iter()
-            .filter(|f| f.kind() == PacketKind::Command)
-            .filter_map(|f| f.as_bytes().try_into().ok())
-            .collect();
+        let mut packets: Vec<[u8; COMMAND_LEN]> = Vec::new();
+        r.wifi.received(now, bytes, |c| packets.push(c));
         if copy && self.cfg.planted_bug == PlantedBug::DoubleExec {
             for p in packets.iter_mut() {
                 if let Ok(mut c) = CommandRepr::parse(p) {
@@ -702,7 +716,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         let current = r
             .visit
             .as_ref()
-            .is_some_and(|v| v.conn == conn & !DUPLICATE);
+            .is_some_and(|(c, _)| *c == conn & !DUPLICATE);
         if !current {
             self.node_event(
                 i,
@@ -713,14 +727,12 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
         self.record(i, |t| Record::ServerHeartbeat { t, bytes });
         let r = &mut self.robots[i];
-        let Some(v) = r.visit.as_mut() else { return };
-        let Some(hb) = frames(&mut v.reader, bytes)
-            .into_iter()
-            .find(|f| f.kind() == PacketKind::Heartbeat)
-        else {
+        let Some((_, v)) = r.visit.as_mut() else {
             return;
         };
-        let hb = hb.as_bytes().to_vec();
+        let Some(hb) = v.received(bytes) else {
+            return;
+        };
         match &mut r.board {
             Board::Relay(_) => {
                 self.end_visit(i);
@@ -739,23 +751,19 @@ impl<'c, G: Ground> Engine<'c, G> {
 
     /// The server board closes the visit's connection.
     fn end_visit(&mut self, i: usize) {
-        if let Some(v) = self.robots[i].visit.take() {
+        if let Some((conn, _)) = self.robots[i].visit.take() {
             let at = self.now
                 + self.robots[i].links[Hop::ServerToA as usize]
                     .model()
                     .latency_us;
-            self.at(
-                at,
-                Ev::Close {
-                    robot: i,
-                    conn: v.conn,
-                },
-            );
+            self.at(at, Ev::Close { robot: i, conn });
         }
     }
 
-    /// The server board opens a connection to board A and writes `packet` to it.
-    fn start_visit(&mut self, i: usize, packet: [u8; COMMAND_LEN], wait_ms: u32) {
+    /// The server board opens a connection to board A and writes the visit's packet to it.
+    fn start_visit(&mut self, i: usize, visit: Visit) {
+        let packet = *visit.packet();
+        let wait_ms = visit.deadline().wrapping_sub(self.now_ms());
         self.conns += 1;
         let conn = self.conns;
         let at = self.now
@@ -763,10 +771,7 @@ impl<'c, G: Ground> Engine<'c, G> {
                 .model()
                 .latency_us;
         self.at(at, Ev::Open { robot: i, conn });
-        self.robots[i].visit = Some(Visit {
-            conn,
-            reader: Deframer::new(),
-        });
+        self.robots[i].visit = Some((conn, visit));
         if self.cfg.protocol == Protocol::Pus {
             if let Some(w) = &mut self.watch {
                 w.commanded(i, &packet);
@@ -809,12 +814,14 @@ impl<'c, G: Ground> Engine<'c, G> {
             let Board::Relay(srv) = &mut self.robots[i].board else {
                 return;
             };
-            if let Some((board, packet)) = srv.next_visit() {
-                srv.delivered(board, &packet);
-                if board == number {
-                    self.start_visit(i, packet, self.cfg.visit_ms);
+            if let Some(visit) = Visit::next(srv, now, self.cfg.visit_ms) {
+                // The engine's write to the link cannot fail (the link may lose it).
+                visit.written(srv);
+                if visit.board() == number {
+                    self.start_visit(i, visit);
                 } else {
-                    self.node_event(i, 2, json!({"type": "no_such_robot", "board": board.get()}));
+                    let board = visit.board().get();
+                    self.node_event(i, 2, json!({"type": "no_such_robot", "board": board}));
                 }
             }
             return;
@@ -843,7 +850,8 @@ impl<'c, G: Ground> Engine<'c, G> {
             .map(|(_, c)| c.to_bytes());
         self.reports(i, out);
         if let Some(packet) = visit {
-            self.start_visit(i, packet, self.cfg.gateway.uplink.timeout_ms);
+            let wait = self.cfg.gateway.uplink.timeout_ms;
+            self.start_visit(i, Visit::new(now, number, packet, wait));
             return;
         }
         let Board::Gateway(g) = &self.robots[i].board else {
@@ -983,8 +991,8 @@ impl Robot {
             b_reader: Deframer::new(),
             b_from_a: VecDeque::new(),
             b_lost: false,
-            wifi_open: None,
-            wifi_reader: Deframer::new(),
+            wifi: WifiSession::new(WifiConfig::default()),
+            wifi_conn: 0,
             board,
             visit: None,
             inbox: VecDeque::new(),
