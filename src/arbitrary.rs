@@ -26,23 +26,24 @@
 //! `tests/wire/round_trip.rs` in the repository, which draws a fixed-seed sample and requires every
 //! one of the 61 command opcodes (and every optional field, both ways) to appear in it.
 
+use crate::bolter::BolterAttempt;
+use crate::bolter::{BolterAux, BolterOrder};
 use crate::bolter::{BolterDirection, BolterStep, MuxLines};
 use crate::command::{
     BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
-    PrimitiveMove, Reconfiguration, ServoTarget,
+    PrimitiveMove, Reconfiguration, ServoTarget, Travel,
 };
-use crate::control::interp::Travel;
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
-use crate::motion::{Primitive, State, StateKind};
+use crate::pose::{Primitive, State, StateKind};
 use crate::refusal::Refusal;
 use crate::units::{
     Axis, BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth, Side, Sign,
 };
-use crate::wire::b_command::{BCommandRepr, BPower, BolterOrder};
+use crate::wire::b_command::{BCommandRepr, BPower};
 use crate::wire::command::CommandRepr;
-use crate::wire::heartbeat::{BolterAttempt, HeartbeatRepr};
-use crate::wire::internal_heartbeat::{BolterAux, InternalHeartbeatRepr};
+use crate::wire::heartbeat::HeartbeatRepr;
+use crate::wire::internal_heartbeat::InternalHeartbeatRepr;
 use crate::wire::{PacketKind, MAX_PACKET_LEN};
 use proptest::arbitrary::{any, Arbitrary};
 use proptest::array::{uniform4, uniform7};

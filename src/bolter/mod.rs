@@ -16,9 +16,13 @@
 use crate::wire_enum::wire_enum;
 
 mod coordinator;
+mod order;
+mod progress;
 mod side;
 
 pub use coordinator::{Config, Coordinator, Job, Output, Status};
+pub use order::{BolterOrder, Fasteners};
+pub use progress::BolterAux;
 pub use side::{BolterSide, Drive, Sensed, SideConfig};
 
 wire_enum! {
@@ -264,8 +268,8 @@ mod tests {
     /// reports its direction.
     #[test]
     fn side_timeouts_mux_and_direction() {
+        use super::BolterOrder;
         use super::{BolterDirection, BolterSide, BolterStep, Sensed, SideConfig};
-        use crate::wire::b_command::BolterOrder;
         let cfg = SideConfig {
             sensed_ms: 1_000,
             home_ms: 3_000,

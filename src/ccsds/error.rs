@@ -2,11 +2,8 @@
 //!
 //! [`PacketError`] covers everything the wire layer checks, one variant per check, in the
 //! order the parsers run them ([`PacketError::NAMES`]); the first failure is the error, so a
-//! given input has exactly one. [`PusError`] is the error of a whole telecommand or telemetry
-//! exchange: today only `Packet`, and the services layer (service and subservice tables,
-//! application data lengths and ranges) adds its own variants after it, each with a
-//! [`PusError::name`], so that one enum names every refusal from the first octet to the last
-//! argument.
+//! given input has exactly one. The error of a whole telecommand, from the first octet to
+//! the last argument, is the services layer's ([`crate::pus::PusError`]): it wraps this one.
 
 use super::primary::PacketType;
 
@@ -152,40 +149,6 @@ impl PacketError {
             PacketError::PusVersion { .. } => 6,
             PacketError::Checksum { .. } => 7,
             PacketError::Apid { .. } => 8,
-        }
-    }
-}
-
-/// Why a telecommand or telemetry packet is refused, from its first octet to its last
-/// argument. The wire layer's checks are [`PusError::Packet`]; the services layer adds a
-/// variant per check of its own (unknown service or subservice, application data of the wrong
-/// length, an argument out of range) with its name in [`PusError::name`], and
-/// `spec/ccsds/bad-inputs.toml` gains a row for each.
-///
-/// ```
-/// use mmic::ccsds::{PusError, tc::TcRepr};
-///
-/// let e: PusError = TcRepr::parse(&[0u8; 4], &[0x10]).unwrap_err().into();
-/// assert_eq!(e.name(), "truncated");
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum PusError {
-    /// The space packet or its PUS secondary header.
-    #[error(transparent)]
-    Packet(#[from] PacketError),
-    /// The service, subservice or application data (the services layer,
-    /// [`crate::pus::request`]).
-    #[error(transparent)]
-    Request(#[from] crate::pus::request::RequestError),
-}
-
-impl PusError {
-    /// The failed check's name.
-    pub const fn name(&self) -> &'static str {
-        match self {
-            PusError::Packet(e) => e.name(),
-            PusError::Request(e) => e.name(),
         }
     }
 }

@@ -962,9 +962,7 @@ impl BoardA {
             // opcode or parameters are no command: ours to answer, with its sequence number,
             // so the ground stops resending it.
             Err(WireError::Command(ce)) => match crate::wire::check::<CommandPacket>(bytes) {
-                Ok(p) if p.board_number() == self.cfg.board.get() => {
-                    (p.seq(), Err(Refusal::for_command_error(&ce)))
-                }
+                Ok(p) if p.board_number() == self.cfg.board.get() => (p.seq(), Err(ce.refusal())),
                 _ => return Received::Ignore(Event::Rejected(WireError::Command(ce))),
             },
             Err(e) => return Received::Ignore(Event::Rejected(e)),

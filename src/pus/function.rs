@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use mmic::command::Command;
-//! use mmic::motion::State;
+//! use mmic::pose::State;
 //! use mmic::pus::function::{self, FunctionError};
 //!
 //! let c = Command::reconfigure(State::A, State::M).unwrap();
@@ -26,13 +26,13 @@
 //! ```
 
 use crate::bolter::BolterPair;
+use crate::command::Travel;
 use crate::command::{
     BolterCommand, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove, PrimitiveMoveError,
     Reconfiguration, ReconfigurationError, ServoTarget,
 };
-use crate::control::interp::Travel;
 use crate::mode::Mode;
-use crate::motion::{Primitive, State};
+use crate::pose::{Primitive, State};
 use crate::units::{HipAngle, Module, PulseWidth, Side};
 
 /// The longest application data of a function: ID and arguments.

@@ -21,7 +21,7 @@
 use crate::bolter::{BolterAttempt, BolterPair};
 use crate::faults::Faults;
 use crate::mode::Mode;
-use crate::motion::State;
+use crate::pose::State;
 use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use crate::wire::heartbeat::HeartbeatRepr;

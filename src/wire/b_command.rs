@@ -25,6 +25,8 @@
 use super::layout::{field_table, FieldSpec};
 use super::pulse;
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
+/// The order is the bolter's vocabulary; re-exported at its old path.
+pub use crate::bolter::BolterOrder;
 use crate::bolter::{BolterDirection, BolterPair, BolterStep};
 use crate::units::PulseWidth;
 use zerocopy::byteorder::little_endian::U16;
@@ -146,20 +148,6 @@ pub struct BPower {
     pub gripper: bool,
     /// Bolter B.
     pub bolter: bool,
-}
-
-/// A bolter step ordered on side B: which pair, which way, which step of Figure 8.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
-pub struct BolterOrder {
-    /// Pair selected through the multiplexer.
-    pub pair: BolterPair,
-    /// Bolt or unbolt.
-    pub direction: BolterDirection,
-    /// Step to execute.
-    pub step: BolterStep,
 }
 
 /// What board A orders board B to do.

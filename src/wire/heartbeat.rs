@@ -16,7 +16,7 @@ use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKin
 use crate::command::BolterPair;
 use crate::faults::Faults;
 use crate::mode::Mode;
-use crate::motion::State;
+use crate::pose::State;
 use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use zerocopy::byteorder::little_endian::U16;

@@ -29,7 +29,7 @@ pub mod opcode;
 
 pub use layout::{ElectricalLayout, FieldSpec, Unit};
 
-use crate::command::CommandError;
+use opcode::CommandError;
 
 /// Length of every header.
 pub const HEADER_LEN: usize = 4;
