@@ -36,11 +36,11 @@
 //! the packets, so the error that joins both is theirs). `spec/ccsds/bad-inputs.toml` holds one refused packet per check, which
 //! `tests/ccsds/bad_inputs.rs` walks through the parsers.
 
+mod bit_field;
 pub mod cuc;
 mod error;
 mod packet;
 pub mod primary;
-mod ranged;
 pub mod tc;
 pub mod tc_header;
 pub mod tm;
