@@ -22,7 +22,7 @@
 //! assert_eq!(BCommandRepr::parse(&bytes), Ok(cmd));
 //! ```
 
-use super::layout::{field_table, FieldSpec};
+use super::layout::fields;
 use super::pulse;
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
 /// The order is the bolter's vocabulary; re-exported at its old path.
@@ -66,56 +66,20 @@ macro_rules! at {
     };
 }
 
-/// Field table, from the layout (spec/packets/b-command.toml is checked against it). The
-/// "paper" labels are this project's, written in the paper's style.
-pub const FIELDS: &[FieldSpec] = field_table![BCommandPacket;
-    // (name, field, type, unit, the paper's label)
-    ("header", header, [u8; 4], Header, "header"),
-    ("seq", seq, u8, Sequence, "sequence number"),
-    ("flags", flags, u8, Bits, "power/stop flags"),
-    ("arm_target", arm_target, U16, Micros, "arm B-target"),
-    ("gripper_target", gripper_target, U16, Micros, "gripper B-target"),
-    ("bolter.pair", bolter_pair, u8, Enum, "bolter pair"),
-    ("bolter.direction", bolter_direction, u8, Enum, "bolter direction"),
-    ("bolter.step", bolter_step, u8, Enum, "bolter step"),
-    ("checksum", checksum, U16, Crc16, "checksum"),
-];
-
-/// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
-pub mod field {
-    use super::*;
-    use crate::wire::layout::span;
-    use core::ops::Range;
-    /// `header`.
-    pub const HEADER: Range<usize> = span!(BCommandPacket, header, [u8; 4]);
-    /// `seq`.
-    pub const SEQ: Range<usize> = span!(BCommandPacket, seq, u8);
-    /// `flags`.
-    pub const FLAGS: Range<usize> = span!(BCommandPacket, flags, u8);
-    /// `arm_target`.
-    pub const ARM_TARGET: Range<usize> = span!(
-        BCommandPacket,
-        arm_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_target`.
-    pub const GRIPPER_TARGET: Range<usize> = span!(
-        BCommandPacket,
-        gripper_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `bolter.pair`.
-    pub const BOLTER_PAIR: Range<usize> = span!(BCommandPacket, bolter_pair, u8);
-    /// `bolter.direction`.
-    pub const BOLTER_DIRECTION: Range<usize> = span!(BCommandPacket, bolter_direction, u8);
-    /// `bolter.step`.
-    pub const BOLTER_STEP: Range<usize> = span!(BCommandPacket, bolter_step, u8);
-    /// `checksum`.
-    pub const CHECKSUM: Range<usize> = span!(
-        BCommandPacket,
-        checksum,
-        zerocopy::byteorder::little_endian::U16
-    );
+// The fields, from the layout (spec/packets/b-command.toml is checked against it). The
+// "paper" labels are this project's, written in the paper's style.
+fields! {
+    BCommandPacket;
+    // CONST: (name, field, type, unit, the paper's label)
+    HEADER: ("header", header, [u8; 4], Header, "header"),
+    SEQ: ("seq", seq, u8, Sequence, "sequence number"),
+    FLAGS: ("flags", flags, u8, Bits, "power/stop flags"),
+    ARM_TARGET: ("arm_target", arm_target, U16, Micros, "arm B-target"),
+    GRIPPER_TARGET: ("gripper_target", gripper_target, U16, Micros, "gripper B-target"),
+    BOLTER_PAIR: ("bolter.pair", bolter_pair, u8, Enum, "bolter pair"),
+    BOLTER_DIRECTION: ("bolter.direction", bolter_direction, u8, Enum, "bolter direction"),
+    BOLTER_STEP: ("bolter.step", bolter_step, u8, Enum, "bolter step"),
+    CHECKSUM: ("checksum", checksum, U16, Crc16, "checksum"),
 }
 
 /// Flag bits of byte 5.
