@@ -197,9 +197,9 @@ impl Default for HeartbeatRepr {
     }
 }
 
-fn angle(name: &'static str, at: usize, v: U16) -> Result<HipAngle, WireError> {
+fn angle(kind: PacketKind, name: &'static str, at: usize, v: U16) -> Result<HipAngle, WireError> {
     HipAngle::new(v.get())
-        .map_err(|_| field_err(KIND, at, name, "0..=35999 (0.01 deg)", v.get() as u32))
+        .map_err(|_| field_err(kind, at, name, "0..=35999 (0.01 deg)", v.get() as u32))
 }
 
 /// Index of the first byte of layout field `$f`.
@@ -277,7 +277,13 @@ impl HeartbeatRepr {
     fn fields(p: &HeartbeatPacket) -> Result<HeartbeatRepr, WireError> {
         let board =
             BoardNumber::new(p.board).map_err(|_| field_err(KIND, 4, "board", "1..=255", 0))?;
-        // An optional byte field whose JSON name is the layout field's name.
+        // The error of a byte field whose JSON name is the layout field's name.
+        macro_rules! refuse {
+            ($f:ident, $expected:literal) => {
+                field_err(KIND, at!($f), stringify!($f), $expected, p.$f as u32)
+            };
+        }
+        // An optional byte field named so.
         macro_rules! opt {
             ($f:ident, $expected:literal, $from:path) => {
                 optional(KIND, at!($f), stringify!($f), $expected, p.$f, $from)?
@@ -285,52 +291,34 @@ impl HeartbeatRepr {
         }
         let target_state = opt!(target_state, "0 or 'a'..='o'", State::from_wire);
         let active_bolter = opt!(active_bolter, "0..=4", BolterPair::from_number);
-        let bolter_attempt = BolterAttempt::new(p.bolter_attempt).map_err(|_| {
-            field_err(
-                KIND,
-                at!(bolter_attempt),
-                "bolter_attempt",
-                "0..=3",
-                p.bolter_attempt as u32,
-            )
-        })?;
+        let bolter_attempt =
+            BolterAttempt::new(p.bolter_attempt).map_err(|_| refuse!(bolter_attempt, "0..=3"))?;
         if p.empty != 0 {
-            return Err(field_err(KIND, at!(empty), "empty", "0", p.empty as u32));
+            return Err(refuse!(empty, "0"));
         }
         let faults = Faults::from_wire(p.faults)
             .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=14 only", e.reserved))?;
         let refusal = opt!(refusal, "0 (accepted) or 1..=8", Refusal::from_wire);
-        let mode = Mode::from_wire(p.mode).ok_or_else(|| {
-            field_err(
-                KIND,
-                at!(mode),
-                "mode",
-                "1 (standby), 2 (operational) or 3 (safed)",
-                p.mode as u32,
-            )
-        })?;
+        let mode = Mode::from_wire(p.mode)
+            .ok_or_else(|| refuse!(mode, "1 (standby), 2 (operational) or 3 (safed)"))?;
+        // A servo field whose JSON name is the layout field's name.
+        macro_rules! servo {
+            ($check:ident, $f:ident) => {
+                $check(KIND, stringify!($f), at!($f), p.$f)?
+            };
+        }
         Ok(HeartbeatRepr {
             board,
-            hip_target: angle("hip_target", at!(hip_target), p.hip_target)?,
-            hip_now: angle("hip_now", at!(hip_now), p.hip_now)?,
-            arm_a_target: pulse(KIND, "arm_a_target", at!(arm_a_target), p.arm_a_target)?,
-            arm_a_now: pulse(KIND, "arm_a_now", at!(arm_a_now), p.arm_a_now)?,
-            arm_b_target: pulse(KIND, "arm_b_target", at!(arm_b_target), p.arm_b_target)?,
-            arm_b_now: pulse(KIND, "arm_b_now", at!(arm_b_now), p.arm_b_now)?,
-            gripper_a_target: pulse(
-                KIND,
-                "gripper_a_target",
-                at!(gripper_a_target),
-                p.gripper_a_target,
-            )?,
-            gripper_a_now: pulse(KIND, "gripper_a_now", at!(gripper_a_now), p.gripper_a_now)?,
-            gripper_b_target: pulse(
-                KIND,
-                "gripper_b_target",
-                at!(gripper_b_target),
-                p.gripper_b_target,
-            )?,
-            gripper_b_now: pulse(KIND, "gripper_b_now", at!(gripper_b_now), p.gripper_b_now)?,
+            hip_target: servo!(angle, hip_target),
+            hip_now: servo!(angle, hip_now),
+            arm_a_target: servo!(pulse, arm_a_target),
+            arm_a_now: servo!(pulse, arm_a_now),
+            arm_b_target: servo!(pulse, arm_b_target),
+            arm_b_now: servo!(pulse, arm_b_now),
+            gripper_a_target: servo!(pulse, gripper_a_target),
+            gripper_a_now: servo!(pulse, gripper_a_now),
+            gripper_b_target: servo!(pulse, gripper_b_target),
+            gripper_b_now: servo!(pulse, gripper_b_now),
             electrical_a: Electrical::from(&p.electrical_a),
             electrical_b: Electrical::from(&p.electrical_b),
             target_state,
