@@ -24,24 +24,7 @@ pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl F
     for m in Mode::ALL {
         visit(Command::Mode(m));
     }
-    for side in Side::ALL {
-        for target in [
-            ServoTarget::Contract,
-            ServoTarget::Extend,
-            ServoTarget::Position(pw),
-        ] {
-            visit(Command::Arm { side, target });
-        }
-    }
-    for side in Side::ALL {
-        for target in [
-            ServoTarget::Contract,
-            ServoTarget::Extend,
-            ServoTarget::Position(pw),
-        ] {
-            visit(Command::Gripper { side, target });
-        }
-    }
+    servo_classes(pw, &mut visit);
     for h in [
         HipTarget::Home,
         HipTarget::Straight,
@@ -51,22 +34,7 @@ pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl F
     ] {
         visit(Command::Hip(h));
     }
-    for bolt in [true, false] {
-        for which in [
-            Fasteners::Pair(BolterPair::P1),
-            Fasteners::Pair(BolterPair::P2),
-            Fasteners::Pair(BolterPair::P3),
-            Fasteners::Pair(BolterPair::P4),
-            Fasteners::All,
-        ] {
-            visit(Command::Bolter(if bolt {
-                BolterCommand::Bolt(which)
-            } else {
-                BolterCommand::Unbolt(which)
-            }));
-        }
-    }
-    visit(Command::Bolter(BolterCommand::Down));
+    bolter_classes(&mut visit);
     // Each primitive with its first final state in Table 5 order.
     for p in Primitive::ALL {
         if let Some(m) = PrimitiveMove::all().find(|m| m.primitive() == p) {
@@ -89,6 +57,45 @@ pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl F
             on,
         });
     }
+}
+
+/// The arm classes, then the gripper classes: each side, contract, extend and `pw`.
+fn servo_classes(pw: PulseWidth, visit: &mut impl FnMut(Command)) {
+    let targets = [
+        ServoTarget::Contract,
+        ServoTarget::Extend,
+        ServoTarget::Position(pw),
+    ];
+    for side in Side::ALL {
+        for target in targets {
+            visit(Command::Arm { side, target });
+        }
+    }
+    for side in Side::ALL {
+        for target in targets {
+            visit(Command::Gripper { side, target });
+        }
+    }
+}
+
+/// Bolt, then unbolt, each pair and all four; then both bolters down.
+fn bolter_classes(visit: &mut impl FnMut(Command)) {
+    for bolt in [true, false] {
+        for which in [
+            Fasteners::Pair(BolterPair::P1),
+            Fasteners::Pair(BolterPair::P2),
+            Fasteners::Pair(BolterPair::P3),
+            Fasteners::Pair(BolterPair::P4),
+            Fasteners::All,
+        ] {
+            visit(Command::Bolter(if bolt {
+                BolterCommand::Bolt(which)
+            } else {
+                BolterCommand::Unbolt(which)
+            }));
+        }
+    }
+    visit(Command::Bolter(BolterCommand::Down));
 }
 
 /// Calls `visit` with every representable command: each variant class, an arm or gripper
