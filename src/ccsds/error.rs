@@ -25,6 +25,7 @@ use super::primary::PacketType;
 /// packet is intact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum PacketError {
     /// Fewer octets than the primary and secondary headers and the CRC.
     #[error("{kind} packet: {found} octets, fewer than its headers and CRC ({expected})")]
@@ -156,6 +157,7 @@ impl PacketError {
 /// Why a packet could not be written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum EmitError {
     /// The caller's buffer is shorter than the packet.
     #[error("the packet needs {expected} octets, the buffer has {found}")]

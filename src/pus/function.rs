@@ -120,6 +120,7 @@ impl FunctionId {
 /// Why application data is no function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum FunctionError {
     /// No application data at all: not even a function ID.
     #[error("no function ID: the application data is empty")]

@@ -201,6 +201,7 @@ pub const REPORT_LEN: usize = {
 /// Why source data is no report of ours. Each names the check and the numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum HousekeepingError {
     /// Not the report's length.
     #[error("housekeeping report of {found} bytes, expected {expected}")]

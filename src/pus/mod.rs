@@ -48,6 +48,7 @@ use request::{Request, RequestError};
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum PusError {
     /// The space packet or its PUS secondary header.
     #[error(transparent)]

@@ -126,6 +126,7 @@ impl fmt::Display for PacketKind {
 /// fields; the first failure is reported with the numbers that explain it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum WireError {
     /// Wrong number of bytes.
     #[error("{kind} packet: length must be {expected} bytes, found {found}")]

@@ -109,6 +109,7 @@ pub const fn seq_slot(id: u8) -> Slot {
 /// A parameter block that does not decode to a command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum CommandError {
     /// Byte 5 holds no assigned opcode.
     #[error("byte 5: unknown command id {id:#04x}")]
