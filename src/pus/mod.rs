@@ -54,7 +54,7 @@ pub enum PusError {
     #[error(transparent)]
     Packet(#[from] PacketError),
     /// The service, subservice or application data (the services layer,
-    /// [`super::request`]).
+    /// [`request`]).
     #[error(transparent)]
     Request(#[from] RequestError),
 }

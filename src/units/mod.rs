@@ -9,7 +9,7 @@
 //! assert_eq!(HipAngle::new(18000).unwrap().centidegrees(), 18000); // 180.00°
 //! ```
 //!
-//! One file per kind of quantity; each bounded integer is a [`ranged!`](range) newtype, so a
+//! One file per kind of quantity; each bounded integer is a `ranged!` newtype, so a
 //! value outside its range cannot be built and is refused by name.
 
 mod board;

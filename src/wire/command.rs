@@ -179,7 +179,7 @@ pub struct CommandRepr {
     /// The command.
     pub command: Command,
     /// Exactly-once sequence number, 1..=65535, carried in the parameter slot
-    /// [`crate::command::seq_slot`] leaves free; 0 = unsequenced, the paper's
+    /// [`crate::wire::opcode::seq_slot`] leaves free; 0 = unsequenced, the paper's
     /// behaviour (board A executes every copy). See spec/protocol/README.md.
     #[cfg_attr(feature = "serde", serde(default))]
     #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq16"))]
