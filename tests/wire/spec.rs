@@ -611,6 +611,7 @@ fn prose_about_bytes() -> Vec<(String, String, Option<&'static str>, bool)> {
             }
             // A packet's module split into a directory: its files speak of that packet.
             _ if p.parent().is_some_and(|d| d.ends_with("wire/opcode")) => Some("command"),
+            _ if p.parent().is_some_and(|d| d.ends_with("wire/b_command")) => Some("b-command"),
             _ => None,
         };
         let raw = std::fs::read_to_string(&p).unwrap();
