@@ -18,6 +18,9 @@
 //! centidegrees, board 1 and 255).
 //! Sum types pick each variant with equal weight, so no variant is starved.
 //!
+//! The ranged quantities (`PulseWidth`, `HipAngle`, `BolterAttempt`, the CCSDS fields) get
+//! theirs from the `ranged!` macro that declares them, with the same weighting.
+//!
 //! Besides the [`Arbitrary`] impls, [`sealed_bytes`] draws byte strings with a packet's length,
 //! header and a correct checksum but arbitrary body bytes: inputs that reach the field checks.
 //!
@@ -26,23 +29,24 @@
 //! `tests/wire/round_trip.rs` in the repository, which draws a fixed-seed sample and requires every
 //! one of the 61 command opcodes (and every optional field, both ways) to appear in it.
 
+use crate::bolter::BolterAttempt;
+use crate::bolter::{BolterAux, BolterOrder};
 use crate::bolter::{BolterDirection, BolterStep, MuxLines};
 use crate::command::{
     BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
-    PrimitiveMove, Reconfiguration, ServoTarget,
+    PrimitiveMove, Reconfiguration, ServoTarget, Travel,
 };
-use crate::control::interp::Travel;
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
-use crate::motion::{Primitive, State, StateKind};
+use crate::pose::{Primitive, State, StateKind};
 use crate::refusal::Refusal;
 use crate::units::{
     Axis, BoardNumber, Electrical, Gravity, HipAngle, Module, PulseWidth, Side, Sign,
 };
-use crate::wire::b_command::{BCommandRepr, BPower, BolterOrder};
+use crate::wire::b_command::{BCommandRepr, BPower};
 use crate::wire::command::CommandRepr;
-use crate::wire::heartbeat::{BolterAttempt, HeartbeatRepr};
-use crate::wire::internal_heartbeat::{BolterAux, InternalHeartbeatRepr};
+use crate::wire::heartbeat::HeartbeatRepr;
+use crate::wire::internal_heartbeat::InternalHeartbeatRepr;
 use crate::wire::{PacketKind, MAX_PACKET_LEN};
 use proptest::arbitrary::{any, Arbitrary};
 use proptest::array::{uniform4, uniform7};
@@ -60,11 +64,6 @@ fn pick<T: Clone + core::fmt::Debug + 'static, const N: usize>(all: &'static [T;
 /// Any `u16`, with 0 and `u16::MAX` over-weighted (raw wire quantities: mV, mA).
 pub fn wire_u16() -> impl Strategy<Value = u16> {
     prop_oneof![1 => Just(0u16), 1 => Just(u16::MAX), 8 => any::<u16>()]
-}
-
-/// A `u16` in `lo..=hi`, with both bounds over-weighted.
-fn bounded_u16(lo: u16, hi: u16) -> impl Strategy<Value = u16> {
-    prop_oneof![1 => Just(lo), 1 => Just(hi), 8 => lo..=hi]
 }
 
 /// Implements `Arbitrary` for a unit enum with a `const ALL` table.
@@ -128,20 +127,6 @@ arbitrary_boxed!(
     BoardNumber,
     prop_oneof![1 => Just(1u8), 1 => Just(u8::MAX), 8 => 1..=u8::MAX]
         .prop_filter_map("board 1..=255", |n| BoardNumber::new(n).ok())
-);
-arbitrary_boxed!(
-    PulseWidth,
-    bounded_u16(PulseWidth::MIN_US, PulseWidth::MAX_US)
-        .prop_filter_map("pulse width 500..=2500", |us| PulseWidth::new(us).ok())
-);
-arbitrary_boxed!(
-    HipAngle,
-    bounded_u16(0, HipAngle::TURN - 1)
-        .prop_filter_map("hip angle < 36000", |a| HipAngle::new(a).ok())
-);
-arbitrary_boxed!(
-    BolterAttempt,
-    (0..=BolterAttempt::MAX).prop_filter_map("attempt 0..=3", |n| BolterAttempt::new(n).ok())
 );
 arbitrary_boxed!(
     Gravity,

@@ -26,6 +26,25 @@
 //! assert!(CommandRepr::parse(&bytes).is_err());
 //! ```
 //!
+//! # Reading order
+//!
+//! The modules read bottom-up: each uses only those of the rows below it, and those before it
+//! in its own row, so there is no import circle (`tests/layering.rs` holds the code to this
+//! table, which it reads from one list of its own).
+//!
+//! | layer | modules | what they hold |
+//! |---|---|---|
+//! | node | `node` | the boards, the gateway and the ground station: everything wired together |
+//! | pus | `pus` | the PUS-C services: what each telecommand means and what each report carries |
+//! | ccsds | `ccsds` | the CCSDS space packets and PUS headers the services travel in |
+//! | wire | `wire`, `arbitrary` | the paper's packets (Tables 2–4, the A→B command), byte by byte; the proptest strategies for them and the vocabulary (feature `proptest`) |
+//! | behaviour | `sensors`, `control`, `motion`, `safety` | the robot's logic: filters, servo and hip control, the motion sequencer, the safety supervisor; it speaks only the vocabulary, never a packet |
+//! | vocabulary | `mode`, `faults`, `refusal`, `pose`, `bolter`, `command` | what the robot and its operator talk about: modes, faults, refusal codes, states and primitives, the bolter's steps, the command set |
+//! | ground | `units`, `wire_enum` | checked quantities (pulse widths, angles, board numbers) and the C-like enum macro |
+//!
+//! The behaviour stands below the packets because nothing in it needs one, while the services
+//! read the safety tables (an event's severity is Table 8's deferral).
+//!
 //! Design decisions that the paper leaves open (header bytes, checksum, units, command IDs)
 //! are listed with their rationale in `spec/decisions.toml` of the repository.
 #![no_std]
@@ -45,6 +64,7 @@ pub mod faults;
 pub mod mode;
 pub mod motion;
 pub mod node;
+pub mod pose;
 pub mod pus;
 pub mod refusal;
 pub mod safety;
@@ -67,8 +87,8 @@ const _: () = {
     format::<faults::Faults>();
     format::<faults::Fault>();
     format::<refusal::Refusal>();
-    format::<motion::State>();
-    format::<motion::Primitive>();
+    format::<pose::State>();
+    format::<pose::Primitive>();
     format::<command::PrimitiveMove>();
     format::<bolter::BolterPair>();
     format::<node::robot::board_a::Event>();
@@ -77,6 +97,6 @@ const _: () = {
     format::<ccsds::tc::TcRepr<'static>>();
     format::<ccsds::tm::TmRepr<'static>>();
     format::<ccsds::PacketError>();
-    format::<ccsds::PusError>();
+    format::<pus::PusError>();
     format::<ccsds::EmitError>();
 };

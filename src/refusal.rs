@@ -54,13 +54,3 @@ wire_enum! {
     pub const fn name(self) -> &'static str;
     impl Display("{}", name);
 }
-
-impl Refusal {
-    /// The refusal a malformed command packet earns.
-    pub const fn for_command_error(e: &crate::command::CommandError) -> Refusal {
-        match e {
-            crate::command::CommandError::UnknownId { .. } => Refusal::UnknownCommand,
-            _ => Refusal::InvalidParameter,
-        }
-    }
-}

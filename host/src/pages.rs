@@ -8,9 +8,7 @@
 //! ([`crate::spec::origins`]); a row of the paper says which table it comes from. A reviewer
 //! reading a page as the paper therefore sees at once what the paper does not say.
 
-use mmic::command::{
-    for_each_variant_class, Command, CommandError, CommandKind, PARAM_LEN, PARAM_OFFSET,
-};
+use mmic::command::{for_each_variant_class, Command, CommandKind};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
 use mmic::refusal::Refusal;
@@ -18,6 +16,7 @@ use mmic::safety::detect::Config;
 use mmic::safety::policy::{accepts, fault_action, is_condition, powered, regulator_on};
 use mmic::safety::ModuleSet;
 use mmic::units::{HipAngle, PulseWidth};
+use mmic::wire::opcode::{decode, encode, CommandError, PARAM_LEN, PARAM_OFFSET};
 use mmic::wire::PacketKind;
 use std::fmt::Write;
 
@@ -166,7 +165,7 @@ pub fn commands() -> String {
         PulseWidth::CENTER,
         HipAngle::new(9000).unwrap_or(HipAngle::ZERO),
         |c| {
-            let (id, _) = c.encode();
+            let (id, _) = encode(&c);
             let used: Vec<String> = param_bytes_used(c)
                 .into_iter()
                 .map(|i| i.to_string())
@@ -194,17 +193,17 @@ pub fn commands() -> String {
 
 /// The packet bytes (6..=11) that `command`'s opcode reads, as the library's own decoder
 /// decides: a byte is unused exactly when making it nonzero in `command`'s encoding makes
-/// `Command::decode` refuse it as "unused, must be 0". (Not "the bytes that happen to be
+/// `opcode::decode` refuse it as "unused, must be 0". (Not "the bytes that happen to be
 /// nonzero", which would miss a parameter whose value has a zero byte.)
 pub fn param_bytes_used(command: Command) -> Vec<usize> {
-    let (id, p) = command.encode();
+    let (id, p) = encode(&command);
     (0..PARAM_LEN)
         .filter(|&i| {
             let mut probe = p;
             probe[i] = p[i].wrapping_add(1) | 1;
             let index = i + PARAM_OFFSET;
             !matches!(
-                Command::decode(id, probe),
+                decode(id, probe),
                 Err(CommandError::UnusedNotZero { index: at, .. }) if at == index
             )
         })

@@ -3,7 +3,7 @@
 //! of spec/ccsds/functions.toml ([`crate::spec`]) for argument names.
 //!
 //! A refused packet is a [`PusCodecError::Refused`] naming the failed check
-//! ([`mmic::ccsds::PusError::name`] for telecommands; for telemetry the wire check's name, or
+//! ([`mmic::pus::PusError::name`] for telecommands; for telemetry the wire check's name, or
 //! `unknown-service`, `unknown-subservice`, `source-data`); bad JSON or hex is
 //! [`PusCodecError::Input`].
 //!
@@ -28,12 +28,13 @@ use mmic::ccsds::tc::TcRepr;
 use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::ccsds::tm::TmRepr;
 use mmic::ccsds::tm_header::{TimeRefStatus, TmSecondaryHeader};
-use mmic::ccsds::{PusError, MAX_PACKET_LEN};
+use mmic::ccsds::MAX_PACKET_LEN;
 use mmic::pus::event::{AttemptResult, Event};
 use mmic::pus::function::FunctionId;
 use mmic::pus::housekeeping;
 use mmic::pus::request::Request;
 use mmic::pus::verification::{Failure, Report, RequestId, Stage};
+use mmic::pus::PusError;
 use mmic::pus::{read_tc, ROBOT_APID_BASE};
 use mmic::wire::heartbeat::HeartbeatRepr;
 use serde_json::{json, Map, Value};

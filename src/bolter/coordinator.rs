@@ -5,13 +5,11 @@
 //! attempts; spec/decisions.toml, `bolting-failure-at-home`).
 
 use super::side::{ended, SideConfig};
-use super::{BolterDirection, BolterPair, BolterStep};
-use crate::command::Fasteners;
+use super::{
+    BolterAttempt, BolterAux, BolterDirection, BolterOrder, BolterPair, BolterStep, Fasteners,
+};
 use crate::faults::Fault;
 use crate::units::Instant;
-use crate::wire::b_command::BolterOrder;
-use crate::wire::heartbeat::BolterAttempt;
-use crate::wire::internal_heartbeat::BolterAux;
 
 /// Coordinator settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -13,12 +13,17 @@
 //! assert_eq!(MuxLines::for_pair(BolterPair::P3), MuxLines { a0: true, a1: false });
 //! ```
 
+use crate::units::ranged;
 use crate::wire_enum::wire_enum;
 
 mod coordinator;
+mod order;
+mod progress;
 mod side;
 
 pub use coordinator::{Config, Coordinator, Job, Output, Status};
+pub use order::{BolterOrder, Fasteners};
+pub use progress::BolterAux;
 pub use side::{BolterSide, Drive, Sensed, SideConfig};
 
 wire_enum! {
@@ -147,63 +152,17 @@ impl MuxLines {
         }
     }
 }
-/// Which attempt of the bolter state machine is running: 0 (none), 1, 2 or 3.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(
-    feature = "serde",
-    derive(serde::Serialize, serde::Deserialize),
-    serde(try_from = "crate::units::Number", into = "u8")
-)]
-pub struct BolterAttempt(u8);
+ranged! {
+    /// Which attempt of the bolter state machine is running: 0 (none), 1, 2 or 3.
+    #[derive(Default)]
+    pub struct BolterAttempt(u8), min 0, max 3, "bolter attempt";
+}
 
 impl BolterAttempt {
     /// Three attempts at most (Table 8).
     pub const MAX: u8 = 3;
     /// No attempt running.
     pub const NONE: BolterAttempt = BolterAttempt(0);
-
-    /// Attempt `n`, refused above 3.
-    pub const fn new(n: u8) -> Result<Self, crate::units::RangeError> {
-        if n <= Self::MAX {
-            Ok(BolterAttempt(n))
-        } else {
-            Err(crate::units::RangeError {
-                quantity: "bolter attempt",
-                min: 0,
-                max: 3,
-                found: n as u32,
-            })
-        }
-    }
-
-    /// The attempt number.
-    pub const fn get(self) -> u8 {
-        self.0
-    }
-}
-
-impl TryFrom<u8> for BolterAttempt {
-    type Error = crate::units::RangeError;
-    fn try_from(n: u8) -> Result<Self, Self::Error> {
-        BolterAttempt::new(n)
-    }
-}
-
-#[cfg(feature = "serde")]
-impl TryFrom<crate::units::Number> for BolterAttempt {
-    type Error = crate::units::NumberRangeError;
-    fn try_from(n: crate::units::Number) -> Result<Self, Self::Error> {
-        n.narrow("bolter attempt", (0, Self::MAX as i128), |v: u8| {
-            Self::new(v).ok()
-        })
-    }
-}
-
-impl From<BolterAttempt> for u8 {
-    fn from(a: BolterAttempt) -> u8 {
-        a.get()
-    }
 }
 
 #[cfg(test)]
@@ -264,8 +223,8 @@ mod tests {
     /// reports its direction.
     #[test]
     fn side_timeouts_mux_and_direction() {
+        use super::BolterOrder;
         use super::{BolterDirection, BolterSide, BolterStep, Sensed, SideConfig};
-        use crate::wire::b_command::BolterOrder;
         let cfg = SideConfig {
             sensed_ms: 1_000,
             home_ms: 3_000,

@@ -2,10 +2,8 @@
 //! current-sensed step from the measured bolter current I_bo against the step's threshold,
 //! latches it, and times out the steps that never end.
 
-use super::{BolterDirection, BolterStep, MuxLines};
+use super::{BolterAux, BolterDirection, BolterOrder, BolterStep, MuxLines};
 use crate::units::{Instant, Milliamps};
-use crate::wire::b_command::BolterOrder;
-use crate::wire::internal_heartbeat::BolterAux;
 
 /// What the side's bolter hardware reads this tick: the raw material of the step decisions,
 /// not the decisions themselves, so that the thresholds live in one place ([`SideConfig`]) and

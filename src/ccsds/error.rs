@@ -2,11 +2,8 @@
 //!
 //! [`PacketError`] covers everything the wire layer checks, one variant per check, in the
 //! order the parsers run them ([`PacketError::NAMES`]); the first failure is the error, so a
-//! given input has exactly one. [`PusError`] is the error of a whole telecommand or telemetry
-//! exchange: today only `Packet`, and the services layer (service and subservice tables,
-//! application data lengths and ranges) adds its own variants after it, each with a
-//! [`PusError::name`], so that one enum names every refusal from the first octet to the last
-//! argument.
+//! given input has exactly one. The error of a whole telecommand, from the first octet to
+//! the last argument, is the services layer's ([`crate::pus::PusError`]): it wraps this one.
 
 use super::primary::PacketType;
 
@@ -28,6 +25,7 @@ use super::primary::PacketType;
 /// packet is intact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum PacketError {
     /// Fewer octets than the primary and secondary headers and the CRC.
     #[error("{kind} packet: {found} octets, fewer than its headers and CRC ({expected})")]
@@ -156,43 +154,10 @@ impl PacketError {
     }
 }
 
-/// Why a telecommand or telemetry packet is refused, from its first octet to its last
-/// argument. The wire layer's checks are [`PusError::Packet`]; the services layer adds a
-/// variant per check of its own (unknown service or subservice, application data of the wrong
-/// length, an argument out of range) with its name in [`PusError::name`], and
-/// `spec/ccsds/bad-inputs.toml` gains a row for each.
-///
-/// ```
-/// use mmic::ccsds::{PusError, tc::TcRepr};
-///
-/// let e: PusError = TcRepr::parse(&[0u8; 4], &[0x10]).unwrap_err().into();
-/// assert_eq!(e.name(), "truncated");
-/// ```
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum PusError {
-    /// The space packet or its PUS secondary header.
-    #[error(transparent)]
-    Packet(#[from] PacketError),
-    /// The service, subservice or application data (the services layer,
-    /// [`crate::pus::request`]).
-    #[error(transparent)]
-    Request(#[from] crate::pus::request::RequestError),
-}
-
-impl PusError {
-    /// The failed check's name.
-    pub const fn name(&self) -> &'static str {
-        match self {
-            PusError::Packet(e) => e.name(),
-            PusError::Request(e) => e.name(),
-        }
-    }
-}
-
 /// Why a packet could not be written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum EmitError {
     /// The caller's buffer is shorter than the packet.
     #[error("the packet needs {expected} octets, the buffer has {found}")]

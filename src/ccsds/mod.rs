@@ -32,20 +32,21 @@
 //! Every check, its order and its error are listed on [`PacketError`]; exactly one error
 //! comes out for a given input. The checks end at the secondary header: whether a service and
 //! subservice exist and what their data must hold is the services layer's, which reports
-//! through [`PusError`]. `spec/ccsds/bad-inputs.toml` holds one refused packet per check, which
+//! through [`crate::pus::PusError`], which wraps [`PacketError`] (the services stand above
+//! the packets, so the error that joins both is theirs). `spec/ccsds/bad-inputs.toml` holds one refused packet per check, which
 //! `tests/ccsds/bad_inputs.rs` walks through the parsers.
 
+mod bit_field;
 pub mod cuc;
 mod error;
 mod packet;
 pub mod primary;
-mod ranged;
 pub mod tc;
 pub mod tc_header;
 pub mod tm;
 pub mod tm_header;
 
-pub use error::{EmitError, PacketError, PusError};
+pub use error::{EmitError, PacketError};
 pub use packet::MAX_PACKET_LEN;
 
 /// The PUS version number of PUS-C (ECSS-E-ST-70-41C), in both secondary headers.

@@ -54,40 +54,7 @@ pub(crate) fn check<'a, H: FixedHeader>(
     let (body, pec_bytes) = bytes.split_last_chunk::<PEC_LEN>().ok_or(truncated)?;
     let (header, data) = H::ref_from_prefix(body).map_err(|_| truncated)?;
     let primary = PrimaryHeader::read(bytes).ok_or(truncated)?;
-    if primary.version != VERSION {
-        return Err(PacketError::Version {
-            kind,
-            expected: VERSION,
-            found: primary.version,
-        });
-    }
-    if primary.packet_type != kind {
-        return Err(PacketError::PacketType {
-            expected: kind,
-            found: primary.packet_type,
-        });
-    }
-    if !primary.secondary_header {
-        return Err(PacketError::SecondaryHeaderFlag {
-            kind,
-            expected: 1,
-            found: 0,
-        });
-    }
-    if primary.seq_flags != UNSEGMENTED {
-        return Err(PacketError::SequenceFlags {
-            kind,
-            expected: UNSEGMENTED,
-            found: primary.seq_flags,
-        });
-    }
-    if primary.total_len() != bytes.len() {
-        return Err(PacketError::Length {
-            kind,
-            expected: primary.total_len(),
-            found: bytes.len(),
-        });
-    }
+    check_primary(&primary, kind, bytes.len())?;
     let pus_version = bytes.get(PRIMARY_LEN).map_or(0, |b| b >> 4);
     if pus_version != PUS_VERSION {
         return Err(PacketError::PusVersion {
@@ -122,6 +89,47 @@ pub(crate) fn check<'a, H: FixedHeader>(
         data,
         pec: carried,
     })
+}
+
+/// The primary header's checks of [`PacketError`], in their order: version, type, secondary
+/// header flag, sequence flags, and the length it states against the `len` octets received.
+#[inline]
+fn check_primary(primary: &PrimaryHeader, kind: PacketType, len: usize) -> Result<(), PacketError> {
+    if primary.version != VERSION {
+        return Err(PacketError::Version {
+            kind,
+            expected: VERSION,
+            found: primary.version,
+        });
+    }
+    if primary.packet_type != kind {
+        return Err(PacketError::PacketType {
+            expected: kind,
+            found: primary.packet_type,
+        });
+    }
+    if !primary.secondary_header {
+        return Err(PacketError::SecondaryHeaderFlag {
+            kind,
+            expected: 1,
+            found: 0,
+        });
+    }
+    if primary.seq_flags != UNSEGMENTED {
+        return Err(PacketError::SequenceFlags {
+            kind,
+            expected: UNSEGMENTED,
+            found: primary.seq_flags,
+        });
+    }
+    if primary.total_len() != len {
+        return Err(PacketError::Length {
+            kind,
+            expected: primary.total_len(),
+            found: len,
+        });
+    }
+    Ok(())
 }
 
 /// Octets of a packet with fixed header `H` and `data_len` octets of user data, or the error

@@ -23,7 +23,7 @@
 //! # assert_eq!(PRIMARY_LEN, 6);
 //! ```
 
-use super::ranged::ranged;
+use super::bit_field::bit_field;
 use core::fmt;
 use zerocopy::byteorder::big_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -96,14 +96,14 @@ impl fmt::Display for PacketType {
     }
 }
 
-ranged! {
+bit_field! {
     /// Application process identifier, 11 bits (0..=2047). 2047 (`0x7ff`) is the idle packets'
     /// APID; which APIDs the robot uses is the services layer's plan, handed to the parsers as
     /// the set they accept.
     Apid(u16), max 0x7ff, "APID"
 }
 
-ranged! {
+bit_field! {
     /// Packet sequence count, 14 bits (0..=16383), counted per APID and wrapping.
     SeqCount(u16), max 0x3fff, "packet sequence count"
 }

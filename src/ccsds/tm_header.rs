@@ -28,8 +28,8 @@
 //! assert_eq!(h.to_bytes(), [0x20, 17, 2, 0, 3, 1, 2, 0, 0, 0, 1, 0x80, 0]);
 //! ```
 
+use super::bit_field::bit_field;
 use super::cuc::{Cuc, CucLayout};
-use super::ranged::ranged;
 use super::PUS_VERSION;
 use zerocopy::byteorder::big_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -59,7 +59,7 @@ pub struct TmSecondaryLayout {
 
 const _: () = assert!(core::mem::size_of::<TmSecondaryLayout>() == TM_SECONDARY_LEN);
 
-ranged! {
+bit_field! {
     /// Spacecraft time reference status, 4 bits: the standard leaves the values to the
     /// mission (ECSS-E-ST-70-41C §7.4.3.2); this robot sends 0 (no time reference services).
     TimeRefStatus(u8), max 0xf, "spacecraft time reference status"

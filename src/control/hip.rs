@@ -120,22 +120,28 @@ impl HipController {
         self.velocity
     }
 
-    /// One control tick at time `now` (ms): the pulse to send to the hip servo.
-    pub fn step(&mut self, target: HipAngle, measured: HipAngle, now: u32) -> PulseWidth {
-        let c = &self.cfg;
-        let max = c.max_offset_us.clamp(0, 1000);
-        // Velocity estimate from successive readings.
+    /// Updates the velocity estimate from the reading `measured` at `now` (ms) and the one
+    /// before; returns the ms between them (0 on the first, at most 1000).
+    fn estimate_velocity(&mut self, measured: HipAngle, now: u32) -> u32 {
         let mut dt_ms = 0u32;
         if let Some((t0, a0)) = self.last {
             dt_ms = Instant::from_millis(now).since(t0).millis().min(1000);
             if dt_ms > 0 {
                 // |raw| ≤ 18000 × 1000: no overflow; the estimate stays within the same bound.
                 let raw = (angle_error(a0, measured) as i64 * 1000 / dt_ms as i64) as i32;
-                let shift = c.smoothing_shift.min(8);
+                let shift = self.cfg.smoothing_shift.min(8);
                 self.velocity += (raw - self.velocity) >> shift;
             }
         }
         self.last = Some((Instant::from_millis(now), measured));
+        dt_ms
+    }
+
+    /// One control tick at time `now` (ms): the pulse to send to the hip servo.
+    pub fn step(&mut self, target: HipAngle, measured: HipAngle, now: u32) -> PulseWidth {
+        let dt_ms = self.estimate_velocity(measured, now);
+        let c = &self.cfg;
+        let max = c.max_offset_us.clamp(0, 1000);
         let e = angle_error(measured, target);
         let band = c.position_band.max(0);
         let mode = if e.abs() > band {

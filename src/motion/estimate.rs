@@ -25,8 +25,8 @@
 //! }
 //! ```
 
-use super::geometry::{arm_direction, cross, unit, Vec3};
-use super::State;
+use crate::pose::geometry::{arm_direction, cross, unit, Vec3};
+use crate::pose::State;
 use crate::units::{Axis, Gravity, HipAngle, Side, Sign};
 
 /// A set of states (bit i = Table 5 index i).

@@ -12,8 +12,8 @@
 //! assert!(grid.starts_with("from\\to"));
 //! ```
 
-use super::map::primitive;
-use super::{Primitive, State};
+use crate::pose::map::primitive;
+use crate::pose::{Primitive, State};
 use core::fmt::Write as _;
 
 /// Whether the move `from → to` appears in a chosen plan between two matched states (the final
@@ -63,7 +63,9 @@ pub fn render(out: &mut impl core::fmt::Write) -> core::fmt::Result {
                 continue;
             }
             match primitive(f, t) {
-                None if super::geometry::turns_without_hip(f, t) => write!(line, " {:>3} ", "x")?,
+                None if crate::pose::geometry::turns_without_hip(f, t) => {
+                    write!(line, " {:>3} ", "x")?
+                }
                 None => write!(line, " {:>3} ", ".")?,
                 Some(p) => {
                     let kind = if t.is_matched() { 'F' } else { 'i' };

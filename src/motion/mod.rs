@@ -1,6 +1,7 @@
-//! Motion generation (Section 6): the 15 configuration states of Table 5, the 8 motion
-//! primitives of Table 6, the reconfiguration map of Figure 9 computed from a geometric model
-//! ([`geometry`], [`map`]), and shortest routes of primitives between states ([`route`]).
+//! Motion generation (Section 6): shortest routes of primitives between states ([`route`]),
+//! the sequencer that runs one primitive ([`sequencer`]) and the runner that chains them
+//! ([`runner`]). The states, primitives and the map of Figure 9 they move over are the
+//! vocabulary of [`crate::pose`], re-exported here under their old paths.
 //!
 //! ```
 //! use mmic::motion::{State, StateKind, Primitive};
@@ -12,13 +13,8 @@
 
 pub mod estimate;
 pub mod figure9;
-pub mod geometry;
-pub mod map;
-mod primitive;
 pub mod route;
 pub mod runner;
 pub mod sequencer;
-mod state;
 
-pub use primitive::Primitive;
-pub use state::{State, StateKind};
+pub use crate::pose::{geometry, map, Primitive, State, StateKind};

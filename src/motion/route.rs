@@ -13,8 +13,8 @@
 //! assert_eq!(route::lookup(State::A, State::B).len(), 3);
 //! ```
 
-use super::map::MAP;
-use super::{Primitive, State};
+use crate::pose::map::MAP;
+use crate::pose::{Primitive, State};
 
 /// Longest shortest plan between any two states.
 pub const MAX_LEN: usize = 3;

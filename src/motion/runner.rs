@@ -17,8 +17,8 @@
 
 use super::route::{lookup, Route};
 use super::sequencer::{Config, Feedback, Sequencer, Status, Targets};
-use super::State;
 use crate::faults::Fault;
+use crate::pose::State;
 
 /// Where a reconfiguration is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -30,10 +30,10 @@
 //! assert_eq!(s.status(), Status::Done);
 //! ```
 
-use super::geometry::robot_move;
-use super::{Primitive, State};
 use crate::command::{preset_angle, HipTarget, ServoTarget};
 use crate::faults::Fault;
+use crate::pose::geometry::robot_move;
+use crate::pose::{Primitive, State};
 use crate::units::{HipAngle, Instant, PerSide, Side};
 
 /// Per-step timeouts, ms.
@@ -149,7 +149,7 @@ pub struct NotAMove {
 ///
 /// - straight primitives (1–4): `None`. So is a turn from one right-angle state to another
 ///   (e → k: A would swing from −X to −Z about B's arm, +Y), which no hip rotation makes: no
-///   move of the robot ([`super::geometry::turns_without_hip`]), and [`Sequencer::start`]
+///   move of the robot ([`crate::pose::geometry::turns_without_hip`]), and [`Sequencer::start`]
 ///   refuses it;
 /// - into a state with the arms in line (matched, stretch): [`HipTarget::Straight`], 180°;
 /// - from arms in line into a right angle: [`HipTarget::RightAngleCw`] (90°) for a CW
@@ -157,7 +157,7 @@ pub struct NotAMove {
 ///   of the state (the hip axis is free while the arms are in line); naming it after the
 ///   primitive keeps the choice deterministic.
 pub fn hip_goal(from: State, to: State, primitive: Primitive) -> Option<HipAngle> {
-    let in_line = |s: State| !matches!(s.kind(), super::StateKind::Turn);
+    let in_line = |s: State| !matches!(s.kind(), crate::pose::StateKind::Turn);
     let target = match primitive {
         Primitive::FwdContract
         | Primitive::BackContract

@@ -38,6 +38,7 @@ use crate::wire::heartbeat::HeartbeatRepr;
 /// Why TM(5,x) source data is not an event of ours (checked in this order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum EventError {
     /// Not a subservice of ST\[5\] (1..=4).
     #[error("TM(5,{0}) is no event report (subservices 1..=4)")]

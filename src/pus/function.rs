@@ -10,7 +10,7 @@
 //!
 //! ```
 //! use mmic::command::Command;
-//! use mmic::motion::State;
+//! use mmic::pose::State;
 //! use mmic::pus::function::{self, FunctionError};
 //!
 //! let c = Command::reconfigure(State::A, State::M).unwrap();
@@ -26,13 +26,13 @@
 //! ```
 
 use crate::bolter::BolterPair;
+use crate::command::Travel;
 use crate::command::{
     BolterCommand, Command, Fasteners, HipTarget, PowerTarget, PrimitiveMove, PrimitiveMoveError,
     Reconfiguration, ReconfigurationError, ServoTarget,
 };
-use crate::control::interp::Travel;
 use crate::mode::Mode;
-use crate::motion::{Primitive, State};
+use crate::pose::{Primitive, State};
 use crate::units::{HipAngle, Module, PulseWidth, Side};
 
 /// The longest application data of a function: ID and arguments.
@@ -120,6 +120,7 @@ impl FunctionId {
 /// Why application data is no function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum FunctionError {
     /// No application data at all: not even a function ID.
     #[error("no function ID: the application data is empty")]
@@ -288,35 +289,8 @@ pub fn decode(data: &[u8]) -> Result<Command, FunctionError> {
             side: side(f, b(0))?,
             target: servo(f, b(1), w(2), Travel::GRIPPER)?,
         },
-        FunctionId::Hip => {
-            let kind = arg(f, "target", b(0).into(), 0, HIP_KINDS)?;
-            if kind < HIP_KINDS {
-                arg(f, "angle", w(1), 0, 0)?;
-            }
-            Command::Hip(match kind {
-                0 => HipTarget::Home,
-                1 => HipTarget::Straight,
-                2 => HipTarget::RightAngleCw,
-                3 => HipTarget::RightAngleCcw,
-                _ => HipTarget::Angle(match HipAngle::new(w(1)) {
-                    Ok(h) => h,
-                    Err(_) => return Err(range_err(f, "angle", w(1), 0, HipAngle::TURN - 1)),
-                }),
-            })
-        }
-        FunctionId::Bolter => {
-            let op = arg(f, "operation", b(0).into(), 0, BOLTER_OPS)?;
-            let pair = arg(f, "pair", b(1).into(), 0, if op == 2 { 0 } else { 4 })?;
-            let fasteners = match BolterPair::from_number(pair as u8) {
-                Some(p) => Fasteners::Pair(p),
-                None => Fasteners::All,
-            };
-            Command::Bolter(match op {
-                0 => BolterCommand::Bolt(fasteners),
-                1 => BolterCommand::Unbolt(fasteners),
-                _ => BolterCommand::Down,
-            })
-        }
+        FunctionId::Hip => Command::Hip(hip(f, b(0), w(1))?),
+        FunctionId::Bolter => Command::Bolter(bolter(f, b(0), b(1))?),
         FunctionId::Primitive => {
             let p =
                 Primitive::from_number(b(0)).ok_or(range_err(f, "primitive", b(0).into(), 1, 8))?;
@@ -325,15 +299,7 @@ pub fn decode(data: &[u8]) -> Result<Command, FunctionError> {
         }
         FunctionId::Stop => Command::Stop,
         FunctionId::Reset => Command::Reset,
-        FunctionId::Power => {
-            let t = arg(f, "target", b(0).into(), 0, Module::ALL.len() as u16)?;
-            let on = arg(f, "on", b(1).into(), 0, 1)? == 1;
-            let target = match t.checked_sub(1).and_then(|i| Module::ALL.get(i as usize)) {
-                Some(&m) => PowerTarget::Module(m),
-                None => PowerTarget::All,
-            };
-            Command::Power { target, on }
-        }
+        FunctionId::Power => power(f, b(0), b(1))?,
         FunctionId::Reconfiguration => {
             let (i, t) = (state(f, "initial", b(0))?, state(f, "target", b(1))?);
             Command::Reconfigure(
@@ -346,6 +312,50 @@ pub fn decode(data: &[u8]) -> Result<Command, FunctionError> {
         FunctionId::SystemFault => Command::SystemFault,
         FunctionId::ClearFaults => Command::ClearFaults,
     })
+}
+
+/// A hip function's target: `kind` 0..=3 a preset (angle 0), 4 the angle given.
+fn hip(f: FunctionId, kind: u8, angle: u16) -> Result<HipTarget, FunctionError> {
+    let kind = arg(f, "target", kind.into(), 0, HIP_KINDS)?;
+    if kind < HIP_KINDS {
+        arg(f, "angle", angle, 0, 0)?;
+    }
+    Ok(match kind {
+        0 => HipTarget::Home,
+        1 => HipTarget::Straight,
+        2 => HipTarget::RightAngleCw,
+        3 => HipTarget::RightAngleCcw,
+        _ => HipTarget::Angle(match HipAngle::new(angle) {
+            Ok(h) => h,
+            Err(_) => return Err(range_err(f, "angle", angle, 0, HipAngle::TURN - 1)),
+        }),
+    })
+}
+
+/// A bolter function: `op` 0 bolt, 1 unbolt (pair 1..=4, or 0 for all), 2 down (pair 0).
+fn bolter(f: FunctionId, op: u8, pair: u8) -> Result<BolterCommand, FunctionError> {
+    let op = arg(f, "operation", op.into(), 0, BOLTER_OPS)?;
+    let pair = arg(f, "pair", pair.into(), 0, if op == 2 { 0 } else { 4 })?;
+    let fasteners = match BolterPair::from_number(pair as u8) {
+        Some(p) => Fasteners::Pair(p),
+        None => Fasteners::All,
+    };
+    Ok(match op {
+        0 => BolterCommand::Bolt(fasteners),
+        1 => BolterCommand::Unbolt(fasteners),
+        _ => BolterCommand::Down,
+    })
+}
+
+/// A power function: `target` 0 for every module, else module `target - 1`; `on` 0 or 1.
+fn power(f: FunctionId, target: u8, on: u8) -> Result<Command, FunctionError> {
+    let t = arg(f, "target", target.into(), 0, Module::ALL.len() as u16)?;
+    let on = arg(f, "on", on.into(), 0, 1)? == 1;
+    let target = match t.checked_sub(1).and_then(|i| Module::ALL.get(i as usize)) {
+        Some(&m) => PowerTarget::Module(m),
+        None => PowerTarget::All,
+    };
+    Ok(Command::Power { target, on })
 }
 
 /// Writes a command's TC(8,1) application data into `out`; returns its length.

@@ -21,7 +21,7 @@
 use crate::bolter::{BolterAttempt, BolterPair};
 use crate::faults::Faults;
 use crate::mode::Mode;
-use crate::motion::State;
+use crate::pose::State;
 use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use crate::wire::heartbeat::HeartbeatRepr;
@@ -57,8 +57,80 @@ const fn f(name: &'static str, len: usize, unit: &'static str, meaning: &'static
     }
 }
 
+/// One side's seven electrical readings, suffixed `_a` or `_b` (the order of
+/// [`Electrical`]'s fields and of the heartbeat's blocks).
+macro_rules! side_rows {
+    ($x:literal, $side:literal) => {
+        [
+            f(
+                concat!("v_bat_", $x),
+                2,
+                "mV",
+                concat!("side ", $side, " battery voltage"),
+            ),
+            f(
+                concat!("i_bat_", $x),
+                2,
+                "mA",
+                concat!("side ", $side, " battery current"),
+            ),
+            f(
+                concat!("i_loc_", $x),
+                2,
+                "mA",
+                concat!("side ", $side, " locomotion (arm and hip) current"),
+            ),
+            f(
+                concat!("i_grip_", $x),
+                2,
+                "mA",
+                concat!("side ", $side, " gripper current"),
+            ),
+            f(
+                concat!("i_3v3_", $x),
+                2,
+                "mA",
+                concat!("side ", $side, " 3.3 V rail current"),
+            ),
+            f(
+                concat!("v_reg_", $x),
+                2,
+                "mV",
+                concat!("side ", $side, " 7.4 V regulator voltage"),
+            ),
+            f(
+                concat!("i_bo_", $x),
+                2,
+                "mA",
+                concat!("side ", $side, " bolter current"),
+            ),
+        ]
+    };
+}
+
+/// `head`, then side A's readings, then side B's: the report's order.
+const fn with_sides<const H: usize, const N: usize>(head: [Field; H]) -> [Field; N] {
+    let (a, b): ([Field; 7], [Field; 7]) = (side_rows!("a", "A"), side_rows!("b", "B"));
+    let mut out = [head[0]; N];
+    let mut i = 0;
+    while i < N {
+        out[i] = if i < H {
+            head[i]
+        } else if i < H + 7 {
+            a[i - H]
+        } else {
+            b[i - H - 7]
+        };
+        i += 1;
+    }
+    out
+}
+
 /// The parameters after the structure ID, in order.
-pub const FIELDS: [Field; 33] = [
+pub const FIELDS: [Field; 33] = with_sides(HEAD);
+
+/// The parameters before the two sides' electrical readings.
+const HEAD: [Field; 19] = [
     f("board", 1, "number", "robot number 1..=255"),
     f("mode", 1, "enum", "1 standby, 2 operational, 3 safed"),
     f(
@@ -113,30 +185,6 @@ pub const FIELDS: [Field; 33] = [
         "us",
         "gripper B last interpolated pulse",
     ),
-    f("v_bat_a", 2, "mV", "side A battery voltage"),
-    f("i_bat_a", 2, "mA", "side A battery current"),
-    f(
-        "i_loc_a",
-        2,
-        "mA",
-        "side A locomotion (arm and hip) current",
-    ),
-    f("i_grip_a", 2, "mA", "side A gripper current"),
-    f("i_3v3_a", 2, "mA", "side A 3.3 V rail current"),
-    f("v_reg_a", 2, "mV", "side A 7.4 V regulator voltage"),
-    f("i_bo_a", 2, "mA", "side A bolter current"),
-    f("v_bat_b", 2, "mV", "side B battery voltage"),
-    f("i_bat_b", 2, "mA", "side B battery current"),
-    f(
-        "i_loc_b",
-        2,
-        "mA",
-        "side B locomotion (arm and hip) current",
-    ),
-    f("i_grip_b", 2, "mA", "side B gripper current"),
-    f("i_3v3_b", 2, "mA", "side B 3.3 V rail current"),
-    f("v_reg_b", 2, "mV", "side B 7.4 V regulator voltage"),
-    f("i_bo_b", 2, "mA", "side B bolter current"),
 ];
 
 /// Source data length of TM(3,25): structure ID and every parameter.
@@ -153,6 +201,7 @@ pub const REPORT_LEN: usize = {
 /// Why source data is no report of ours. Each names the check and the numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum HousekeepingError {
     /// Not the report's length.
     #[error("housekeeping report of {found} bytes, expected {expected}")]
@@ -256,78 +305,114 @@ pub fn parse(data: &[u8]) -> Result<HeartbeatRepr, HousekeepingError> {
             found: sid,
         });
     }
-    let mut v = [0u32; 33];
-    let mut at = 1;
-    for (field, slot) in FIELDS.iter().zip(v.iter_mut()) {
-        for b in data.get(at..at + field.len).unwrap_or(&[]) {
-            *slot = *slot << 8 | u32::from(*b);
-        }
-        at += field.len;
-    }
-    let bad = |i: usize| HousekeepingError::Parameter {
-        name: FIELDS[i % FIELDS.len()].name,
-        value: v[i % v.len()],
-    };
-    let byte = |i: usize| u8::try_from(v[i]).map_err(|_| bad(i));
-    let word = |i: usize| u16::try_from(v[i]).map_err(|_| bad(i));
-    let opt = |i: usize| -> Result<Option<u8>, HousekeepingError> {
-        byte(i).map(|b| if b == 0 { None } else { Some(b) })
-    };
-    let pulse = |i: usize| word(i).and_then(|w| PulseWidth::new(w).map_err(|_| bad(i)));
-    let angle = |i: usize| word(i).and_then(|w| HipAngle::new(w).map_err(|_| bad(i)));
-    let el = |k: usize| -> Result<Electrical, HousekeepingError> {
-        Ok(Electrical {
-            v_bat: word(k)?,
-            i_bat: word(k + 1)?,
-            i_loc: word(k + 2)?,
-            i_grip: word(k + 3)?,
-            i_3v3: word(k + 4)?,
-            v_reg: word(k + 5)?,
-            i_bo: word(k + 6)?,
-        })
-    };
-    let faults = Faults::from_wire({
-        let [_, _, hi, lo] = v[2].to_be_bytes();
-        if v[2] > 0xFFFF {
-            return Err(bad(2));
-        }
-        [lo, hi]
-    })
-    .map_err(|_| bad(2))?;
+    let v = Values::read(data);
+    // The faults are checked first, as they always were: with several bad parameters, the
+    // error names the same one.
+    let faults = v.faults(2)?;
     Ok(HeartbeatRepr {
-        board: BoardNumber::new(byte(0)?).map_err(|_| bad(0))?,
-        mode: Mode::from_wire(byte(1)?).ok_or(bad(1))?,
+        board: BoardNumber::new(v.byte(0)?).map_err(|_| v.bad(0))?,
+        mode: Mode::from_wire(v.byte(1)?).ok_or(v.bad(1))?,
         faults,
-        refusal: match opt(3)? {
-            None => None,
-            Some(r) => Some(Refusal::from_wire(r).ok_or(bad(3))?),
-        },
-        last_seq: word(4)?,
-        target_state: match opt(5)? {
-            None => None,
-            Some(s) => Some(State::from_wire(s).ok_or(bad(5))?),
-        },
-        command_complete: match byte(6)? {
-            0 => false,
-            1 => true,
-            _ => return Err(bad(6)),
-        },
-        active_bolter: match opt(7)? {
-            None => None,
-            Some(p) => Some(BolterPair::from_number(p).ok_or(bad(7))?),
-        },
-        bolter_attempt: BolterAttempt::new(byte(8)?).map_err(|_| bad(8))?,
-        hip_target: angle(9)?,
-        hip_now: angle(10)?,
-        arm_a_target: pulse(11)?,
-        arm_a_now: pulse(12)?,
-        arm_b_target: pulse(13)?,
-        arm_b_now: pulse(14)?,
-        gripper_a_target: pulse(15)?,
-        gripper_a_now: pulse(16)?,
-        gripper_b_target: pulse(17)?,
-        gripper_b_now: pulse(18)?,
-        electrical_a: el(19)?,
-        electrical_b: el(26)?,
+        refusal: v.opt(3, Refusal::from_wire)?,
+        last_seq: v.word(4)?,
+        target_state: v.opt(5, State::from_wire)?,
+        command_complete: v.flag(6)?,
+        active_bolter: v.opt(7, BolterPair::from_number)?,
+        bolter_attempt: BolterAttempt::new(v.byte(8)?).map_err(|_| v.bad(8))?,
+        hip_target: v.angle(9)?,
+        hip_now: v.angle(10)?,
+        arm_a_target: v.pulse(11)?,
+        arm_a_now: v.pulse(12)?,
+        arm_b_target: v.pulse(13)?,
+        arm_b_now: v.pulse(14)?,
+        gripper_a_target: v.pulse(15)?,
+        gripper_a_now: v.pulse(16)?,
+        gripper_b_target: v.pulse(17)?,
+        gripper_b_now: v.pulse(18)?,
+        electrical_a: v.electrical(19)?,
+        electrical_b: v.electrical(26)?,
     })
+}
+
+/// The report's parameter values, in [`FIELDS`] order, and the checked reading of each: a
+/// value its type refuses is a [`HousekeepingError::Parameter`] naming the field.
+struct Values([u32; 33]);
+
+impl Values {
+    /// The values of `data`, whose length is checked.
+    fn read(data: &[u8]) -> Values {
+        let mut v = [0u32; 33];
+        let mut at = 1;
+        for (field, slot) in FIELDS.iter().zip(v.iter_mut()) {
+            for b in data.get(at..at + field.len).unwrap_or(&[]) {
+                *slot = *slot << 8 | u32::from(*b);
+            }
+            at += field.len;
+        }
+        Values(v)
+    }
+
+    fn bad(&self, i: usize) -> HousekeepingError {
+        HousekeepingError::Parameter {
+            name: FIELDS[i % FIELDS.len()].name,
+            value: self.0[i % self.0.len()],
+        }
+    }
+
+    fn byte(&self, i: usize) -> Result<u8, HousekeepingError> {
+        u8::try_from(self.0[i]).map_err(|_| self.bad(i))
+    }
+
+    fn word(&self, i: usize) -> Result<u16, HousekeepingError> {
+        u16::try_from(self.0[i]).map_err(|_| self.bad(i))
+    }
+
+    /// 0 for none, else what `from` makes of the byte (refused when it makes nothing).
+    fn opt<T>(
+        &self,
+        i: usize,
+        from: impl Fn(u8) -> Option<T>,
+    ) -> Result<Option<T>, HousekeepingError> {
+        match self.byte(i)? {
+            0 => Ok(None),
+            b => from(b).map(Some).ok_or(self.bad(i)),
+        }
+    }
+
+    fn flag(&self, i: usize) -> Result<bool, HousekeepingError> {
+        match self.byte(i)? {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(self.bad(i)),
+        }
+    }
+
+    fn pulse(&self, i: usize) -> Result<PulseWidth, HousekeepingError> {
+        PulseWidth::new(self.word(i)?).map_err(|_| self.bad(i))
+    }
+
+    fn angle(&self, i: usize) -> Result<HipAngle, HousekeepingError> {
+        HipAngle::new(self.word(i)?).map_err(|_| self.bad(i))
+    }
+
+    fn faults(&self, i: usize) -> Result<Faults, HousekeepingError> {
+        let [_, _, hi, lo] = self.0[i].to_be_bytes();
+        if self.0[i] > 0xFFFF {
+            return Err(self.bad(i));
+        }
+        Faults::from_wire([lo, hi]).map_err(|_| self.bad(i))
+    }
+
+    /// The seven readings from `k` on, in [`Electrical`]'s order.
+    fn electrical(&self, k: usize) -> Result<Electrical, HousekeepingError> {
+        Ok(Electrical {
+            v_bat: self.word(k)?,
+            i_bat: self.word(k + 1)?,
+            i_loc: self.word(k + 2)?,
+            i_grip: self.word(k + 3)?,
+            i_3v3: self.word(k + 4)?,
+            v_reg: self.word(k + 5)?,
+            i_bo: self.word(k + 6)?,
+        })
+    }
 }

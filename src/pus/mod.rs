@@ -29,9 +29,45 @@ pub mod request;
 pub mod verification;
 
 use crate::ccsds::tc::TcRepr;
-use crate::ccsds::PusError;
+use crate::ccsds::PacketError;
 use crate::units::BoardNumber;
-use request::Request;
+use request::{Request, RequestError};
+
+/// Why a telecommand or telemetry packet is refused, from its first octet to its last
+/// argument. The wire layer's checks are [`PusError::Packet`]; the services layer adds a
+/// variant per check of its own (unknown service or subservice, application data of the wrong
+/// length, an argument out of range) with its name in [`PusError::name`], and
+/// `spec/ccsds/bad-inputs.toml` gains a row for each.
+///
+/// ```
+/// use mmic::ccsds::tc::TcRepr;
+/// use mmic::pus::PusError;
+///
+/// let e: PusError = TcRepr::parse(&[0u8; 4], &[0x10]).unwrap_err().into();
+/// assert_eq!(e.name(), "truncated");
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum PusError {
+    /// The space packet or its PUS secondary header.
+    #[error(transparent)]
+    Packet(#[from] PacketError),
+    /// The service, subservice or application data (the services layer,
+    /// [`request`]).
+    #[error(transparent)]
+    Request(#[from] RequestError),
+}
+
+impl PusError {
+    /// The failed check's name.
+    pub const fn name(&self) -> &'static str {
+        match self {
+            PusError::Packet(e) => e.name(),
+            PusError::Request(e) => e.name(),
+        }
+    }
+}
 
 /// Reads a telecommand whole: the packet's CCSDS and PUS checks (for the `apids` given), then
 /// its service, subservice and application data as one [`Request`]. Every refusal names its

@@ -60,6 +60,7 @@ pub enum Request {
 /// Why a telecommand is no request. Each names the check that failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum RequestError {
     /// A service the robot does not serve.
     #[error("unknown service {service} (served: 3, 8, 17)")]

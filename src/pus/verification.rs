@@ -124,6 +124,7 @@ pub const FAILURE_LEN: usize = 10;
 /// Why source data is no ST\[1\] report of ours.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum VerificationError {
     /// Not a subservice of ours (1, 2, 3, 4, 7, 8).
     #[error("TM(1,{0}) is no report of ours (1, 2, 3, 4, 7, 8)")]

@@ -296,19 +296,8 @@ impl Supervisor {
                     Faults::from_iter(self.latched.iter().filter(|f| input.faults.contains(*f)));
             }
             Command::Mode(Mode::Operational) if self.mode != Mode::Operational => {
-                if input.faults.iter().any(is_condition) {
-                    return Answer::Refused(Refusal::FaultConditionHolds);
-                }
-                self.enter(Mode::Operational, stop);
-                self.enabled = ModuleSet::ALL;
-                if input.hip_at_home {
-                    *go_home = true;
-                } else {
-                    self.raise(
-                        Faults::EMPTY.with(Fault::HipMismatch),
-                        input.in_motion,
-                        stop,
-                    );
+                if let Err(r) = self.enter_operational(input, stop, go_home) {
+                    return Answer::Refused(r);
                 }
             }
             Command::Mode(m) => self.enter(m, stop),
@@ -320,16 +309,45 @@ impl Supervisor {
                 );
                 return Answer::Refused(Refusal::InitialStateMismatch);
             }
-            Command::Power { target, on } => {
-                self.enabled = match (target, on) {
-                    (PowerTarget::All, true) => ModuleSet::ALL,
-                    (PowerTarget::All, false) => ModuleSet::EMPTY,
-                    (PowerTarget::Module(m), true) => self.enabled.with(m),
-                    (PowerTarget::Module(m), false) => self.enabled.without(m),
-                };
-            }
+            Command::Power { target, on } => self.switch(target, on),
             _ => {}
         }
         Answer::Accepted(cmd)
+    }
+
+    /// A mode command to Operational from another mode: refused while a fault condition
+    /// holds (Table 7); otherwise every module enabled and the servos sent home, or, with the
+    /// hip away from home, the hip mismatch fault raised (Table 8).
+    fn enter_operational(
+        &mut self,
+        input: &Input,
+        stop: &mut bool,
+        go_home: &mut bool,
+    ) -> Result<(), Refusal> {
+        if input.faults.iter().any(is_condition) {
+            return Err(Refusal::FaultConditionHolds);
+        }
+        self.enter(Mode::Operational, stop);
+        self.enabled = ModuleSet::ALL;
+        if input.hip_at_home {
+            *go_home = true;
+        } else {
+            self.raise(
+                Faults::EMPTY.with(Fault::HipMismatch),
+                input.in_motion,
+                stop,
+            );
+        }
+        Ok(())
+    }
+
+    /// A power command: the modules the operator enables (Table 7 powers them by mode).
+    fn switch(&mut self, target: PowerTarget, on: bool) {
+        self.enabled = match (target, on) {
+            (PowerTarget::All, true) => ModuleSet::ALL,
+            (PowerTarget::All, false) => ModuleSet::EMPTY,
+            (PowerTarget::Module(m), true) => self.enabled.with(m),
+            (PowerTarget::Module(m), false) => self.enabled.without(m),
+        };
     }
 }

@@ -2,7 +2,7 @@
 //!
 //! ```
 //! use mmic::command::Command;
-//! use mmic::motion::State;
+//! use mmic::pose::State;
 //! use mmic::units::BoardNumber;
 //! use mmic::wire::command::CommandRepr;
 //!
@@ -16,8 +16,9 @@
 //! ```
 
 use super::layout::{span, FieldSpec, Unit};
+use super::opcode::{seq_slot, Slot, PARAM_LEN, PARAM_OFFSET};
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
-use crate::command::{seq_slot, Command, Slot, PARAM_LEN, PARAM_OFFSET};
+use crate::command::Command;
 use crate::units::BoardNumber;
 use zerocopy::byteorder::little_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -178,7 +179,7 @@ pub struct CommandRepr {
     /// The command.
     pub command: Command,
     /// Exactly-once sequence number, 1..=65535, carried in the parameter slot
-    /// [`crate::command::seq_slot`] leaves free; 0 = unsequenced, the paper's
+    /// [`crate::wire::opcode::seq_slot`] leaves free; 0 = unsequenced, the paper's
     /// behaviour (board A executes every copy). See spec/protocol/README.md.
     #[cfg_attr(feature = "serde", serde(default))]
     #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq16"))]
@@ -204,7 +205,7 @@ impl CommandRepr {
         let seq = u16::from_le_bytes([params[at], params[at + 1]]);
         params[at] = 0;
         params[at + 1] = 0;
-        let command = Command::decode(p.command, params)?;
+        let command = super::opcode::decode(p.command, params)?;
         Ok(CommandRepr {
             board,
             command,
@@ -214,7 +215,7 @@ impl CommandRepr {
 
     /// Writes the packet, header and checksum included.
     pub fn emit(&self, out: &mut [u8; COMMAND_LEN]) {
-        let (id, mut params) = self.command.encode();
+        let (id, mut params) = super::opcode::encode(&self.command);
         let at = seq_slot(id).offset();
         params[at..at + 2].copy_from_slice(&self.seq.to_le_bytes());
         out[field::BOARD.start] = self.board.get();

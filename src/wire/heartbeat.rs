@@ -11,12 +11,12 @@
 //! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
 
-use super::layout::{field_table, span, ElectricalLayout, FieldSpec, Unit};
+use super::layout::{fields, ElectricalLayout};
 use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKind, WireError};
 use crate::command::BolterPair;
 use crate::faults::Faults;
 use crate::mode::Mode;
-use crate::motion::State;
+use crate::pose::State;
 use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use zerocopy::byteorder::little_endian::U16;
@@ -65,228 +65,45 @@ impl Packet for HeartbeatPacket {
 
 const _: () = assert!(core::mem::size_of::<HeartbeatPacket>() == HEARTBEAT_LEN);
 
-/// Field table, from the layout (spec/packets/heartbeat.toml is checked against it).
-pub const FIELDS: &[FieldSpec] = field_table![HeartbeatPacket;
-    // (name, field, type, unit, the paper's label)
-    ("header", header, [u8; 4], Header, "header"),
-    ("board", board, u8, Board, "board number"),
-    ("hip_target", hip_target, U16, Centidegrees, "hip-target"),
-    ("hip_now", hip_now, U16, Centidegrees, "hip-now"),
-    ("arm_a_target", arm_a_target, U16, Micros, "arm A-target"),
-    ("arm_a_now", arm_a_now, U16, Micros, "arm A-now"),
-    ("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
-    ("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
-    ("gripper_a_target", gripper_a_target, U16, Micros, "gripper A-target"),
-    ("gripper_a_now", gripper_a_now, U16, Micros, "gripper A-now"),
-    ("gripper_b_target", gripper_b_target, U16, Micros, "gripper B-target"),
-    ("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
-    ..electrical(electrical_a, "A"),
-    ..electrical(electrical_b, "B"),
-    ("target_state", target_state, u8, StateLetter, "target state"),
-    ("command_complete", command_complete, u8, Bool, "command complete"),
-    ("active_bolter", active_bolter, u8, Enum, "active bolter"),
-    ("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
-    FieldSpec {
-        name: "last_seq",
-        range: span!(HeartbeatPacket, last_seq, U16),
-        unit: Unit::Sequence16,
-        paper: "empty",
-        cells: &["empty", "empty"],
-    },
-    ("empty", empty, u8, Reserved, "empty"),
-    FieldSpec {
-        name: "faults",
-        range: span!(HeartbeatPacket, faults, [u8; 2]),
-        unit: Unit::Bits,
-        paper: "fault byte0-1",
-        cells: &["fault byte0", "fault byte1"],
-    },
-    ("refusal", refusal, u8, Enum, "fault byte2"),
-    ("mode", mode, u8, Enum, "operating mode"),
-    ("checksum", checksum, U16, Crc16, "checksum"),
-];
-
-/// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
-pub mod field {
-    use super::*;
-    use crate::wire::layout::span;
-    use core::ops::Range;
-    /// `faults` (bytes 60–61).
-    pub const FAULTS: Range<usize> = span!(HeartbeatPacket, faults, [u8; 2]);
-    /// `last_seq` (bytes 57–58).
-    pub const LAST_SEQ: Range<usize> = span!(
-        HeartbeatPacket,
-        last_seq,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `header`.
-    pub const HEADER: Range<usize> = span!(HeartbeatPacket, header, [u8; 4]);
-    /// `board`.
-    pub const BOARD: Range<usize> = span!(HeartbeatPacket, board, u8);
-    /// `hip_target`.
-    pub const HIP_TARGET: Range<usize> = span!(
-        HeartbeatPacket,
-        hip_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `hip_now`.
-    pub const HIP_NOW: Range<usize> = span!(
-        HeartbeatPacket,
-        hip_now,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `arm_a_target`.
-    pub const ARM_A_TARGET: Range<usize> = span!(
-        HeartbeatPacket,
-        arm_a_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `arm_a_now`.
-    pub const ARM_A_NOW: Range<usize> = span!(
-        HeartbeatPacket,
-        arm_a_now,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `arm_b_target`.
-    pub const ARM_B_TARGET: Range<usize> = span!(
-        HeartbeatPacket,
-        arm_b_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `arm_b_now`.
-    pub const ARM_B_NOW: Range<usize> = span!(
-        HeartbeatPacket,
-        arm_b_now,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_a_target`.
-    pub const GRIPPER_A_TARGET: Range<usize> = span!(
-        HeartbeatPacket,
-        gripper_a_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_a_now`.
-    pub const GRIPPER_A_NOW: Range<usize> = span!(
-        HeartbeatPacket,
-        gripper_a_now,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_b_target`.
-    pub const GRIPPER_B_TARGET: Range<usize> = span!(
-        HeartbeatPacket,
-        gripper_b_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_b_now`.
-    pub const GRIPPER_B_NOW: Range<usize> = span!(
-        HeartbeatPacket,
-        gripper_b_now,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_a.v_bat`.
-    pub const ELECTRICAL_A_V_BAT: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_a.v_bat,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_a.i_bat`.
-    pub const ELECTRICAL_A_I_BAT: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_a.i_bat,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_a.i_loc`.
-    pub const ELECTRICAL_A_I_LOC: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_a.i_loc,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_a.i_grip`.
-    pub const ELECTRICAL_A_I_GRIP: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_a.i_grip,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_a.i_3v3`.
-    pub const ELECTRICAL_A_I_3V3: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_a.i_3v3,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_a.v_reg`.
-    pub const ELECTRICAL_A_V_REG: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_a.v_reg,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_a.i_bo`.
-    pub const ELECTRICAL_A_I_BO: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_a.i_bo,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.v_bat`.
-    pub const ELECTRICAL_B_V_BAT: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_b.v_bat,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_bat`.
-    pub const ELECTRICAL_B_I_BAT: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_b.i_bat,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_loc`.
-    pub const ELECTRICAL_B_I_LOC: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_b.i_loc,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_grip`.
-    pub const ELECTRICAL_B_I_GRIP: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_b.i_grip,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_3v3`.
-    pub const ELECTRICAL_B_I_3V3: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_b.i_3v3,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.v_reg`.
-    pub const ELECTRICAL_B_V_REG: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_b.v_reg,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_bo`.
-    pub const ELECTRICAL_B_I_BO: Range<usize> = span!(
-        HeartbeatPacket,
-        electrical_b.i_bo,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `target_state`.
-    pub const TARGET_STATE: Range<usize> = span!(HeartbeatPacket, target_state, u8);
-    /// `command_complete`.
-    pub const COMMAND_COMPLETE: Range<usize> = span!(HeartbeatPacket, command_complete, u8);
-    /// `active_bolter`.
-    pub const ACTIVE_BOLTER: Range<usize> = span!(HeartbeatPacket, active_bolter, u8);
-    /// `bolter_attempt`.
-    pub const BOLTER_ATTEMPT: Range<usize> = span!(HeartbeatPacket, bolter_attempt, u8);
-    /// `empty`.
-    pub const EMPTY: Range<usize> = span!(HeartbeatPacket, empty, u8);
-    /// `refusal`.
-    pub const REFUSAL: Range<usize> = span!(HeartbeatPacket, refusal, u8);
-    /// `mode`.
-    pub const MODE: Range<usize> = span!(HeartbeatPacket, mode, u8);
-    /// `checksum`.
-    pub const CHECKSUM: Range<usize> = span!(
-        HeartbeatPacket,
-        checksum,
-        zerocopy::byteorder::little_endian::U16
-    );
+// The fields, from the layout (spec/packets/heartbeat.toml is checked against it).
+fields! {
+    HeartbeatPacket;
+    // CONST: (name, field, type, unit, the paper's label)
+    HEADER: ("header", header, [u8; 4], Header, "header"),
+    BOARD: ("board", board, u8, Board, "board number"),
+    HIP_TARGET: ("hip_target", hip_target, U16, Centidegrees, "hip-target"),
+    HIP_NOW: ("hip_now", hip_now, U16, Centidegrees, "hip-now"),
+    ARM_A_TARGET: ("arm_a_target", arm_a_target, U16, Micros, "arm A-target"),
+    ARM_A_NOW: ("arm_a_now", arm_a_now, U16, Micros, "arm A-now"),
+    ARM_B_TARGET: ("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
+    ARM_B_NOW: ("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
+    GRIPPER_A_TARGET: ("gripper_a_target", gripper_a_target, U16, Micros, "gripper A-target"),
+    GRIPPER_A_NOW: ("gripper_a_now", gripper_a_now, U16, Micros, "gripper A-now"),
+    GRIPPER_B_TARGET: ("gripper_b_target", gripper_b_target, U16, Micros, "gripper B-target"),
+    GRIPPER_B_NOW: ("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
+    [
+        ELECTRICAL_A_V_BAT, ELECTRICAL_A_I_BAT, ELECTRICAL_A_I_LOC, ELECTRICAL_A_I_GRIP,
+        ELECTRICAL_A_I_3V3, ELECTRICAL_A_V_REG, ELECTRICAL_A_I_BO,
+    ]:
+        ..electrical(electrical_a, "A"),
+    [
+        ELECTRICAL_B_V_BAT, ELECTRICAL_B_I_BAT, ELECTRICAL_B_I_LOC, ELECTRICAL_B_I_GRIP,
+        ELECTRICAL_B_I_3V3, ELECTRICAL_B_V_REG, ELECTRICAL_B_I_BO,
+    ]:
+        ..electrical(electrical_b, "B"),
+    TARGET_STATE: ("target_state", target_state, u8, StateLetter, "target state"),
+    COMMAND_COMPLETE: ("command_complete", command_complete, u8, Bool, "command complete"),
+    ACTIVE_BOLTER: ("active_bolter", active_bolter, u8, Enum, "active bolter"),
+    BOLTER_ATTEMPT: ("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
+    LAST_SEQ: ("last_seq", last_seq, U16, Sequence16, "empty", cells &["empty", "empty"]),
+    EMPTY: ("empty", empty, u8, Reserved, "empty"),
+    FAULTS: (
+        "faults", faults, [u8; 2], Bits, "fault byte0-1",
+        cells &["fault byte0", "fault byte1"]
+    ),
+    REFUSAL: ("refusal", refusal, u8, Enum, "fault byte2"),
+    MODE: ("mode", mode, u8, Enum, "operating mode"),
+    CHECKSUM: ("checksum", checksum, U16, Crc16, "checksum"),
 }
 
 /// The attempt counter is the bolter's ([`crate::bolter`]); the heartbeat reports it.
@@ -380,9 +197,9 @@ impl Default for HeartbeatRepr {
     }
 }
 
-fn angle(name: &'static str, at: usize, v: U16) -> Result<HipAngle, WireError> {
+fn angle(kind: PacketKind, name: &'static str, at: usize, v: U16) -> Result<HipAngle, WireError> {
     HipAngle::new(v.get())
-        .map_err(|_| field_err(KIND, at, name, "0..=35999 (0.01 deg)", v.get() as u32))
+        .map_err(|_| field_err(kind, at, name, "0..=35999 (0.01 deg)", v.get() as u32))
 }
 
 /// Index of the first byte of layout field `$f`.
@@ -460,7 +277,13 @@ impl HeartbeatRepr {
     fn fields(p: &HeartbeatPacket) -> Result<HeartbeatRepr, WireError> {
         let board =
             BoardNumber::new(p.board).map_err(|_| field_err(KIND, 4, "board", "1..=255", 0))?;
-        // An optional byte field whose JSON name is the layout field's name.
+        // The error of a byte field whose JSON name is the layout field's name.
+        macro_rules! refuse {
+            ($f:ident, $expected:literal) => {
+                field_err(KIND, at!($f), stringify!($f), $expected, p.$f as u32)
+            };
+        }
+        // An optional byte field named so.
         macro_rules! opt {
             ($f:ident, $expected:literal, $from:path) => {
                 optional(KIND, at!($f), stringify!($f), $expected, p.$f, $from)?
@@ -468,52 +291,34 @@ impl HeartbeatRepr {
         }
         let target_state = opt!(target_state, "0 or 'a'..='o'", State::from_wire);
         let active_bolter = opt!(active_bolter, "0..=4", BolterPair::from_number);
-        let bolter_attempt = BolterAttempt::new(p.bolter_attempt).map_err(|_| {
-            field_err(
-                KIND,
-                at!(bolter_attempt),
-                "bolter_attempt",
-                "0..=3",
-                p.bolter_attempt as u32,
-            )
-        })?;
+        let bolter_attempt =
+            BolterAttempt::new(p.bolter_attempt).map_err(|_| refuse!(bolter_attempt, "0..=3"))?;
         if p.empty != 0 {
-            return Err(field_err(KIND, at!(empty), "empty", "0", p.empty as u32));
+            return Err(refuse!(empty, "0"));
         }
         let faults = Faults::from_wire(p.faults)
             .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=14 only", e.reserved))?;
         let refusal = opt!(refusal, "0 (accepted) or 1..=8", Refusal::from_wire);
-        let mode = Mode::from_wire(p.mode).ok_or_else(|| {
-            field_err(
-                KIND,
-                at!(mode),
-                "mode",
-                "1 (standby), 2 (operational) or 3 (safed)",
-                p.mode as u32,
-            )
-        })?;
+        let mode = Mode::from_wire(p.mode)
+            .ok_or_else(|| refuse!(mode, "1 (standby), 2 (operational) or 3 (safed)"))?;
+        // A servo field whose JSON name is the layout field's name.
+        macro_rules! servo {
+            ($check:ident, $f:ident) => {
+                $check(KIND, stringify!($f), at!($f), p.$f)?
+            };
+        }
         Ok(HeartbeatRepr {
             board,
-            hip_target: angle("hip_target", at!(hip_target), p.hip_target)?,
-            hip_now: angle("hip_now", at!(hip_now), p.hip_now)?,
-            arm_a_target: pulse(KIND, "arm_a_target", at!(arm_a_target), p.arm_a_target)?,
-            arm_a_now: pulse(KIND, "arm_a_now", at!(arm_a_now), p.arm_a_now)?,
-            arm_b_target: pulse(KIND, "arm_b_target", at!(arm_b_target), p.arm_b_target)?,
-            arm_b_now: pulse(KIND, "arm_b_now", at!(arm_b_now), p.arm_b_now)?,
-            gripper_a_target: pulse(
-                KIND,
-                "gripper_a_target",
-                at!(gripper_a_target),
-                p.gripper_a_target,
-            )?,
-            gripper_a_now: pulse(KIND, "gripper_a_now", at!(gripper_a_now), p.gripper_a_now)?,
-            gripper_b_target: pulse(
-                KIND,
-                "gripper_b_target",
-                at!(gripper_b_target),
-                p.gripper_b_target,
-            )?,
-            gripper_b_now: pulse(KIND, "gripper_b_now", at!(gripper_b_now), p.gripper_b_now)?,
+            hip_target: servo!(angle, hip_target),
+            hip_now: servo!(angle, hip_now),
+            arm_a_target: servo!(pulse, arm_a_target),
+            arm_a_now: servo!(pulse, arm_a_now),
+            arm_b_target: servo!(pulse, arm_b_target),
+            arm_b_now: servo!(pulse, arm_b_now),
+            gripper_a_target: servo!(pulse, gripper_a_target),
+            gripper_a_now: servo!(pulse, gripper_a_now),
+            gripper_b_target: servo!(pulse, gripper_b_target),
+            gripper_b_now: servo!(pulse, gripper_b_now),
             electrical_a: Electrical::from(&p.electrical_a),
             electrical_b: Electrical::from(&p.electrical_b),
             target_state,

@@ -9,8 +9,10 @@
 //! assert_eq!(InternalHeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
 
-use super::layout::{field_table, ElectricalLayout, FieldSpec};
+use super::layout::{fields, ElectricalLayout};
 use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKind, WireError};
+/// Bolter B's progress is the bolter's vocabulary; re-exported at its old path.
+pub use crate::bolter::BolterAux;
 use crate::bolter::{BolterDirection, BolterPair, BolterStep, MuxLines};
 use crate::units::{Axis, Electrical, Gravity, PulseWidth, Sign};
 use zerocopy::byteorder::little_endian::U16;
@@ -70,187 +72,42 @@ macro_rules! at {
 
 const AUX: &str = "bolter B operation auxiliary variables";
 
-/// Field table, from the layout (spec/packets/internal-heartbeat.toml is checked against it).
-pub const FIELDS: &[FieldSpec] = field_table![InternalHeartbeatPacket;
-    // (name, field, type, unit, the paper's label)
-    ("header", header, [u8; 4], Header, "header"),
-    ("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
-    ("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
-    ("gripper_b_target", gripper_b_target, U16, Micros, "gripper B-target"),
-    ("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
-    ..electrical(electrical_b, "B"),
-    ("bolter_aux.step", bolter_step, u8, Enum, AUX),
-    ("bolter_aux.seq", bolter_seq, u8, Sequence, AUX),
-    ("bolter_aux.pair", bolter_pair, u8, Enum, AUX),
-    ("bolter_aux.direction", bolter_direction, u8, Enum, AUX),
-    ("bolter_aux.threshold_reached", bolter_threshold, u8, Bool, AUX),
-    ("bolter_aux.locked", bolter_locked, u8, Bool, AUX),
-    ("bolter_aux.timed_out", bolter_timed_out, u8, Bool, AUX),
-    ("bolter_aux.at_home", bolter_at_home, u8, Bool, AUX),
-    ("bolter_aux.mux", bolter_mux, u8, Bits, AUX),
-    ("command_received", command_received, u8, Sequence, "command received"),
-    ("gravity.sign", g_sign, u8, Enum, "g direction sign"),
-    ("gravity.axis", g_axis, u8, Enum, "g direction axis"),
-    ("arm_over_idle", arm_over_idle, u8, Bool, "arm B over-idle"),
-    ("gripper_over_idle", gripper_over_idle, u8, Bool, "gripper B over-idle"),
-    ("bolter_over_idle", bolter_over_idle, u8, Bool, "bolter B over-idle"),
-    ("arm_overcurrent", arm_overcurrent, u8, Bool, "arm B overcurrent"),
-    ("gripper_overcurrent", gripper_overcurrent, u8, Bool, "gripper B overcurrent"),
-    ("bolter_overcurrent", bolter_overcurrent, u8, Bool, "bolter B overcurrent"),
-    ("arm_contracted", arm_contracted, u8, Bool, "arm B contracted"),
-    ("checksum", checksum, U16, Crc16, "checksum"),
-];
-
-/// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
-pub mod field {
-    use super::*;
-    use crate::wire::layout::span;
-    use core::ops::Range;
-    /// `header`.
-    pub const HEADER: Range<usize> = span!(InternalHeartbeatPacket, header, [u8; 4]);
-    /// `arm_b_target`.
-    pub const ARM_B_TARGET: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        arm_b_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `arm_b_now`.
-    pub const ARM_B_NOW: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        arm_b_now,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_b_target`.
-    pub const GRIPPER_B_TARGET: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        gripper_b_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_b_now`.
-    pub const GRIPPER_B_NOW: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        gripper_b_now,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.v_bat`.
-    pub const ELECTRICAL_B_V_BAT: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        electrical_b.v_bat,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_bat`.
-    pub const ELECTRICAL_B_I_BAT: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        electrical_b.i_bat,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_loc`.
-    pub const ELECTRICAL_B_I_LOC: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        electrical_b.i_loc,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_grip`.
-    pub const ELECTRICAL_B_I_GRIP: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        electrical_b.i_grip,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_3v3`.
-    pub const ELECTRICAL_B_I_3V3: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        electrical_b.i_3v3,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.v_reg`.
-    pub const ELECTRICAL_B_V_REG: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        electrical_b.v_reg,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `electrical_b.i_bo`.
-    pub const ELECTRICAL_B_I_BO: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        electrical_b.i_bo,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `bolter_aux.step`.
-    pub const BOLTER_AUX_STEP: Range<usize> = span!(InternalHeartbeatPacket, bolter_step, u8);
-    /// `bolter_aux.seq`.
-    pub const BOLTER_AUX_SEQ: Range<usize> = span!(InternalHeartbeatPacket, bolter_seq, u8);
-    /// `bolter_aux.pair`.
-    pub const BOLTER_AUX_PAIR: Range<usize> = span!(InternalHeartbeatPacket, bolter_pair, u8);
-    /// `bolter_aux.direction`.
-    pub const BOLTER_AUX_DIRECTION: Range<usize> =
-        span!(InternalHeartbeatPacket, bolter_direction, u8);
-    /// `bolter_aux.threshold_reached`.
-    pub const BOLTER_AUX_THRESHOLD_REACHED: Range<usize> =
-        span!(InternalHeartbeatPacket, bolter_threshold, u8);
-    /// `bolter_aux.locked`.
-    pub const BOLTER_AUX_LOCKED: Range<usize> = span!(InternalHeartbeatPacket, bolter_locked, u8);
-    /// `bolter_aux.timed_out`.
-    pub const BOLTER_AUX_TIMED_OUT: Range<usize> =
-        span!(InternalHeartbeatPacket, bolter_timed_out, u8);
-    /// `bolter_aux.at_home`.
-    pub const BOLTER_AUX_AT_HOME: Range<usize> = span!(InternalHeartbeatPacket, bolter_at_home, u8);
-    /// `bolter_aux.mux`.
-    pub const BOLTER_AUX_MUX: Range<usize> = span!(InternalHeartbeatPacket, bolter_mux, u8);
-    /// `command_received`.
-    pub const COMMAND_RECEIVED: Range<usize> = span!(InternalHeartbeatPacket, command_received, u8);
-    /// `gravity.sign`.
-    pub const GRAVITY_SIGN: Range<usize> = span!(InternalHeartbeatPacket, g_sign, u8);
-    /// `gravity.axis`.
-    pub const GRAVITY_AXIS: Range<usize> = span!(InternalHeartbeatPacket, g_axis, u8);
-    /// `arm_over_idle`.
-    pub const ARM_OVER_IDLE: Range<usize> = span!(InternalHeartbeatPacket, arm_over_idle, u8);
-    /// `gripper_over_idle`.
-    pub const GRIPPER_OVER_IDLE: Range<usize> =
-        span!(InternalHeartbeatPacket, gripper_over_idle, u8);
-    /// `bolter_over_idle`.
-    pub const BOLTER_OVER_IDLE: Range<usize> = span!(InternalHeartbeatPacket, bolter_over_idle, u8);
-    /// `arm_overcurrent`.
-    pub const ARM_OVERCURRENT: Range<usize> = span!(InternalHeartbeatPacket, arm_overcurrent, u8);
-    /// `gripper_overcurrent`.
-    pub const GRIPPER_OVERCURRENT: Range<usize> =
-        span!(InternalHeartbeatPacket, gripper_overcurrent, u8);
-    /// `bolter_overcurrent`.
-    pub const BOLTER_OVERCURRENT: Range<usize> =
-        span!(InternalHeartbeatPacket, bolter_overcurrent, u8);
-    /// `arm_contracted`.
-    pub const ARM_CONTRACTED: Range<usize> = span!(InternalHeartbeatPacket, arm_contracted, u8);
-    /// `checksum`.
-    pub const CHECKSUM: Range<usize> = span!(
-        InternalHeartbeatPacket,
-        checksum,
-        zerocopy::byteorder::little_endian::U16
-    );
-}
-
-/// Bolter B's progress, the nine "auxiliary variables" A needs to keep both bolters in step.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
-pub struct BolterAux {
-    /// Step B is executing; none when idle (wire 0).
-    pub step: Option<BolterStep>,
-    #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq8"))]
-    /// Sequence number of the A→B command that ordered that step.
-    pub seq: u8,
-    /// Pair B has selected; none when idle.
-    pub pair: Option<BolterPair>,
-    /// Bolting or unbolting; none when idle.
-    pub direction: Option<BolterDirection>,
-    /// B's bolter current passed its threshold in the current step.
-    pub threshold_reached: bool,
-    /// B's current says the fastener is locked (unlocked when unbolting).
-    pub locked: bool,
-    /// The current step timed out on B.
-    pub timed_out: bool,
-    /// Bolter B is in its initial configuration.
-    pub at_home: bool,
-    /// Read-back of B's multiplexer lines.
-    pub mux: MuxLines,
+// The fields, from the layout (spec/packets/internal-heartbeat.toml is checked against it).
+fields! {
+    InternalHeartbeatPacket;
+    // CONST: (name, field, type, unit, the paper's label)
+    HEADER: ("header", header, [u8; 4], Header, "header"),
+    ARM_B_TARGET: ("arm_b_target", arm_b_target, U16, Micros, "arm B-target"),
+    ARM_B_NOW: ("arm_b_now", arm_b_now, U16, Micros, "arm B-now"),
+    GRIPPER_B_TARGET: ("gripper_b_target", gripper_b_target, U16, Micros, "gripper B-target"),
+    GRIPPER_B_NOW: ("gripper_b_now", gripper_b_now, U16, Micros, "gripper B-now"),
+    [
+        ELECTRICAL_B_V_BAT, ELECTRICAL_B_I_BAT, ELECTRICAL_B_I_LOC, ELECTRICAL_B_I_GRIP,
+        ELECTRICAL_B_I_3V3, ELECTRICAL_B_V_REG, ELECTRICAL_B_I_BO,
+    ]:
+        ..electrical(electrical_b, "B"),
+    BOLTER_AUX_STEP: ("bolter_aux.step", bolter_step, u8, Enum, AUX),
+    BOLTER_AUX_SEQ: ("bolter_aux.seq", bolter_seq, u8, Sequence, AUX),
+    BOLTER_AUX_PAIR: ("bolter_aux.pair", bolter_pair, u8, Enum, AUX),
+    BOLTER_AUX_DIRECTION: ("bolter_aux.direction", bolter_direction, u8, Enum, AUX),
+    BOLTER_AUX_THRESHOLD_REACHED: ("bolter_aux.threshold_reached", bolter_threshold, u8, Bool, AUX),
+    BOLTER_AUX_LOCKED: ("bolter_aux.locked", bolter_locked, u8, Bool, AUX),
+    BOLTER_AUX_TIMED_OUT: ("bolter_aux.timed_out", bolter_timed_out, u8, Bool, AUX),
+    BOLTER_AUX_AT_HOME: ("bolter_aux.at_home", bolter_at_home, u8, Bool, AUX),
+    BOLTER_AUX_MUX: ("bolter_aux.mux", bolter_mux, u8, Bits, AUX),
+    COMMAND_RECEIVED: ("command_received", command_received, u8, Sequence, "command received"),
+    GRAVITY_SIGN: ("gravity.sign", g_sign, u8, Enum, "g direction sign"),
+    GRAVITY_AXIS: ("gravity.axis", g_axis, u8, Enum, "g direction axis"),
+    ARM_OVER_IDLE: ("arm_over_idle", arm_over_idle, u8, Bool, "arm B over-idle"),
+    GRIPPER_OVER_IDLE: ("gripper_over_idle", gripper_over_idle, u8, Bool, "gripper B over-idle"),
+    BOLTER_OVER_IDLE: ("bolter_over_idle", bolter_over_idle, u8, Bool, "bolter B over-idle"),
+    ARM_OVERCURRENT: ("arm_overcurrent", arm_overcurrent, u8, Bool, "arm B overcurrent"),
+    GRIPPER_OVERCURRENT:
+        ("gripper_overcurrent", gripper_overcurrent, u8, Bool, "gripper B overcurrent"),
+    BOLTER_OVERCURRENT:
+        ("bolter_overcurrent", bolter_overcurrent, u8, Bool, "bolter B overcurrent"),
+    ARM_CONTRACTED: ("arm_contracted", arm_contracted, u8, Bool, "arm B contracted"),
+    CHECKSUM: ("checksum", checksum, U16, Crc16, "checksum"),
 }
 
 /// Board B's status, sent to A periodically.

@@ -60,69 +60,81 @@ macro_rules! span {
 }
 pub(crate) use span;
 
-/// A packet's field table, `&[FieldSpec]`, from layout `$t` and its entries in byte order, each
-/// one of:
-/// - a row `(name, field, type, unit, paper)`: field `field` (of type `type`) of `$t`, named
-///   `name`, its unit `Unit::unit` and the paper's label `paper`;
-/// - `..electrical(field, "X")`: the seven readings of the [`ElectricalLayout`] `field`, named
-///   `field.v_bat` … `field.i_bo` and labelled as the paper does, `V_{batX}` … `I_{boX}` (`X` the
-///   side): both heartbeats carry such blocks;
-/// - any `FieldSpec` expression (explicit `cells`).
-macro_rules! field_table {
-    (@munch $t:ty; [$($done:expr,)*];) => {
-        &[$($done,)*]
-    };
-    (
-        @munch $t:ty; [$($done:expr,)*];
-        ($name:literal, $($field:ident).+, $ft:ty, $unit:ident, $paper:expr) $(, $($rest:tt)*)?
-    ) => {
-        $crate::wire::layout::field_table!(@munch $t; [
-            $($done,)*
-            $crate::wire::layout::field_table!(@field $t, $name, $($field).+, $ft, $unit, $paper),
-        ]; $($($rest)*)?)
-    };
-    (
-        @munch $t:ty; [$($done:expr,)*];
-        ..electrical($side:ident, $x:literal) $(, $($rest:tt)*)?
-    ) => {
-        $crate::wire::layout::field_table!(@munch $t; [
-            $($done,)*
-            $crate::wire::layout::field_table!(@reading $t, $side, v_bat, Millivolts, "V_{bat", $x),
-            $crate::wire::layout::field_table!(@reading $t, $side, i_bat, Milliamps, "I_{bat", $x),
-            $crate::wire::layout::field_table!(@reading $t, $side, i_loc, Milliamps, "I_{loc", $x),
-            $crate::wire::layout::field_table!(@reading $t, $side, i_grip, Milliamps, "I_{grip", $x),
-            $crate::wire::layout::field_table!(@reading $t, $side, i_3v3, Milliamps, "I_{3v3", $x),
-            $crate::wire::layout::field_table!(@reading $t, $side, v_reg, Millivolts, "V_{reg", $x),
-            $crate::wire::layout::field_table!(@reading $t, $side, i_bo, Milliamps, "I_{bo", $x),
-        ]; $($($rest)*)?)
-    };
-    (@munch $t:ty; [$($done:expr,)*]; $entry:expr $(, $($rest:tt)*)?) => {
-        $crate::wire::layout::field_table!(@munch $t; [$($done,)* $entry,]; $($($rest)*)?)
-    };
-    (@reading $t:ty, $side:ident, $reading:ident, $unit:ident, $label:literal, $x:literal) => {
-        $crate::wire::layout::field_table!(
-            @field $t,
-            concat!(stringify!($side), ".", stringify!($reading)),
-            $side.$reading,
-            zerocopy::byteorder::little_endian::U16,
-            $unit,
-            concat!($label, $x, "}")
-        )
-    };
-    (@field $t:ty, $name:expr, $($field:ident).+, $ft:ty, $unit:ident, $paper:expr) => {
-        $crate::wire::layout::FieldSpec {
-            name: $name,
-            range: $crate::wire::layout::span!($t, $($field).+, $ft),
-            unit: $crate::wire::layout::Unit::$unit,
-            paper: $paper,
-            cells: &[],
+/// A packet's fields, written once: `pub const FIELDS: &[FieldSpec]` (the table spec/ is
+/// checked against) and `pub mod field` (one `Range<usize>` constant per field, for code that
+/// indexes the bytes), both from layout `$t` and its entries in byte order, each one of:
+/// - `CONST: (name, field, type, unit, paper)`: field `field` (of type `type`) of `$t`, named
+///   `name`, its unit `Unit::unit` and the paper's label `paper`, optionally followed by
+///   `cells [..]` (the paper's grid cells, when they are not one label);
+/// - `[V_BAT, I_BAT, I_LOC, I_GRIP, I_3V3, V_REG, I_BO]: ..electrical(field, "X")`: the seven
+///   readings of the [`ElectricalLayout`] `field`, named `field.v_bat` … `field.i_bo` and
+///   labelled as the paper does, `V_{batX}` … `I_{boX}` (`X` the side): both heartbeats carry
+///   such blocks.
+macro_rules! fields {
+    (@munch $t:ty; [$($c:item)*] [$($s:expr,)*];) => {
+        /// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
+        pub mod field {
+            #[allow(unused_imports)]
+            use super::*;
+            $($c)*
         }
+
+        /// Field table, from the layout (spec/packets/ is checked against it).
+        pub const FIELDS: &[$crate::wire::layout::FieldSpec] = &[$($s,)*];
     };
+    (
+        @munch $t:ty; [$($c:item)*] [$($s:expr,)*];
+        $C:ident:
+            ($name:expr, $($f:ident).+, $ft:ty, $unit:ident, $paper:expr $(, cells $cells:expr)?)
+        $(, $($rest:tt)*)?
+    ) => {
+        $crate::wire::layout::fields!(@munch $t; [
+            $($c)*
+            #[doc = concat!("`", $name, "`.")]
+            pub const $C: core::ops::Range<usize> =
+                $crate::wire::layout::span!($t, $($f).+, $ft);
+        ] [
+            $($s,)*
+            $crate::wire::layout::FieldSpec {
+                name: $name,
+                range: field::$C,
+                unit: $crate::wire::layout::Unit::$unit,
+                paper: $paper,
+                cells: $crate::wire::layout::fields!(@cells $($cells)?),
+            },
+        ]; $($($rest)*)?);
+    };
+    (
+        @munch $t:ty; [$($c:item)*] [$($s:expr,)*];
+        [$vb:ident, $ib:ident, $il:ident, $ig:ident, $i3:ident, $vr:ident, $io:ident $(,)?]:
+            ..electrical($side:ident, $x:literal)
+        $(, $($rest:tt)*)?
+    ) => {
+        $crate::wire::layout::fields!(@munch $t; [$($c)*] [$($s,)*];
+            $vb: (concat!(stringify!($side), ".v_bat"), $side.v_bat, U16, Millivolts,
+                concat!("V_{bat", $x, "}")),
+            $ib: (concat!(stringify!($side), ".i_bat"), $side.i_bat, U16, Milliamps,
+                concat!("I_{bat", $x, "}")),
+            $il: (concat!(stringify!($side), ".i_loc"), $side.i_loc, U16, Milliamps,
+                concat!("I_{loc", $x, "}")),
+            $ig: (concat!(stringify!($side), ".i_grip"), $side.i_grip, U16, Milliamps,
+                concat!("I_{grip", $x, "}")),
+            $i3: (concat!(stringify!($side), ".i_3v3"), $side.i_3v3, U16, Milliamps,
+                concat!("I_{3v3", $x, "}")),
+            $vr: (concat!(stringify!($side), ".v_reg"), $side.v_reg, U16, Millivolts,
+                concat!("V_{reg", $x, "}")),
+            $io: (concat!(stringify!($side), ".i_bo"), $side.i_bo, U16, Milliamps,
+                concat!("I_{bo", $x, "}"))
+            $(, $($rest)*)?
+        );
+    };
+    (@cells) => { &[] };
+    (@cells $cells:expr) => { $cells };
     ($t:ty; $($entries:tt)*) => {
-        $crate::wire::layout::field_table!(@munch $t; []; $($entries)*)
+        $crate::wire::layout::fields!(@munch $t; [] []; $($entries)*);
     };
 }
-pub(crate) use field_table;
+pub(crate) use fields;
 
 /// Unit or encoding of a field, as spec/ names it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -29,7 +29,7 @@ pub mod opcode;
 
 pub use layout::{ElectricalLayout, FieldSpec, Unit};
 
-use crate::command::CommandError;
+use opcode::CommandError;
 
 /// Length of every header.
 pub const HEADER_LEN: usize = 4;
@@ -126,6 +126,7 @@ impl fmt::Display for PacketKind {
 /// fields; the first failure is reported with the numbers that explain it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum WireError {
     /// Wrong number of bytes.
     #[error("{kind} packet: length must be {expected} bytes, found {found}")]

@@ -4,7 +4,8 @@
 use super::{hex, unhex};
 use mmic::ccsds::tc::TcRepr;
 use mmic::ccsds::tm::TmRepr;
-use mmic::ccsds::{PacketError, PusError};
+use mmic::ccsds::PacketError;
+use mmic::pus::PusError;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;

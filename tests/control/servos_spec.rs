@@ -92,14 +92,14 @@ fn servo_defaults_equal_spec() {
 /// past each refused with the range in the message.
 #[test]
 fn the_decoder_enforces_the_spec_travel() {
-    use mmic::command::{Command, CommandError};
+    use mmic::wire::opcode::{decode, CommandError};
     let s = spec();
     for (base, t) in [(0x20u8, &s.travel.arm), (0x28, &s.travel.gripper)] {
         let (min, max) = (t.contracted_us, t.extended_us);
         for (us, ok) in [(min - 1, false), (min, true), (max, true), (max + 1, false)] {
             let mut p = [0u8; 6];
             p[2..4].copy_from_slice(&us.to_le_bytes());
-            let r = Command::decode(base + 2, p);
+            let r = decode(base + 2, p);
             assert_eq!(r.is_ok(), ok, "{base:#x} {us}: {r:?}");
             if let Err(e) = r {
                 assert!(matches!(e, CommandError::OutOfTravel { .. }), "{e:?}");

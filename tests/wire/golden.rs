@@ -13,7 +13,7 @@ use crate::common;
 
 use common::crc16_bitwise;
 use mmic::bolter::{BolterDirection, BolterStep, MuxLines};
-use mmic::command::{BolterPair, Command, CommandError, ServoTarget};
+use mmic::command::{BolterPair, Command, ServoTarget};
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
 use mmic::motion::{Primitive, State};
@@ -23,6 +23,7 @@ use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder, B_COMMAND_LEN};
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::heartbeat::{BolterAttempt, HeartbeatRepr, HEARTBEAT_LEN};
 use mmic::wire::internal_heartbeat::{BolterAux, InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
+use mmic::wire::opcode::CommandError;
 use mmic::wire::WireError;
 
 fn pw(us: u16) -> PulseWidth {

@@ -21,6 +21,7 @@ use mmic::wire::b_command::BCommandRepr;
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::HeartbeatRepr;
 use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
+use mmic::wire::opcode::{decode, encode};
 use mmic::wire::{PacketKind, WireError, CHECKSUM_LEN, HEADER_LEN};
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
@@ -124,8 +125,8 @@ proptest! {
 
     #[test]
     fn command_encode_decode_round_trips(c in any::<Command>()) {
-        let (id, params) = c.encode();
-        prop_assert_eq!(Command::decode(id, params), Ok(c));
+        let (id, params) = encode(&c);
+        prop_assert_eq!(decode(id, params), Ok(c));
     }
 
     #[test]
@@ -198,14 +199,14 @@ fn sample<S: Strategy>(strategy: S, n: usize) -> Vec<S::Value> {
 fn command_strategy_reaches_every_opcode() {
     let mut seen = [false; 256];
     for c in sample(any::<Command>(), 20_000) {
-        seen[c.encode().0 as usize] = true;
+        seen[encode(&c).0 as usize] = true;
     }
     let mut classes = 0;
     mmic::command::for_each_variant_class(
         mmic::units::PulseWidth::CENTER,
         mmic::units::HipAngle::ZERO,
         |c| {
-            let id = c.encode().0;
+            let id = encode(&c).0;
             assert!(seen[id as usize], "opcode {id:#04x} ({c:?}) never drawn");
             classes += 1;
         },
@@ -308,8 +309,8 @@ fn every_command_round_trips_with_its_sequence_number() {
                 seq,
             };
             let bytes = repr.to_bytes();
-            let (id, _) = command.encode();
-            let at = 6 + mmic::command::seq_slot(id).offset();
+            let (id, _) = encode(&command);
+            let at = 6 + mmic::wire::opcode::seq_slot(id).offset();
             assert_eq!(u16::from_le_bytes([bytes[at], bytes[at + 1]]), seq);
             assert_eq!(
                 CommandRepr::parse(&bytes),

@@ -21,7 +21,7 @@ fn not_in_json(kind: PacketKind, name: &str) -> bool {
 /// JSON keys that are no field-table name, and why.
 fn json_only(kind: PacketKind, key: &str) -> bool {
     // The exactly-once sequence number rides in whichever parameter slot the opcode leaves
-    // free (`mmic::command::seq_slot`), so like the other slot contents it has no byte range
+    // free (`mmic::wire::opcode::seq_slot`), so like the other slot contents it has no byte range
     // of its own.
     kind == PacketKind::Command && key == "seq"
 }

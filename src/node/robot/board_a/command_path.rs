@@ -205,7 +205,7 @@ impl BoardA {
             // so the ground stops resending it.
             Err(WireError::Command(ce)) => match crate::wire::check::<CommandPacket>(bytes) {
                 Ok(p) if p.board_number() == self.cfg.board.get() => {
-                    Ok((p.seq(), Err(Refusal::for_command_error(&ce))))
+                    Ok((p.seq(), Err(ce.refusal())))
                 }
                 _ => Err(Event::Rejected(WireError::Command(ce))),
             },

@@ -22,9 +22,11 @@
 //! assert_eq!(BCommandRepr::parse(&bytes), Ok(cmd));
 //! ```
 
-use super::layout::{field_table, FieldSpec};
+use super::layout::fields;
 use super::pulse;
 use super::{check, field_err, seal, Packet, PacketKind, WireError};
+/// The order is the bolter's vocabulary; re-exported at its old path.
+pub use crate::bolter::BolterOrder;
 use crate::bolter::{BolterDirection, BolterPair, BolterStep};
 use crate::units::PulseWidth;
 use zerocopy::byteorder::little_endian::U16;
@@ -64,56 +66,20 @@ macro_rules! at {
     };
 }
 
-/// Field table, from the layout (spec/packets/b-command.toml is checked against it). The
-/// "paper" labels are this project's, written in the paper's style.
-pub const FIELDS: &[FieldSpec] = field_table![BCommandPacket;
-    // (name, field, type, unit, the paper's label)
-    ("header", header, [u8; 4], Header, "header"),
-    ("seq", seq, u8, Sequence, "sequence number"),
-    ("flags", flags, u8, Bits, "power/stop flags"),
-    ("arm_target", arm_target, U16, Micros, "arm B-target"),
-    ("gripper_target", gripper_target, U16, Micros, "gripper B-target"),
-    ("bolter.pair", bolter_pair, u8, Enum, "bolter pair"),
-    ("bolter.direction", bolter_direction, u8, Enum, "bolter direction"),
-    ("bolter.step", bolter_step, u8, Enum, "bolter step"),
-    ("checksum", checksum, U16, Crc16, "checksum"),
-];
-
-/// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
-pub mod field {
-    use super::*;
-    use crate::wire::layout::span;
-    use core::ops::Range;
-    /// `header`.
-    pub const HEADER: Range<usize> = span!(BCommandPacket, header, [u8; 4]);
-    /// `seq`.
-    pub const SEQ: Range<usize> = span!(BCommandPacket, seq, u8);
-    /// `flags`.
-    pub const FLAGS: Range<usize> = span!(BCommandPacket, flags, u8);
-    /// `arm_target`.
-    pub const ARM_TARGET: Range<usize> = span!(
-        BCommandPacket,
-        arm_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `gripper_target`.
-    pub const GRIPPER_TARGET: Range<usize> = span!(
-        BCommandPacket,
-        gripper_target,
-        zerocopy::byteorder::little_endian::U16
-    );
-    /// `bolter.pair`.
-    pub const BOLTER_PAIR: Range<usize> = span!(BCommandPacket, bolter_pair, u8);
-    /// `bolter.direction`.
-    pub const BOLTER_DIRECTION: Range<usize> = span!(BCommandPacket, bolter_direction, u8);
-    /// `bolter.step`.
-    pub const BOLTER_STEP: Range<usize> = span!(BCommandPacket, bolter_step, u8);
-    /// `checksum`.
-    pub const CHECKSUM: Range<usize> = span!(
-        BCommandPacket,
-        checksum,
-        zerocopy::byteorder::little_endian::U16
-    );
+// The fields, from the layout (spec/packets/b-command.toml is checked against it). The
+// "paper" labels are this project's, written in the paper's style.
+fields! {
+    BCommandPacket;
+    // CONST: (name, field, type, unit, the paper's label)
+    HEADER: ("header", header, [u8; 4], Header, "header"),
+    SEQ: ("seq", seq, u8, Sequence, "sequence number"),
+    FLAGS: ("flags", flags, u8, Bits, "power/stop flags"),
+    ARM_TARGET: ("arm_target", arm_target, U16, Micros, "arm B-target"),
+    GRIPPER_TARGET: ("gripper_target", gripper_target, U16, Micros, "gripper B-target"),
+    BOLTER_PAIR: ("bolter.pair", bolter_pair, u8, Enum, "bolter pair"),
+    BOLTER_DIRECTION: ("bolter.direction", bolter_direction, u8, Enum, "bolter direction"),
+    BOLTER_STEP: ("bolter.step", bolter_step, u8, Enum, "bolter step"),
+    CHECKSUM: ("checksum", checksum, U16, Crc16, "checksum"),
 }
 
 /// Flag bits of byte 5.
@@ -148,20 +114,6 @@ pub struct BPower {
     pub bolter: bool,
 }
 
-/// A bolter step ordered on side B: which pair, which way, which step of Figure 8.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
-pub struct BolterOrder {
-    /// Pair selected through the multiplexer.
-    pub pair: BolterPair,
-    /// Bolt or unbolt.
-    pub direction: BolterDirection,
-    /// Step to execute.
-    pub step: BolterStep,
-}
-
 /// What board A orders board B to do.
 ///
 /// JSON (feature `serde`) follows [`FIELDS`]: byte 5 is one object, `flags`, holding the
@@ -185,73 +137,9 @@ pub struct BCommandRepr {
     pub bolter: Option<BolterOrder>,
 }
 
-/// The JSON form of [`BCommandRepr`]: the field names of [`FIELDS`], byte 5 as `flags`.
+/// The JSON form (feature `serde`).
 #[cfg(feature = "serde")]
-mod json {
-    use super::{BCommandRepr, BPower, BolterOrder};
-    use crate::units::PulseWidth;
-
-    /// Byte 5, bit by bit.
-    #[derive(serde::Serialize, serde::Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct Flags {
-        regulator: bool,
-        arm: bool,
-        gripper: bool,
-        bolter: bool,
-        stop: bool,
-    }
-
-    #[derive(serde::Serialize, serde::Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct Form {
-        #[serde(deserialize_with = "crate::units::de::seq8")]
-        seq: u8,
-        flags: Flags,
-        arm_target: PulseWidth,
-        gripper_target: PulseWidth,
-        bolter: Option<BolterOrder>,
-    }
-
-    impl serde::Serialize for BCommandRepr {
-        fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-            let p = self.power;
-            Form {
-                seq: self.seq,
-                flags: Flags {
-                    regulator: p.regulator,
-                    arm: p.arm,
-                    gripper: p.gripper,
-                    bolter: p.bolter,
-                    stop: self.stop,
-                },
-                arm_target: self.arm_target,
-                gripper_target: self.gripper_target,
-                bolter: self.bolter,
-            }
-            .serialize(s)
-        }
-    }
-
-    impl<'de> serde::Deserialize<'de> for BCommandRepr {
-        fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-            let f = Form::deserialize(d)?;
-            Ok(BCommandRepr {
-                seq: f.seq,
-                power: BPower {
-                    regulator: f.flags.regulator,
-                    arm: f.flags.arm,
-                    gripper: f.flags.gripper,
-                    bolter: f.flags.bolter,
-                },
-                stop: f.flags.stop,
-                arm_target: f.arm_target,
-                gripper_target: f.gripper_target,
-                bolter: f.bolter,
-            })
-        }
-    }
-}
+mod ser;
 
 impl BCommandRepr {
     /// Checks length, header, checksum and every field.

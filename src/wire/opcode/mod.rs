@@ -13,12 +13,15 @@
 
 use crate::command::{
     BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
-    PrimitiveMove, PrimitiveMoveError, Reconfiguration, ReconfigurationError, ServoTarget,
+    PrimitiveMove, PrimitiveMoveError, Reconfiguration, ReconfigurationError, ServoTarget, Travel,
 };
-use crate::control::interp::Travel;
 use crate::mode::Mode;
-use crate::motion::{Primitive, State};
+use crate::pose::{Primitive, State};
+use crate::refusal::Refusal;
 use crate::units::{HipAngle, Module, PulseWidth, Side};
+
+#[cfg(test)]
+mod tests;
 
 /// Index in the command packet of the first parameter byte (Table 2 byte 6).
 pub const PARAM_OFFSET: usize = 6;
@@ -106,6 +109,7 @@ pub const fn seq_slot(id: u8) -> Slot {
 /// A parameter block that does not decode to a command.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum CommandError {
     /// Byte 5 holds no assigned opcode.
     #[error("byte 5: unknown command id {id:#04x}")]
@@ -175,6 +179,18 @@ pub enum CommandError {
     /// A primitive whose final state it reaches from no state.
     #[error("byte 8: {0}")]
     Primitive(#[from] PrimitiveMoveError),
+}
+
+impl CommandError {
+    /// The refusal a malformed command packet earns: an unknown opcode is an unknown command,
+    /// anything else a parameter the command cannot take. The mapping lives with the error,
+    /// not with [`Refusal`], because the refusal codes are vocabulary and the error is layout.
+    pub const fn refusal(&self) -> Refusal {
+        match self {
+            CommandError::UnknownId { .. } => Refusal::UnknownCommand,
+            _ => Refusal::InvalidParameter,
+        }
+    }
 }
 
 fn get_u16(p: &[u8; PARAM_LEN], slot: Slot) -> u16 {

@@ -4,8 +4,8 @@
 //! reconfiguration map is computed at compile time, never typed in (spec/motion/model.md).
 //!
 //! ```
-//! use mmic::motion::geometry::{robot_move, single_move, turns_without_hip};
-//! use mmic::motion::{Primitive, State};
+//! use mmic::pose::geometry::{robot_move, single_move, turns_without_hip};
+//! use mmic::pose::{Primitive, State};
 //! use mmic::units::Side;
 //! // b -> g: B leaves the Y- face for X+, its arm turns with the hip: a move of the robot.
 //! assert_eq!(robot_move(State::B, State::G), Some((Side::B, Primitive::BackTurnCw)));

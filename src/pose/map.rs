@@ -1,7 +1,7 @@
 //! The reconfiguration map of Figure 9, computed at compile time from the geometric model.
 //!
 //! ```
-//! use mmic::motion::{map, Primitive, State};
+//! use mmic::pose::{map, Primitive, State};
 //! assert_eq!(map::primitive(State::A, State::D), Some(Primitive::BackExtend));
 //! assert_eq!(map::primitive(State::A, State::M), None); // needs two primitives
 //! assert_eq!(map::moves().count(), 60);
