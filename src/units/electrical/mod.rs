@@ -1,5 +1,8 @@
 //! One side's voltages and currents, as its ADS7828 reads them.
 
+#[cfg(feature = "serde")]
+mod ser;
+
 /// A voltage in millivolts (battery 10.0–12.6 V, regulator 7.4 V: both fit a u16).
 pub type Millivolts = u16;
 /// A current in milliamperes (unsigned: the sense resistors measure draw only).
@@ -9,48 +12,20 @@ pub type Milliamps = u16;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+#[cfg_attr(feature = "serde", serde(from = "ser::Json"))]
 pub struct Electrical {
     /// Battery voltage V_bat, mV.
-    #[cfg_attr(
-        feature = "serde",
-        serde(deserialize_with = "crate::units::de::millivolts")
-    )]
     pub v_bat: Millivolts,
     /// Battery current I_bat, mA.
-    #[cfg_attr(
-        feature = "serde",
-        serde(deserialize_with = "crate::units::de::milliamps")
-    )]
     pub i_bat: Milliamps,
     /// Locomotion (arm and hip) current I_loc, mA.
-    #[cfg_attr(
-        feature = "serde",
-        serde(deserialize_with = "crate::units::de::milliamps")
-    )]
     pub i_loc: Milliamps,
     /// Gripper current I_grip, mA.
-    #[cfg_attr(
-        feature = "serde",
-        serde(deserialize_with = "crate::units::de::milliamps")
-    )]
     pub i_grip: Milliamps,
     /// 3.3 V rail current I_3v3, mA.
-    #[cfg_attr(
-        feature = "serde",
-        serde(deserialize_with = "crate::units::de::milliamps")
-    )]
     pub i_3v3: Milliamps,
     /// Regulated voltage V_reg, mV.
-    #[cfg_attr(
-        feature = "serde",
-        serde(deserialize_with = "crate::units::de::millivolts")
-    )]
     pub v_reg: Millivolts,
     /// Bolter current I_bo, mA.
-    #[cfg_attr(
-        feature = "serde",
-        serde(deserialize_with = "crate::units::de::milliamps")
-    )]
     pub i_bo: Milliamps,
 }
