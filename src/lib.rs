@@ -34,10 +34,11 @@
 //!
 //! | layer | modules | what they hold |
 //! |---|---|---|
+//! | checks | `arbitrary` | feature `proptest`: the proptest strategies of every `Repr` and the types they are built from (the CCSDS headers' too), and the exhaustive enumerations of the command set; what the checks use and the robot does not |
 //! | node | `node` | the boards, the gateway and the ground station: everything wired together |
 //! | pus | `pus` | the PUS-C services: what each telecommand means and what each report carries |
 //! | ccsds | `ccsds` | the CCSDS space packets and PUS headers the services travel in |
-//! | wire | `wire`, `arbitrary` | the paper's packets (Tables 2–4, the A→B command), byte by byte; the proptest strategies for them and the vocabulary (feature `proptest`) |
+//! | wire | `wire` | the paper's packets (Tables 2–4, the A→B command), byte by byte |
 //! | behaviour | `sensors`, `control`, `motion`, `safety` | the robot's logic: filters, servo and hip control, the motion sequencer, the safety supervisor; it speaks only the vocabulary, never a packet |
 //! | vocabulary | `mode`, `faults`, `refusal`, `pose`, `bolter`, `command` | what the robot and its operator talk about: modes, faults, refusal codes, states and primitives, the bolter's steps, the command set |
 //! | ground | `units`, `wire_enum` | checked quantities (pulse widths, angles, board numbers) and the C-like enum macro |

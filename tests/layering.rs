@@ -19,10 +19,11 @@ const ORDER: &[(&str, &[&str])] = &[
         &["mode", "faults", "refusal", "pose", "bolter", "command"],
     ),
     ("behaviour", &["sensors", "control", "motion", "safety"]),
-    ("wire", &["wire", "arbitrary"]),
+    ("wire", &["wire"]),
     ("ccsds", &["ccsds"]),
     ("pus", &["pus"]),
     ("node", &["node"]),
+    ("checks", &["arbitrary"]),
 ];
 
 /// The module's place in the reading order, and its layer's name.

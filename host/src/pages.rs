@@ -8,7 +8,8 @@
 //! ([`crate::spec::origins`]); a row of the paper says which table it comes from. A reviewer
 //! reading a page as the paper therefore sees at once what the paper does not say.
 
-use mmic::command::{for_each_variant_class, Command, CommandKind};
+use mmic::arbitrary::for_each_variant_class;
+use mmic::command::{Command, CommandKind};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
 use mmic::refusal::Refusal;

@@ -34,8 +34,9 @@ pub mod ccsds;
 pub mod pus;
 
 use core::fmt::Debug;
+use mmic::arbitrary::for_each_variant_class;
 use mmic::bolter::{BolterDirection, BolterStep, MuxLines};
-use mmic::command::{for_each_variant_class, BolterPair, Command, PrimitiveMove, ServoTarget};
+use mmic::command::{BolterPair, Command, PrimitiveMove, ServoTarget};
 use mmic::control::interp::Travel;
 use mmic::faults::Faults;
 use mmic::mode::Mode;

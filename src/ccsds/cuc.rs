@@ -113,21 +113,6 @@ impl From<Cuc> for CucLayout {
     }
 }
 
-#[cfg(feature = "proptest")]
-impl proptest::arbitrary::Arbitrary for Cuc {
-    type Parameters = ();
-    type Strategy = proptest::strategy::BoxedStrategy<Cuc>;
-    fn arbitrary_with((): ()) -> Self::Strategy {
-        use proptest::strategy::Strategy;
-        (
-            proptest::arbitrary::any::<u32>(),
-            crate::arbitrary::wire_u16(),
-        )
-            .prop_map(|(coarse, fine)| Cuc { coarse, fine })
-            .boxed()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -145,34 +145,6 @@ impl From<&TcSecondaryHeader> for TcSecondaryLayout {
     }
 }
 
-#[cfg(feature = "proptest")]
-impl proptest::arbitrary::Arbitrary for AckFlags {
-    type Parameters = ();
-    type Strategy = proptest::strategy::Map<core::ops::RangeInclusive<u8>, fn(u8) -> AckFlags>;
-    fn arbitrary_with((): ()) -> Self::Strategy {
-        use proptest::strategy::Strategy;
-        (0u8..=15).prop_map(AckFlags::from_bits)
-    }
-}
-
-#[cfg(feature = "proptest")]
-impl proptest::arbitrary::Arbitrary for TcSecondaryHeader {
-    type Parameters = ();
-    type Strategy = proptest::strategy::BoxedStrategy<TcSecondaryHeader>;
-    fn arbitrary_with((): ()) -> Self::Strategy {
-        use proptest::arbitrary::any;
-        use proptest::strategy::Strategy;
-        (any::<AckFlags>(), any::<u8>(), any::<u8>(), any::<u16>())
-            .prop_map(|(ack, service, subservice, source_id)| TcSecondaryHeader {
-                ack,
-                service,
-                subservice,
-                source_id,
-            })
-            .boxed()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

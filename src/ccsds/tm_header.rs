@@ -128,37 +128,6 @@ impl From<&TmSecondaryHeader> for TmSecondaryLayout {
     }
 }
 
-#[cfg(feature = "proptest")]
-impl proptest::arbitrary::Arbitrary for TmSecondaryHeader {
-    type Parameters = ();
-    type Strategy = proptest::strategy::BoxedStrategy<TmSecondaryHeader>;
-    fn arbitrary_with((): ()) -> Self::Strategy {
-        use proptest::arbitrary::any;
-        use proptest::strategy::Strategy;
-        (
-            any::<TimeRefStatus>(),
-            any::<u8>(),
-            any::<u8>(),
-            crate::arbitrary::wire_u16(),
-            any::<u16>(),
-            any::<Cuc>(),
-        )
-            .prop_map(
-                |(time_ref_status, service, subservice, counter, destination_id, time)| {
-                    TmSecondaryHeader {
-                        time_ref_status,
-                        service,
-                        subservice,
-                        counter,
-                        destination_id,
-                        time,
-                    }
-                },
-            )
-            .boxed()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -37,7 +37,6 @@ use crate::mode::Mode;
 use crate::pose::{Primitive, State};
 use crate::units::{Module, Side};
 
-mod enumerate;
 mod kind;
 mod moves;
 #[cfg(feature = "serde")]
@@ -46,7 +45,6 @@ mod servo;
 
 /// The bolter's vocabulary ([`crate::bolter`]); commands name its pairs and fasteners.
 pub use crate::bolter::{BolterPair, BolterPairError, Fasteners};
-pub use enumerate::{for_each_command, for_each_variant_class};
 pub use kind::CommandKind;
 pub use moves::{PrimitiveMove, PrimitiveMoveError, Reconfiguration, ReconfigurationError};
 #[cfg(feature = "serde")]

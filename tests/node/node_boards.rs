@@ -2,7 +2,8 @@
 //! acknowledges its sequence number, runs once however often it arrives, and the A–B link's
 //! loss takes an Operational robot to Safed within the timeout.
 
-use mmic::command::{for_each_variant_class, Command};
+use mmic::arbitrary::for_each_variant_class;
+use mmic::command::Command;
 use mmic::faults::Fault;
 use mmic::mode::Mode;
 use mmic::motion::geometry::single_move;

@@ -5,7 +5,8 @@
 //! faults × in-motion flag × hip-at-home × initial-state-agrees. Every property below is
 //! asserted on every one of those steps; the test prints the domain size.
 
-use mmic::command::{for_each_variant_class, Command, CommandKind, PowerTarget};
+use mmic::arbitrary::for_each_variant_class;
+use mmic::command::{Command, CommandKind, PowerTarget};
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
 use mmic::refusal::Refusal;

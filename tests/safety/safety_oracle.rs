@@ -1,7 +1,8 @@
 //! Random event sequences: the supervisor against a small oracle written directly from
 //! spec/modes.toml (its tables drive the oracle; src/safety/policy.rs is not used here).
 
-use mmic::command::{for_each_variant_class, Command, PowerTarget};
+use mmic::arbitrary::for_each_variant_class;
+use mmic::command::{Command, PowerTarget};
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
 use mmic::refusal::Refusal;

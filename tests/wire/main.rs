@@ -7,6 +7,7 @@ mod common;
 
 mod corruption;
 mod golden;
+mod opcode;
 mod proptest_config;
 mod round_trip;
 mod spec;

@@ -202,7 +202,7 @@ fn command_strategy_reaches_every_opcode() {
         seen[encode(&c).0 as usize] = true;
     }
     let mut classes = 0;
-    mmic::command::for_each_variant_class(
+    mmic::arbitrary::for_each_variant_class(
         mmic::units::PulseWidth::CENTER,
         mmic::units::HipAngle::ZERO,
         |c| {
@@ -292,13 +292,13 @@ fn every_command_round_trips_with_its_sequence_number() {
     let mut n = 0u32;
     let each_command = |visit: &mut dyn FnMut(Command)| {
         if cfg!(miri) {
-            mmic::command::for_each_variant_class(
+            mmic::arbitrary::for_each_variant_class(
                 mmic::units::PulseWidth::new(2000).unwrap(),
                 mmic::units::HipAngle::new(mmic::units::HipAngle::TURN - 1).unwrap(),
                 visit,
             );
         } else {
-            mmic::command::for_each_command(visit);
+            mmic::arbitrary::for_each_command(visit);
         }
     };
     each_command(&mut |command| {

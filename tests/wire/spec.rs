@@ -1,8 +1,9 @@
 //! The code equals spec/: every packet's offsets, sizes, units and the paper's grid labels;
 //! the command set and its opcodes; the fault bits; the design decisions that have values.
 
+use mmic::arbitrary::for_each_variant_class;
 use mmic::bolter::{BolterStep, MuxLines};
-use mmic::command::{for_each_variant_class, BolterPair, HipTarget};
+use mmic::command::{BolterPair, HipTarget};
 use mmic::faults::Fault;
 use mmic::mode::Mode;
 use mmic::units::{HipAngle, PulseWidth};

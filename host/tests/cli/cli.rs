@@ -1,7 +1,8 @@
 //! The `mmic` binary end to end: encode → decode round trips for every command variant class
 //! and every packet kind, a golden vector, every error path, and fresh review pages.
 
-use mmic::command::{for_each_variant_class, Command, Reconfiguration};
+use mmic::arbitrary::for_each_variant_class;
+use mmic::command::{Command, Reconfiguration};
 use mmic::motion::State;
 use mmic::units::{BoardNumber, HipAngle, PulseWidth};
 use mmic::wire::command::CommandRepr;

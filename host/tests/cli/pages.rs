@@ -1,7 +1,8 @@
 //! The review pages' rendering: the paper's 7-column grid, the field tables and the opcode
 //! table, checked against the library they are rendered from.
 
-use mmic::command::{for_each_variant_class, Command, HipTarget, ServoTarget};
+use mmic::arbitrary::for_each_variant_class;
+use mmic::command::{Command, HipTarget, ServoTarget};
 use mmic::units::{HipAngle, PulseWidth, Side};
 use mmic::wire::opcode::encode;
 use mmic::wire::PacketKind;

@@ -1,9 +1,10 @@
 //! Plan files: every command class round-trips through the text, and every error names the
 //! line and column of the token to fix.
 
+use mmic::arbitrary::for_each_variant_class;
 use mmic::command::{
-    for_each_variant_class, BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget,
-    ReconfigurationError, ServoTarget,
+    BolterCommand, BolterPair, Command, Fasteners, HipTarget, PowerTarget, ReconfigurationError,
+    ServoTarget,
 };
 use mmic::mode::Mode;
 use mmic::motion::{Primitive, State};

@@ -20,9 +20,6 @@ use crate::pose::{Primitive, State};
 use crate::refusal::Refusal;
 use crate::units::{HipAngle, Module, PulseWidth, Side};
 
-#[cfg(test)]
-mod tests;
-
 /// Index in the command packet of the first parameter byte (Table 2 byte 6).
 pub const PARAM_OFFSET: usize = 6;
 /// Number of parameter bytes (Table 2 bytes 6–11).

@@ -21,6 +21,10 @@
 //! The ranged quantities (`PulseWidth`, `HipAngle`, `BolterAttempt`, the CCSDS fields) get
 //! theirs from the `ranged!` macro that declares them, with the same weighting.
 //!
+//! The CCSDS/PUS headers' strategies are here too (`ccsds.rs`), and so are the exhaustive
+//! enumerations of the command set ([`enumerate`]): everything the checks use and the robot
+//! does not, in one place behind one feature.
+//!
 //! Besides the [`Arbitrary`] impls, [`sealed_bytes`] draws byte strings with a packet's length,
 //! header and a correct checksum but arbitrary body bytes: inputs that reach the field checks.
 //!
@@ -28,6 +32,11 @@
 //! stay next to the types they must cover. A variant added without a strategy arm is caught by
 //! `tests/wire/round_trip.rs` in the repository, which draws a fixed-seed sample and requires every
 //! one of the 61 command opcodes (and every optional field, both ways) to appear in it.
+
+mod ccsds;
+pub mod enumerate;
+
+pub use enumerate::{for_each_command, for_each_variant_class};
 
 use crate::bolter::BolterAttempt;
 use crate::bolter::{BolterAux, BolterOrder};

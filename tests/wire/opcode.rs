@@ -1,9 +1,11 @@
 //! The opcode encoding, exhaustively: every command round-trips, no two variant classes share
 //! an opcode, unused bytes must be zero, range errors name the byte.
 
-use super::*;
-use crate::command::{for_each_command, for_each_variant_class};
-use crate::command::{PrimitiveMove, PrimitiveMoveError, ReconfigurationError};
+use mmic::arbitrary::{for_each_command, for_each_variant_class};
+use mmic::command::*;
+use mmic::pose::{Primitive, State};
+use mmic::units::{HipAngle, PulseWidth};
+use mmic::wire::opcode::*;
 
 /// The commands the exhaustive checks below walk, and how many: every command
 /// (`for_each_command`), 40,595. Under Miri, which interprets each step some 100x slower
@@ -173,9 +175,9 @@ fn every_move_of_the_model_is_one_primitive_command() {
     let (mut moves, mut hipless) = (0, 0);
     for m in PrimitiveMove::all() {
         for from in State::ALL {
-            let cell = crate::pose::map::primitive(from, m.target());
+            let cell = mmic::pose::map::primitive(from, m.target());
             assert_eq!(m.is_move_from(from), cell == Some(m.primitive()));
-            let model = crate::pose::geometry::single_move(from, m.target());
+            let model = mmic::pose::geometry::single_move(from, m.target());
             assert_eq!(
                 m.turns_without_hip_from(from),
                 model.map(|x| x.1) == Some(m.primitive()) && cell.is_none(),
@@ -187,7 +189,7 @@ fn every_move_of_the_model_is_one_primitive_command() {
         }
     }
     assert_eq!((PrimitiveMove::all().count(), moves, hipless), (60, 60, 12));
-    for (from, to, p) in crate::pose::map::moves() {
+    for (from, to, p) in mmic::pose::map::moves() {
         assert!(PrimitiveMove::new(p, to).is_ok_and(|m| m.is_move_from(from)));
     }
 }
