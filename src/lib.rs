@@ -51,6 +51,17 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
+// No panics on any input: outside the tests, no unwrap, expect or panic! (clippy denies them in CI).
+#![cfg_attr(
+    not(test),
+    deny(
+        clippy::unwrap_used,
+        clippy::expect_used,
+        clippy::panic,
+        clippy::todo,
+        clippy::unimplemented
+    )
+)]
 
 // First: the modules below declare their C-like enums with it.
 mod wire_enum;
