@@ -37,6 +37,7 @@
 //! | checks | `arbitrary` | feature `proptest`: the proptest strategies of every `Repr` and the types they are built from (the CCSDS headers' too), and the exhaustive enumerations of the command set; what the checks use and the robot does not |
 //! | node | `node` | the boards, the gateway and the ground station: everything wired together |
 //! | pus | `pus` | the PUS-C services: what each telecommand means and what each report carries |
+//! | link | `link` | the space data link: TC transfer frames with COP-1 (FARM-1, FOP-1, the CLCW) and fixed-length TM transfer frames |
 //! | ccsds | `ccsds` | the CCSDS space packets and PUS headers the services travel in |
 //! | wire | `wire` | the paper's packets (Tables 2–4, the A→B command), byte by byte |
 //! | behaviour | `sensors`, `control`, `motion`, `safety` | the robot's logic: filters, servo and hip control, the motion sequencer, the safety supervisor; it speaks only the vocabulary, never a packet |
@@ -73,6 +74,7 @@ pub mod ccsds;
 pub mod command;
 pub mod control;
 pub mod faults;
+pub mod link;
 pub mod mode;
 pub mod motion;
 pub mod node;

@@ -21,6 +21,7 @@ const ORDER: &[(&str, &[&str])] = &[
     ("behaviour", &["sensors", "control", "motion", "safety"]),
     ("wire", &["wire"]),
     ("ccsds", &["ccsds"]),
+    ("link", &["link"]),
     ("pus", &["pus"]),
     ("node", &["node"]),
     ("checks", &["arbitrary"]),
