@@ -84,7 +84,12 @@ class Yamcs:
     def __init__(self, mdb: str | os.PathLike = DEFAULT_MDB, *, http_port: int | None = None,
                  tm_port: int | None = None, tc_port: int | None = None,
                  run_dir: str | os.PathLike | None = None, start_timeout: float = 60.0,
-                 max_lifetime: int = 600, java: str | None = None, xmx: str = "512m"):
+                 max_lifetime: int = 600, java: str | None = None, xmx: str = "512m",
+                 link: str = "packets", spacecraft_id: int = 0x101):
+        if link not in ("packets", "frames"):
+            raise ValueError(f"link {link!r}: packets or frames (ground/yamcs/links/)")
+        self.link = link
+        self.spacecraft_id = spacecraft_id
         self.mdb = Path(mdb).resolve()
         if not self.mdb.is_file():
             raise FileNotFoundError(self.mdb)
@@ -123,7 +128,12 @@ class Yamcs:
         etc.mkdir(parents=True)
         (self.run_dir / "data").mkdir()
         values = {"@HTTP_PORT@": str(self.http_port), "@TM_PORT@": str(self.tm_port),
-                  "@TC_PORT@": str(self.tc_port), "@MDB@": str(self.mdb)}
+                  "@TC_PORT@": str(self.tc_port), "@MDB@": str(self.mdb),
+                  "@SCID@": str(self.spacecraft_id)}
+        links = (GROUND / "yamcs" / "links" / f"{self.link}.yaml").read_text()
+        # First: the links' text holds placeholders of its own.
+        values = {"@DATA_LINKS@": "\n".join(l for l in links.splitlines() if not l.startswith("#")),
+                  **values}
         for tpl in TEMPLATES.glob("*.yaml"):
             text = tpl.read_text()
             for k, v in values.items():
@@ -221,11 +231,13 @@ def main(argv=None) -> int:
     run = sub.add_parser("run", help="start YAMCS, print its ports, stop after --seconds or Ctrl-C")
     run.add_argument("--mdb", default=str(DEFAULT_MDB), help="XTCE file (default: the example)")
     run.add_argument("--seconds", type=int, default=600, help="stop after this long (default 600)")
+    run.add_argument("--link", choices=("packets", "frames"), default="packets",
+                     help="bare packets over UDP, or TC/TM transfer frames with COP-1 (ground/yamcs/links/)")
     for name in ("http", "tm", "tc"):
         run.add_argument(f"--{name}-port", type=int, default=None, help="default: a free port")
     a = ap.parse_args(argv)
     y = Yamcs(a.mdb, http_port=a.http_port, tm_port=a.tm_port, tc_port=a.tc_port,
-              max_lifetime=a.seconds + 30)
+              max_lifetime=a.seconds + 30, link=a.link)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
     with y:
         print(json.dumps({"http": y.url, "instance": INSTANCE, "tm_udp_in": f"127.0.0.1:{y.tm_port}",
