@@ -67,10 +67,10 @@ pub fn reseal(f: &mut [u8]) {
 // BC Unlock: bypass 1, control 1 -> octet 0 = 0011_0001 = 0x31; 5 + 1 + 2 = 8 octets, field 7;
 //   data field 0x00 (no segment header in a BC frame); FECF 0x4bfd
 // BC Set V(R) = 5: 5 + 3 + 2 = 10 octets, field 9; data field 0x82 0x00 0x05; FECF 0x25b3
-const AD_PING: &str = "0101001400c01842c00700062f1101000012d06a5a";
-const BD_PING: &str = "2101001400c01842c00700062f1101000012d00ae0";
-const BC_UNLOCK: &str = "3101000700004bfd";
-const BC_SET_VR_5: &str = "310100090082000525b3";
+pub const AD_PING: &str = "0101001400c01842c00700062f1101000012d06a5a";
+pub const BD_PING: &str = "2101001400c01842c00700062f1101000012d00ae0";
+pub const BC_UNLOCK: &str = "3101000700004bfd";
+pub const BC_SET_VR_5: &str = "310100090082000525b3";
 
 #[test]
 fn golden_frames_are_the_standards_bits() {
