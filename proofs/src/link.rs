@@ -187,9 +187,8 @@ pub fn tc_frame_oracle(b: &[u8], cfg: &TcFrameConfig<'_>) -> Result<OracleFrame,
             ControlCommand::SetVr(d[2])
         } else {
             let mut head = [0u8; 3];
-            for i in 0..d.len().min(3) {
-                head[i] = d[i];
-            }
+            let k = d.len().min(3);
+            head[..k].copy_from_slice(&d[..k]);
             return Err(TcFrameError::ControlCommand { len: d.len(), head });
         });
     } else if vc.segment_header {
