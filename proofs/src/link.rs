@@ -255,6 +255,12 @@ pub fn reseal(frame: &mut [u8], fecf: bool) {
 /// packets are split as the oracle splits them, and emitting the `Repr` gives `bytes` back
 /// (parse → emit identity). Returns whether it was accepted.
 pub fn check_tc_frame_parse_with(bytes: &[u8], cfg: &TcFrameConfig<'_>) -> bool {
+    check_tc_frame_verdict(bytes, cfg).is_none()
+}
+
+/// [`check_tc_frame_parse_with`], returning the refusing check's name (`None`: accepted), so
+/// that the harnesses can count which checks their inputs reach.
+pub fn check_tc_frame_verdict(bytes: &[u8], cfg: &TcFrameConfig<'_>) -> Option<&'static str> {
     assert!(
         bytes.len() <= MAX_FRAME,
         "inputs are at most MAX_FRAME octets"
@@ -288,7 +294,7 @@ pub fn check_tc_frame_parse_with(bytes: &[u8], cfg: &TcFrameConfig<'_>) -> bool 
                 .emit_with(cfg.fecf, &mut out)
                 .expect("an accepted frame fits the buffer it came in");
             assert_eq!(&out[..n], bytes, "parse -> emit is not the identity");
-            true
+            None
         }
         (got, expected) => {
             assert_eq!(
@@ -297,16 +303,22 @@ pub fn check_tc_frame_parse_with(bytes: &[u8], cfg: &TcFrameConfig<'_>) -> bool 
                 "verdict differs from the oracle"
             );
             assert_eq!(view.err(), got.err());
-            false
+            got.err().map(|e| e.name())
         }
     }
 }
 
 /// [`check_tc_frame_parse_with`] for both [`CONFIGS`]; whether the first accepted.
 pub fn check_tc_frame_parse(bytes: &[u8]) -> bool {
-    let a = check_tc_frame_parse_with(bytes, &CONFIGS[0]);
-    check_tc_frame_parse_with(bytes, &CONFIGS[1]);
-    a
+    check_tc_frame_verdicts(bytes)[0].is_none()
+}
+
+/// [`check_tc_frame_verdict`] for both [`CONFIGS`].
+pub fn check_tc_frame_verdicts(bytes: &[u8]) -> [Option<&'static str>; 2] {
+    [
+        check_tc_frame_verdict(bytes, &CONFIGS[0]),
+        check_tc_frame_verdict(bytes, &CONFIGS[1]),
+    ]
 }
 
 /// A frame built from seed choices (data a prefix of `data`) and the one-VC channel that
@@ -386,13 +398,13 @@ pub fn check_tc_frame_round_trip(seed: &[u8], data: &[u8]) {
 /// A valid frame built from `seed`, then up to two octets overwritten (`[index, value]`, the
 /// index taken modulo the length) and, if `reseal_it`, the length field and FECF rewritten:
 /// near misses that reach every check. The verdict must be the oracle's, on the channel built
-/// for the sample.
+/// for the sample; returns the refusing check's name (`None`: accepted).
 pub fn check_tc_frame_near_valid(
     seed: &[u8],
     data: &[u8],
     edits: &[[u8; 2]],
     reseal_it: bool,
-) -> bool {
+) -> Option<&'static str> {
     let (r, vc, fecf) = sample_tc_frame(&mut Seed::new(seed), data);
     let vcs = [vc];
     let cfg = TcFrameConfig {
@@ -410,5 +422,5 @@ pub fn check_tc_frame_near_valid(
     if reseal_it {
         reseal(frame, fecf);
     }
-    check_tc_frame_parse_with(frame, &cfg)
+    check_tc_frame_verdict(frame, &cfg)
 }

@@ -51,16 +51,21 @@ fn base_seed(k: usize) -> [u8; SEED] {
     })
 }
 
-/// The four base frames of the parse harness's exhaustive part: frames of [`CONFIGS`]'s
+/// The five base frames of the parse harness's exhaustive part: frames of `CONFIGS`'s
 /// channel (spacecraft 0x101, VC 0, MAP 0, FECF): AD with the ping, BD with the ping, BC
-/// Unlock, BC Set V(R) = 5.
+/// Unlock, BC Set V(R) = 5, and AD with five pings (73 octets: longer than `CONFIGS[0]`'s 64).
 #[cfg(not(any(kani, fuzzing)))]
 fn base_frame(k: usize, out: &mut [u8]) -> usize {
     use mmic::link::tc_frame::{MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
     use mmic::link::ControlCommand;
     let d = data();
+    let pings: [u8; 65] = core::array::from_fn(|i| d[i % 13]);
     let map_id = Some(MapId::new(0).expect("6 bits"));
     let content = match k {
+        4 => TcContent::Ad {
+            map_id,
+            data: &pings,
+        },
         0 => TcContent::Ad {
             map_id,
             data: &d[..13],
@@ -86,15 +91,17 @@ fn base_frame(k: usize, out: &mut [u8]) -> usize {
 /// split into packets as the oracle splits them and re-emit to the same octets.
 ///
 /// Under `cargo test`: every input of ≤ 2 octets; every single-octet substitution (each of the
-/// first 32 positions, modulo the length, each value) of the four base frames, length field
-/// and FECF left or rewritten; every prefix (0..=`MAX_LEN` octets, zero-padded) of each; then
-/// sampled inputs of every length.
+/// first 32 positions, modulo the length, each value) of the five base frames, length field
+/// and FECF left or rewritten; every prefix (0..=`MAX_LEN` octets, zero-padded) of each (the
+/// last two parts must reach every check of the frame and acceptance); then sampled inputs of
+/// every length.
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(26))]
 fn tc_frame_parse_matches_oracle() {
     #[cfg(not(any(kani, fuzzing)))]
     {
         let name = "tc_frame_parse_matches_oracle";
+        let reached = std::sync::Mutex::new(std::collections::BTreeSet::new());
         crate::ledger::exhaustive(
             name,
             3 * 65_536,
@@ -105,9 +112,9 @@ fn tc_frame_parse_matches_oracle() {
         );
         crate::ledger::exhaustive(
             &format!("{name} (substitutions)"),
-            4 * 32 * 256 * 2,
+            5 * 32 * 256 * 2,
             (
-                0usize..4,
+                0usize..5,
                 0usize..32,
                 bolero::produce::<u8>(),
                 bolero::produce::<bool>(),
@@ -120,19 +127,38 @@ fn tc_frame_parse_matches_oracle() {
                 if reseal_it {
                     mmic_proofs::link::reseal(f, true);
                 }
-                check_tc_frame_parse(f);
+                let mut reached = reached.lock().expect("not poisoned");
+                reached.extend(
+                    mmic_proofs::link::check_tc_frame_verdicts(f).map(|v| v.unwrap_or("accepted")),
+                );
             },
         );
         crate::ledger::exhaustive(
             &format!("{name} (prefixes)"),
-            4 * (MAX_LEN as u64 + 1),
-            (0usize..4, 0usize..=MAX_LEN),
+            5 * (MAX_LEN as u64 + 1),
+            (0usize..5, 0usize..=MAX_LEN),
             |&(k, len)| {
                 let mut out = [0u8; MAX_LEN];
                 base_frame(k, &mut out);
-                check_tc_frame_parse(&out[..len]);
+                let mut reached = reached.lock().expect("not poisoned");
+                reached.extend(
+                    mmic_proofs::link::check_tc_frame_verdicts(&out[..len])
+                        .map(|v| v.unwrap_or("accepted")),
+                );
             },
         );
+        // The substitutions and prefixes reach every check of the frame (the packets' is not
+        // the parser's) and acceptance.
+        let reached = reached.into_inner().expect("not poisoned");
+        for name in mmic::link::tc_frame::TcFrameError::NAMES[..12]
+            .iter()
+            .chain(&["accepted"])
+        {
+            assert!(
+                reached.contains(name),
+                "no substitution or prefix reached {name}"
+            );
+        }
         crate::ledger::sampled_with(
             name,
             SAMPLED,
@@ -185,21 +211,26 @@ fn tc_frame_round_trip() {
 }
 
 /// The property of the near-valid harness for one input.
-fn near_valid((seed, data, n, edits): &([u8; SEED], [u8; DATA], u8, [[u8; 2]; 2])) {
-    check_tc_frame_near_valid(seed, data, &edits[..*n as usize % 3], n & 0x80 == 0);
+fn near_valid(
+    (seed, data, n, edits): &([u8; SEED], [u8; DATA], u8, [[u8; 2]; 2]),
+) -> Option<&'static str> {
+    check_tc_frame_near_valid(seed, data, &edits[..*n as usize % 3], n & 0x80 == 0)
 }
 
 /// A valid frame with up to two octets overwritten, its length field and FECF rewritten or
 /// not: the oracle's verdict on the frame's channel, parse → emit identity when accepted.
 ///
 /// Under `cargo test`: every single edit (each of the first 64 positions, modulo the length,
-/// each value), resealed or not, of the four base seeds' frames; then sampled inputs.
+/// each value), resealed or not, of the four base seeds' frames, which must reach every check
+/// but `truncated` and `too-long` (a channel of 1024-octet frames) and acceptance; then
+/// sampled inputs.
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(26))]
 fn tc_frame_near_valid() {
     #[cfg(not(any(kani, fuzzing)))]
     {
         let name = "tc_frame_near_valid";
+        let reached = std::sync::Mutex::new(std::collections::BTreeSet::new());
         crate::ledger::exhaustive(
             name,
             4 * 64 * 256 * 2,
@@ -210,15 +241,39 @@ fn tc_frame_near_valid() {
                 bolero::produce::<bool>(),
             ),
             |&(k, at, v, reseal_it)| {
-                let n = if reseal_it { 1 } else { 0x81 };
-                near_valid(&(base_seed(k), data(), n, [[at, v], [0, 0]]));
+                // One edit (n % 3 = 1); bit 7 clear: reseal.
+                let n = if reseal_it { 1 } else { 0x82 };
+                let verdict = near_valid(&(base_seed(k), data(), n, [[at, v], [0, 0]]));
+                let mut reached = reached.lock().expect("not poisoned");
+                reached.insert(verdict.unwrap_or("accepted"));
             },
         );
-        crate::ledger::sampled(name, SAMPLED, near_valid);
+        let reached = reached.into_inner().expect("not poisoned");
+        println!("{name}: the exhaustive part reached {reached:?}");
+        for name in [
+            "version",
+            "flags",
+            "spare",
+            "spacecraft-id",
+            "vcid",
+            "fecf",
+            "length",
+            "sequence-flags",
+            "map-id",
+            "control-command",
+            "accepted",
+        ] {
+            assert!(reached.contains(name), "no single edit reached {name}");
+        }
+        crate::ledger::sampled(name, SAMPLED, |x| {
+            near_valid(x);
+        });
         return;
     }
     #[allow(unreachable_code)]
     bolero::check!()
         .with_type::<([u8; SEED], [u8; DATA], u8, [[u8; 2]; 2])>()
-        .for_each(near_valid);
+        .for_each(|x| {
+            near_valid(x);
+        });
 }
