@@ -36,7 +36,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 10] = [
+pub const TARGETS: [&str; 11] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -47,6 +47,7 @@ pub const TARGETS: [&str; 10] = [
     "pus_request",
     "pus_housekeeping",
     "pus_verification",
+    "tc_frame_parser",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -187,6 +188,97 @@ pub fn pus_near_misses(packet: &[u8]) -> Vec<(&'static str, &'static str, Vec<u8
         ("-checksum-miss", "checksum", checksum),
         ("-apid-miss", "apid", apid),
     ]
+}
+
+/// Seeds of `tc_frame_parser`: frames of `mmic_proofs::link::CONFIGS[0]`'s channel
+/// (spacecraft 0x101, VC 0, MAP 0, FECF): AD and BD frames carrying the TC(17,1) ping, BC
+/// Unlock and BC Set V(R) = 5, and for the AD frame one near miss per check of
+/// `TcFrameError::NAMES`, named after it (the length field and FECF rewritten where the defect
+/// is before them). The check each must fail, or `None` for the valid ones.
+pub fn tc_frame_seeds() -> Vec<(String, Option<&'static str>, Vec<u8>)> {
+    use mmic::link::tc_frame::{MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
+    use mmic::link::ControlCommand;
+    use mmic_proofs::link::reseal;
+    let ping = valid_pus_packets()
+        .into_iter()
+        .find(|(_, name, _)| *name == "tc-17-1-ping")
+        .map(|(_, _, b)| b)
+        .expect("the ping");
+    let map_id = Some(MapId::new(0).expect("6 bits"));
+    let frame = |content| {
+        let r = TcFrameRepr {
+            spacecraft_id: SpacecraftId::new(0x101).expect("10 bits"),
+            vcid: Vcid::new(0).expect("6 bits"),
+            seq: 0,
+            content,
+        };
+        let mut out = vec![0u8; r.len()];
+        r.emit(&mut out).expect("fits");
+        out
+    };
+    let ad = frame(TcContent::Ad {
+        map_id,
+        data: &ping,
+    });
+    let mut out = vec![
+        ("ad-ping".to_string(), None, ad.clone()),
+        (
+            "bd-ping".to_string(),
+            None,
+            frame(TcContent::Bd {
+                map_id,
+                data: &ping,
+            }),
+        ),
+        (
+            "bc-unlock".to_string(),
+            None,
+            frame(TcContent::Bc(ControlCommand::Unlock)),
+        ),
+        (
+            "bc-set-vr-5".to_string(),
+            None,
+            frame(TcContent::Bc(ControlCommand::SetVr(5))),
+        ),
+    ];
+    let with = |at: usize, f: &dyn Fn(u8) -> u8| {
+        let mut b = ad.clone();
+        b[at] = f(b[at]);
+        reseal(&mut b, true);
+        b
+    };
+    let mut long = ad.clone();
+    long.push(0);
+    let mut too_long = ad.clone();
+    too_long.splice(6..6, [0u8; 44]);
+    reseal(&mut too_long, true);
+    let mut fecf = ad.clone();
+    *fecf.last_mut().expect("non-empty") ^= 0x01;
+    let mut bc = frame(TcContent::Bc(ControlCommand::SetVr(5)));
+    bc[6] = 0x01;
+    reseal(&mut bc, true);
+    let mut cut = ad.clone();
+    cut.remove(18);
+    reseal(&mut cut, true);
+    let misses: [(&str, Vec<u8>); 13] = [
+        ("truncated", ad[..7].to_vec()),
+        ("version", with(0, &|b| b | 0x40)),
+        ("flags", with(0, &|b| b | 0x10)),
+        ("spare", with(0, &|b| b | 0x08)),
+        ("length", long),
+        ("too-long", too_long),
+        ("fecf", fecf),
+        ("spacecraft-id", with(1, &|b| b ^ 0x03)),
+        ("vcid", with(2, &|b| b | 0x08)),
+        ("sequence-flags", with(5, &|b| b & 0x3f)),
+        ("map-id", with(5, &|b| b | 0x01)),
+        ("control-command", bc),
+        ("packet-boundary", cut),
+    ];
+    for (check, bytes) in misses {
+        out.push((format!("ad-ping-{check}"), Some(check), bytes));
+    }
+    out
 }
 
 /// One seed file.
@@ -421,6 +513,13 @@ pub fn seeds() -> Vec<SeedFile> {
             target: TARGETS[9],
             name: name.into(),
             bytes: v,
+        });
+    }
+    for (name, _, bytes) in tc_frame_seeds() {
+        out.push(SeedFile {
+            target: TARGETS[10],
+            name,
+            bytes,
         });
     }
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.

@@ -99,3 +99,22 @@ fn pus_seeds_are_what_their_names_say() {
     }
     assert_eq!(n, 4 * 8);
 }
+
+#[test]
+fn tc_frame_seeds_are_what_their_names_say() {
+    use mmic::link::tc_frame::TcFrame;
+    let cfg = &mmic_proofs::link::CONFIGS[0];
+    let seeds = mmic_fuzz::tc_frame_seeds();
+    for (name, expected, bytes) in &seeds {
+        let got = TcFrame::new_checked(&bytes[..], cfg)
+            .and_then(|f| f.packets().try_for_each(|p| p.map(|_| ())))
+            .err()
+            .map(|e| e.name());
+        assert_eq!(got, *expected, "{name}");
+        mmic_proofs::link::check_tc_frame_parse(bytes);
+    }
+    // Every check has its near miss.
+    for check in mmic::link::tc_frame::TcFrameError::NAMES {
+        assert!(seeds.iter().any(|(_, e, _)| *e == Some(check)), "{check}");
+    }
+}

@@ -12,6 +12,11 @@
 //!   accepted re-emit identically; then, if long enough, the same octets with the length field
 //!   and CRC rewritten over them (`reseal`) and their own APID accepted, which lets mutations
 //!   reach the checks after the checksum.
+//! * `tc_frame_parser`: the input (cut to 1024 octets) must get exactly the TC frame oracle's
+//!   verdict (`mmic_proofs::link::check_tc_frame_parse`, two channels), and when accepted split
+//!   into packets as the oracle does and re-emit identically; then, if long enough, the same
+//!   octets with the frame length field and FECF rewritten, on the channel of the frame's own
+//!   spacecraft, which lets mutations reach the addressing and content checks.
 //! * `pus_request`: service, subservice and application data through the services layer's
 //!   `Request::parse` (`mmic_proofs::pus::check_request`): refused by a named check, or read
 //!   canonically (an accepted function encodes back to the same octets).
@@ -47,6 +52,35 @@ fn pus_parser(kind: PacketType, input: &[u8]) {
         let apid = PrimaryHeader::read(packet).map_or(0, |h| h.apid);
         check_pus_parse_with(kind, packet, &[apid]);
     }
+}
+
+/// A TC transfer frame (cut to `MAX_FRAME` octets) through `TcFrameRepr::parse` on both of the
+/// oracle's channels (`check_tc_frame_parse`); then, if long enough, the same octets with the
+/// length field and FECF rewritten, on the FECF channel of the frame's own spacecraft with
+/// frames up to 1024 octets, which lets mutations reach the checks after the FECF.
+fn tc_frame_parser_property(input: &[u8]) {
+    use mmic::link::tc_frame::{SpacecraftId, TcFrameConfig, TcPrimaryHeader};
+    use mmic_proofs::link::{check_tc_frame_parse, check_tc_frame_parse_with, CONFIGS, MAX_FRAME};
+    let input = &input[..input.len().min(MAX_FRAME)];
+    check_tc_frame_parse(input);
+    if input.len() >= 8 {
+        let mut buf = [0u8; MAX_FRAME];
+        let frame = &mut buf[..input.len()];
+        frame.copy_from_slice(input);
+        mmic_proofs::link::reseal(frame, true);
+        let scid = TcPrimaryHeader::read(frame).map_or(0, |h| h.spacecraft_id);
+        let cfg = TcFrameConfig {
+            spacecraft_id: SpacecraftId::new(scid).expect("10 bits"),
+            max_frame_len: MAX_FRAME,
+            ..CONFIGS[0]
+        };
+        check_tc_frame_parse_with(frame, &cfg);
+    }
+}
+
+#[test]
+fn tc_frame_parser() {
+    bolero::check!().for_each(tc_frame_parser_property);
 }
 
 #[test]

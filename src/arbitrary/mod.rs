@@ -21,7 +21,8 @@
 //! The ranged quantities (`PulseWidth`, `HipAngle`, `BolterAttempt`, the CCSDS fields) get
 //! theirs from the `ranged!` macro that declares them, with the same weighting.
 //!
-//! The CCSDS/PUS headers' strategies are here too (`ccsds.rs`), and so are the exhaustive
+//! The CCSDS/PUS headers' strategies are here too (`ccsds.rs`), and the space data link's value
+//! types' (`link.rs`: `FrameKind`, `ControlCommand`), and so are the exhaustive
 //! enumerations of the command set ([`enumerate`]): everything the checks use and the robot
 //! does not, in one place behind one feature.
 //!
@@ -35,6 +36,7 @@
 
 mod ccsds;
 pub mod enumerate;
+mod link;
 
 pub use enumerate::{for_each_command, for_each_variant_class};
 

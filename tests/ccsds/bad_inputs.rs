@@ -1,10 +1,12 @@
-//! Walks `spec/ccsds/bad-inputs.toml`: every row's packet, through the parser it names, must be
-//! refused with exactly the error it names; every check of `PacketError::NAMES` has a row.
+//! Walks `spec/ccsds/bad-inputs.toml`: every row's packet (or TC frame), through the parser it
+//! names, must be refused with exactly the error it names; every check of `PacketError::NAMES`,
+//! `RequestError::NAMES` and `TcFrameError::NAMES` has a row.
 
 use super::{hex, unhex};
 use mmic::ccsds::tc::TcRepr;
 use mmic::ccsds::tm::TmRepr;
 use mmic::ccsds::PacketError;
+use mmic::link::tc_frame::{TcFrame, TcFrameError};
 use mmic::pus::PusError;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -115,16 +117,25 @@ fn the_line_reader_reads_what_toml_reads() {
     assert_eq!(table_by_lines(&text), by_toml);
 }
 
-/// The row's packet through its parser: the error, or `None` if accepted.
-pub fn verdict(row: &Row, apids: &[u16]) -> Option<PusError> {
+/// The row's input through its parser: the refusing check's name, or `None` if accepted.
+pub fn verdict(row: &Row, apids: &[u16]) -> Option<&'static str> {
     let bytes = unhex(&row.hex);
     let r: Result<(), PacketError> = match row.parser.as_str() {
         "tc" => TcRepr::parse(&bytes, apids).map(|_| ()),
         "tm" => TmRepr::parse(&bytes, apids).map(|_| ()),
-        "tc-service" => return mmic::pus::read_tc(&bytes, apids).err(),
+        "tc-service" => return mmic::pus::read_tc(&bytes, apids).err().map(|e| e.name()),
+        "tc-frame" => return tc_frame_verdict(&bytes).err().map(|e| e.name()),
         other => panic!("row {}: no parser named {other:?}", row.name),
     };
-    r.err().map(PusError::from)
+    r.err().map(|e| PusError::from(e).name())
+}
+
+/// A `tc-frame` row: the frame through `TcFrame::new_checked` with the mission's configuration
+/// for spacecraft 0x101 (board 1's robot: VC 0, segment header, MAP 0, FECF, at most 256
+/// octets), then an AD or BD frame's data through `TcFrame::packets`.
+pub fn tc_frame_verdict(bytes: &[u8]) -> Result<(), TcFrameError> {
+    let frame = TcFrame::new_checked(bytes, &super::tc_frame::config())?;
+    frame.packets().try_for_each(|p| p.map(|_| ()))
 }
 
 #[test]
@@ -137,11 +148,9 @@ fn every_bad_input_is_refused_by_name() {
         assert!(!row.why.is_empty(), "row {}: no why", row.name);
         match verdict(row, &t.parser.apids) {
             Some(e) => assert_eq!(
-                e.name(),
-                row.error,
+                e, row.error,
                 "row {} ({}): refused as {e}",
-                row.name,
-                row.hex
+                row.name, row.hex
             ),
             None => panic!("row {} ({}) was accepted", row.name, row.hex),
         }
@@ -150,6 +159,7 @@ fn every_bad_input_is_refused_by_name() {
     for name in PacketError::NAMES
         .iter()
         .chain(&mmic::pus::request::RequestError::NAMES)
+        .chain(&TcFrameError::NAMES)
     {
         assert!(checks.contains(name), "no row for the check {name}");
     }
@@ -163,7 +173,11 @@ fn each_row_is_one_defect_away_from_a_valid_packet() {
     let t = table();
     let tc = hex(&super::tc_bytes(&super::ping()));
     let tm = hex(&super::tm_bytes(&super::alive()));
-    for row in t.row.iter().filter(|r| r.parser != "tc-service") {
+    for row in t
+        .row
+        .iter()
+        .filter(|r| r.parser == "tc" || r.parser == "tm")
+    {
         let reference = if row.parser == "tc" { &tc } else { &tm };
         let bytes = unhex(&row.hex);
         let good = unhex(reference);
@@ -193,5 +207,57 @@ fn services_rows_are_valid_packets_refused_for_their_request_only() {
             "row {}",
             row.name
         );
+    }
+}
+
+#[test]
+fn each_tc_frame_row_is_one_defect_away_from_a_valid_frame() {
+    // As for the packets: with the defect undone, the frame is valid. A row changing a field
+    // differs from its reference (the AD frame carrying the ping, or BC Set V(R) = 5, by the
+    // flags in its first octet) in at most three octets: the field, the length field, the
+    // FECF. The three rows whose defect is their length are checked for that defect alone.
+    let t = table();
+    let ad = super::tc_frame::AD_PING;
+    let bc = super::tc_frame::BC_SET_VR_5;
+    let rows: Vec<&Row> = t.row.iter().filter(|r| r.parser == "tc-frame").collect();
+    assert!(rows.len() >= TcFrameError::NAMES.len());
+    for row in rows {
+        let bytes = unhex(&row.hex);
+        match row.error.as_str() {
+            // The same frame is valid for a channel that takes 1024-octet frames, and its
+            // defect is its length alone.
+            "too-long" => {
+                let mut cfg = super::tc_frame::config();
+                cfg.max_frame_len = 1024;
+                assert!(
+                    TcFrame::new_checked(&bytes[..], &cfg).is_ok(),
+                    "{}",
+                    row.name
+                );
+                assert_eq!(bytes.len(), 257);
+            }
+            // A prefix of the valid frame.
+            "truncated" => assert!(unhex(ad).starts_with(&bytes), "{}", row.name),
+            // A valid frame whose data does not end on a packet boundary.
+            "packet-boundary" => {
+                let cfg = super::tc_frame::config();
+                assert!(
+                    TcFrame::new_checked(&bytes[..], &cfg).is_ok(),
+                    "{}",
+                    row.name
+                );
+            }
+            _ => {
+                let reference = unhex(if bytes.first() == Some(&0x31) { bc } else { ad });
+                let differing = (0..bytes.len().max(reference.len()))
+                    .filter(|&i| bytes.get(i) != reference.get(i))
+                    .count();
+                assert!(
+                    (1..=3).contains(&differing),
+                    "row {}: {differing} octets differ from the reference",
+                    row.name
+                );
+            }
+        }
     }
 }

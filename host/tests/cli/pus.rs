@@ -211,6 +211,8 @@ fn every_bad_input_is_refused_by_name() {
         let kind = match r.parser.as_str() {
             "tc" | "tc-service" => "pus-tc",
             "tm" => "pus-tm",
+            // TC transfer frames (issue 27): no `mmic decode` subcommand for them yet.
+            "tc-frame" => continue,
             p => panic!("row {}: parser {p} unknown to this test", r.name),
         };
         refused(
