@@ -237,8 +237,9 @@ fn near_valid_exhaustive(name: &str, kind: PacketType) {
                 _ => 0xff,
             });
             let data: [u8; DATA] = core::array::from_fn(|i| i as u8);
-            // n = 1 (one edit), bit 7 clear = reseal.
-            let n = if reseal_it { 1 } else { 0x81 };
+            // One edit (n % 3 == 1); bit 7 clear = reseal. (0x81 would be no edit at all:
+            // 0x81 % 3 == 0, which left the unsealed half of this part unedited until issue 27.)
+            let n = if reseal_it { 1 } else { 0x82 };
             near_valid(kind, &(seed, data, n, [[at, v], [0, 0]]));
         },
     );
