@@ -5,6 +5,7 @@ use super::{hex, unhex};
 use mmic::ccsds::tc::TcRepr;
 use mmic::ccsds::tm::TmRepr;
 use mmic::ccsds::PacketError;
+use mmic::link::tm_frame::{TmFrameError, TmFrameRepr};
 use mmic::pus::PusError;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -115,6 +116,21 @@ fn the_line_reader_reads_what_toml_reads() {
     assert_eq!(table_by_lines(&text), by_toml);
 }
 
+/// The row's frame through the link layer's parser it names: `None` if the parser is not a
+/// frame parser, else the refusal's name, `None` inside if accepted. `tm-frame`:
+/// `TmFrameRepr::parse` under `TmFrameParams::mission(0x142)` (robot 0x42's spacecraft ID).
+pub fn frame_verdict(row: &Row) -> Option<Option<&'static str>> {
+    let bytes = unhex(&row.hex);
+    match row.parser.as_str() {
+        "tm-frame" => Some(
+            TmFrameRepr::parse(&bytes, &super::tm_frame::params())
+                .err()
+                .map(|e| e.name()),
+        ),
+        _ => None,
+    }
+}
+
 /// The row's packet through its parser: the error, or `None` if accepted.
 pub fn verdict(row: &Row, apids: &[u16]) -> Option<PusError> {
     let bytes = unhex(&row.hex);
@@ -132,9 +148,16 @@ fn every_bad_input_is_refused_by_name() {
     let t = table();
     let mut names = BTreeSet::new();
     let mut checks = BTreeSet::new();
+    let mut frame_checks = BTreeSet::new();
     for row in &t.row {
         assert!(names.insert(&row.name), "duplicate row {}", row.name);
         assert!(!row.why.is_empty(), "row {}: no why", row.name);
+        if let Some(refused) = frame_verdict(row) {
+            let name = refused.unwrap_or_else(|| panic!("row {} was accepted", row.name));
+            assert_eq!(name, row.error, "row {}: refused as {name}", row.name);
+            frame_checks.insert((row.parser.as_str(), row.error.as_str()));
+            continue;
+        }
         match verdict(row, &t.parser.apids) {
             Some(e) => assert_eq!(
                 e.name(),
@@ -153,6 +176,12 @@ fn every_bad_input_is_refused_by_name() {
     {
         assert!(checks.contains(name), "no row for the check {name}");
     }
+    for name in TmFrameError::NAMES {
+        assert!(
+            frame_checks.contains(&("tm-frame", name)),
+            "no tm-frame row for the check {name}"
+        );
+    }
     println!("{} bad inputs refused by name", t.row.len());
 }
 
@@ -163,7 +192,11 @@ fn each_row_is_one_defect_away_from_a_valid_packet() {
     let t = table();
     let tc = hex(&super::tc_bytes(&super::ping()));
     let tm = hex(&super::tm_bytes(&super::alive()));
-    for row in t.row.iter().filter(|r| r.parser != "tc-service") {
+    for row in t
+        .row
+        .iter()
+        .filter(|r| matches!(r.parser.as_str(), "tc" | "tm"))
+    {
         let reference = if row.parser == "tc" { &tc } else { &tm };
         let bytes = unhex(&row.hex);
         let good = unhex(reference);
@@ -191,6 +224,27 @@ fn services_rows_are_valid_packets_refused_for_their_request_only() {
         assert!(
             TcRepr::parse(&bytes, &t.parser.apids).is_ok(),
             "row {}",
+            row.name
+        );
+    }
+}
+
+#[test]
+fn each_tm_frame_row_is_one_defect_away_from_the_reference_frame() {
+    // As for the packets: the changed field (one or two octets: the data field status is
+    // 16 bits) and the two FECF octets rewritten over it (a missing octet counts once).
+    let t = table();
+    let good = super::tm_frame::reference_frame();
+    let rows: Vec<&Row> = t.row.iter().filter(|r| r.parser == "tm-frame").collect();
+    assert!(rows.len() >= TmFrameError::NAMES.len());
+    for row in rows {
+        let bytes = unhex(&row.hex);
+        let differing = (0..bytes.len().max(good.len()))
+            .filter(|&i| bytes.get(i) != good.get(i))
+            .count();
+        assert!(
+            (1..=4).contains(&differing),
+            "row {}: {differing} octets differ from the reference frame",
             row.name
         );
     }

@@ -11,6 +11,7 @@ mod bad_inputs;
 mod corruption;
 mod golden;
 mod interop_spacepackets;
+mod tm_frame;
 
 use mmic::ccsds::primary::{Apid, SeqCount};
 use mmic::ccsds::tc::TcRepr;
