@@ -146,9 +146,14 @@ impl<const N: usize> Extractor<N> {
         &self.counters
     }
 
-    /// Whether a packet is in reassembly (its rest expected in the next frame).
-    pub const fn in_packet(&self) -> bool {
-        !matches!(self.state, State::Sync)
+    /// Whether a packet is in reassembly (its rest expected in the next frame): not when out
+    /// of step, nor between packets (the last one ended with the last data field).
+    pub fn in_packet(&self) -> bool {
+        match self.state {
+            State::Sync => false,
+            State::Header => !self.buf.is_empty(),
+            State::Body { .. } => true,
+        }
     }
 
     /// Takes the next frame of the VC (parsed and checked: [`TmFrameRepr::parse`]) and hands
@@ -174,6 +179,13 @@ impl<const N: usize> Extractor<N> {
             FirstHeaderPointer::NoPacketStart => None,
             FirstHeaderPointer::Packet(p) => Some((p as usize).min(data.len())),
         };
+        if matches!(self.state, State::Header) && self.buf.is_empty() {
+            // Between packets: the next one starts at octet 0 of this data field.
+            if start != Some(0) {
+                self.counters.bad_fhp = self.counters.bad_fhp.wrapping_add(1);
+            }
+            self.state = State::Sync;
+        }
         // The octets before the first header pointer continue the packet in reassembly.
         let cont = data.get(..start.unwrap_or(data.len())).unwrap_or(&[]);
         if self.in_packet() {
@@ -194,16 +206,15 @@ impl<const N: usize> Extractor<N> {
 
     /// Drops the packet in reassembly (counted unless it is a known idle or too-long one).
     fn abandon(&mut self) {
-        match self.state {
-            State::Sync
-            | State::Body {
+        let skipped = matches!(
+            self.state,
+            State::Body {
                 kind: Kind::Idle | Kind::TooLong,
                 ..
-            } => {}
-            State::Header
-            | State::Body {
-                kind: Kind::Keep, ..
-            } => self.counters.dropped = self.counters.dropped.wrapping_add(1),
+            }
+        );
+        if self.in_packet() && !skipped {
+            self.counters.dropped = self.counters.dropped.wrapping_add(1);
         }
         self.state = State::Sync;
         self.buf.clear();

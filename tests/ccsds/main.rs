@@ -12,6 +12,7 @@ mod corruption;
 mod golden;
 mod interop_spacepackets;
 mod tm_frame;
+mod tm_link;
 
 use mmic::ccsds::primary::{Apid, SeqCount};
 use mmic::ccsds::tc::TcRepr;
