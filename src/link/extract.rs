@@ -1,4 +1,4 @@
-//! The ground's packet extractor (CCSDS 132.0-B-3 §4.1.2.7 and §4.1.2.5, the receiving side of
+//! The ground's packet extractor (CCSDS 132.0-B-3 §4.1.2.7 and §4.1.2.6, the receiving side of
 //! §4.1.4): checked TM frames of one virtual channel in, whole space packets out, through a
 //! callback, reassembled in a buffer of `N` octets (no allocation).
 //!
@@ -31,7 +31,7 @@
 //! * The packets of a VC's data fields form one octet stream; each packet's primary header
 //!   says how long it is. A frame's first header pointer says where the first packet that
 //!   starts in it starts: the octets before it continue the packet in reassembly.
-//! * **Lost frames** show as a gap in the virtual channel frame count (mod 256, §4.1.2.5): the
+//! * **Lost frames** show as a gap in the virtual channel frame count (mod 256, §4.1.2.6): the
 //!   gap is counted in `lost_frames`, a packet in reassembly is dropped and counted in
 //!   `dropped`, never spliced with the next frame's octets, and extraction resumes at the next
 //!   first header pointer. (A loss of a multiple of 256 frames cannot be seen in the count; a

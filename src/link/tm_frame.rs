@@ -63,17 +63,25 @@ pub const FECF_LEN: usize = 2;
 pub const TM_FRAME_LEN: usize = 256;
 /// The mission's one TM virtual channel (`[tm] vcid`).
 pub const TM_VCID: u8 = 0;
+/// Whether the mission's TM frames carry an OCF (`[tm] ocf`: the CLCW in every frame).
+pub const TM_OCF: bool = true;
+/// Whether the mission's TM frames end with a FECF (`[tm] fecf`).
+pub const TM_FECF: bool = true;
+/// Whether the mission's TM frames have a secondary header (`[tm] secondary_header`): no, and
+/// the parser refuses the flag ([`TmFrameError::SecondaryHeaderFlag`]).
+pub const TM_SECONDARY_HEADER: bool = false;
 /// The mission's data field length: 256 - 6 - 4 - 2.
 pub const TM_DATA_LEN: usize = TM_FRAME_LEN - PRIMARY_HEADER_LEN - OCF_LEN - FECF_LEN;
-/// The longest TM transfer frame 132.0-B-3 §4.1.1 allows.
+/// The longest TM transfer frame 132.0-B-3 allows (§4.1.1; `spacepackets` 0.32 takes
+/// only shorter ones).
 pub const MAX_FRAME_LEN: usize = 2048;
 /// The only transfer frame version number of TM frames (`00`, version 1).
 pub const VERSION: u8 = 0;
 /// The segment length ID required when the synchronisation flag is 0 (132.0-B-3 §4.1.2.7.5).
 pub const SEGMENT_LENGTH_ID: u8 = 0b11;
-/// First header pointer value: no packet starts in this frame (132.0-B-3 §4.1.2.7.6.4).
+/// First header pointer value: no packet starts in this frame (132.0-B-3 §4.1.2.7.6).
 pub const FHP_NO_PACKET_START: u16 = 0x7ff;
-/// First header pointer value: the data field holds only idle data (132.0-B-3 §4.1.2.7.6.5).
+/// First header pointer value: the data field holds only idle data (132.0-B-3 §4.1.2.7.6).
 pub const FHP_ONLY_IDLE_DATA: u16 = 0x7fe;
 /// Largest spacecraft ID (10 bits).
 pub const MAX_SPACECRAFT_ID: u16 = 0x3ff;
@@ -142,7 +150,7 @@ impl TmFrameParams {
     /// The mission's (`spec/ccsds/link.toml` `[tm]`) for spacecraft `spacecraft_id`: 256
     /// octets, VC 0, OCF and FECF present; `None` if the ID needs more than 10 bits.
     pub const fn mission(spacecraft_id: u16) -> Option<TmFrameParams> {
-        TmFrameParams::new(TM_FRAME_LEN, spacecraft_id, TM_VCID, true, true)
+        TmFrameParams::new(TM_FRAME_LEN, spacecraft_id, TM_VCID, TM_OCF, TM_FECF)
     }
 
     /// Octets of every frame.

@@ -31,7 +31,7 @@
 //! The choices, each where the standard leaves one:
 //!
 //! * **Packets are laid end to end** across frames: a packet that does not fit the rest of a
-//!   data field continues in the next frame(s) (§4.1.4.2.2); the first header pointer of
+//!   data field continues in the next frame(s) (§4.1.4); the first header pointer of
 //!   each frame points at the first packet that *starts* in it, `0x7FF` when none does
 //!   (§4.1.2.7.6).
 //! * **Never dropped silently**: [`TmFramer::push`] takes a whole packet or refuses it with
@@ -41,21 +41,23 @@
 //!   later packet for the ground.
 //! * **When a frame must go before it is full** (the caller calls [`TmFramer::next_frame`]:
 //!   [`TmFramer::frame_due`] says the idle period elapsed, or the caller flushes) the rest of
-//!   the data field is one idle packet (133.0-B-2 §4.1.3.3.4.4: APID `0x7FF`; data octets
+//!   the data field is one idle packet (133.0-B-2 §4.1.3.3.4: APID `0x7FF`; data octets
 //!   [`IDLE_OCTET`] as `spec/ccsds/link.toml` says; sequence count 0; type TM; no secondary
 //!   header). When the room left is shorter than the shortest idle packet (7 octets), a
 //!   7-octet idle packet starts there anyway and **spills over** into the next frame, whose
 //!   first header pointer then points past its tail — the ground extracts it as any packet
 //!   that spans frames (and drops it as idle). No octet of a data field is left outside a
-//!   packet, so the ground never has to guess.
+//!   packet, so the ground never has to guess. YAMCS reads it so too: its `PacketDecoder`
+//!   (`yamcs-core/.../tctm/ccsds/`) collects a primary header across frames and skips packets
+//!   of APID `0x7FF` by default.
 //! * **A frame with nothing waiting at all** (no packet, no packet in flight, no idle tail) is
-//!   an only-idle-data frame (first header pointer `0x7FE`, §4.1.2.7.6.5), its data field
+//!   an only-idle-data frame (first header pointer `0x7FE`, §4.1.2.7.6), its data field
 //!   [`IDLE_OCTET`]s: the ground discards it without looking into its data field (YAMCS's
 //!   `VcTmPacketHandler` counts it as an idle frame and keeps any packet it is reassembling,
 //!   as [`crate::link::extract`] does). It only goes out when no packet is in flight, so it
 //!   never cuts one.
 //! * **Counts**: the master and virtual channel frame counts go up by one per frame, mod 256
-//!   (§4.1.2.4, §4.1.2.5); with one VC per master channel they are equal.
+//!   (§4.1.2.5, §4.1.2.6); with one VC per master channel they are equal.
 //! * **The OCF** of every frame is the CLCW the caller hands to [`TmFramer::next_frame`]
 //!   (when the channel carries an OCF), the FECF the CRC of [`crate::ccsds::pec`].
 
@@ -67,7 +69,7 @@ use crate::ccsds::primary::{PrimaryHeader, PRIMARY_LEN};
 /// The data octets of idle packets and of only-idle-data frames (`spec/ccsds/link.toml`
 /// `[tm] idle_fill`).
 pub const IDLE_OCTET: u8 = 0x55;
-/// The idle packets' APID (133.0-B-2 §4.1.3.3.4.4).
+/// The idle packets' APID (133.0-B-2 §4.1.3.3.4).
 pub const IDLE_APID: u16 = 0x7ff;
 /// Octets of the shortest space packet, and so of the shortest idle packet: six of header
 /// and one of data.
