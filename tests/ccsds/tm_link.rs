@@ -371,3 +371,114 @@ proptest! {
         check(&p, &r, &lost);
     }
 }
+
+/// A frame repr of VC count `count` over `data` (the extractor reads no other field).
+fn repr(count: u8, fhp: FirstHeaderPointer, data: &[u8]) -> TmFrameRepr<'_> {
+    TmFrameRepr {
+        spacecraft_id: SCID,
+        vcid: 0,
+        mc_frame_count: count,
+        vc_frame_count: count,
+        first_header_pointer: fhp,
+        data,
+        ocf: None,
+    }
+}
+
+/// Feeds `frames` to a fresh extractor: the packets out and the counters.
+fn feed(frames: &[TmFrameRepr]) -> (Vec<Vec<u8>>, ExtractCounters) {
+    let mut x = Extractor::<64>::new();
+    let mut got = Vec::new();
+    for f in frames {
+        x.frame(f, |p| got.push(p.to_vec()));
+    }
+    (got, *x.counters())
+}
+
+#[test]
+fn a_pointer_past_the_packet_end_delivers_it_and_resumes_at_the_pointer() {
+    // Frame 0: a 12-octet packet starts at 0 and runs 8 octets into frame 1; frame 1 says the
+    // next packet starts at 10, not 8: the packet is whole (delivered), octets 8..10 skipped.
+    let (a, b) = (packet(12, 1), packet(7, 2));
+    let d0 = a[..4].to_vec();
+    let mut d1 = a[4..].to_vec();
+    d1.extend([0xee, 0xee]);
+    d1.extend(&b);
+    let (got, c) = feed(&[
+        repr(0, FirstHeaderPointer::Packet(0), &d0),
+        repr(1, FirstHeaderPointer::Packet(10), &d1),
+    ]);
+    assert_eq!(got, vec![a, b]);
+    assert_eq!((c.bad_fhp, c.dropped, c.packets), (1, 0, 2));
+}
+
+#[test]
+fn a_pointer_inside_the_packet_drops_it() {
+    // The packet needs 8 more octets, the pointer says a packet starts at 3: dropped, never
+    // spliced; the packet at 3 comes out.
+    let (a, b) = (packet(12, 1), packet(9, 2));
+    let d0 = a[..4].to_vec();
+    let mut d1 = a[4..7].to_vec();
+    d1.extend(&b);
+    let (got, c) = feed(&[
+        repr(7, FirstHeaderPointer::Packet(0), &d0),
+        repr(8, FirstHeaderPointer::Packet(3), &d1),
+    ]);
+    assert_eq!(got, vec![b]);
+    assert_eq!((c.bad_fhp, c.dropped, c.packets), (1, 1, 1));
+}
+
+#[test]
+fn no_packet_start_where_one_is_due_is_a_bad_pointer() {
+    // Frame 0 ends exactly with its packet: frame 1 must start one at octet 0.
+    let a = packet(8, 1);
+    let (got, c) = feed(&[
+        repr(0, FirstHeaderPointer::Packet(0), &a),
+        repr(1, FirstHeaderPointer::NoPacketStart, &[0; 8]),
+        repr(2, FirstHeaderPointer::Packet(0), &a),
+    ]);
+    assert_eq!(got, vec![a.clone(), a]);
+    assert_eq!((c.bad_fhp, c.dropped), (1, 0));
+}
+
+#[test]
+fn an_only_idle_frame_keeps_the_packet_in_reassembly() {
+    // As YAMCS's VcTmPacketHandler: the idle frame counts, the packet continues after it.
+    let (a, b) = (packet(12, 1), packet(7, 2));
+    let d2 = [&a[5..], &b[..]].concat();
+    let (got, c) = feed(&[
+        repr(0, FirstHeaderPointer::Packet(0), &a[..5]),
+        repr(1, FirstHeaderPointer::OnlyIdleData, &[0x55; 5]),
+        repr(2, FirstHeaderPointer::Packet(7), &d2),
+    ]);
+    assert_eq!(got, vec![a, b]);
+    assert_eq!((c.idle_frames, c.lost_frames, c.dropped), (1, 0, 0));
+}
+
+#[test]
+fn a_repeated_frame_reads_as_a_gap_of_255() {
+    // The count does not move: 255 frames lost (mod 256), the packet in reassembly dropped.
+    let a = packet(12, 1);
+    let (got, c) = feed(&[
+        repr(5, FirstHeaderPointer::Packet(0), &a[..6]),
+        repr(5, FirstHeaderPointer::Packet(0), &a[..6]),
+    ]);
+    assert!(got.is_empty());
+    assert_eq!((c.lost_frames, c.dropped), (255, 1));
+}
+
+#[test]
+fn a_lost_frame_inside_a_header_drops_the_header() {
+    // The header is cut after 3 octets, the next frame is lost: the 3 octets are dropped;
+    // the next frame's pointer (a packet at 2) is where extraction resumes.
+    let a = packet(7, 1);
+    let b = packet(7, 2);
+    let mut d2 = vec![0xee, 0xee];
+    d2.extend(&b);
+    let (got, c) = feed(&[
+        repr(0, FirstHeaderPointer::Packet(0), &a[..3]),
+        repr(2, FirstHeaderPointer::Packet(2), &d2),
+    ]);
+    assert_eq!(got, vec![b]);
+    assert_eq!((c.lost_frames, c.dropped, c.bad_fhp), (1, 1, 0));
+}
