@@ -36,7 +36,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 11] = [
+pub const TARGETS: [&str; 13] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -47,6 +47,8 @@ pub const TARGETS: [&str; 11] = [
     "pus_request",
     "pus_housekeeping",
     "pus_verification",
+    "tm_frame_parser",
+    "tm_extractor",
     "tc_frame_parser",
 ];
 
@@ -517,11 +519,12 @@ pub fn seeds() -> Vec<SeedFile> {
     }
     for (name, _, bytes) in tc_frame_seeds() {
         out.push(SeedFile {
-            target: TARGETS[10],
+            target: TARGETS[12],
             name,
             bytes,
         });
     }
+    out.extend(tm_seeds());
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.
     let packet = |k: PacketKind| {
         valid
@@ -571,5 +574,74 @@ pub fn seeds() -> Vec<SeedFile> {
             });
         }
     }
+    out
+}
+
+/// Seeds of the TM link targets: for `tm_frame_parser`, the reference frame of the
+/// `tm-frame` bad-input rows and one near miss per check (the field changed, the FECF
+/// rewritten); for `tm_extractor`, link runs (frame-length selector, loss mask, steps: see
+/// `mmic_proofs::link_tm::check_link`) and two frames as the framer makes them.
+pub fn tm_seeds() -> Vec<SeedFile> {
+    use mmic_proofs::link_tm::{reference_frame, reseal};
+    let mut out = Vec::new();
+    let good = reference_frame();
+    let mut frame = |name: &str, edits: &[(usize, u8)]| {
+        let mut b = good.clone();
+        for &(at, v) in edits {
+            b[at] = v;
+        }
+        if !edits.is_empty() {
+            reseal(&mut b);
+        }
+        out.push(SeedFile {
+            target: TARGETS[10],
+            name: name.into(),
+            bytes: b,
+        });
+    };
+    frame("reference", &[]);
+    frame("version-1", &[(0, 0x54)]);
+    frame("secondary-header", &[(4, 0x98)]);
+    frame("no-ocf", &[(1, 0x20)]);
+    frame("other-spacecraft", &[(1, 0x31)]);
+    frame("vc-1", &[(1, 0x23)]);
+    frame("synch", &[(4, 0x58)]);
+    frame("packet-order", &[(4, 0x38)]);
+    frame("segment-01", &[(4, 0x10)]);
+    frame("fhp-244", &[(5, 0xf4)]);
+    frame("no-packet-start", &[(4, 0x1f), (5, 0xff)]);
+    frame("only-idle-data", &[(4, 0x1f), (5, 0xfe)]);
+    let mut fecf = good.clone();
+    fecf[10] ^= 0x04;
+    out.push(SeedFile {
+        target: TARGETS[10],
+        name: "fecf".into(),
+        bytes: fecf,
+    });
+    for (name, bytes) in [
+        ("two-packets", vec![0u8, 0xff, 0x28]),
+        (
+            "spanning-and-flushes",
+            vec![0, 0xfe, 0, 0xdc, 0x29, 0, 0xff],
+        ),
+        (
+            "short-frames-with-loss",
+            vec![55, 0x12, 0x40, 0, 0, 0, 0, 0, 0, 0xff, 0x60, 0, 0xa0],
+        ),
+    ] {
+        out.push(SeedFile {
+            target: TARGETS[11],
+            name: name.into(),
+            bytes,
+        });
+    }
+    let mut two = vec![0u8];
+    two.extend(&good);
+    two.extend(&good);
+    out.push(SeedFile {
+        target: TARGETS[11],
+        name: "reference-frame-twice".into(),
+        bytes: two,
+    });
     out
 }

@@ -22,6 +22,11 @@
 //!   canonically (an accepted function encodes back to the same octets).
 //! * `pus_housekeeping`, `pus_verification`: TM(3,25) and TM(1,x) source data through the
 //!   ground side's readers: refused, or read into a value that writes back exactly the input.
+//! * `tm_frame_parser`: the input (cut to 300 octets) through the TM frame parser under the
+//!   mission's parameters, exactly the oracle's verdict (`check_tm_frame_parse`); then its
+//!   first 256 octets with the spacecraft ID set and the FECF rewritten (the later checks).
+//! * `tm_extractor`: the input as a framer → extractor run with frame loss (`check_link`) and
+//!   as a stream of arbitrary frames through the parser and the extractor.
 //! * `deframer_stream`: four bytes of chunk plan, then the stream, fed as it is to deframers
 //!   with the smallest (66) and a larger (256) buffer, and once more after `build_stream` has
 //!   turned it into packets with sound framing, garbage and near misses; `run_deframer` checks
@@ -118,6 +123,41 @@ fn pus_verification() {
         if let [subservice, data @ ..] = input {
             mmic_proofs::pus::check_verification(*subservice, data);
         }
+    });
+}
+
+/// The TM frame parser: the input (cut to 300 octets) under the mission's parameters must get
+/// exactly the oracle's verdict (`check_tm_frame_parse`); then, if long enough, its first 256
+/// octets with the IDs and fixed flags set and the FECF rewritten, which reaches the checks
+/// after the FECF and acceptance.
+#[test]
+fn tm_frame_parser() {
+    use mmic_proofs::link_tm::{check_tm_frame_parse, reseal, PARAMS};
+    bolero::check!().for_each(|input: &[u8]| {
+        let input = &input[..input.len().min(300)];
+        check_tm_frame_parse(input, &PARAMS);
+        if input.len() >= 256 {
+            let mut f = input[..256].to_vec();
+            // Spacecraft 0x142 and segment length ID 11 set; version, VCID, OCF flag, the
+            // other flags and the pointer left as the input has them (each check reachable).
+            f[0] = (f[0] & 0xc0) | 0x14;
+            f[1] = (f[1] & 0x0f) | 0x20;
+            f[4] |= 0x18;
+            reseal(&mut f);
+            check_tm_frame_parse(&f, &PARAMS);
+        }
+    });
+}
+
+/// The TM link: the input as a run of the framer and the extractor with frame loss
+/// (`check_link`, the input cut to 80 octets: at most 71 steps), and as a stream of arbitrary
+/// frames through the parser and the extractor (`check_extractor_stream`).
+#[test]
+fn tm_extractor() {
+    use mmic_proofs::link_tm::{check_extractor_stream, check_link};
+    bolero::check!().for_each(|input: &[u8]| {
+        check_link(&input[..input.len().min(80)], true);
+        check_extractor_stream(input);
     });
 }
 

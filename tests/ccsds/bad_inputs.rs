@@ -1,12 +1,14 @@
-//! Walks `spec/ccsds/bad-inputs.toml`: every row's packet (or TC frame), through the parser it
-//! names, must be refused with exactly the error it names; every check of `PacketError::NAMES`,
-//! `RequestError::NAMES` and `TcFrameError::NAMES` has a row.
+//! Walks `spec/ccsds/bad-inputs.toml`: every row's packet (or TC or TM frame), through the
+//! parser it names, must be refused with exactly the error it names; every check of
+//! `PacketError::NAMES`, `RequestError::NAMES`, `TcFrameError::NAMES` and `TmFrameError::NAMES`
+//! has a row.
 
 use super::{hex, unhex};
 use mmic::ccsds::tc::TcRepr;
 use mmic::ccsds::tm::TmRepr;
 use mmic::ccsds::PacketError;
 use mmic::link::tc_frame::{TcFrame, TcFrameError};
+use mmic::link::tm_frame::{TmFrameError, TmFrameRepr};
 use mmic::pus::PusError;
 use serde::Deserialize;
 use std::collections::{BTreeMap, BTreeSet};
@@ -125,6 +127,12 @@ pub fn verdict(row: &Row, apids: &[u16]) -> Option<&'static str> {
         "tm" => TmRepr::parse(&bytes, apids).map(|_| ()),
         "tc-service" => return mmic::pus::read_tc(&bytes, apids).err().map(|e| e.name()),
         "tc-frame" => return tc_frame_verdict(&bytes).err().map(|e| e.name()),
+        // Under `TmFrameParams::mission(0x142)` (robot 0x42's spacecraft ID).
+        "tm-frame" => {
+            return TmFrameRepr::parse(&bytes, &super::tm_frame::params())
+                .err()
+                .map(|e| e.name())
+        }
         other => panic!("row {}: no parser named {other:?}", row.name),
     };
     r.err().map(|e| PusError::from(e).name())
@@ -154,14 +162,29 @@ fn every_bad_input_is_refused_by_name() {
             ),
             None => panic!("row {} ({}) was accepted", row.name, row.hex),
         }
-        checks.insert(row.error.as_str());
+        // Keyed by parser: the frames' checks share names with the packets' (length, version).
+        checks.insert((row.parser.as_str(), row.error.as_str()));
     }
+    let packet_parsers = ["tc", "tm", "tc-service"];
     for name in PacketError::NAMES
         .iter()
         .chain(&mmic::pus::request::RequestError::NAMES)
-        .chain(&TcFrameError::NAMES)
     {
-        assert!(checks.contains(name), "no row for the check {name}");
+        assert!(
+            packet_parsers.iter().any(|p| checks.contains(&(*p, *name))),
+            "no row for the check {name}"
+        );
+    }
+    for (parser, names) in [
+        ("tc-frame", &TcFrameError::NAMES[..]),
+        ("tm-frame", &TmFrameError::NAMES[..]),
+    ] {
+        for name in names {
+            assert!(
+                checks.contains(&(parser, *name)),
+                "no {parser} row for the check {name}"
+            );
+        }
     }
     println!("{} bad inputs refused by name", t.row.len());
 }
@@ -259,5 +282,26 @@ fn each_tc_frame_row_is_one_defect_away_from_a_valid_frame() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn each_tm_frame_row_is_one_defect_away_from_the_reference_frame() {
+    // As for the packets: the changed field (one or two octets: the data field status is
+    // 16 bits) and the two FECF octets rewritten over it (a missing octet counts once).
+    let t = table();
+    let good = super::tm_frame::reference_frame();
+    let rows: Vec<&Row> = t.row.iter().filter(|r| r.parser == "tm-frame").collect();
+    assert!(rows.len() >= TmFrameError::NAMES.len());
+    for row in rows {
+        let bytes = unhex(&row.hex);
+        let differing = (0..bytes.len().max(good.len()))
+            .filter(|&i| bytes.get(i) != good.get(i))
+            .count();
+        assert!(
+            (1..=4).contains(&differing),
+            "row {}: {differing} octets differ from the reference frame",
+            row.name
+        );
     }
 }

@@ -12,6 +12,8 @@ mod corruption;
 mod golden;
 mod interop_spacepackets;
 mod tc_frame;
+mod tm_frame;
+mod tm_link;
 
 use mmic::ccsds::primary::{Apid, SeqCount};
 use mmic::ccsds::tc::TcRepr;

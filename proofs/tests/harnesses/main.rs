@@ -10,6 +10,7 @@ mod deframer;
 #[cfg(not(any(kani, fuzzing)))]
 mod ledger;
 mod link_tc;
+mod link_tm;
 mod motion_sequencer;
 mod node;
 mod packets;
