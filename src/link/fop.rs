@@ -91,6 +91,14 @@ pub struct FopConfig {
     pub tx_limit: u8,
     /// What the timer's last expiry does.
     pub timeout_type: TimeoutType,
+    /// Start T1 when a CLCW takes FOP-1 out of Retransmit with Wait (S3) into S1 or S2 with
+    /// frames still unacknowledged and T1 stopped. Table 5-1 ignores T1's expiry in S3
+    /// (dariol83/ccsds and YAMCS do nothing then, so T1 stops), and leaving S3 by E6
+    /// ("remove acknowledged frames, look for FDU") starts nothing: when FARM-1 has meanwhile
+    /// cleared its Retransmit flag by accepting a late copy, no CLCW and no timer ever sends
+    /// the remaining frames again (the COP-1 model in host/tests/protocol/cop1.rs finds the
+    /// path). `false` is the table as written; the mission sets `true`.
+    pub restart_t1_after_wait: bool,
 }
 
 impl FopConfig {
@@ -100,6 +108,7 @@ impl FopConfig {
         t1_ms: T1_MS,
         tx_limit: TX_LIMIT,
         timeout_type: TimeoutType::Alert,
+        restart_t1_after_wait: true,
     };
 }
 
@@ -554,6 +563,7 @@ impl<P: Clone, const K: usize> Fop<P, K> {
         use FopState::*;
         let ev = self.classify(clcw);
         let nr = clcw.report_value;
+        let from = self.state;
         match (self.state, ev) {
             (Initial, _) => {}
             // Active, and the two retransmit states.
@@ -618,6 +628,14 @@ impl<P: Clone, const K: usize> Fop<P, K> {
             // Every other CLCW in S4 and S5 is ignored (in S5 a Lockout or Retransmit may
             // still show until FARM-1 has the BC frame).
             (InitialisingWithoutBc | InitialisingWithBc, _) => {}
+        }
+        if self.config.restart_t1_after_wait
+            && from == RetransmitWithWait
+            && matches!(self.state, Active | RetransmitWithoutWait)
+            && !self.sent.is_empty()
+            && self.timer.is_none()
+        {
+            self.timer = Some(now_ms);
         }
     }
 
@@ -848,6 +866,7 @@ mod tests {
             t1_ms: 100,
             tx_limit: 3,
             timeout_type: TimeoutType::Alert,
+            restart_t1_after_wait: true,
         }
     }
 
@@ -1054,6 +1073,38 @@ mod tests {
         f.tick(305, &mut |o| outs.push(o));
         assert_eq!(outs.len(), 3);
         assert_eq!(outs[2], FopOutput::Alert(AlertCode::T1));
+    }
+
+    /// T1 runs out in Retransmit with Wait (ignored: T1 stops); FARM-1 then accepts a late
+    /// copy of N(S) = 0, which clears its Retransmit flag, and reports N(R) = 1 with no flag.
+    /// FOP-1 goes back to Active with N(S) = 1 unacknowledged: with the table as written
+    /// nothing will ever send it again; with `restart_t1_after_wait` T1 does.
+    #[test]
+    fn leaving_wait_restarts_t1_for_what_is_left() {
+        for restart in [false, true] {
+            let mut f = active(FopConfig {
+                restart_t1_after_wait: restart,
+                ..small()
+            });
+            let mut outs = Vec::new();
+            f.transfer_ad(0, 0, &mut |o| outs.push(o)).unwrap();
+            f.transfer_ad(1, 0, &mut |o| outs.push(o)).unwrap();
+            let waiting = Clcw {
+                retransmit: true,
+                wait: true,
+                ..clcw(0)
+            };
+            f.clcw(&waiting, 1, &mut |o| outs.push(o));
+            assert_eq!(f.state(), FopState::RetransmitWithWait);
+            f.tick(100, &mut |o| outs.push(o));
+            assert_eq!(f.timer_deadline(), None);
+            f.clcw(&clcw(1), 200, &mut |o| outs.push(o));
+            assert_eq!((f.state(), f.sent_len()), (FopState::Active, 1));
+            assert_eq!(f.timer_deadline(), restart.then_some(300));
+            outs.clear();
+            f.tick(300, &mut |o| outs.push(o));
+            assert_eq!(sent_ns(&outs), if restart { &[1][..] } else { &[][..] });
+        }
     }
 
     #[test]
