@@ -714,12 +714,17 @@ impl<P: Clone, const K: usize> Fop<P, K> {
         }
     }
 
+    /// Negative confirm for each frame of the sent queue, which empties; NN(R) := V(S), so
+    /// that V(S) − NN(R) stays the sent queue's length (NN(R) is the oldest frame on it, and
+    /// with none the next one; YAMCS's `purgeSentQueue` does the same, dariol83/ccsds leaves
+    /// NN(R) behind, after which no CLCW can acknowledge anything).
     fn purge_sent_queue(&mut self, out: &mut impl FnMut(FopOutput<P>)) {
         for s in self.sent.iter() {
             out(FopOutput::NegativeConfirm { ns: s.ns });
         }
         self.sent.clear();
         self.bc = None;
+        self.nnr = self.vs;
     }
 
     fn purge_wait_queue(&mut self, out: &mut impl FnMut(FopOutput<P>)) {

@@ -9,6 +9,7 @@ mod control_interp;
 mod deframer;
 #[cfg(not(any(kani, fuzzing)))]
 mod ledger;
+mod link_cop;
 mod motion_sequencer;
 mod node;
 mod packets;
