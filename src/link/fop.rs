@@ -27,6 +27,22 @@
 //! `S6FopState` implement it (event numbers as there: E1–E14 and E101–E103 for CLCWs, E16–E18
 //! and E104 for the timer, E19–E21 for requests, E23–E40 for directives).
 //!
+//! Where the references differ, or the table as written loses a frame, the choice:
+//!
+//! - E10 in Retransmit with Wait (S3): "initiate AD retransmission, look for FDU" as in S1
+//!   (YAMCS); dariol83/ccsds leaves out the look for FDU, so nothing would go out until the
+//!   next event.
+//! - Purging the sent queue (alert, initialise) sets NN(R) := V(S), as YAMCS does; dariol83
+//!   leaves NN(R) behind, after which V(S) − NN(R) no longer counts the sent queue and no
+//!   CLCW acknowledges anything.
+//! - E1 in S4 ("initiate with CLCW") needs N(R) = V(S) = NN(R) (dariol83); YAMCS instead
+//!   adopts the CLCW's N(R) as V(S) and NN(R) on the first CLCW in S4. Here a FARM-1 that
+//!   expects another N(S) gives "NN(R)" (E13): set V(S) first ([`Directive::SetVs`]) or
+//!   initiate with Set V(R).
+//! - [`FopConfig::restart_t1_after_wait`]: T1 starts again when a CLCW takes FOP-1 out of
+//!   Retransmit with Wait with frames unacknowledged (neither reference does; without it the
+//!   COP-1 model finds a frame left unsent for good).
+//!
 //! Simplification (allowed by the standard's "lower procedures" being local): the transport
 //! always accepts a frame at once, so the AD, BC and BD "out ready" flags are always Ready and
 //! events E41–E46 never happen: where the standard waits for "AD Accept" to look for the next
