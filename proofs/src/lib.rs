@@ -31,6 +31,7 @@
 #![deny(missing_docs)]
 
 pub mod ccsds;
+pub mod link_cop;
 pub mod pus;
 
 use core::fmt::Debug;
