@@ -59,6 +59,11 @@ pub const T1_MS: u32 = 3000;
 /// The mission's transmission limit (`cop1.tx_limit`).
 pub const TX_LIMIT: u8 = 10;
 
+// K ≤ PW: with at most K frames unacknowledged, every frame FOP-1 sends or resends lies in
+// FARM-1's window (N(S) ≤ NN(R) + K − 1 ≤ V(R) + PW − 1, N(S) ≥ NN(R) ≥ V(R) − K ≥ V(R) − NW),
+// so the link never reaches the lockout area by itself.
+const _: () = assert!(FOP_WINDOW <= super::farm::FARM_WINDOW / 2);
+
 /// FOP-1's six states (232.1-B-2 §5.1.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
