@@ -116,6 +116,7 @@ class TmExtractor:
     dropped_partial: int = 0
     idle_packets: int = 0
     fhp_mismatch: int = 0
+    repeated: int = 0
     clcws: list = field(default_factory=list)
     _buf: bytearray = field(default_factory=bytearray)
     _synced: bool = False
@@ -130,6 +131,9 @@ class TmExtractor:
         self.frames += 1
         if f.ocf is not None:
             self.clcws.append(f.clcw)
+        if self._last_vc is not None and (self._last_vc - f.vc_count) % 256 < 128:
+            self.repeated += 1      # a copy, or a frame overtaken in transport: skipped whole
+            return []
         if self._last_vc is not None and (f.vc_count - self._last_vc) % 256 != 1:
             self.lost_frames += (f.vc_count - self._last_vc - 1) % 256
             if self._buf:

@@ -34,8 +34,13 @@
 //! * **Lost frames** show as a gap in the virtual channel frame count (mod 256, §4.1.2.6): the
 //!   gap is counted in `lost_frames`, a packet in reassembly is dropped and counted in
 //!   `dropped`, never spliced with the next frame's octets, and extraction resumes at the next
-//!   first header pointer. (A loss of a multiple of 256 frames cannot be seen in the count; a
-//!   repeated frame reads as a gap of 255.) The first frame sets the count.
+//!   first header pointer. (A loss of a multiple of 256 frames cannot be seen in the count.) The first frame
+//!   sets the count.
+//! * **A repeated or stale frame** (a VC frame count equal to the last one, or less than
+//!   [`STALE_WINDOW`] behind it: the transport duplicated or reordered it; a space link does
+//!   neither, a UDP link or a relay may) is skipped whole and counted (`repeated`): its packets
+//!   came with the first copy, or were given up when the gap was seen; taking them now would
+//!   deliver them out of order. A loss of 128 frames or more in a row reads the same way.
 //! * **A first header pointer that disagrees** with the packet in reassembly (the packet ends
 //!   before it, or has not ended at it) counts in `bad_fhp`; the pointer wins: a packet not yet
 //!   ended is dropped (`dropped`), the octets between a packet's end and the pointer skipped.
@@ -73,6 +78,9 @@ pub struct ExtractCounters {
     pub too_long: u32,
     /// First header pointers that disagreed with the packet in reassembly.
     pub bad_fhp: u32,
+    /// Frames whose VC frame count is the last one's or up to [`STALE_WINDOW`] − 1 behind it:
+    /// copies and frames overtaken in transport, skipped whole.
+    pub repeated: u32,
 }
 
 /// Where the extractor is in the packet stream.
@@ -100,6 +108,10 @@ enum Kind {
     /// Longer than the buffer: skipped (already counted).
     TooLong,
 }
+
+/// How far behind the last VC frame count a frame is taken for a copy or a late one (half the
+/// count's range: a gap of up to 128 frames is a loss, a count up to 128 behind is stale).
+pub const STALE_WINDOW: u8 = 128;
 
 /// The packet extractor of one virtual channel, reassembling packets of up to `N` octets
 /// (`N` at least 6: the header is collected in the same buffer).
@@ -137,6 +149,7 @@ impl<const N: usize> Extractor<N> {
                 idle_packets: 0,
                 too_long: 0,
                 bad_fhp: 0,
+                repeated: 0,
             },
         }
     }
@@ -163,6 +176,13 @@ impl<const N: usize> Extractor<N> {
         c.frames = c.frames.wrapping_add(1);
         let count = frame.vc_frame_count;
         if let Some(last) = self.last_vc_count {
+            if last.wrapping_sub(count) < STALE_WINDOW {
+                // The frame again, or one overtaken by later frames (a UDP link or a relay
+                // may duplicate and reorder; a space link does neither): its packets came
+                // with the first copy, or were dropped when the gap was seen.
+                c.repeated = c.repeated.wrapping_add(1);
+                return;
+            }
             let gap = count.wrapping_sub(last).wrapping_sub(1);
             if gap != 0 {
                 c.lost_frames = c.lost_frames.wrapping_add(gap as u32);

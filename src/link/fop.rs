@@ -254,10 +254,14 @@ pub enum FopOutput<P> {
         ns: u8,
     },
     /// The AD frame N(S) = `ns` was purged unacknowledged ("Negative Confirm"): FARM-1 may or
-    /// may not have it.
+    /// may not have it. Its FDU comes back, so that nothing is lost silently: the caller
+    /// decides whether to send it again (the PUS layer's request keys make a second copy
+    /// harmless).
     NegativeConfirm {
         /// Its N(S).
         ns: u8,
+        /// Its FDU.
+        fdu: P,
     },
     /// An FDU of the wait queue was purged, never sent ("Reject").
     Rejected(P),
@@ -741,7 +745,10 @@ impl<P: Clone, const K: usize> Fop<P, K> {
     /// NN(R) behind, after which no CLCW can acknowledge anything).
     fn purge_sent_queue(&mut self, out: &mut impl FnMut(FopOutput<P>)) {
         for s in self.sent.iter() {
-            out(FopOutput::NegativeConfirm { ns: s.ns });
+            out(FopOutput::NegativeConfirm {
+                ns: s.ns,
+                fdu: s.fdu.clone(),
+            });
         }
         self.sent.clear();
         self.bc = None;
@@ -967,7 +974,7 @@ mod tests {
         assert_eq!(
             outs,
             [
-                FopOutput::NegativeConfirm { ns: 0 },
+                FopOutput::NegativeConfirm { ns: 0, fdu: 7 },
                 FopOutput::Alert(AlertCode::T1)
             ]
         );
@@ -1018,7 +1025,7 @@ mod tests {
         assert_eq!(
             outs,
             [
-                FopOutput::NegativeConfirm { ns: 0 },
+                FopOutput::NegativeConfirm { ns: 0, fdu: 1 },
                 FopOutput::Alert(AlertCode::Lockout)
             ]
         );

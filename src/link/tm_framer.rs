@@ -149,6 +149,12 @@ impl<const N: usize> TmFramer<N> {
         &self.params
     }
 
+    /// When the last frame went out (`None`: none yet); the next is due by the idle period
+    /// after it.
+    pub const fn last_frame_ms(&self) -> Option<u32> {
+        self.last_frame_ms
+    }
+
     /// Octets waiting (packets, the rest of the one in flight).
     pub fn waiting(&self) -> usize {
         self.queue.len()

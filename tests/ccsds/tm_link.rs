@@ -456,15 +456,33 @@ fn an_only_idle_frame_keeps_the_packet_in_reassembly() {
 }
 
 #[test]
-fn a_repeated_frame_reads_as_a_gap_of_255() {
-    // The count does not move: 255 frames lost (mod 256), the packet in reassembly dropped.
+fn a_repeated_or_overtaken_frame_is_skipped_whole() {
+    // The count does not move (a copy), or moves back (a frame overtaken in transport): the
+    // frame is skipped, the packet in reassembly kept, nothing delivered twice or out of order.
     let a = packet(12, 1);
     let (got, c) = feed(&[
         repr(5, FirstHeaderPointer::Packet(0), &a[..6]),
         repr(5, FirstHeaderPointer::Packet(0), &a[..6]),
+        repr(6, FirstHeaderPointer::NoPacketStart, &a[6..]),
     ]);
-    assert!(got.is_empty());
-    assert_eq!((c.lost_frames, c.dropped), (255, 1));
+    assert_eq!(got, vec![a.clone()]);
+    assert_eq!((c.lost_frames, c.dropped, c.repeated), (0, 0, 1));
+    // 7 arrives before 6: 6 is lost to the extractor (the gap), and late when it comes.
+    let b = packet(7, 2);
+    let (got, c) = feed(&[
+        repr(5, FirstHeaderPointer::Packet(0), &a),
+        repr(7, FirstHeaderPointer::Packet(0), &b),
+        repr(6, FirstHeaderPointer::Packet(0), &a),
+    ]);
+    assert_eq!(got, vec![a.clone(), b]);
+    assert_eq!((c.lost_frames, c.repeated), (1, 1));
+    // 128 behind is a loss, not a late frame.
+    let (got, c) = feed(&[
+        repr(200, FirstHeaderPointer::Packet(0), &a),
+        repr(72, FirstHeaderPointer::Packet(0), &a),
+    ]);
+    assert_eq!(got.len(), 2);
+    assert_eq!((c.lost_frames, c.repeated), (127, 0));
 }
 
 #[test]

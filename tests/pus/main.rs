@@ -7,6 +7,7 @@
 mod common;
 
 mod event;
+mod frames;
 mod function;
 mod gateway;
 mod housekeeping;

@@ -3,6 +3,7 @@
 //! [`pus::TcLink`]), and the [`plan_runner`] that sends a plan's commands one at a time over
 //! either and follows the robot's heartbeats (Section 4, Figures 10 and 11).
 
+pub mod frames;
 pub mod link;
 pub mod plan_runner;
 pub mod pus;

@@ -3,6 +3,7 @@
 //! as the CCSDS/PUS [`gateway`] it takes telecommands, sends each robot its commands
 //! exactly-once ([`crate::node::exactly_once`]) and reports them in PUS telemetry.
 
+pub mod frames;
 pub mod gateway;
 pub mod relay;
 pub mod visit;

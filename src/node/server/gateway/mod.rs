@@ -261,6 +261,16 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
         best.map(|d| now.wrapping_add(d))
     }
 
+    /// How many more telecommands robot `board`'s queue can take now (`None`: not served).
+    /// The space data link's FARM-1 takes an AD frame only when its packets fit
+    /// ([`crate::node::server::frames`]).
+    pub fn queue_room(&self, board: BoardNumber) -> Option<usize> {
+        self.robots
+            .iter()
+            .find(|r| r.board == board)
+            .map(|r| Q - r.queue.len())
+    }
+
     /// The latest heartbeat of robot `board`.
     pub fn latest(&self, board: BoardNumber) -> Option<&HeartbeatRepr> {
         self.robots

@@ -1,0 +1,321 @@
+//! The space data link end to end in the library: the ground's [`GroundLink`] (FOP-1, the
+//! packet extractor) and the server board's [`FrameGateway`] (FARM-1, the PUS gateway, the TM
+//! framer) over frame channels that lose, duplicate and reorder, with a board A that answers
+//! every legacy command at once. Every telecommand reaches the gateway exactly once and in
+//! order (its ST[1] acceptance reports, read back through the TM frames, say so), whatever the
+//! channels do; COP-1 retransmits what they lose.
+
+use mmic::ccsds::primary::{Apid, SeqCount};
+use mmic::ccsds::tc::TcRepr;
+use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
+use mmic::ccsds::tm::TmRepr;
+use mmic::link::farm::{DiscardReason, FarmState};
+use mmic::link::fop::FopState;
+use mmic::mode::Mode;
+use mmic::node::ground::frames::GroundLink;
+use mmic::node::server::frames::{FrameConfig, FrameGateway};
+use mmic::node::server::gateway::Config;
+use mmic::pus::verification::{Report, Stage};
+use mmic::units::BoardNumber;
+use mmic::wire::heartbeat::HeartbeatRepr;
+
+type Server = FrameGateway<1, 4, 64, 4096>;
+type Ground = GroundLink<10, 64, 1024>;
+
+/// A frame channel: each frame lost, duplicated or held back with the given probabilities,
+/// otherwise delivered after 2..=6 ms; seeded (xorshift64*).
+struct Channel {
+    state: u64,
+    loss: f64,
+    dup: f64,
+    reorder: f64,
+    queue: Vec<(u32, Vec<u8>)>,
+    sent: u32,
+    lost: u32,
+    last: u32,
+}
+
+impl Channel {
+    fn new(seed: u64, loss: f64, dup: f64, reorder: f64) -> Channel {
+        Channel {
+            state: seed | 1,
+            loss,
+            dup,
+            reorder,
+            queue: Vec::new(),
+            sent: 0,
+            lost: 0,
+            last: 0,
+        }
+    }
+
+    fn uniform(&mut self) -> f64 {
+        self.state ^= self.state >> 12;
+        self.state ^= self.state << 25;
+        self.state ^= self.state >> 27;
+        (self.state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn send(&mut self, now: u32, frame: &[u8]) {
+        self.sent += 1;
+        if self.uniform() < self.loss {
+            self.lost += 1;
+            return;
+        }
+        let copies = if self.uniform() < self.dup { 2 } else { 1 };
+        for _ in 0..copies {
+            // In order (after the last frame in order), unless held back to be overtaken.
+            let mut at = (now + 2 + (self.uniform() * 5.0) as u32).max(self.last);
+            self.last = at;
+            if self.uniform() < self.reorder {
+                at += 40;
+            }
+            self.queue.push((at, frame.to_vec()));
+        }
+    }
+
+    fn due(&mut self, now: u32) -> Vec<Vec<u8>> {
+        let (due, rest): (Vec<_>, Vec<_>) = self.queue.drain(..).partition(|(t, _)| *t <= now);
+        self.queue = rest;
+        let mut due = due;
+        due.sort_by_key(|(t, _)| *t); // stable: frames due together keep their order
+        due.into_iter().map(|(_, f)| f).collect()
+    }
+}
+
+/// TC(8,1) perform function 6, Stop (spec/ccsds/functions.toml), numbered `seq`.
+fn stop(seq: u16) -> Vec<u8> {
+    let mut b = [0u8; 14];
+    TcRepr {
+        apid: Apid::new(0x101).unwrap(),
+        seq_count: SeqCount::new(seq).unwrap(),
+        header: TcSecondaryHeader {
+            ack: AckFlags::ALL,
+            service: 8,
+            subservice: 1,
+            source_id: 9,
+        },
+        app_data: &[6],
+    }
+    .emit(&mut b)
+    .unwrap();
+    b.to_vec()
+}
+
+struct Run {
+    /// Legacy commands board A ran (distinct sequence numbers answered).
+    executed: usize,
+    accepted: Vec<u16>,
+    completed: Vec<u16>,
+    ground: Ground,
+    server: Server,
+    up: Channel,
+    down: Channel,
+}
+
+/// `n` pings sent at once through channels with `loss`, `dup` and `reorder` each way, for at
+/// most `limit_ms` of simulated time (1 ms steps); board A answers every command 3 ms later.
+fn run(n: u16, seed: u64, loss: f64, dup: f64, reorder: f64, limit_ms: u32) -> Run {
+    let board = BoardNumber::ONE;
+    let mut server = Server::new(FrameConfig {
+        gateway: Config {
+            hk_enabled: false,
+            ..Config::default()
+        },
+        ..FrameConfig::default()
+    });
+    assert!(server.add(board));
+    let mut ground = Ground::new(board);
+    let mut up = Channel::new(seed, loss, dup, reorder);
+    let mut down = Channel::new(seed ^ 0x5555, loss, dup, reorder);
+    let (mut accepted, mut completed) = (Vec::new(), Vec::new());
+    let mut answers: Vec<(u32, u16)> = Vec::new();
+    let mut ran = std::collections::BTreeSet::new();
+    ground.start(0, &mut |f: &[u8]| up.send(0, f));
+    for s in 0..n {
+        ground
+            .send(&stop(s), 0, &mut |f: &[u8]| up.send(0, f))
+            .unwrap();
+    }
+    for now in 0..limit_ms {
+        for f in up.due(now) {
+            server.tc_frame(now, &f);
+        }
+        for f in down.due(now) {
+            let mut tms = Vec::new();
+            let _ = ground.tm_frame(
+                now,
+                &f,
+                &mut |t: &[u8]| up.send(now, t),
+                &mut |p: &[u8]| tms.push(p.to_vec()),
+            );
+            for p in tms {
+                let tm = TmRepr::parse(&p, &[0x101]).unwrap();
+                if tm.header.service == 1 {
+                    let r = Report::parse(tm.header.subservice, tm.source_data).unwrap();
+                    match (r.stage, r.failure) {
+                        (Stage::Acceptance, None) => accepted.push(r.request.seq_count),
+                        (Stage::Completion, None) => completed.push(r.request.seq_count),
+                        (_, None) => {}
+                        (stage, Some(f)) => panic!("{stage:?} failed: {f:?}"),
+                    }
+                }
+            }
+        }
+        ground.tick(now, &mut |f: &[u8]| up.send(now, f));
+        for (b, c) in server.tick(now) {
+            assert_eq!(b, board);
+            if c.command == mmic::command::Command::Stop {
+                ran.insert(c.seq);
+            }
+            answers.push((now + 3, c.seq));
+        }
+        let (due, rest): (Vec<_>, Vec<_>) = answers.iter().partition(|(t, _)| *t <= now);
+        answers = rest;
+        for (_, seq) in due {
+            let hb = HeartbeatRepr {
+                last_seq: seq,
+                mode: Mode::Operational,
+                ..HeartbeatRepr::default()
+            };
+            server.heartbeat(now, &hb);
+        }
+        let mut buf = [0u8; 256];
+        while let Some((_, len)) = server.frame(now, &mut buf) {
+            down.send(now, &buf[..len]);
+        }
+        if completed.len() == n as usize && ground.fop().sent_len() == 0 {
+            break;
+        }
+    }
+    Run {
+        executed: ran.len(),
+        accepted,
+        completed,
+        ground,
+        server,
+        up,
+        down,
+    }
+}
+
+#[test]
+fn a_clean_link_delivers_every_telecommand_once_in_order() {
+    let r = run(12, 1, 0.0, 0.0, 0.0, 20_000);
+    let want: Vec<u16> = (0..12).collect();
+    assert_eq!(r.accepted, want);
+    assert_eq!(r.completed, want);
+    assert_eq!(r.executed, want.len());
+    let c = r.ground.counters();
+    assert_eq!((c.packets, c.confirmed, c.alerts), (12, 12, [0; 7]));
+    assert_eq!(r.ground.state(), FopState::Active);
+    let farm = r.server.farm(BoardNumber::ONE).unwrap();
+    assert_eq!((farm.vr(), farm.counters().accepted_ad), (12, 12));
+    // Nothing lost: FARM-1 discarded only for want of room (the queue holds 4 of the 12) and
+    // the frames FOP-1 had sent after one it refused (ahead of V(R)), or copies it had
+    // passed (behind): go-back-N, never a lockout.
+    for reason in [
+        DiscardReason::LockoutArea,
+        DiscardReason::Locked,
+        DiscardReason::Invalid,
+    ] {
+        assert_eq!(farm.counters().discarded(reason), 0, "{reason:?}");
+    }
+    let no_buffer = farm.counters().discarded(DiscardReason::NoBuffer);
+    assert_eq!(c.ad_frames, 12 + c.retransmissions);
+    assert!(c.retransmissions >= no_buffer.min(1), "{c:?} {no_buffer}");
+    println!(
+        "clean: {} retransmissions after {no_buffer} frames found no room",
+        c.retransmissions
+    );
+}
+
+#[test]
+fn a_lossy_duplicating_reordering_link_still_delivers_once_in_order() {
+    // 20 % of frames lost each way, 10 % duplicated, 10 % overtaken: many seeds. The ground
+    // hears what survives of the reports (a lost TM frame takes its reports with it; the PUS
+    // layer above asks again): those it hears come once and in order.
+    let (mut retransmissions, mut alerts, mut lost) = (0, 0, 0);
+    for seed in 1..=40 {
+        let r = run(12, seed, 0.2, 0.1, 0.1, 120_000);
+        assert_eq!(
+            r.executed, 12,
+            "seed {seed}: board A ran {} commands",
+            r.executed
+        );
+        for heard in [&r.accepted, &r.completed] {
+            // In order, counting each request at its first report (after an alert, the copies
+            // the ground sends again are answered with their latest report once more).
+            let mut first = heard.clone();
+            let mut seen = std::collections::BTreeSet::new();
+            first.retain(|s| seen.insert(*s));
+            assert!(
+                first.windows(2).all(|w| w[0] < w[1]),
+                "seed {seed}: {heard:?}"
+            );
+        }
+        let farm = r.server.farm(BoardNumber::ONE).unwrap();
+        assert_eq!(
+            farm.counters().accepted_ad,
+            12,
+            "seed {seed}: FARM-1 accepted each frame once"
+        );
+        assert_eq!(r.server.counters(BoardNumber::ONE).unwrap().tc_packets, 12);
+        assert!(
+            r.up.lost > 0 && r.down.lost > 0,
+            "seed {seed}: the channels lost nothing"
+        );
+        retransmissions += r.ground.counters().retransmissions;
+        alerts += r.ground.counters().alerts.iter().sum::<u32>();
+        lost += r.up.lost + r.down.lost;
+    }
+    assert!(retransmissions > 0);
+    println!("40 runs: {lost} frames lost, {retransmissions} retransmissions, {alerts} alerts");
+}
+
+#[test]
+fn a_full_queue_holds_frames_back_with_wait_and_loses_none() {
+    // Board A never answers: the gateway's queue (4) fills, FARM-1 goes to Wait, and FOP-1
+    // keeps the rest. Nothing is refused at the PUS level for a full queue.
+    let board = BoardNumber::ONE;
+    let mut server = Server::new(FrameConfig::default());
+    server.add(board);
+    let mut ground = Ground::new(board);
+    let mut frames: Vec<Vec<u8>> = Vec::new();
+    ground.start(0, &mut |f: &[u8]| frames.push(f.to_vec()));
+    let mut buf = [0u8; 256];
+    let (_, n) = server.frame(0, &mut buf).unwrap();
+    ground
+        .tm_frame(
+            0,
+            &buf[..n],
+            &mut |f: &[u8]| frames.push(f.to_vec()),
+            &mut |_p: &[u8]| {},
+        )
+        .unwrap();
+    for s in 0..8 {
+        ground
+            .send(&stop(s), 1, &mut |f: &[u8]| frames.push(f.to_vec()))
+            .unwrap();
+    }
+    // The gateway holds telecommands until board A's first heartbeat: the queue takes 4.
+    for f in frames.drain(..) {
+        server.tc_frame(2, &f);
+    }
+    let farm = server.farm(board).unwrap();
+    assert_eq!(farm.state(), FarmState::Wait);
+    assert_eq!(farm.vr(), 4);
+    assert_eq!(server.gateway().queue_room(board), Some(0));
+    // The CLCW says Wait; the ground stops sending new frames.
+    let (_, n) = server.frame(3, &mut buf).unwrap();
+    ground
+        .tm_frame(
+            3,
+            &buf[..n],
+            &mut |f: &[u8]| frames.push(f.to_vec()),
+            &mut |_p: &[u8]| {},
+        )
+        .unwrap();
+    assert_eq!(ground.state(), FopState::RetransmitWithWait);
+    assert!(frames.is_empty());
+}
