@@ -126,6 +126,10 @@ pub struct SimArgs {
     /// line) or pus (PUS-C telecommands and telemetry over UDP, the server board as gateway).
     #[arg(long, default_value = "legacy", value_parser = protocol)]
     pub protocol: sim::Protocol,
+    /// With --protocol pus: packets (one space packet per datagram) or frames (the space data
+    /// link: TC transfer frames under COP-1, fixed-length TM transfer frames with the CLCW).
+    #[arg(long, default_value = "packets", value_parser = link_layer)]
+    pub link: sim::LinkLayer,
     /// With --realtime: simulated seconds per wall second.
     #[arg(long, default_value_t = 10.0)]
     pub scale: f64,
@@ -233,6 +237,10 @@ fn protocol(s: &str) -> Result<sim::Protocol, String> {
     s.parse()
 }
 
+fn link_layer(s: &str) -> Result<sim::LinkLayer, String> {
+    s.parse()
+}
+
 fn probability(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
     if (0.0..=1.0).contains(&v) {
@@ -299,6 +307,16 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let mut cfg = SimConfig::with_steps(steps);
     cfg.start_state = start;
     cfg.protocol = a.protocol;
+    cfg.link = a.link;
+    if a.link == sim::LinkLayer::Frames && a.protocol != sim::Protocol::Pus {
+        return Err(CliError::Usage("--link frames needs --protocol pus".into()));
+    }
+    if a.link == sim::LinkLayer::Frames && a.record.is_some() {
+        return Err(CliError::Usage(
+            "--record with --link frames: the replay trace holds packets, not frames (not yet)"
+                .into(),
+        ));
+    }
     cfg.scale = a.scale;
     cfg.seed = a.seed;
     cfg.wifi_loss = a.wifi_loss;

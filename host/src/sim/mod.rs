@@ -92,11 +92,71 @@ impl std::str::FromStr for Protocol {
     }
 }
 
+/// With [`Protocol::Pus`], what carries the packets between the ground and the server board.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinkLayer {
+    /// One space packet per datagram.
+    #[default]
+    Packets,
+    /// The space data link: TC transfer frames under COP-1 (the ground's FOP-1, the server
+    /// board's FARM-1), fixed-length TM transfer frames with the CLCW
+    /// ([`mmic::node::server::frames`], [`mmic::node::ground::frames`]).
+    Frames,
+}
+
+impl LinkLayer {
+    /// Its name on the command line and in the summary.
+    pub const fn name(self) -> &'static str {
+        match self {
+            LinkLayer::Packets => "packets",
+            LinkLayer::Frames => "frames",
+        }
+    }
+}
+
+impl std::str::FromStr for LinkLayer {
+    type Err = String;
+    fn from_str(s: &str) -> Result<LinkLayer, String> {
+        match s {
+            "packets" => Ok(LinkLayer::Packets),
+            "frames" => Ok(LinkLayer::Frames),
+            _ => Err(format!("{s:?} is no link: packets or frames")),
+        }
+    }
+}
+
+/// What the space data link did in a run with [`LinkLayer::Frames`], all robots.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct FrameStats {
+    /// TC frames the ground sent (AD first transmissions, retransmissions, BC).
+    pub tc_frames: u64,
+    /// AD frames sent again by FOP-1 (the Retransmit flag, timer T1).
+    pub retransmissions: u64,
+    /// FOP-1 alerts (transmission limit, lockout, ...), each followed by a re-initiation.
+    pub alerts: u64,
+    /// CLCWs the ground received.
+    pub clcws: u64,
+    /// Of those, reporting Lockout.
+    pub lockout_reports: u64,
+    /// AD frames FARM-1 accepted.
+    pub accepted: u64,
+    /// Frames FARM-1 discarded (out of sequence, no buffer, locked out).
+    pub discarded: u64,
+    /// TM frames the server boards sent.
+    pub tm_frames: u64,
+    /// TM frames the ground's extractor found missing (VC frame count gaps).
+    pub tm_lost: u64,
+    /// TM packets dropped because a lost frame cut them.
+    pub tm_packets_dropped: u64,
+}
+
 /// What to simulate.
 #[derive(Debug, Clone)]
 pub struct SimConfig {
     /// How the ground and the server board talk.
     pub protocol: Protocol,
+    /// With [`Protocol::Pus`], packets or frames.
+    pub link: LinkLayer,
     /// The ground's telecommand link with [`Protocol::Pus`].
     pub pus: pus::Config,
     /// The server board's gateway with [`Protocol::Pus`] (its uplink to board A, polls,
@@ -208,6 +268,7 @@ impl SimConfig {
     pub fn with_steps(steps: Vec<SimStep>) -> SimConfig {
         SimConfig {
             protocol: Protocol::Legacy,
+            link: LinkLayer::Packets,
             pus: pus::Config::default(),
             gateway: gateway::Config::default(),
             steps,
@@ -251,6 +312,10 @@ impl SimConfig {
 pub struct Summary {
     /// The protocol between the ground and the server board.
     pub protocol: Protocol,
+    /// Packets or frames (with [`Protocol::Pus`]).
+    pub link: LinkLayer,
+    /// The space data link's figures, with [`LinkLayer::Frames`].
+    pub frames: Option<FrameStats>,
     /// How each robot's plan ended (none: the time limit came first).
     pub ends: Vec<Option<PlanEnd>>,
     /// The plan's steps (their number is the plan's length), for reports that quote the step
@@ -304,6 +369,8 @@ impl Summary {
     ) -> Summary {
         Summary {
             protocol: cfg.protocol,
+            link: cfg.link,
+            frames: None,
             ends,
             plan: cfg.steps.clone(),
             start_state: cfg.start_state,

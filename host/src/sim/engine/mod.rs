@@ -45,13 +45,15 @@ pub mod watch;
 use super::log::{self, Log};
 use super::plant::Plant;
 use super::shell::{frames, Ground, GroundSide, LegacyGround, SideA, SideB};
-use super::{Protocol, SimConfig, Summary};
+use super::{FrameStats, LinkLayer, Protocol, SimConfig, Summary};
 use link::{Fate, Link, LinkModel};
 use mmic::node::ground::plan_runner::PlanRunner;
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
+use mmic::node::ground::frames::GroundLink;
+use mmic::node::server::frames::{FrameConfig, FrameGateway};
 use mmic::node::server::gateway::{Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -192,10 +194,20 @@ type SimGateway = Gateway<1, 8, 64>;
 /// The largest telemetry packet the gateway writes, bytes.
 const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + mmic::node::server::gateway::MAX_TM_DATA;
 
-/// The server board's logic: the legacy relay, or the PUS gateway.
+/// The PUS gateway behind the space data link (`--link frames`): the same sizes, 4 KiB of
+/// TM packets waiting for frames.
+type SimFrameGateway = FrameGateway<1, 8, 64, 4096>;
+
+/// The ground's end of a robot's space data link: FOP-1's window K = 10, 64 packets waiting,
+/// packets of up to 1 KiB reassembled.
+type SimGroundLink = GroundLink<10, 64, 1024>;
+
+/// The server board's logic: the legacy relay, the PUS gateway, or the PUS gateway behind the
+/// space data link.
 enum Board {
     Relay(Server<4>),
     Gateway(Box<SimGateway>),
+    Frames(Box<SimFrameGateway>),
 }
 
 /// One robot's nodes and links.
@@ -227,6 +239,8 @@ struct Robot {
     server_wake: Option<(u64, u64)>,
     /// The ground's reader of this robot's serial line (legacy).
     ground_reader: Deframer<256>,
+    /// The ground's end of the space data link (`--link frames`).
+    ground_link: Option<Box<SimGroundLink>>,
     links: [Link; 6],
 }
 
@@ -325,6 +339,10 @@ impl<'c, G: Ground> Engine<'c, G> {
         if cfg.protocol == Protocol::Pus {
             for i in 0..n {
                 e.wake_server(i, 0);
+                // The ground initiates the AD service; it runs once a CLCW confirms it.
+                if let Some(gl) = e.robots[i].ground_link.as_mut() {
+                    gl.start(0, &mut |_: &[u8]| {});
+                }
             }
         }
         e.at(0, Ev::GroundTick);
@@ -378,13 +396,17 @@ impl<'c, G: Ground> Engine<'c, G> {
         if let (Some(p), Some(t)) = (&self.cfg.record, &self.trace) {
             std::fs::write(p, t)?;
         }
+        let frames = self.frame_stats();
         let (ends, stats) = self.ground.finish(now);
         let records = self.log.as_ref().map(Log::take).unwrap_or_default();
         if let Some(p) = &self.cfg.log_path {
             let f = std::fs::File::create(p)?;
             log::write_lines(&records, &mut std::io::BufWriter::new(f))?;
         }
-        let summary = Summary::of_run(self.cfg, ends, stats, records, self.status, wall.elapsed());
+        let summary = Summary {
+            frames,
+            ..Summary::of_run(self.cfg, ends, stats, records, self.status, wall.elapsed())
+        };
         Ok((summary, self.watch))
     }
 
@@ -478,6 +500,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         if now > self.cfg.max_sim_ms || over {
             return false;
         }
+        self.ground_links_tick();
         for i in 0..self.robots.len() {
             for p in self.ground.tick(i, now) {
                 self.ground_sends(i, &p);
@@ -491,14 +514,62 @@ impl<'c, G: Ground> Engine<'c, G> {
         true
     }
 
-    /// The ground writes `p` to robot `i`'s server board.
+    /// The ground writes `p` to robot `i`'s server board (through FOP-1 with `--link frames`:
+    /// the frames due go out).
     fn ground_sends(&mut self, i: usize, p: &[u8]) {
         if self.cfg.protocol == Protocol::Legacy {
             if let Some(w) = &mut self.watch {
                 w.commanded(i, p);
             }
         }
+        let now = self.now_ms();
+        if let Some(gl) = self.robots[i].ground_link.as_mut() {
+            let mut frames = Vec::new();
+            if gl.send(p, now, &mut |f: &[u8]| frames.push(f.to_vec())).is_err() {
+                self.node_event(i, 2, json!({"type": "ground_outbox_full"}));
+            }
+            for f in frames {
+                self.send(i, Hop::GroundToServer, 0, &f);
+            }
+            return;
+        }
         self.send(i, Hop::GroundToServer, 0, p);
+    }
+
+    /// A TM frame reaches the ground's end of robot `i`'s link: its CLCW to FOP-1 (frames
+    /// it sends again go out), its packets returned.
+    fn tm_frame_at_ground(&mut self, i: usize, bytes: &[u8]) -> Vec<Vec<u8>> {
+        let now = self.now_ms();
+        let (mut frames, mut packets) = (Vec::new(), Vec::new());
+        if let Some(gl) = self.robots[i].ground_link.as_mut() {
+            let refused = gl.tm_frame(
+                now,
+                bytes,
+                &mut |f: &[u8]| frames.push(f.to_vec()),
+                &mut |p: &[u8]| packets.push(p.to_vec()),
+            );
+            if let Err(e) = refused {
+                self.node_event(i, 2, json!({"type": "tm_frame_refused", "check": e.name()}));
+            }
+        }
+        for f in frames {
+            self.send(i, Hop::GroundToServer, 0, &f);
+        }
+        packets
+    }
+
+    /// The ground's end of every link: timer T1.
+    fn ground_links_tick(&mut self) {
+        let now = self.now_ms();
+        for i in 0..self.robots.len() {
+            let mut frames = Vec::new();
+            if let Some(gl) = self.robots[i].ground_link.as_mut() {
+                gl.tick(now, &mut |f: &[u8]| frames.push(f.to_vec()));
+            }
+            for f in frames {
+                self.send(i, Hop::GroundToServer, 0, &f);
+            }
+        }
     }
 
     fn deliver(&mut self, i: usize, hop: Hop, conn: u64, bytes: Vec<u8>) {
@@ -512,7 +583,7 @@ impl<'c, G: Ground> Engine<'c, G> {
                             r.inbox.push_back(f.as_bytes().to_vec());
                         }
                     }
-                    Board::Gateway(_) => r.inbox.push_back(bytes),
+                    Board::Gateway(_) | Board::Frames(_) => r.inbox.push_back(bytes),
                 }
                 self.server_loop(i);
             }
@@ -523,6 +594,9 @@ impl<'c, G: Ground> Engine<'c, G> {
                         .into_iter()
                         .map(|f| f.as_bytes().to_vec())
                         .collect(),
+                    Protocol::Pus if self.cfg.link == LinkLayer::Frames => {
+                        self.tm_frame_at_ground(i, &bytes)
+                    }
                     Protocol::Pus => vec![bytes],
                 };
                 for p in packets {
@@ -745,6 +819,13 @@ impl<'c, G: Ground> Engine<'c, G> {
                     self.reports(i, out);
                 }
             }
+            Board::Frames(g) => {
+                if let Ok(h) = HeartbeatRepr::parse(&hb) {
+                    g.heartbeat(now, &h);
+                }
+                self.end_visit(i);
+                self.tm_frames(i);
+            }
         }
         self.server_loop(i);
     }
@@ -826,6 +907,10 @@ impl<'c, G: Ground> Engine<'c, G> {
             }
             return;
         }
+        if let Board::Frames(_) = self.robots[i].board {
+            self.frames_loop(i, inbox);
+            return;
+        }
         for p in inbox {
             let Board::Gateway(g) = &mut self.robots[i].board else {
                 return;
@@ -861,6 +946,100 @@ impl<'c, G: Ground> Engine<'c, G> {
             let at = (t.max(now.saturating_add(1)) as u64) * 1000;
             self.wake_server(i, at);
         }
+    }
+
+    /// The server board's loop behind the space data link: the ground's TC frames through
+    /// FARM-1 into the gateway, the gateway's tick, the TM frames due, the next visit.
+    fn frames_loop(&mut self, i: usize, inbox: Vec<Vec<u8>>) {
+        let now = self.now_ms();
+        let number = self.robots[i].number;
+        for f in inbox {
+            let Board::Frames(g) = &mut self.robots[i].board else {
+                return;
+            };
+            let got = g.tc_frame(now, &f);
+            match got.verdict {
+                Err(e) => self.node_event(
+                    i,
+                    2,
+                    json!({"type": "tc_frame_refused", "check": e.name(), "hex": log::hex(&f)}),
+                ),
+                Ok(v) if self.packet_log => self.node_event(
+                    i,
+                    2,
+                    json!({"type": "tc_frame", "farm": format!("{v:?}"),
+                           "packets": got.accepted, "refused": got.refused}),
+                ),
+                Ok(_) => {}
+            }
+        }
+        let Board::Frames(g) = &mut self.robots[i].board else {
+            return;
+        };
+        let visit = g
+            .tick(now)
+            .iter()
+            .find(|(b, _)| *b == number)
+            .map(|(_, c)| c.to_bytes());
+        self.tm_frames(i);
+        if let Some(packet) = visit {
+            let wait = self.cfg.gateway.uplink.timeout_ms;
+            self.start_visit(i, Visit::new(now, number, packet, wait));
+            return;
+        }
+        let Board::Frames(g) = &self.robots[i].board else {
+            return;
+        };
+        if let Some(t) = g.next_deadline(now) {
+            let at = (t.max(now.saturating_add(1)) as u64) * 1000;
+            self.wake_server(i, at);
+        }
+    }
+
+    /// The TM frames due at robot `i`'s server board, sent to the ground.
+    fn tm_frames(&mut self, i: usize) {
+        let now = self.now_ms();
+        let mut out = Vec::new();
+        if let Board::Frames(g) = &mut self.robots[i].board {
+            let mut buf = [0u8; mmic::link::tm_frame::TM_FRAME_LEN];
+            while let Some((_, n)) = g.frame(now, &mut buf) {
+                out.push(buf.get(..n).unwrap_or(&[]).to_vec());
+            }
+        }
+        for f in out {
+            self.send(i, Hop::ServerToGround, 0, &f);
+        }
+    }
+
+    /// The space data link's figures of the run, all robots.
+    fn frame_stats(&self) -> Option<FrameStats> {
+        if self.cfg.link != LinkLayer::Frames || self.cfg.protocol != Protocol::Pus {
+            return None;
+        }
+        let mut s = FrameStats::default();
+        for r in &self.robots {
+            if let Some(gl) = &r.ground_link {
+                let c = gl.counters();
+                s.tc_frames += u64::from(c.ad_frames) + u64::from(c.bc_frames);
+                s.retransmissions += u64::from(c.retransmissions);
+                s.alerts += c.alerts.iter().map(|&a| u64::from(a)).sum::<u64>();
+                s.clcws += u64::from(c.clcws);
+                s.lockout_reports += u64::from(c.lockouts);
+                let x = gl.extract_counters();
+                s.tm_lost += u64::from(x.lost_frames);
+                s.tm_packets_dropped += u64::from(x.dropped);
+            }
+            if let Board::Frames(g) = &r.board {
+                if let Some(f) = g.farm(r.number) {
+                    s.accepted += u64::from(f.counters().accepted_ad);
+                    s.discarded += f.counters().discarded.iter().map(|&d| u64::from(d)).sum::<u64>();
+                }
+                if let Some(c) = g.counters(r.number) {
+                    s.tm_frames += u64::from(c.tm_frames);
+                }
+            }
+        }
+        Some(s)
     }
 
     /// Schedules the gateway's loop at `at` (µs) unless it runs sooner already.
@@ -962,12 +1141,22 @@ impl Robot {
         ];
         let board = match cfg.protocol {
             Protocol::Legacy => Board::Relay(Server::new()),
+            Protocol::Pus if cfg.link == LinkLayer::Frames => {
+                let mut g = Box::new(SimFrameGateway::new(FrameConfig {
+                    gateway: cfg.gateway,
+                    ..FrameConfig::default()
+                }));
+                g.add(number);
+                Board::Frames(g)
+            }
             Protocol::Pus => {
                 let mut g = Box::new(SimGateway::new(cfg.gateway));
                 g.add(number);
                 Board::Gateway(g)
             }
         };
+        let ground_link = (cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames)
+            .then(|| Box::new(SimGroundLink::new(number)));
         Robot {
             number,
             names: [
@@ -999,6 +1188,7 @@ impl Robot {
             server_reader: Deframer::new(),
             server_wake: None,
             ground_reader: Deframer::new(),
+            ground_link,
             links,
         }
     }
