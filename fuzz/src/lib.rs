@@ -1,4 +1,5 @@
-//! Coverage-guided fuzz targets for mmic's four parsers and its deframer, and their seed corpus.
+//! Coverage-guided fuzz targets for mmic's four parsers and its deframer (and the CCSDS layers'
+//! parsers, services and COP-1), and their seed corpus.
 //!
 //! The targets are the bolero tests in `tests/targets.rs`; the properties they check are the
 //! functions of `mmic-proofs`, shared with the proof harnesses. Under plain `cargo test` each
@@ -36,7 +37,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 13] = [
+pub const TARGETS: [&str; 15] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -50,6 +51,8 @@ pub const TARGETS: [&str; 13] = [
     "tm_frame_parser",
     "tm_extractor",
     "tc_frame_parser",
+    "link_clcw",
+    "link_cop",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -573,6 +576,64 @@ pub fn seeds() -> Vec<SeedFile> {
                 bytes,
             });
         }
+    }
+    // The CLCW: valid words and one near miss per check (232.0-B-4 §4.2).
+    for (name, word) in [
+        ("open-vr-7", 0x0100_0007u32),
+        ("retransmit-farm-b-2", 0x0100_0c07),
+        ("lockout-wait-vc-63", 0x01fc_3000),
+        ("type-miss", 0x8100_0007),
+        ("version-miss", 0x2100_0007),
+        ("cop-miss", 0x0000_0007),
+        ("spare-miss", 0x0100_0107),
+    ] {
+        out.push(SeedFile {
+            target: TARGETS[13],
+            name: name.into(),
+            bytes: word.to_be_bytes().to_vec(),
+        });
+    }
+    // COP-1: octet 0 even for FARM-1, odd for FOP-1; octet 1 the window (FARM: 9 gives
+    // W = 20) or the FOP's options (0: running, timeout type 0, T1 restarted after Wait);
+    // then FARM events of three octets (selector, N(S), flag) or FOP inputs of two.
+    let farm = |events: &[(u8, u8, u8)]| {
+        let mut b = vec![0u8, 9];
+        for &(sel, ns, flag) in events {
+            b.extend_from_slice(&[sel, ns, flag]);
+        }
+        b
+    };
+    let fop = |inputs: &[(u8, u8)]| {
+        let mut b = vec![1u8, 0];
+        for &(sel, v) in inputs {
+            b.extend_from_slice(&[sel, v]);
+        }
+        b
+    };
+    for (name, bytes) in [
+        ("farm-in-order", farm(&[(0, 0, 1), (0, 1, 1), (0, 2, 1)])),
+        (
+            "farm-gap-lockout-unlock",
+            farm(&[(0, 0, 1), (0, 2, 1), (0, 200, 1), (5, 0, 1), (0, 1, 1)]),
+        ),
+        (
+            "farm-wait-release",
+            farm(&[(0, 0, 0), (7, 0, 1), (0, 0, 1)]),
+        ),
+        (
+            "fop-window-ack",
+            fop(&[(0, 1), (0, 2), (0, 3), (0, 4), (2, 3), (2, 4)]),
+        ),
+        (
+            "fop-retransmit-timer",
+            fop(&[(0, 1), (0, 2), (2, 0x12), (6, 0), (5, 200), (2, 3)]),
+        ),
+    ] {
+        out.push(SeedFile {
+            target: TARGETS[14],
+            name: name.into(),
+            bytes,
+        });
     }
     out
 }

@@ -31,6 +31,9 @@
 //!   with the smallest (66) and a larger (256) buffer, and once more after `build_stream` has
 //!   turned it into packets with sound framing, garbage and near misses; `run_deframer` checks
 //!   byte conservation, frame contents and offsets, and that nothing is left after `resync`.
+//! * `link_clcw`, `link_cop`: COP-1 of the space data link (`mmic_proofs::link_cop`): the
+//!   CLCW's verdict and round trip; FARM-1 taking AD frames once and in order, FOP-1 keeping
+//!   its window and confirming in order, over any sequence of events.
 
 use mmic::ccsds::primary::{PacketType, PrimaryHeader};
 use mmic::wire::b_command::BCommandRepr;
@@ -190,5 +193,49 @@ fn deframer_stream() {
         let mut built = [0u8; 4096];
         let n = build_stream(stream, &mut built);
         run_deframer::<MAX_PACKET_LEN>(&built[..n], plan, |_, _| {});
+    });
+}
+
+/// Four octets (zero-padded) through `Clcw::parse`: the verdict of the CLCW's bit table, the
+/// fields where it puts them, `emit` back to the same octets
+/// (`mmic_proofs::link_cop::check_clcw_word`); any other length refused by the length check.
+#[test]
+fn link_clcw() {
+    bolero::check!().for_each(|input: &[u8]| {
+        let mut w = [0u8; 4];
+        let n = input.len().min(4);
+        w[..n].copy_from_slice(&input[..n]);
+        mmic_proofs::link_cop::check_clcw_word(u32::from_be_bytes(w));
+        if input.len() != 4 {
+            let e = mmic::link::clcw::Clcw::parse(input).err().map(|e| e.name());
+            assert_eq!(e, Some("length"));
+        }
+    });
+}
+
+/// Octet 0 even: FARM-1 (octet 1 the window, then events of three octets) through
+/// `check_farm_events`; odd: FOP-1 (octet 1 its options, then inputs of two octets) through
+/// `check_fop_inputs`. At most 64 events.
+#[test]
+fn link_cop() {
+    bolero::check!().for_each(|input: &[u8]| {
+        let [which, param, rest @ ..] = input else {
+            return;
+        };
+        if which % 2 == 0 {
+            let evs: Vec<(u8, u8, bool)> = rest
+                .chunks_exact(3)
+                .take(64)
+                .map(|c| (c[0], c[1], c[2] & 1 == 1))
+                .collect();
+            mmic_proofs::link_cop::check_farm_events(*param, &evs);
+        } else {
+            let inputs: Vec<(u8, u8)> = rest
+                .chunks_exact(2)
+                .take(64)
+                .map(|c| (c[0], c[1]))
+                .collect();
+            mmic_proofs::link_cop::check_fop_inputs(*param, &inputs);
+        }
     });
 }

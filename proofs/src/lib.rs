@@ -32,6 +32,7 @@
 
 pub mod ccsds;
 pub mod link;
+pub mod link_cop;
 pub mod link_tm;
 pub mod pus;
 

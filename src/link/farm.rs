@@ -1,1 +1,717 @@
-//! (being written: issue 27)
+//! FARM-1, the receiving end of COP-1 (CCSDS 232.1-B-2 §6): one per spacecraft and TC virtual
+//! channel, it takes each AD frame exactly once and in order, lets BD frames through, obeys the
+//! BC control commands, and reports its state in the [`Clcw`].
+//!
+//! ```
+//! use mmic::link::farm::{Farm, FarmEvent, FarmState, FarmWindow, Verdict, DiscardReason};
+//! use mmic::link::ControlCommand;
+//!
+//! let mut farm = Farm::new(FarmWindow::MISSION); // W = 20, Open, V(R) = 0
+//! assert_eq!(farm.step(FarmEvent::Ad { ns: 0, buffer_ready: true }), Verdict::Accept);
+//! assert_eq!(farm.step(FarmEvent::Ad { ns: 0, buffer_ready: true }),
+//!            Verdict::Discard(DiscardReason::Behind));             // a duplicate
+//! assert_eq!(farm.step(FarmEvent::Ad { ns: 3, buffer_ready: true }),
+//!            Verdict::Discard(DiscardReason::Ahead));              // a gap: Retransmit set
+//! assert!(farm.clcw(Default::default(), false, false).retransmit);
+//! assert_eq!(farm.step(FarmEvent::Ad { ns: 100, buffer_ready: true }),
+//!            Verdict::Discard(DiscardReason::LockoutArea));        // outside the window
+//! assert_eq!(farm.state(), FarmState::Lockout);
+//! farm.step(FarmEvent::Bc(ControlCommand::Unlock));
+//! assert_eq!((farm.state(), farm.vr()), (FarmState::Open, 1));
+//! ```
+//!
+//! The state table (232.1-B-2 Table 6-1) is transcribed in `spec/ccsds/farm-1.toml`, and
+//! `tests/ccsds/farm_table.rs` checks [`Farm::step`] against it cell by cell for every V(R),
+//! N(S), state and window of a set. Where the references differ, the choice is written at
+//! the cell (the Wait flag in Lockout, below).
+//!
+//! The frame's checks (its header, CRC, spacecraft and VC) are the frame parser's: what
+//! reaches FARM-1 is a valid frame's kind, N(S) and control command, or
+//! [`FarmEvent::Invalid`] for a frame that failed them (E9). All arithmetic on sequence
+//! numbers is modulo 256 (232.1-B-2 §6.2.1, note).
+
+use super::clcw::{Clcw, ClcwVcid, FarmBCounter, StatusField};
+use super::{ControlCommand, FrameKind};
+
+/// The mission's FARM sliding window width W (`spec/ccsds/link.toml`, `cop1.farm_window`).
+pub const FARM_WINDOW: u8 = 20;
+
+/// The FARM sliding window width W (232.1-B-2 §6.1.8.2): even, 2..=254, split into a positive
+/// half PW and a negative half NW, both W/2. With V(R) the window holds W sequence numbers:
+/// V(R) itself, the PW − 1 above it, the NW below; the other 256 − W are the lockout area.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct FarmWindow(u8);
+
+/// A window width 232.1-B-2 §6.1.8.2 does not allow: odd, or outside 2..=254.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[error("FARM sliding window width must be even and within 2..=254, found {found}")]
+pub struct FarmWindowError {
+    /// The width asked for.
+    pub found: u8,
+}
+
+impl FarmWindow {
+    /// The mission's window, [`FARM_WINDOW`].
+    pub const MISSION: FarmWindow = FarmWindow(FARM_WINDOW);
+
+    /// The window of width `w`, refused unless even and within 2..=254.
+    pub const fn new(w: u8) -> Result<FarmWindow, FarmWindowError> {
+        if w >= 2 && w <= 254 && w % 2 == 0 {
+            Ok(FarmWindow(w))
+        } else {
+            Err(FarmWindowError { found: w })
+        }
+    }
+
+    /// W.
+    pub const fn width(self) -> u8 {
+        self.0
+    }
+
+    /// PW = W/2: the positive window holds N(S) ∈ [V(R)+1, V(R)+PW−1].
+    pub const fn positive(self) -> u8 {
+        self.0 / 2
+    }
+
+    /// NW = W/2: the negative window holds N(S) ∈ [V(R)−NW, V(R)−1].
+    pub const fn negative(self) -> u8 {
+        self.0 / 2
+    }
+
+    /// Where `ns` lies relative to `vr` (232.1-B-2 Table 6-1's conditions of E1–E5).
+    pub const fn place(self, vr: u8, ns: u8) -> WindowPlace {
+        let ahead = ns.wrapping_sub(vr);
+        let behind = vr.wrapping_sub(ns);
+        if ahead == 0 {
+            WindowPlace::Expected
+        } else if ahead < self.positive() {
+            WindowPlace::Positive
+        } else if behind <= self.negative() {
+            WindowPlace::Negative
+        } else {
+            WindowPlace::Lockout
+        }
+    }
+}
+
+impl Default for FarmWindow {
+    fn default() -> FarmWindow {
+        FarmWindow::MISSION
+    }
+}
+
+/// Where an AD frame's N(S) lies relative to V(R) and the window.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub enum WindowPlace {
+    /// N(S) = V(R): the frame expected next.
+    Expected,
+    /// V(R) < N(S) ≤ V(R) + PW − 1: ahead, a frame before it was lost.
+    Positive,
+    /// V(R) − NW ≤ N(S) < V(R): behind, already accepted (a retransmission).
+    Negative,
+    /// Neither: the lockout area.
+    Lockout,
+}
+
+/// FARM-1's three states (232.1-B-2 §6.1.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub enum FarmState {
+    /// S1: AD frames in sequence are accepted.
+    #[default]
+    Open,
+    /// S2: no buffer for AD frames; the Wait flag is set until the buffer is released.
+    Wait,
+    /// S3: an AD frame fell in the lockout area; no AD frame is taken until an Unlock.
+    Lockout,
+}
+
+/// What happens to FARM-1: a valid frame, a frame that failed validation, or the higher
+/// procedures freeing the buffer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub enum FarmEvent {
+    /// A valid type-AD frame with sequence number `ns`; `buffer_ready` says whether the
+    /// higher procedures can take its FDU now (E1 or E2).
+    Ad {
+        /// N(S).
+        ns: u8,
+        /// Room for the FDU.
+        buffer_ready: bool,
+    },
+    /// A valid type-BD frame (E6): accepted whatever the state.
+    Bd,
+    /// A valid type-BC frame with its control command (E7 Unlock, E8 Set V(R)).
+    Bc(ControlCommand),
+    /// A frame that failed validation (E9).
+    Invalid,
+    /// The higher procedures freed the buffer (E10, "buffer release signal").
+    BufferRelease,
+}
+
+impl FarmEvent {
+    /// The event of a frame as the frame parser reads it: an AD or BD frame without a
+    /// control command, a BC frame with one; any other combination is [`FarmEvent::Invalid`].
+    pub const fn of_frame(
+        kind: FrameKind,
+        ns: u8,
+        control: Option<ControlCommand>,
+        buffer_ready: bool,
+    ) -> FarmEvent {
+        match (kind, control) {
+            (FrameKind::Ad, None) => FarmEvent::Ad { ns, buffer_ready },
+            (FrameKind::Bd, None) => FarmEvent::Bd,
+            (FrameKind::Bc, Some(c)) => FarmEvent::Bc(c),
+            _ => FarmEvent::Invalid,
+        }
+    }
+}
+
+/// The event numbers of 232.1-B-2 Table 6-1 (E11, "report", is [`Farm::clcw`]: it changes
+/// nothing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[allow(missing_docs)]
+pub enum EventId {
+    E1,
+    E2,
+    E3,
+    E4,
+    E5,
+    E6,
+    E7,
+    E8,
+    E9,
+    E10,
+}
+
+impl EventId {
+    /// Every event, in the table's order.
+    pub const ALL: [EventId; 10] = [
+        EventId::E1,
+        EventId::E2,
+        EventId::E3,
+        EventId::E4,
+        EventId::E5,
+        EventId::E6,
+        EventId::E7,
+        EventId::E8,
+        EventId::E9,
+        EventId::E10,
+    ];
+
+    /// "E1" … "E10".
+    pub const fn name(self) -> &'static str {
+        match self {
+            EventId::E1 => "E1",
+            EventId::E2 => "E2",
+            EventId::E3 => "E3",
+            EventId::E4 => "E4",
+            EventId::E5 => "E5",
+            EventId::E6 => "E6",
+            EventId::E7 => "E7",
+            EventId::E8 => "E8",
+            EventId::E9 => "E9",
+            EventId::E10 => "E10",
+        }
+    }
+}
+
+/// Why FARM-1 discarded a frame: one reason per event of Table 6-1 that discards, so the
+/// discard counters say what the link did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub enum DiscardReason {
+    /// E2 (and E1 in Wait): the expected frame, but no buffer for it.
+    NoBuffer,
+    /// E3: ahead of V(R), inside the positive window (a frame before it was lost).
+    Ahead,
+    /// E4: behind V(R), inside the negative window (already accepted).
+    Behind,
+    /// E5 in Open or Wait: in the lockout area; FARM-1 goes to Lockout.
+    LockoutArea,
+    /// E1–E5 in Lockout: no AD frame is taken until an Unlock.
+    Locked,
+    /// E9: the frame failed validation.
+    Invalid,
+}
+
+impl DiscardReason {
+    /// Every reason, in the order of the counters.
+    pub const ALL: [DiscardReason; 6] = [
+        DiscardReason::NoBuffer,
+        DiscardReason::Ahead,
+        DiscardReason::Behind,
+        DiscardReason::LockoutArea,
+        DiscardReason::Locked,
+        DiscardReason::Invalid,
+    ];
+
+    /// Kebab-case name (reports, `spec/ccsds/farm-1.toml`).
+    pub const fn name(self) -> &'static str {
+        match self {
+            DiscardReason::NoBuffer => "no-buffer",
+            DiscardReason::Ahead => "ahead",
+            DiscardReason::Behind => "behind",
+            DiscardReason::LockoutArea => "lockout-area",
+            DiscardReason::Locked => "locked",
+            DiscardReason::Invalid => "invalid",
+        }
+    }
+
+    const fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// What FARM-1 did with an event.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "kebab-case"))]
+pub enum Verdict {
+    /// The AD or BD frame's FDU goes to the higher procedures ("Accept", §6.2.2).
+    Accept,
+    /// The frame is dropped ("Discard", §6.2.3).
+    Discard(DiscardReason),
+    /// A BC frame was taken (FARM-B counter incremented); `executed` is false for Set V(R) in
+    /// Lockout, which the table counts but does not obey.
+    Control {
+        /// The command.
+        command: ControlCommand,
+        /// Whether it changed V(R) or the state as it says.
+        executed: bool,
+    },
+    /// The buffer release was noted (E10).
+    Released,
+}
+
+/// FARM-1's state variables (232.1-B-2 §6.1): what the CLCW reports, without the counters.
+/// [`Farm::status`] reads them, [`Farm::restore`] builds a FARM from them (tests, model
+/// checks, a restart).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct FarmStatus {
+    /// S1, S2 or S3.
+    pub state: FarmState,
+    /// V(R), the N(S) of the next AD frame expected.
+    pub vr: u8,
+    /// The Retransmit flag (§6.1.3).
+    pub retransmit: bool,
+    /// The Wait flag (§6.1.4): set in Wait, and kept in Lockout when Lockout was entered
+    /// from Wait (until a buffer release or an Unlock).
+    pub wait: bool,
+    /// The FARM-B counter (§6.1.5).
+    pub farm_b: FarmBCounter,
+}
+
+impl FarmStatus {
+    /// Whether the variables fit together as Table 6-1 can leave them: Wait ⇔ the Wait flag
+    /// outside Lockout, and the Wait flag ⇒ the Retransmit flag (E2 sets both; only E1, E7
+    /// and E8 clear Retransmit, and each leaves Wait behind).
+    pub const fn is_consistent(&self) -> bool {
+        let wait_ok = match self.state {
+            FarmState::Open => !self.wait,
+            FarmState::Wait => self.wait,
+            FarmState::Lockout => true,
+        };
+        wait_ok && (!self.wait || self.retransmit)
+    }
+}
+
+/// Counts of what FARM-1 did, for reports. Each wraps at `u32::MAX` (a report takes
+/// differences; 4 × 10⁹ frames is years of link).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct FarmCounters {
+    /// AD frames accepted.
+    pub accepted_ad: u32,
+    /// BD frames accepted.
+    pub accepted_bd: u32,
+    /// BC frames taken (executed or not).
+    pub control: u32,
+    /// Frames discarded, by [`DiscardReason`] in the order of [`DiscardReason::ALL`].
+    pub discarded: [u32; 6],
+}
+
+impl FarmCounters {
+    /// Frames discarded for `reason`.
+    pub const fn discarded(&self, reason: DiscardReason) -> u32 {
+        self.discarded[reason.index()]
+    }
+}
+
+/// FARM-1 for one TC virtual channel.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Farm {
+    window: FarmWindow,
+    status: FarmStatus,
+    counters: FarmCounters,
+}
+
+impl Farm {
+    /// FARM-1 in Open with V(R) = 0 and every flag clear: the state after the ground's
+    /// "Initiate AD service" on a fresh link (232.1-B-2 leaves the initial state to the
+    /// mission; dariol83/ccsds starts in Lockout, which the ground leaves with an Unlock —
+    /// both work with FOP-1's "initiate with Unlock").
+    pub const fn new(window: FarmWindow) -> Farm {
+        Farm {
+            window,
+            status: FarmStatus {
+                state: FarmState::Open,
+                vr: 0,
+                retransmit: false,
+                wait: false,
+                farm_b: FarmBCounter::ZERO,
+            },
+            counters: FarmCounters {
+                accepted_ad: 0,
+                accepted_bd: 0,
+                control: 0,
+                discarded: [0; 6],
+            },
+        }
+    }
+
+    /// FARM-1 with these variables and zero counters; `None` if they do not fit together
+    /// ([`FarmStatus::is_consistent`]).
+    pub const fn restore(window: FarmWindow, status: FarmStatus) -> Option<Farm> {
+        if !status.is_consistent() {
+            return None;
+        }
+        let mut farm = Farm::new(window);
+        farm.status = status;
+        Some(farm)
+    }
+
+    /// The state.
+    pub const fn state(&self) -> FarmState {
+        self.status.state
+    }
+
+    /// V(R).
+    pub const fn vr(&self) -> u8 {
+        self.status.vr
+    }
+
+    /// The state variables.
+    pub const fn status(&self) -> FarmStatus {
+        self.status
+    }
+
+    /// The window.
+    pub const fn window(&self) -> FarmWindow {
+        self.window
+    }
+
+    /// The counters.
+    pub const fn counters(&self) -> &FarmCounters {
+        &self.counters
+    }
+
+    /// The event number of Table 6-1 that `event` is in the present state.
+    pub const fn classify(&self, event: FarmEvent) -> EventId {
+        match event {
+            FarmEvent::Ad { ns, buffer_ready } => match self.window.place(self.status.vr, ns) {
+                WindowPlace::Expected if buffer_ready => EventId::E1,
+                WindowPlace::Expected => EventId::E2,
+                WindowPlace::Positive => EventId::E3,
+                WindowPlace::Negative => EventId::E4,
+                WindowPlace::Lockout => EventId::E5,
+            },
+            FarmEvent::Bd => EventId::E6,
+            FarmEvent::Bc(ControlCommand::Unlock) => EventId::E7,
+            FarmEvent::Bc(ControlCommand::SetVr(_)) => EventId::E8,
+            FarmEvent::Invalid => EventId::E9,
+            FarmEvent::BufferRelease => EventId::E10,
+        }
+    }
+
+    /// A frame as the frame parser reads it ([`FarmEvent::of_frame`]).
+    pub fn frame(
+        &mut self,
+        kind: FrameKind,
+        ns: u8,
+        control: Option<ControlCommand>,
+        buffer_ready: bool,
+    ) -> Verdict {
+        self.step(FarmEvent::of_frame(kind, ns, control, buffer_ready))
+    }
+
+    /// The higher procedures freed the buffer (E10).
+    pub fn buffer_released(&mut self) {
+        self.step(FarmEvent::BufferRelease);
+    }
+
+    /// Runs `event` through Table 6-1 of 232.1-B-2: the actions of its cell for the present
+    /// state, then the cell's next state.
+    pub fn step(&mut self, event: FarmEvent) -> Verdict {
+        use FarmState::*;
+        let id = self.classify(event);
+        let s = &mut self.status;
+        let verdict = match (id, s.state) {
+            // E1: N(S) = V(R), buffer ready.
+            (EventId::E1, Open) => {
+                s.vr = s.vr.wrapping_add(1);
+                s.retransmit = false;
+                Verdict::Accept
+            }
+            // "Not applicable" in the table: Wait means no buffer until the release (E10),
+            // so the frame is refused as E2 would be in Wait.
+            (EventId::E1, Wait) => Verdict::Discard(DiscardReason::NoBuffer),
+            // E2: N(S) = V(R), no buffer.
+            (EventId::E2, Open) => {
+                s.retransmit = true;
+                s.wait = true;
+                s.state = Wait;
+                Verdict::Discard(DiscardReason::NoBuffer)
+            }
+            (EventId::E2, Wait) => Verdict::Discard(DiscardReason::NoBuffer),
+            // E3: positive window.
+            (EventId::E3, Open) => {
+                s.retransmit = true;
+                Verdict::Discard(DiscardReason::Ahead)
+            }
+            (EventId::E3, Wait) => Verdict::Discard(DiscardReason::Ahead),
+            // E4: negative window.
+            (EventId::E4, Open | Wait) => Verdict::Discard(DiscardReason::Behind),
+            // E5: lockout area.
+            (EventId::E5, Open | Wait) => {
+                s.state = Lockout;
+                Verdict::Discard(DiscardReason::LockoutArea)
+            }
+            (EventId::E1 | EventId::E2 | EventId::E3 | EventId::E4 | EventId::E5, Lockout) => {
+                Verdict::Discard(DiscardReason::Locked)
+            }
+            // E6: BD frame, every state.
+            (EventId::E6, _) => {
+                s.farm_b = s.farm_b.wrapping_next();
+                Verdict::Accept
+            }
+            // E7: Unlock, every state: to Open, flags cleared.
+            (EventId::E7, _) => {
+                s.farm_b = s.farm_b.wrapping_next();
+                s.retransmit = false;
+                s.wait = false;
+                s.state = Open;
+                Verdict::Control {
+                    command: ControlCommand::Unlock,
+                    executed: true,
+                }
+            }
+            // E8: Set V(R): obeyed in Open and Wait (to Open), counted only in Lockout.
+            (EventId::E8, Open | Wait) => {
+                s.farm_b = s.farm_b.wrapping_next();
+                s.retransmit = false;
+                s.wait = false;
+                s.state = Open;
+                let v = match event {
+                    FarmEvent::Bc(ControlCommand::SetVr(v)) => v,
+                    _ => s.vr,
+                };
+                s.vr = v;
+                Verdict::Control {
+                    command: ControlCommand::SetVr(v),
+                    executed: true,
+                }
+            }
+            (EventId::E8, Lockout) => {
+                s.farm_b = s.farm_b.wrapping_next();
+                let v = match event {
+                    FarmEvent::Bc(ControlCommand::SetVr(v)) => v,
+                    _ => s.vr,
+                };
+                Verdict::Control {
+                    command: ControlCommand::SetVr(v),
+                    executed: false,
+                }
+            }
+            // E9: invalid frame, every state.
+            (EventId::E9, _) => Verdict::Discard(DiscardReason::Invalid),
+            // E10: buffer release: ignored in Open; leaves Wait; clears a Wait flag carried
+            // into Lockout.
+            (EventId::E10, Open) => Verdict::Released,
+            (EventId::E10, Wait) => {
+                s.wait = false;
+                s.state = Open;
+                Verdict::Released
+            }
+            (EventId::E10, Lockout) => {
+                s.wait = false;
+                Verdict::Released
+            }
+        };
+        let c = &mut self.counters;
+        match verdict {
+            Verdict::Accept if id == EventId::E6 => c.accepted_bd = c.accepted_bd.wrapping_add(1),
+            Verdict::Accept => c.accepted_ad = c.accepted_ad.wrapping_add(1),
+            Verdict::Discard(r) => {
+                if let Some(n) = c.discarded.get_mut(r.index()) {
+                    *n = n.wrapping_add(1);
+                }
+            }
+            Verdict::Control { .. } => c.control = c.control.wrapping_add(1),
+            Verdict::Released => {}
+        }
+        verdict
+    }
+
+    /// The CLCW reporting this FARM (232.1-B-2 §6.2.4 "Report", E11): status field 0, COP-1,
+    /// the flags and V(R) from the state; `vcid` and the two physical-layer flags are the
+    /// caller's.
+    pub const fn clcw(&self, vcid: ClcwVcid, no_rf_available: bool, no_bit_lock: bool) -> Clcw {
+        Clcw {
+            status: StatusField::ZERO,
+            vcid,
+            no_rf_available,
+            no_bit_lock,
+            lockout: matches!(self.status.state, FarmState::Lockout),
+            wait: self.status.wait,
+            retransmit: self.status.retransmit,
+            farm_b_counter: self.status.farm_b,
+            report_value: self.status.vr,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ad(ns: u8) -> FarmEvent {
+        FarmEvent::Ad {
+            ns,
+            buffer_ready: true,
+        }
+    }
+
+    #[test]
+    fn window_places_match_the_bounds_of_table_6_1() {
+        let w = FarmWindow::new(10).unwrap(); // PW = NW = 5
+        let mut places = [WindowPlace::Expected; 256];
+        for (ns, p) in places.iter_mut().enumerate() {
+            *p = w.place(0, ns as u8);
+        }
+        assert_eq!(places[0], WindowPlace::Expected);
+        assert!(places[1..=4].iter().all(|p| *p == WindowPlace::Positive));
+        assert_eq!(places[5], WindowPlace::Lockout);
+        assert_eq!(places[250], WindowPlace::Lockout);
+        assert!(places[251..=255]
+            .iter()
+            .all(|p| *p == WindowPlace::Negative));
+        // W sequence numbers in the window, 256 − W in the lockout area, for every W.
+        for width in (2..=254).step_by(2) {
+            let w = FarmWindow::new(width).unwrap();
+            for vr in [0u8, 7, 255] {
+                let n = (0..=255u8)
+                    .filter(|ns| w.place(vr, *ns) != WindowPlace::Lockout)
+                    .count();
+                assert_eq!(n, width as usize);
+            }
+        }
+        assert!(FarmWindow::new(0).is_err());
+        assert!(FarmWindow::new(3).is_err());
+        assert!(FarmWindow::new(255).is_err());
+        assert_eq!(FarmWindow::new(1), Err(FarmWindowError { found: 1 }));
+    }
+
+    #[test]
+    fn wait_then_release_then_the_same_frame_is_taken() {
+        let mut f = Farm::new(FarmWindow::MISSION);
+        let busy = FarmEvent::Ad {
+            ns: 0,
+            buffer_ready: false,
+        };
+        assert_eq!(f.step(busy), Verdict::Discard(DiscardReason::NoBuffer));
+        assert_eq!(f.state(), FarmState::Wait);
+        let c = f.clcw(ClcwVcid::ZERO, false, false);
+        assert!(c.wait && c.retransmit && !c.lockout);
+        f.buffer_released();
+        assert_eq!(f.state(), FarmState::Open);
+        assert_eq!(f.step(ad(0)), Verdict::Accept);
+        assert!(!f.clcw(ClcwVcid::ZERO, false, false).retransmit);
+        assert_eq!(f.counters().accepted_ad, 1);
+        assert_eq!(f.counters().discarded(DiscardReason::NoBuffer), 1);
+    }
+
+    #[test]
+    fn lockout_from_wait_keeps_the_wait_flag_until_release_or_unlock() {
+        let mut f = Farm::new(FarmWindow::MISSION);
+        f.step(FarmEvent::Ad {
+            ns: 0,
+            buffer_ready: false,
+        });
+        assert_eq!(
+            f.step(ad(128)),
+            Verdict::Discard(DiscardReason::LockoutArea)
+        );
+        let c = f.clcw(ClcwVcid::ZERO, false, false);
+        assert!(c.lockout && c.wait);
+        f.buffer_released();
+        assert_eq!(f.state(), FarmState::Lockout);
+        assert!(!f.clcw(ClcwVcid::ZERO, false, false).wait);
+        assert_eq!(
+            f.step(FarmEvent::Bc(ControlCommand::SetVr(9))),
+            Verdict::Control {
+                command: ControlCommand::SetVr(9),
+                executed: false
+            }
+        );
+        assert_eq!(f.vr(), 0);
+        f.step(FarmEvent::Bc(ControlCommand::Unlock));
+        f.step(FarmEvent::Bc(ControlCommand::SetVr(9)));
+        assert_eq!((f.state(), f.vr()), (FarmState::Open, 9));
+        // Three B frames: the counter says 3.
+        assert_eq!(f.clcw(ClcwVcid::ZERO, false, false).farm_b_counter.get(), 3);
+        f.step(FarmEvent::Bd);
+        assert_eq!(f.clcw(ClcwVcid::ZERO, false, false).farm_b_counter.get(), 0);
+    }
+
+    #[test]
+    fn frames_map_to_events() {
+        use ControlCommand::*;
+        use FrameKind::*;
+        assert_eq!(
+            FarmEvent::of_frame(Ad, 3, None, false),
+            FarmEvent::Ad {
+                ns: 3,
+                buffer_ready: false
+            }
+        );
+        assert_eq!(FarmEvent::of_frame(Bd, 3, None, true), FarmEvent::Bd);
+        assert_eq!(
+            FarmEvent::of_frame(Bc, 3, Some(Unlock), true),
+            FarmEvent::Bc(Unlock)
+        );
+        assert_eq!(FarmEvent::of_frame(Bc, 3, None, true), FarmEvent::Invalid);
+        assert_eq!(
+            FarmEvent::of_frame(Ad, 3, Some(SetVr(1)), true),
+            FarmEvent::Invalid
+        );
+        assert!(Farm::restore(
+            FarmWindow::MISSION,
+            FarmStatus {
+                state: FarmState::Wait,
+                ..FarmStatus::default()
+            }
+        )
+        .is_none());
+    }
+}

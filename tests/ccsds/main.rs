@@ -9,6 +9,7 @@ mod common;
 
 mod bad_inputs;
 mod corruption;
+mod farm_table;
 mod golden;
 mod interop_spacepackets;
 mod tc_frame;

@@ -2,6 +2,7 @@
 //!
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
+mod cop1;
 mod protocol_exactly_once;
 mod protocol_paper;
 mod protocol_pus;

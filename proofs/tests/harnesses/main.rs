@@ -9,6 +9,7 @@ mod control_interp;
 mod deframer;
 #[cfg(not(any(kani, fuzzing)))]
 mod ledger;
+mod link_cop;
 mod link_tc;
 mod link_tm;
 mod motion_sequencer;
