@@ -442,3 +442,125 @@ fn clcw_every_field_both_ways() {
         "disagrees",
     );
 }
+
+/// In process (no binary spawned, so that many values are cheap): every N(S), every control
+/// command and every MAP ID through `encode tc-frame` → the library's own emission →
+/// `decode tc-frame` → `encode tc-frame` again, the same octets each time.
+#[test]
+fn tc_frame_json_round_trips_over_every_seq_map_and_control_command() {
+    use mmic::link::tc_frame::{MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
+    use mmic::link::ControlCommand;
+    use mmic_host::link::{decode_tc_frame, encode_tc_frame, FrameOptions};
+    let ping = mmic_host::codec::from_hex(PING).unwrap();
+    let mut n = 0;
+    let mut check = |j: Value, repr: TcFrameRepr<'_>, options: &FrameOptions| {
+        let bytes = encode_tc_frame(&j.to_string(), &[0x42]).unwrap();
+        let mut want = vec![0u8; repr.len()];
+        repr.emit(&mut want).unwrap();
+        assert_eq!(bytes, want, "{j}");
+        let d = decode_tc_frame(&bytes, options).unwrap();
+        assert_eq!(
+            encode_tc_frame(&d.to_string(), &[0x42]).unwrap(),
+            bytes,
+            "{d}"
+        );
+        n += 1;
+    };
+    let sc = SpacecraftId::new(0x1a5).unwrap();
+    let vc = Vcid::new(0).unwrap();
+    let options = |map_id: u8| FrameOptions {
+        spacecraft_id: Some(0x1a5),
+        map_id: Some(map_id),
+        apids: vec![0x42],
+        ..FrameOptions::default()
+    };
+    for seq in 0..=255u8 {
+        for (kind, ad) in [("ad", true), ("bd", false)] {
+            let map = seq % 64;
+            let map_id = Some(MapId::new(map).unwrap());
+            let content = if ad {
+                TcContent::Ad {
+                    map_id,
+                    data: &ping,
+                }
+            } else {
+                TcContent::Bd {
+                    map_id,
+                    data: &ping,
+                }
+            };
+            let repr = TcFrameRepr {
+                spacecraft_id: sc,
+                vcid: vc,
+                seq,
+                content,
+            };
+            let j = json!({"spacecraft_id": 0x1a5, "seq": seq, "kind": kind, "map_id": map, "data": PING});
+            check(j, repr, &options(map));
+        }
+        let vr = seq;
+        for (control, c) in [
+            (json!({"set-vr": vr}), ControlCommand::SetVr(vr)),
+            (json!("unlock"), ControlCommand::Unlock),
+        ] {
+            let repr = TcFrameRepr {
+                spacecraft_id: sc,
+                vcid: vc,
+                seq,
+                content: TcContent::Bc(c),
+            };
+            let j = json!({"spacecraft_id": 0x1a5, "seq": seq, "kind": "bc", "control": control});
+            check(j, repr, &options(0));
+        }
+    }
+    assert_eq!(n, 256 * 4);
+}
+
+/// In process: every first header pointer value (0..=243 and the two reserved ones) and every
+/// value of each CLCW field in turn, through `encode tm-frame` → `decode tm-frame` → `encode`.
+#[test]
+fn tm_frame_and_clcw_json_round_trip_over_every_field_value() {
+    use mmic_host::link::{decode_clcw, decode_tm_frame, encode_clcw, encode_tm_frame};
+    let options = mmic_host::link::FrameOptions::default();
+    let mut fhps: Vec<Value> = (0..244).map(|p| json!(p)).collect();
+    fhps.extend([json!("no-packet-start"), json!("only-idle-data")]);
+    for (i, fhp) in fhps.iter().enumerate() {
+        let j = json!({"spacecraft_id": 0x100 + i, "mc_frame_count": i, "vc_frame_count": 255 - i,
+                       "first_header_pointer": fhp, "data": "55".repeat(244), "ocf": "01000c07"});
+        let bytes = encode_tm_frame(&j.to_string()).unwrap();
+        let d = decode_tm_frame(&bytes, &options).unwrap();
+        assert_eq!(&d["first_header_pointer"], fhp);
+        assert_eq!(d["vc_frame_count"], 255 - i);
+        assert_eq!(encode_tm_frame(&d.to_string()).unwrap(), bytes);
+    }
+    let mut clcws = Vec::new();
+    for (field, max) in [
+        ("status", 7),
+        ("vcid", 63),
+        ("farm_b_counter", 3),
+        ("report_value", 255),
+    ] {
+        clcws.extend((0..=max).map(|v| json!({ field: v })));
+    }
+    for flag in [
+        "no_rf_available",
+        "no_bit_lock",
+        "lockout",
+        "wait",
+        "retransmit",
+    ] {
+        clcws.extend([json!({ flag: true }), json!({ flag: false })]);
+    }
+    assert_eq!(clcws.len(), 8 + 64 + 4 + 256 + 10);
+    for c in &clcws {
+        let bytes = encode_clcw(&c.to_string()).unwrap();
+        let d = decode_clcw(&bytes).unwrap();
+        for (k, v) in c.as_object().unwrap() {
+            assert_eq!(&d[k], v, "{c}");
+        }
+        assert_eq!(encode_clcw(&d.to_string()).unwrap(), bytes);
+        // The same word through the library.
+        let lib = mmic::link::clcw::Clcw::parse(&bytes).unwrap();
+        assert_eq!(lib.emit().to_vec(), bytes);
+    }
+}
