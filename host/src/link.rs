@@ -188,8 +188,9 @@ pub fn decode_tc_frame(bytes: &[u8], options: &FrameOptions) -> Result<Value, Pu
             .map_err(|e| tc_input(e.to_string()))?,
         segment_header: MISSION_SEGMENT_HEADER && !options.no_segment_header,
         map_ids: 1u64
-            .checked_shl(u32::from(options.map_id.unwrap_or(MISSION_MAP_ID)))
-            .unwrap_or(0),
+            << MapId::new(options.map_id.unwrap_or(MISSION_MAP_ID))
+                .map_err(|e| tc_input(e.to_string()))?
+                .get(),
     }];
     let config = TcFrameConfig {
         spacecraft_id: SpacecraftId::new(spacecraft_id).map_err(|e| tc_input(e.to_string()))?,

@@ -234,6 +234,16 @@ fn tc_frame_refusals_name_their_check() {
         2,
         "more than 10 bits",
     );
+    refused(
+        &["decode", "tc-frame", AD_PING, "--map-id", "64"],
+        2,
+        "MAP ID",
+    );
+    refused(
+        &["decode", "tc-frame", AD_PING, "--vcid", "64"],
+        2,
+        "virtual channel ID",
+    );
 }
 
 #[test]
