@@ -185,15 +185,16 @@ pub fn decode_tc_frame(bytes: &[u8], options: &FrameOptions) -> Result<Value, Pu
         .unwrap_or(0);
     let vcs = [VcConfig {
         vcid: Vcid::new(options.vcid.unwrap_or(MISSION_VCID))
-            .map_err(|e| tc_input(e.to_string()))?,
+            .map_err(|e| input("tc-frame option")(e.to_string()))?,
         segment_header: MISSION_SEGMENT_HEADER && !options.no_segment_header,
         map_ids: 1u64
             << MapId::new(options.map_id.unwrap_or(MISSION_MAP_ID))
-                .map_err(|e| tc_input(e.to_string()))?
+                .map_err(|e| input("tc-frame option")(e.to_string()))?
                 .get(),
     }];
     let config = TcFrameConfig {
-        spacecraft_id: SpacecraftId::new(spacecraft_id).map_err(|e| tc_input(e.to_string()))?,
+        spacecraft_id: SpacecraftId::new(spacecraft_id)
+            .map_err(|e| input("tc-frame option")(e.to_string()))?,
         vcs: &vcs,
         fecf: MISSION_FECF && !options.no_fecf,
         max_frame_len: options.frame_len.unwrap_or(MAX_FRAME_LEN),
@@ -454,7 +455,7 @@ pub fn decode_tm_frame(bytes: &[u8], options: &FrameOptions) -> Result<Value, Pu
     let fecf = TM_FECF && !options.no_fecf;
     let params =
         TmFrameParams::new(frame_len, spacecraft_id, vcid, ocf, fecf).ok_or_else(|| {
-            tm_input(format!(
+            input("tm-frame option")(format!(
                 "no TM frame has length {frame_len} (with{} OCF, with{} FECF), VC {vcid} (0..=7), \
              spacecraft {spacecraft_id}",
                 if ocf { "" } else { "out" },
