@@ -2,8 +2,9 @@
 //! [`run`], which does the work and writes to the given streams, so that `main.rs` only parses
 //! the arguments and maps the error to an exit code.
 //!
-//! Exit codes: [`EXIT_OK`] 0; [`EXIT_INVALID_PACKET`] 1 when the bytes are not a valid packet
-//! (stderr names the failed check: length, header, checksum, field or command); [`EXIT_INPUT`] 2
+//! Exit codes: [`EXIT_OK`] 0; [`EXIT_INVALID_PACKET`] 1 when the bytes are not a valid packet,
+//! frame or CLCW (stderr names the failed check: length, header, checksum, field or command;
+//! for PUS packets and link frames the check's name, e.g. `fecf`); [`EXIT_INPUT`] 2
 //! for bad input (unknown kind or state, invalid JSON, malformed hex) and usage errors (clap's
 //! own code); [`EXIT_IO`] 3 when a page cannot be written or stdout is closed.
 

@@ -41,10 +41,18 @@
 //! octets is refused there, since an idle packet is at least 7 and would spill into a next
 //! frame. The first header pointer is a number or `"no-packet-start"` / `"only-idle-data"`.
 //! The OCF is `ocf` (4 octets hex) or `clcw` (an object as `decode clcw` prints it); null for a
-//! frame without one. `decode tm-frame` prints every header field, the OCF as hex and as a
-//! CLCW, the data field and the FECF.
+//! frame without one; `fecf` null for a frame without the FECF. `decode tm-frame` prints every
+//! header field (the fixed ones too: `version`, `secondary_header_flag`, `synch_flag`,
+//! `packet_order_flag`, `segment_length_id`, the `ocf_flag`), the first header pointer as
+//! above and as its 11-bit field, the data field, the OCF as hex and as a CLCW (an OCF that is
+//! no CLCW leaves the frame valid, the frame parser takes any OCF: `clcw` is then null and
+//! `clcw_refused` names the CLCW's failed check), the FECF and `len`.
 //!
-//! **CLCW** (`encode clcw` / `decode clcw`): every field of the word by name.
+//! **CLCW** (`encode clcw` / `decode clcw`): every field of the word by name (`status`, `vcid`,
+//! `no_rf_available`, `no_bit_lock`, `lockout`, `wait`, `retransmit`, `farm_b_counter`,
+//! `report_value`; a field not given to `encode` is 0 or false), the fixed ones
+//! (`control_word_type` 0, `clcw_version` 0, `cop_in_effect` 1) and the `word` as hex, both
+//! checked when given.
 
 use crate::codec::{from_hex, to_hex};
 use crate::pus::{self, check_derived, object, uint, PusCodecError};
