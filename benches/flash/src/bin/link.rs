@@ -30,7 +30,10 @@ pub extern "C" fn _start() -> ! {
         black_box(verdict);
         for p in frame.packets().flatten() {
             let tc = TcRepr::parse(p, black_box(&[0x42]));
-            black_box(tc.map(|r| (r.header.service, r.header.subservice, r.app_data.len())).ok());
+            black_box(
+                tc.map(|r| (r.header.service, r.header.subservice, r.app_data.len()))
+                    .ok(),
+            );
         }
     }
     let (apid, seq, service, subservice, counter, dest, coarse, fine) = fields();
