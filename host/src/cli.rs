@@ -2,13 +2,14 @@
 //! [`run`], which does the work and writes to the given streams, so that `main.rs` only parses
 //! the arguments and maps the error to an exit code.
 //!
-//! Exit codes: [`EXIT_OK`] 0; [`EXIT_INVALID_PACKET`] 1 when the bytes are not a valid packet
-//! (stderr names the failed check: length, header, checksum, field or command); [`EXIT_INPUT`] 2
+//! Exit codes: [`EXIT_OK`] 0; [`EXIT_INVALID_PACKET`] 1 when the bytes are not a valid packet,
+//! frame or CLCW (stderr names the failed check: length, header, checksum, field or command;
+//! for PUS packets and link frames the check's name, e.g. `fecf`); [`EXIT_INPUT`] 2
 //! for bad input (unknown kind or state, invalid JSON, malformed hex) and usage errors (clap's
 //! own code); [`EXIT_IO`] 3 when a page cannot be written or stdout is closed.
 
 use crate::codec;
-use crate::{ground, motion, pages, pus, xtce};
+use crate::{ground, link, motion, pages, pus, xtce};
 use clap::{Parser, Subcommand};
 use mmic::motion::State;
 use mmic::wire::PacketKind;
@@ -27,7 +28,9 @@ Exit codes:
   0  success
   1  the bytes are not a valid packet; stderr names the failed check
      (length, header, checksum, field or command; for pus-tc/pus-tm the check's name of
-     spec/ccsds/bad-inputs.toml, e.g. `checksum`, `unknown-function`) with the numbers
+     spec/ccsds/bad-inputs.toml, e.g. `checksum`, `unknown-function`; for tc-frame, tm-frame
+     and clcw the frame's check, e.g. `fecf`, `spacecraft-id`, `packet-boundary`) with the
+     numbers
   2  bad input: unknown kind, invalid or out-of-range JSON, malformed hex, usage error
   3  a file could not be written (spec --write), or stdout is closed
 
@@ -36,6 +39,9 @@ Examples:
   mmic decode command 4d49434d0102000000000000ad97
   mmic encode pus-tc '{\"apid\":257,\"seq_count\":1,\"function\":\"reconfiguration\",\"args\":{\"initial\":\"a\",\"target\":\"m\"}}'
   mmic decode pus-tc 1901c00100082f08010000096164....
+  mmic decode tc-frame 0101001400c01842c00700062f1101000012d06a5a --apid 0x42
+  mmic encode tc-frame '{\"spacecraft_id\":257,\"kind\":\"bc\",\"control\":{\"set-vr\":5}}'
+  mmic decode clcw 01000c07
   mmic xtce > spec/ccsds/mmic.xtce.xml
   mmic spec --write spec/pages";
 
@@ -60,7 +66,19 @@ Examples (command packet, Table 2):
   mmic encode command '{\"board\":1,\"command\":\"stop\",\"seq\":258}'   (exactly-once sequence number; omitted = 0)
   mmic encode b-command '{\"seq\":1,\"flags\":{\"regulator\":true,\"arm\":true,\"gripper\":false,\"bolter\":false,\"stop\":false},\"arm_target\":1500,\"gripper_target\":500,\"bolter\":null}'
 
-Exit codes: 0 success, 2 bad kind or JSON (the message names the field and the allowed range).";
+Space data link (CCSDS 232.0 TC frames, 132.0 TM frames, the CLCW; host/src/link.rs has the
+JSON shapes; every key has a default: spacecraft 257 = robot 1, VC 0, MAP 0, counts 0):
+  mmic encode tc-frame '{\"spacecraft_id\":257,\"seq\":0,\"kind\":\"ad\",\"data\":\"1842c00700062f1101000012d0\"}'
+    (AD frame carrying one packet; \"map_id\":null for no segment header)
+  mmic encode tc-frame '{\"kind\":\"bc\",\"control\":\"unlock\"}'
+  mmic encode tm-frame '{\"spacecraft_id\":322,\"data\":\"0842c009000e201102000300000000005a8000ef0f\",\"pad\":true,\"clcw\":{\"report_value\":7}}'
+    (the data field is given whole, or with \"pad\":true ends in one idle packet;
+     \"first_header_pointer\": offset, \"no-packet-start\" or \"only-idle-data\")
+  mmic encode clcw '{\"vcid\":0,\"retransmit\":true,\"farm_b_counter\":2,\"report_value\":7}'
+
+Exit codes: 0 success; 1 the result would be refused (pus-tc, pus-tm, tc-frame, tm-frame,
+clcw: stderr names the check, e.g. `packet-boundary`); 2 bad kind or JSON (the message names
+the field and the allowed range).";
 
 const DECODE_HELP: &str = "\
 Decode a packet from hex; prints its JSON form on one line, every field included.
@@ -81,7 +99,18 @@ Examples:
 Exit codes: 0 success; 1 not a valid packet, stderr names the failed check, e.g.
   mmic: checksum check failed: command packet: checksum carried 0xd54a (bytes 4a d5),
   computed 0xd44a (bytes 4a d4)
-2 bad kind or malformed hex (the message gives the 0-based character position).";
+2 bad kind or malformed hex (the message gives the 0-based character position).
+
+Frames: `decode tc-frame` and `decode tm-frame` check the mission's parameters
+(spec/ccsds/link.toml: VC 0, TC frames with the segment header for MAP 0 and at most 256
+octets, TM frames of 256 octets with OCF; FECF on both), any spacecraft unless
+--spacecraft-id names one; --vcid, --map-id, --frame-len, --no-segment-header, --no-fecf,
+--no-ocf change them. A TC frame's packets are listed, each decoded as `decode pus-tc` would
+(with --apid) where it is a valid telecommand; a TM frame's OCF is decoded as a CLCW.
+  mmic decode tc-frame 3101000700004bfd
+    {\"kind\":\"bc\",...,\"control\":\"unlock\",...}
+  mmic decode tm-frame <512 hex digits> --spacecraft-id 0x142
+  mmic decode clcw 01000c07";
 
 /// `mmic`: encode and decode MMIC-I packets, print the spec tables.
 #[derive(Debug, Parser)]
@@ -103,7 +132,8 @@ pub enum Cmd {
     /// Encode a packet from JSON; prints lowercase hex.
     #[command(long_about = ENCODE_HELP, after_help = ENCODE_AFTER)]
     Encode {
-        /// Packet kind: command | heartbeat | internal-heartbeat | b-command | pus-tc | pus-tm.
+        /// Packet kind: command | heartbeat | internal-heartbeat | b-command | pus-tc | pus-tm;
+        /// or a space data link frame or word: tc-frame | tm-frame | clcw.
         #[arg(value_parser = parse_any_kind)]
         kind: AnyKind,
         /// The packet as JSON (as `mmic decode` prints it).
@@ -112,15 +142,19 @@ pub enum Cmd {
     /// Decode a packet from hex; prints JSON with every field.
     #[command(long_about = DECODE_HELP, after_help = DECODE_AFTER)]
     Decode {
-        /// Packet kind: command | heartbeat | internal-heartbeat | b-command | pus-tc | pus-tm.
+        /// Packet kind: command | heartbeat | internal-heartbeat | b-command | pus-tc | pus-tm;
+        /// or a space data link frame or word: tc-frame | tm-frame | clcw.
         #[arg(value_parser = parse_any_kind)]
         kind: AnyKind,
         /// The packet bytes in hex.
         hex: String,
-        /// pus-tc, pus-tm: an APID to accept (repeatable; decimal or 0x hex). Default: every
-        /// robot's, 0x101..=0x1FF.
+        /// pus-tc, pus-tm (and the packets of a tc-frame): an APID to accept (repeatable;
+        /// decimal or 0x hex). Default: every robot's, 0x101..=0x1FF.
         #[arg(long = "apid", value_parser = pus::parse_apid)]
         apids: Vec<u16>,
+        /// The frame options (tc-frame, tm-frame only).
+        #[command(flatten)]
+        frame: FrameArgs,
     },
     /// The XTCE mission database of the PUS-C packets, generated from the library and spec/
     /// (spec/ccsds/mmic.xtce.xml is this output); or the ccsdspy field list of TM(3,25).
@@ -224,6 +258,60 @@ pub enum Cmd {
     },
 }
 
+/// `mmic decode tc-frame|tm-frame`: the receiver's managed parameters, the mission's
+/// (spec/ccsds/link.toml) unless given.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct FrameArgs {
+    /// tc-frame, tm-frame: the one spacecraft ID accepted (decimal or 0x hex; the robot of
+    /// board n is 0x100 + n). Default: the frame header's, so any robot's frame decodes.
+    #[arg(long, value_parser = link::parse_spacecraft_id)]
+    pub spacecraft_id: Option<u16>,
+    /// tc-frame, tm-frame: the virtual channel accepted. Default: the mission's, 0.
+    #[arg(long)]
+    pub vcid: Option<u8>,
+    /// tc-frame: the MAP accepted. Default: the mission's, 0.
+    #[arg(long)]
+    pub map_id: Option<u8>,
+    /// tc-frame: the longest frame accepted; tm-frame: the frame length. Default: the
+    /// mission's, 256 octets.
+    #[arg(long, value_name = "OCTETS")]
+    pub frame_len: Option<usize>,
+    /// tc-frame: the virtual channel's AD and BD frames have no segment header.
+    #[arg(long)]
+    pub no_segment_header: bool,
+    /// tc-frame, tm-frame: the frames have no FECF.
+    #[arg(long)]
+    pub no_fecf: bool,
+    /// tm-frame: the frames have no OCF (no CLCW).
+    #[arg(long)]
+    pub no_ocf: bool,
+}
+
+impl FrameArgs {
+    fn given(&self) -> bool {
+        self.spacecraft_id.is_some()
+            || self.vcid.is_some()
+            || self.map_id.is_some()
+            || self.frame_len.is_some()
+            || self.no_segment_header
+            || self.no_fecf
+            || self.no_ocf
+    }
+
+    fn options(&self, apids: &[u16]) -> link::FrameOptions {
+        link::FrameOptions {
+            spacecraft_id: self.spacecraft_id,
+            vcid: self.vcid,
+            map_id: self.map_id,
+            frame_len: self.frame_len,
+            no_segment_header: self.no_segment_header,
+            no_fecf: self.no_fecf,
+            no_ocf: self.no_ocf,
+            apids: apids.to_vec(),
+        }
+    }
+}
+
 const XTCE_AFTER: &str = "\
 Regenerate the committed files (tests fail when they are stale):
   cargo run -q -p mmic-host -- xtce > spec/ccsds/mmic.xtce.xml
@@ -269,13 +357,23 @@ pub enum AnyKind {
     PusTc,
     /// A PUS-C telemetry packet.
     PusTm,
+    /// A TC transfer frame (CCSDS 232.0-B).
+    TcFrame,
+    /// A TM transfer frame (CCSDS 132.0-B).
+    TmFrame,
+    /// A Communications Link Control Word (CCSDS 232.0-B §4.2).
+    Clcw,
 }
 
-/// A packet kind from its name: the legacy names, `pus-tc`, `pus-tm`.
+/// A packet kind from its name: the legacy names, `pus-tc`, `pus-tm`, `tc-frame`, `tm-frame`,
+/// `clcw`.
 pub fn parse_any_kind(name: &str) -> Result<AnyKind, CliError> {
     match name {
         "pus-tc" => Ok(AnyKind::PusTc),
         "pus-tm" => Ok(AnyKind::PusTm),
+        "tc-frame" => Ok(AnyKind::TcFrame),
+        "tm-frame" => Ok(AnyKind::TmFrame),
+        "clcw" => Ok(AnyKind::Clcw),
         _ => parse_kind(name).map(AnyKind::Legacy),
     }
 }
@@ -314,11 +412,27 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
                 AnyKind::Legacy(k) => codec::encode(k, &json)?,
                 AnyKind::PusTc => pus::encode_tc(&json)?,
                 AnyKind::PusTm => pus::encode_tm(&json)?,
+                AnyKind::TcFrame => link::encode_tc_frame(&json, &[])?,
+                AnyKind::TmFrame => link::encode_tm_frame(&json)?,
+                AnyKind::Clcw => link::encode_clcw(&json)?,
             };
             writeln!(out, "{}", codec::to_hex(&bytes)).map_err(CliError::Output)?;
         }
-        Cmd::Decode { kind, hex, apids } => {
+        Cmd::Decode {
+            kind,
+            hex,
+            apids,
+            frame,
+        } => {
+            if frame.given() && !matches!(kind, AnyKind::TcFrame | AnyKind::TmFrame) {
+                return Err(CliError::Usage(
+                    "--spacecraft-id, --vcid, --map-id, --frame-len, --no-segment-header, \
+                     --no-fecf and --no-ocf are for tc-frame and tm-frame only"
+                        .into(),
+                ));
+            }
             let bytes = codec::from_hex(&hex)?;
+            let options = frame.options(&apids);
             let apids = if apids.is_empty() {
                 pus::robot_apids()
             } else {
@@ -328,6 +442,9 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
                 AnyKind::Legacy(k) => codec::decode(k, &bytes)?,
                 AnyKind::PusTc => pus::decode_tc(&bytes, &apids)?.to_string(),
                 AnyKind::PusTm => pus::decode_tm(&bytes, &apids)?.to_string(),
+                AnyKind::TcFrame => link::decode_tc_frame(&bytes, &options)?.to_string(),
+                AnyKind::TmFrame => link::decode_tm_frame(&bytes, &options)?.to_string(),
+                AnyKind::Clcw => link::decode_clcw(&bytes)?.to_string(),
             };
             writeln!(out, "{json}").map_err(CliError::Output)?;
         }

@@ -7,9 +7,10 @@ use std::path::PathBuf;
 /// Why `mmic` failed.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
-    /// The packet kind is not one of the four names.
+    /// The packet kind is not one of the names.
     #[error(
-        "unknown packet kind {name:?}; expected one of: command, heartbeat, internal-heartbeat, b-command"
+        "unknown packet kind {name:?}; expected one of: command, heartbeat, internal-heartbeat, \
+         b-command, pus-tc, pus-tm, tc-frame, tm-frame, clcw"
     )]
     UnknownKind {
         /// What was given.

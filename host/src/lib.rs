@@ -8,6 +8,7 @@ pub mod error;
 pub mod exit;
 pub mod fleet;
 pub mod ground;
+pub mod link;
 pub mod motion;
 pub mod pages;
 pub mod plan;

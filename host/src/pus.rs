@@ -39,7 +39,7 @@ use mmic::pus::{read_tc, ROBOT_APID_BASE};
 use mmic::wire::heartbeat::HeartbeatRepr;
 use serde_json::{json, Map, Value};
 
-/// Why a PUS codec call failed.
+/// Why a PUS codec call (or a transfer frame codec call, [`crate::link`]) failed.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum PusCodecError {
     /// The JSON (or hex) is not a packet description: which key and why.
@@ -50,7 +50,7 @@ pub enum PusCodecError {
         /// Why.
         reason: String,
     },
-    /// The packet is refused: the failed check's name and the library's message.
+    /// The packet (or frame) is refused: the failed check's name and the library's message.
     #[error("{name} check failed: {message}")]
     Refused {
         /// The check's name (spec/ccsds/bad-inputs.toml).
@@ -142,7 +142,7 @@ const TC_KEYS: [&str; 15] = [
     "ack_bits",
 ];
 
-fn uint(
+pub(crate) fn uint(
     v: &Value,
     key: &str,
     max: u64,
@@ -218,7 +218,7 @@ fn function_data(name: &str, args: Option<&Value>) -> Result<Vec<u8>, PusCodecEr
 }
 
 /// The JSON object of `json`, every key one of `keys`.
-fn object(
+pub(crate) fn object(
     json: &str,
     keys: &[&str],
     err: fn(String) -> PusCodecError,
@@ -317,7 +317,7 @@ pub fn encode_tc(json: &str) -> Result<Vec<u8>, PusCodecError> {
 }
 
 /// The keys of `given` among `derived` must equal the decoded packet's.
-fn check_derived(
+pub(crate) fn check_derived(
     given: &Map<String, Value>,
     decoded: &Value,
     derived: &[&str],

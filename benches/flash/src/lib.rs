@@ -1,4 +1,4 @@
-//! What the three measurement images share: the inputs, hidden from the optimiser, and the
+//! What the measurement images share: the inputs, hidden from the optimiser, and the
 //! panic handler. Each image in `src/bin/` parses one telecommand and builds one telemetry
 //! packet; `baseline` does neither, so its size is subtracted.
 #![no_std]
@@ -6,6 +6,13 @@
 /// The TC(8,1) of benches/ccsds.rs (16 octets), in RAM so the optimiser cannot read it.
 pub static TC: [u8; 16] = [
     0x18, 0x42, 0xc0, 0x07, 0x00, 0x09, 0x2f, 0x08, 0x01, 0x00, 0x01, 0x60, 0x6d, 0x61, 0, 0,
+];
+
+/// The same TC(8,1), its CRC this time, in an AD frame of spacecraft 0x142 (robot 0x42), VC 0,
+/// N(S) 3, MAP 0, with its FECF (24 octets): what the `link` image parses.
+pub static TC_FRAME: [u8; 24] = [
+    0x01, 0x42, 0x00, 0x17, 0x03, 0xc0, 0x18, 0x42, 0xc0, 0x07, 0x00, 0x09, 0x2f, 0x08, 0x01, 0x00,
+    0x01, 0x60, 0x6d, 0x61, 0x50, 0xe9, 0xba, 0xe1,
 ];
 
 /// A housekeeping report's 60 octets of parameters.

@@ -4,6 +4,7 @@
 
 mod cli;
 mod json_shape;
+mod link;
 mod pages;
 mod plan;
 mod plot;

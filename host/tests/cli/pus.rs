@@ -200,35 +200,51 @@ struct BadInputs {
     row: Vec<Row>,
 }
 
-/// Every row of spec/ccsds/bad-inputs.toml through `mmic decode pus-tc|pus-tm --apid 0x042`:
+/// Every row of spec/ccsds/bad-inputs.toml through `mmic decode`: packets as `pus-tc|pus-tm
+/// --apid 0x042`, TC frames as `tc-frame --spacecraft-id 0x101` and TM frames as `tm-frame
+/// --spacecraft-id 0x142` (the receivers the rows are written for, see the toml's comments):
 /// exit code 1, the check's name in stderr, nothing on stdout.
 #[test]
 fn every_bad_input_is_refused_by_name() {
     let text = std::fs::read_to_string(repo("spec/ccsds/bad-inputs.toml")).unwrap();
     let bad: BadInputs = toml::from_str(&text).unwrap();
     let mut names = std::collections::BTreeSet::new();
+    let (mut tc_frames, mut tm_frames) = (
+        std::collections::BTreeSet::new(),
+        std::collections::BTreeSet::new(),
+    );
     for r in &bad.row {
-        let kind = match r.parser.as_str() {
-            "tc" | "tc-service" => "pus-tc",
-            "tm" => "pus-tm",
-            // TC transfer frames (issue 27): no `mmic decode` subcommand for them yet.
-            "tc-frame" | "tm-frame" => continue,
+        let (kind, option, value) = match r.parser.as_str() {
+            "tc" | "tc-service" => ("pus-tc", "--apid", "0x042"),
+            "tm" => ("pus-tm", "--apid", "0x042"),
+            "tc-frame" => ("tc-frame", "--spacecraft-id", "0x101"),
+            "tm-frame" => ("tm-frame", "--spacecraft-id", "0x142"),
             p => panic!("row {}: parser {p} unknown to this test", r.name),
         };
         refused(
-            &["decode", kind, &r.hex, "--apid", "0x042"],
+            &["decode", kind, &r.hex, option, value],
             1,
             &format!("{} check failed", r.error),
         );
-        names.insert(r.error.clone());
+        match kind {
+            "tc-frame" => tc_frames.insert(r.error.clone()),
+            "tm-frame" => tm_frames.insert(r.error.clone()),
+            _ => names.insert(r.error.clone()),
+        };
     }
     assert!(bad.row.len() >= 38);
-    // Every check of the wire and services layers was exercised.
+    // Every check of the wire and services layers, and of both frames, was exercised.
     for n in mmic::ccsds::PacketError::NAMES
         .iter()
         .chain(mmic::pus::request::RequestError::NAMES.iter())
     {
         assert!(names.contains(*n), "no bad-input row for {n}");
+    }
+    for n in mmic::link::tc_frame::TcFrameError::NAMES {
+        assert!(tc_frames.contains(n), "no tc-frame bad-input row for {n}");
+    }
+    for n in mmic::link::tm_frame::TmFrameError::NAMES {
+        assert!(tm_frames.contains(n), "no tm-frame bad-input row for {n}");
     }
     // Without --apid, APID 0x042 is no robot's: the good TC of the table is refused as `apid`.
     refused(
