@@ -950,7 +950,9 @@ fn stop_during_a_reconfiguration_then_reset_resumes_it_and_the_demo_completes() 
             mode: "standby".into(),
             faults: vec![],
             refusals: vec![],
-            exit: 0
+            exit: 0,
+            link: None,
+            frames: None,
         }
     );
 }

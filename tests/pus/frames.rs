@@ -254,13 +254,23 @@ fn a_lossy_duplicating_reordering_link_still_delivers_once_in_order() {
                 "seed {seed}: {heard:?}"
             );
         }
+        // FARM-1 passes each frame once; after an alert the ground sends the purged packets
+        // again in new frames, and the gateway's request keys answer those copies.
         let farm = r.server.farm(BoardNumber::ONE).unwrap();
-        assert_eq!(
-            farm.counters().accepted_ad,
-            12,
-            "seed {seed}: FARM-1 accepted each frame once"
-        );
-        assert_eq!(r.server.counters(BoardNumber::ONE).unwrap().tc_packets, 12);
+        let packets = r.server.counters(BoardNumber::ONE).unwrap().tc_packets;
+        if r.ground.counters().alerts.iter().sum::<u32>() == 0 {
+            assert_eq!(
+                farm.counters().accepted_ad,
+                12,
+                "seed {seed}: FARM-1 accepted each frame once"
+            );
+            assert_eq!(packets, 12, "seed {seed}");
+        } else {
+            assert!(
+                packets >= 12 && farm.counters().accepted_ad == packets,
+                "seed {seed}"
+            );
+        }
         assert!(
             r.up.lost > 0 && r.down.lost > 0,
             "seed {seed}: the channels lost nothing"

@@ -68,6 +68,12 @@ pub struct SummaryJson {
     pub refusals: Vec<String>,
     /// The process's exit code (the caller decides it).
     pub exit: u8,
+    /// With `--protocol pus`: "packets" or "frames" (absent with the legacy protocol).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub link: Option<String>,
+    /// With `--link frames`: the space data link's figures (retransmissions, alerts, CLCWs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frames: Option<serde_json::Value>,
 }
 
 /// The run's [`SummaryJson`], given the exit code the process returns.
@@ -78,6 +84,8 @@ pub fn summary_json(s: &Summary, exit: u8) -> SummaryJson {
         faults: faults_raised(s),
         refusals: refusals(s),
         exit,
+        link: (s.protocol == super::Protocol::Pus).then(|| s.link.name().to_string()),
+        frames: s.frames.and_then(|f| serde_json::to_value(f).ok()),
     }
 }
 
@@ -380,6 +388,24 @@ fn pus_lines(t: &mut String, s: &Summary) {
             "over a simulated datagram link"
         }
     );
+    if let Some(f) = &s.frames {
+        let _ = writeln!(
+            t,
+            "link: frames -- TC transfer frames under COP-1, 256-octet TM frames with the CLCW: \
+             {} TC frames ({} retransmissions, {} alerts), FARM-1 accepted {} and discarded {}; \
+             {} TM frames ({} lost, {} packets cut), {} CLCWs ({} with Lockout)",
+            f.tc_frames,
+            f.retransmissions,
+            f.alerts,
+            f.accepted,
+            f.discarded,
+            f.tm_frames,
+            f.tm_lost,
+            f.tm_packets_dropped,
+            f.clcws,
+            f.lockout_reports
+        );
+    }
     if let Some(c) = pus_counts(s) {
         let _ = writeln!(
             t,

@@ -232,9 +232,15 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
         self.fop.timer_deadline()
     }
 
-    /// Hands FOP-1 the next waiting packets while its wait queue is free.
+    /// Hands FOP-1 the next waiting packets while its wait queue is free and it is Active.
+    ///
+    /// Not while it retransmits: every new AD frame restarts timer T1 (232.1-B-2, "Transmit
+    /// Type-AD Frame"; YAMCS does the same), so new packets arriving faster than T1 would
+    /// postpone the retransmission of a frame lost twice for as long as they keep coming
+    /// (the simulator's ground, resending unanswered telecommands every second, did exactly
+    /// that). Held here, they go once the CLCW shows the lost frame accepted.
     fn pump(&mut self, now: u32, emit: &mut impl FnMut(&[u8])) {
-        while !self.fop.waiting() {
+        while !self.fop.waiting() && self.fop.state() == FopState::Active {
             let Some(p) = self.outbox.pop_front() else {
                 return;
             };

@@ -47,12 +47,12 @@ use super::plant::Plant;
 use super::shell::{frames, Ground, GroundSide, LegacyGround, SideA, SideB};
 use super::{FrameStats, LinkLayer, Protocol, SimConfig, Summary};
 use link::{Fate, Link, LinkModel};
+use mmic::node::ground::frames::GroundLink;
 use mmic::node::ground::plan_runner::PlanRunner;
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::ground::frames::GroundLink;
 use mmic::node::server::frames::{FrameConfig, FrameGateway};
 use mmic::node::server::gateway::{Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
@@ -525,7 +525,10 @@ impl<'c, G: Ground> Engine<'c, G> {
         let now = self.now_ms();
         if let Some(gl) = self.robots[i].ground_link.as_mut() {
             let mut frames = Vec::new();
-            if gl.send(p, now, &mut |f: &[u8]| frames.push(f.to_vec())).is_err() {
+            if gl
+                .send(p, now, &mut |f: &[u8]| frames.push(f.to_vec()))
+                .is_err()
+            {
                 self.node_event(i, 2, json!({"type": "ground_outbox_full"}));
             }
             for f in frames {
@@ -1032,7 +1035,12 @@ impl<'c, G: Ground> Engine<'c, G> {
             if let Board::Frames(g) = &r.board {
                 if let Some(f) = g.farm(r.number) {
                     s.accepted += u64::from(f.counters().accepted_ad);
-                    s.discarded += f.counters().discarded.iter().map(|&d| u64::from(d)).sum::<u64>();
+                    s.discarded += f
+                        .counters()
+                        .discarded
+                        .iter()
+                        .map(|&d| u64::from(d))
+                        .sum::<u64>();
                 }
                 if let Some(c) = g.counters(r.number) {
                     s.tm_frames += u64::from(c.tm_frames);
