@@ -286,7 +286,9 @@ pub struct SimConfig {
 /// P`): the server board's gateway takes telecommands on 127.0.0.1:`tc_port` and sends its
 /// telemetry to `tm_to`; no plan runs; the run ends after [`SimConfig::max_sim_ms`] of wall
 /// time (the scale is 1, since the ground's timeouts run on the wall clock) or when killed.
-/// One JSON line per packet on `wire` ([`nodes::WireLog`]), after `{"ready":true,"tc_port":P}`.
+/// One JSON line per packet on `wire` ([`nodes::WireLog`]), after `{"ready":true,"tc_port":P}`;
+/// with [`LinkLayer::Frames`] TC and TM transfer frames instead of packets, one per datagram,
+/// and one line per frame ([`nodes::FrameGatewayTask`]).
 #[derive(Clone)]
 pub struct External {
     /// Where telemetry goes (YAMCS's UDP TM link).

@@ -567,7 +567,11 @@ pub struct GatewayTask {
 
 /// The packets between an external ground and the gateway, one JSON line each, as
 /// `mmic ground robot` prints them (ground/README.md): `{"dir":"tc","hex":..,"refused":null|check}`
-/// per telecommand datagram, `{"dir":"tm","hex":..}` per telemetry packet sent.
+/// per telecommand datagram, `{"dir":"tm","hex":..}` per telemetry packet sent. Behind the space
+/// data link ([`FrameGatewayTask`]) one line per frame instead:
+/// `{"dir":"tc-frame","hex":..,"refused":null|check,"farm":verdict|null,"packets":[hex,..]}` per TC
+/// frame received (the frame check that refused it, or FARM-1's verdict as [`verdict_name`] writes
+/// it; the packets it carries), `{"dir":"tm-frame","hex":..}` per TM frame sent.
 #[derive(Clone)]
 pub struct WireLog(pub Arc<Mutex<Box<dyn Write + Send>>>);
 
