@@ -122,6 +122,10 @@ fn the_view_reads_every_field() {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "1,534 frames through the CRC: minutes under Miri (the golden frames run)"
+)]
 fn round_trips_over_every_field_value() {
     // Every spacecraft ID, VCID, count value and first header pointer, each with the others at
     // the reference's: emit → parse gives the repr back (parsed with the repr's own IDs).
