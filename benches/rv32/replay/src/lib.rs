@@ -417,98 +417,18 @@ impl Replay {
 
     #[inline(never)]
     fn server_loop(&mut self, now: u32, m: &mut impl Meter) {
-        let number = self.header.board;
+        let mut io = ServerIo {
+            inbox: &mut self.inbox,
+            w: &mut self.w,
+            visit: &mut self.visit,
+            number: self.header.board,
+            now,
+        };
         m.enter(Phase::Node);
         match &mut self.board {
-            Board::Relay(srv) => {
-                while let Some(p) = self.inbox.pop_front() {
-                    let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(p.as_slice()) else {
-                        continue;
-                    };
-                    let r = srv.accept(&packet);
-                    m.enter(Phase::Record);
-                    match r {
-                        Ok(Accepted::Superseded(old)) => {
-                            self.w.debug(Field::Accepted, &"Superseded");
-                            self.w.bytes(Field::Accepted, &old);
-                        }
-                        Ok(a) => self.w.debug(Field::Accepted, &a),
-                        Err(e) => self.w.debug(Field::Refused, &e),
-                    }
-                    m.enter(Phase::Node);
-                }
-                // The replay keeps no deadline: the trace has a heartbeat record only while
-                // the engine's visit was current.
-                if let Some(visit) = Visit::next(srv, now, u32::MAX / 2) {
-                    visit.written(srv);
-                    let (board, packet) = (visit.board(), *visit.packet());
-                    if board == number {
-                        self.visit = Some(visit);
-                    }
-                    m.enter(Phase::Record);
-                    self.w.u8(Field::Visit, board.get());
-                    self.w.bytes(Field::Visit, &packet);
-                }
-            }
-            Board::Gateway(g) => {
-                while let Some(p) = self.inbox.pop_front() {
-                    match g.tc_packet(&p) {
-                        Ok(o) => reports(&mut self.w, g, o, now, m),
-                        Err(e) => {
-                            m.enter(Phase::Record);
-                            self.w.debug(Field::Refused, &e);
-                            m.enter(Phase::Node);
-                        }
-                    }
-                }
-                let o = g.tick(now);
-                let visit = o
-                    .to_robots
-                    .iter()
-                    .find(|(b, _)| *b == number)
-                    .map(|(_, c)| c.to_bytes());
-                reports(&mut self.w, g, o, now, m);
-                if let Some(packet) = visit {
-                    self.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
-                    m.enter(Phase::Record);
-                    self.w.u8(Field::Visit, number.get());
-                    self.w.bytes(Field::Visit, &packet);
-                } else {
-                    let d = g.next_deadline(now);
-                    m.enter(Phase::Record);
-                    self.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
-                }
-            }
-            Board::Frames(g) => {
-                // As the engine's `frames_loop`: the TC frames through FARM-1 into the
-                // gateway, the tick, the TM frames due, the next visit.
-                while let Some(f) = self.inbox.pop_front() {
-                    m.call(Call::TcFrame, true);
-                    let got = g.tc_frame(now, &f);
-                    m.call(Call::TcFrame, false);
-                    m.enter(Phase::Record);
-                    self.w.debug(Field::TcFrame, &got);
-                    m.enter(Phase::Node);
-                }
-                m.call(Call::Tick, true);
-                let to_robots = g.tick(now);
-                m.call(Call::Tick, false);
-                let visit = to_robots
-                    .iter()
-                    .find(|(b, _)| *b == number)
-                    .map(|(_, c)| c.to_bytes());
-                tm_frames(&mut self.w, g, now, m);
-                if let Some(packet) = visit {
-                    self.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
-                    m.enter(Phase::Record);
-                    self.w.u8(Field::Visit, number.get());
-                    self.w.bytes(Field::Visit, &packet);
-                } else {
-                    let d = g.next_deadline(now);
-                    m.enter(Phase::Record);
-                    self.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
-                }
-            }
+            Board::Relay(srv) => relay_loop(srv, &mut io, m),
+            Board::Gateway(g) => gateway_loop(g, &mut io, m),
+            Board::Frames(g) => frames_loop(g, &mut io, m),
         }
     }
 
@@ -538,6 +458,120 @@ impl Replay {
                 tm_frames(&mut self.w, g, now, m);
             }
         }
+    }
+}
+
+/// What a server board's loop works on besides its node: the ground's packets waiting, the
+/// output record, the current visit.
+struct ServerIo<'r> {
+    inbox: &'r mut Deque<Vec<u8, MAX_GROUND_PACKET>, QUEUE>,
+    w: &'r mut RecordWriter,
+    visit: &'r mut Option<Visit>,
+    number: mmic::units::BoardNumber,
+    now: u32,
+}
+
+// Each board's loop in a function of its own, never inlined, so that a call's stack holds the
+// buffers of its own node only (the RV32 runner measures it).
+/// The legacy relay's loop: the ground's commands accepted, the next visit.
+#[inline(never)]
+fn relay_loop(srv: &mut Server<4>, io: &mut ServerIo<'_>, m: &mut impl Meter) {
+    let (number, now) = (io.number, io.now);
+    while let Some(p) = io.inbox.pop_front() {
+        let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(p.as_slice()) else {
+            continue;
+        };
+        let r = srv.accept(&packet);
+        m.enter(Phase::Record);
+        match r {
+            Ok(Accepted::Superseded(old)) => {
+                io.w.debug(Field::Accepted, &"Superseded");
+                io.w.bytes(Field::Accepted, &old);
+            }
+            Ok(a) => io.w.debug(Field::Accepted, &a),
+            Err(e) => io.w.debug(Field::Refused, &e),
+        }
+        m.enter(Phase::Node);
+    }
+    // The replay keeps no deadline: the trace has a heartbeat record only while
+    // the engine's visit was current.
+    if let Some(visit) = Visit::next(srv, now, u32::MAX / 2) {
+        visit.written(srv);
+        let (board, packet) = (visit.board(), *visit.packet());
+        if board == number {
+            *io.visit = Some(visit);
+        }
+        m.enter(Phase::Record);
+        io.w.u8(Field::Visit, board.get());
+        io.w.bytes(Field::Visit, &packet);
+    }
+}
+
+/// The PUS gateway's loop: the telecommands, the tick and its reports, the next visit.
+#[inline(never)]
+fn gateway_loop(g: &mut ReplayGateway, io: &mut ServerIo<'_>, m: &mut impl Meter) {
+    let (number, now) = (io.number, io.now);
+    while let Some(p) = io.inbox.pop_front() {
+        match g.tc_packet(&p) {
+            Ok(o) => reports(io.w, g, o, now, m),
+            Err(e) => {
+                m.enter(Phase::Record);
+                io.w.debug(Field::Refused, &e);
+                m.enter(Phase::Node);
+            }
+        }
+    }
+    let o = g.tick(now);
+    let visit = o
+        .to_robots
+        .iter()
+        .find(|(b, _)| *b == number)
+        .map(|(_, c)| c.to_bytes());
+    reports(io.w, g, o, now, m);
+    if let Some(packet) = visit {
+        *io.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
+        m.enter(Phase::Record);
+        io.w.u8(Field::Visit, number.get());
+        io.w.bytes(Field::Visit, &packet);
+    } else {
+        let d = g.next_deadline(now);
+        m.enter(Phase::Record);
+        io.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
+    }
+}
+
+/// The frame gateway's loop, as the engine's `frames_loop`: the TC frames through FARM-1 into
+/// the gateway, the tick, the TM frames due, the next visit.
+#[inline(never)]
+fn frames_loop(g: &mut ReplayFrameGateway, io: &mut ServerIo<'_>, m: &mut impl Meter) {
+    let (number, now) = (io.number, io.now);
+    // As the engine's `frames_loop`: the TC frames through FARM-1 into the
+    // gateway, the tick, the TM frames due, the next visit.
+    while let Some(f) = io.inbox.pop_front() {
+        m.call(Call::TcFrame, true);
+        let got = g.tc_frame(now, &f);
+        m.call(Call::TcFrame, false);
+        m.enter(Phase::Record);
+        io.w.debug(Field::TcFrame, &got);
+        m.enter(Phase::Node);
+    }
+    m.call(Call::Tick, true);
+    let to_robots = g.tick(now);
+    m.call(Call::Tick, false);
+    let visit = to_robots
+        .iter()
+        .find(|(b, _)| *b == number)
+        .map(|(_, c)| c.to_bytes());
+    tm_frames(io.w, g, now, m);
+    if let Some(packet) = visit {
+        *io.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
+        m.enter(Phase::Record);
+        io.w.u8(Field::Visit, number.get());
+        io.w.bytes(Field::Visit, &packet);
+    } else {
+        let d = g.next_deadline(now);
+        m.enter(Phase::Record);
+        io.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
     }
 }
 

@@ -87,12 +87,6 @@ pub enum Protocol {
     PusFrames = 2,
 }
 
-impl Protocol {
-    /// Whether the server board runs the PUS gateway (bare or behind the frames).
-    pub const fn is_pus(self) -> bool {
-        matches!(self, Protocol::Pus | Protocol::PusFrames)
-    }
-}
 
 /// The scenario's fixed settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
