@@ -443,22 +443,43 @@ impl Replay {
                 m.enter(Phase::Record);
                 self.w.bytes(Field::Sent, &hb);
             }
-            Board::Gateway(g) => {
-                if let Ok(h) = HeartbeatRepr::parse(&hb) {
-                    let o = g.heartbeat(now, &h);
-                    reports(&mut self.w, g, o, now, m);
-                }
-            }
-            Board::Frames(g) => {
-                if let Ok(h) = HeartbeatRepr::parse(&hb) {
-                    m.call(Call::Heartbeat, true);
-                    g.heartbeat(now, &h);
-                    m.call(Call::Heartbeat, false);
-                }
-                tm_frames(&mut self.w, g, now, m);
-            }
+            Board::Gateway(g) => gateway_heartbeat(g, &mut self.w, now, &hb, m),
+            Board::Frames(g) => frames_heartbeat(g, &mut self.w, now, &hb, m),
         }
     }
+}
+
+/// A heartbeat into the PUS gateway, its reports into the record.
+#[inline(never)]
+fn gateway_heartbeat(
+    g: &mut ReplayGateway,
+    w: &mut RecordWriter,
+    now: u32,
+    hb: &[u8; HEARTBEAT_LEN],
+    m: &mut impl Meter,
+) {
+    if let Ok(h) = HeartbeatRepr::parse(hb) {
+        let o = g.heartbeat(now, &h);
+        reports(w, g, o, now, m);
+    }
+}
+
+/// A heartbeat into the frame gateway, the TM frames due into the record (as the engine's
+/// `heartbeat_at_server` with `--link frames`).
+#[inline(never)]
+fn frames_heartbeat(
+    g: &mut ReplayFrameGateway,
+    w: &mut RecordWriter,
+    now: u32,
+    hb: &[u8; HEARTBEAT_LEN],
+    m: &mut impl Meter,
+) {
+    if let Ok(h) = HeartbeatRepr::parse(hb) {
+        m.call(Call::Heartbeat, true);
+        g.heartbeat(now, &h);
+        m.call(Call::Heartbeat, false);
+    }
+    tm_frames(w, g, now, m);
 }
 
 /// What a server board's loop works on besides its node: the ground's packets waiting, the

@@ -87,7 +87,6 @@ pub enum Protocol {
     PusFrames = 2,
 }
 
-
 /// The scenario's fixed settings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Header {
