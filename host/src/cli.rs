@@ -190,8 +190,8 @@ pub enum Cmd {
         /// The trace (`mmic sim --record FILE`).
         #[arg(required_unless_present = "record_scenarios")]
         trace: Option<PathBuf>,
-        /// Instead: record the scenarios CI replays on RV32 (the demo over both protocols,
-        /// every Table 8 fault, lossy links) as DIR/NAME.trace.
+        /// Instead: record the scenarios CI replays on RV32 (the demo over both protocols and
+        /// over the space data link, every Table 8 fault, lossy links) as DIR/NAME.trace.
         #[arg(long, value_name = "DIR", conflicts_with_all = ["trace", "against", "out"])]
         record_scenarios: Option<PathBuf>,
         /// Compare with this output stream (the RV32 runner's); exit 1 on any difference.

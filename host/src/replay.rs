@@ -24,8 +24,9 @@ pub const FAULTS: &[(&str, Protocol)] = &[
 ];
 
 /// The scenarios CI replays on RV32 (benches/rv32/README.md), by name: the demo plan over
-/// both protocols, the demo over lossy, duplicating and reordering links, and one run per
-/// Table 8 fault (`fault-NAME`). Each runs in virtual time, deterministically.
+/// both protocols, the demo over lossy, duplicating and reordering links, the demo over the
+/// space data link with loss on the ground link (`frames`: TC frames under COP-1, TM frames),
+/// and one run per Table 8 fault (`fault-NAME`). Each runs in virtual time, deterministically.
 pub fn scenarios() -> Vec<(String, SimConfig)> {
     let demo = |protocol| {
         let mut c = SimConfig::demo();
@@ -42,10 +43,20 @@ pub fn scenarios() -> Vec<(String, SimConfig)> {
     lossy.links.wifi.duplicate = 0.05;
     lossy.links.wifi.reorder = 0.05;
     lossy.links.wifi.reorder_us = 50_000;
+    // The acceptance run, shorter: the demo behind the space data link, 10 % of the
+    // TC and TM frames lost on the ground link (FOP-1 retransmits, TM frames go missing) and
+    // 10 % of the WiFi packets.
+    let mut frames = demo(Protocol::Pus);
+    frames.link = crate::sim::LinkLayer::Frames;
+    frames.seed = 1;
+    frames.max_sim_ms = 400_000;
+    frames.wifi_loss = 0.1;
+    frames.serial_loss = 0.1;
     let mut all = vec![
         ("demo-legacy".to_string(), demo(Protocol::Legacy)),
         ("demo-pus".to_string(), demo(Protocol::Pus)),
         ("lossy".to_string(), lossy),
+        ("frames".to_string(), frames),
     ];
     for (f, protocol) in FAULTS {
         let mut c = demo(*protocol);

@@ -312,12 +312,6 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     if a.link == sim::LinkLayer::Frames && a.protocol != sim::Protocol::Pus {
         return Err(CliError::Usage("--link frames needs --protocol pus".into()));
     }
-    if a.link == sim::LinkLayer::Frames && a.record.is_some() {
-        return Err(CliError::Usage(
-            "--record with --link frames: the replay trace holds packets, not frames (not yet)"
-                .into(),
-        ));
-    }
     cfg.scale = a.scale;
     cfg.seed = a.seed;
     cfg.wifi_loss = a.wifi_loss;

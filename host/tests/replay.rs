@@ -6,7 +6,7 @@
 
 use mmic_host::replay::{compare, run, scenarios, tag_name, FAULTS};
 use mmic_replay::out::{fields, records, Field};
-use mmic_replay::trace::{Record, Trace, TraceError};
+use mmic_replay::trace::{Protocol, Record, Trace, TraceError};
 use serde_json::Value;
 
 type Streams = std::collections::BTreeMap<&'static str, Vec<(u32, String)>>;
@@ -49,7 +49,9 @@ fn replay_streams(out: &[u8]) -> Streams {
                 (1, Some(Field::ToB)) => "A to B",
                 (2, Some(Field::InternalHeartbeat)) => "B to A",
                 (8, Some(Field::Sent)) => "A to server",
-                (11, Some(Field::Sent)) | (_, Some(Field::Report)) => "server to ground",
+                (11, Some(Field::Sent)) | (_, Some(Field::Report)) | (_, Some(Field::TmFrame)) => {
+                    "server to ground"
+                }
                 (_, Some(Field::Visit)) => {
                     // The board number, then the command.
                     visit_board = !visit_board;
@@ -71,7 +73,7 @@ fn replay_sends_what_the_engine_sent_in_every_scenario() {
     let dir = std::env::temp_dir().join(format!("mmic-replay-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let all = scenarios();
-    assert_eq!(all.len(), 3 + FAULTS.len());
+    assert_eq!(all.len(), 4 + FAULTS.len());
     for (name, mut cfg) in all {
         let path = dir.join(format!("{name}.trace"));
         cfg.record = Some(path.clone());
@@ -121,6 +123,23 @@ fn replay_sends_what_the_engine_sent_in_every_scenario() {
             status["state"],
             "{name}"
         );
+        if cfg.link == mmic_host::sim::LinkLayer::Frames {
+            // The frame gateway ran: TC frames in (some retransmitted after the ground link
+            // lost them), every TM frame out in the streams compared above.
+            assert_eq!(t.header.protocol, Protocol::PusFrames, "{name}");
+            assert!(summary.completed(), "{name}");
+            let f = summary.frames.expect("the link's figures");
+            assert!(f.retransmissions > 0 && f.tm_lost > 0, "{name}: {f:?}");
+            let count = |field: Field| {
+                records(&out)
+                    .flat_map(|r| fields(r.fields))
+                    .filter(|(id, _)| *id == field as u8)
+                    .count() as u64
+            };
+            assert_eq!(count(Field::TmFrame), f.tm_frames, "{name}");
+            assert!(count(Field::TcFrame) > 0, "{name}");
+            assert_eq!(count(Field::Report), 0, "{name}: no bare packets");
+        }
         if let Some(f) = name.strip_prefix("fault-") {
             let raised = mmic_host::sim::report::faults_raised(&summary);
             assert!(raised.iter().any(|x| x == f), "{name}: raised {raised:?}");

@@ -9,7 +9,8 @@
 //! (the hand-off queue's next command, the next internal heartbeat from the serial line, side
 //! A's [`Frontend`], [`BoardA::tick`], the heartbeat into the other hand-off queue), board A's
 //! WiFi task (commands deframed into the queue; heartbeats drained), board B's tick, and the
-//! server board (the legacy relay [`Server`] or the PUS [`Gateway`]). No `unsafe`, no
+//! server board (the legacy relay [`Server`], the PUS [`Gateway`], or the gateway behind the
+//! space data link, [`FrameGateway`]: TC frames in, TM frames out). No `unsafe`, no
 //! allocation, no panic on any trace.
 //!
 //! ```
@@ -33,10 +34,12 @@ pub mod parsers;
 pub mod trace;
 
 use heapless::{Deque, Vec};
+use mmic::link::tm_frame::TM_FRAME_LEN;
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
+use mmic::node::server::frames::FrameGateway;
 use mmic::node::server::gateway::{self, Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -91,10 +94,45 @@ impl Phase {
     }
 }
 
+/// One library call of the frame gateway inside a record's node phase, timed on its own (a
+/// server loop makes several: each TC frame, the tick, each TM frame handed out).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Call {
+    /// [`FrameGateway::tc_frame`]: the frame checks, FARM-1, the packets into the gateway and
+    /// their reports into the TM framer.
+    TcFrame = 0,
+    /// [`FrameGateway::tick`]: the gateway's resends, polls and housekeeping.
+    Tick = 1,
+    /// [`FrameGateway::frame`]: one TM frame written (or the answer that none is due).
+    Frame = 2,
+    /// [`FrameGateway::heartbeat`]: a heartbeat's reports into the TM framer.
+    Heartbeat = 3,
+}
+
+impl Call {
+    /// Every call, in table order.
+    pub const ALL: [Call; 4] = [Call::TcFrame, Call::Tick, Call::Frame, Call::Heartbeat];
+
+    /// The call's name in tables.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Call::TcFrame => "tc_frame",
+            Call::Tick => "tick",
+            Call::Frame => "frame",
+            Call::Heartbeat => "heartbeat",
+        }
+    }
+}
+
 /// Told where a call's phases begin (the runner counts instructions; the host does nothing).
 pub trait Meter {
     /// The call enters phase `p`.
     fn enter(&mut self, p: Phase);
+
+    /// The library call `c` starts (`start`) or has returned; the phase does not change.
+    fn call(&mut self, c: Call, start: bool) {
+        let _ = (c, start);
+    }
 }
 
 impl Meter for () {
@@ -103,6 +141,12 @@ impl Meter for () {
 
 /// The gateway of the simulator: one robot, eight waiting telecommands, 64 remembered keys.
 pub type ReplayGateway = Gateway<1, 8, 64>;
+
+/// The gateway behind the space data link, with the simulator's sizes (`host/src/sim/engine`'s
+/// `SimFrameGateway`: one robot, eight waiting telecommands, 64 remembered keys, 4 KiB of TM
+/// packets waiting): the same sizes, or the two runs' outputs diverge (a framer that fills
+/// sooner loses other reports).
+pub type ReplayFrameGateway = FrameGateway<1, 8, 64, 4096>;
 
 /// The largest telemetry packet the gateway writes, bytes.
 pub const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + gateway::MAX_TM_DATA;
@@ -119,6 +163,7 @@ const QUEUE: usize = 32;
 enum Board {
     Relay(Server<4>),
     Gateway(ReplayGateway),
+    Frames(ReplayFrameGateway),
 }
 
 /// One robot's nodes, and the glue between them.
@@ -182,6 +227,11 @@ impl Replay {
                 let mut g = ReplayGateway::new(h.gateway);
                 g.add(h.board);
                 Board::Gateway(g)
+            }
+            Protocol::PusFrames => {
+                let mut g = ReplayFrameGateway::new(h.frame_config());
+                g.add(h.board);
+                Board::Frames(g)
             }
         };
         Replay {
@@ -359,7 +409,7 @@ impl Replay {
                 m.enter(Phase::Node);
                 frames(&mut self.server_reader, bytes, |f| keep(f.as_bytes()));
             }
-            Board::Gateway(_) => keep(bytes),
+            Board::Gateway(_) | Board::Frames(_) => keep(bytes),
         }
         m.enter(Phase::Record);
         queued_record(&mut self.w, n, over);
@@ -367,68 +417,18 @@ impl Replay {
 
     #[inline(never)]
     fn server_loop(&mut self, now: u32, m: &mut impl Meter) {
-        let number = self.header.board;
+        let mut io = ServerIo {
+            inbox: &mut self.inbox,
+            w: &mut self.w,
+            visit: &mut self.visit,
+            number: self.header.board,
+            now,
+        };
         m.enter(Phase::Node);
         match &mut self.board {
-            Board::Relay(srv) => {
-                while let Some(p) = self.inbox.pop_front() {
-                    let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(p.as_slice()) else {
-                        continue;
-                    };
-                    let r = srv.accept(&packet);
-                    m.enter(Phase::Record);
-                    match r {
-                        Ok(Accepted::Superseded(old)) => {
-                            self.w.debug(Field::Accepted, &"Superseded");
-                            self.w.bytes(Field::Accepted, &old);
-                        }
-                        Ok(a) => self.w.debug(Field::Accepted, &a),
-                        Err(e) => self.w.debug(Field::Refused, &e),
-                    }
-                    m.enter(Phase::Node);
-                }
-                // The replay keeps no deadline: the trace has a heartbeat record only while
-                // the engine's visit was current.
-                if let Some(visit) = Visit::next(srv, now, u32::MAX / 2) {
-                    visit.written(srv);
-                    let (board, packet) = (visit.board(), *visit.packet());
-                    if board == number {
-                        self.visit = Some(visit);
-                    }
-                    m.enter(Phase::Record);
-                    self.w.u8(Field::Visit, board.get());
-                    self.w.bytes(Field::Visit, &packet);
-                }
-            }
-            Board::Gateway(g) => {
-                while let Some(p) = self.inbox.pop_front() {
-                    match g.tc_packet(&p) {
-                        Ok(o) => reports(&mut self.w, g, o, now, m),
-                        Err(e) => {
-                            m.enter(Phase::Record);
-                            self.w.debug(Field::Refused, &e);
-                            m.enter(Phase::Node);
-                        }
-                    }
-                }
-                let o = g.tick(now);
-                let visit = o
-                    .to_robots
-                    .iter()
-                    .find(|(b, _)| *b == number)
-                    .map(|(_, c)| c.to_bytes());
-                reports(&mut self.w, g, o, now, m);
-                if let Some(packet) = visit {
-                    self.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
-                    m.enter(Phase::Record);
-                    self.w.u8(Field::Visit, number.get());
-                    self.w.bytes(Field::Visit, &packet);
-                } else {
-                    let d = g.next_deadline(now);
-                    m.enter(Phase::Record);
-                    self.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
-                }
-            }
+            Board::Relay(srv) => relay_loop(srv, &mut io, m),
+            Board::Gateway(g) => gateway_loop(g, &mut io, m),
+            Board::Frames(g) => frames_loop(g, &mut io, m),
         }
     }
 
@@ -443,13 +443,172 @@ impl Replay {
                 m.enter(Phase::Record);
                 self.w.bytes(Field::Sent, &hb);
             }
-            Board::Gateway(g) => {
-                if let Ok(h) = HeartbeatRepr::parse(&hb) {
-                    let o = g.heartbeat(now, &h);
-                    reports(&mut self.w, g, o, now, m);
-                }
+            Board::Gateway(g) => gateway_heartbeat(g, &mut self.w, now, &hb, m),
+            Board::Frames(g) => frames_heartbeat(g, &mut self.w, now, &hb, m),
+        }
+    }
+}
+
+/// A heartbeat into the PUS gateway, its reports into the record.
+#[inline(never)]
+fn gateway_heartbeat(
+    g: &mut ReplayGateway,
+    w: &mut RecordWriter,
+    now: u32,
+    hb: &[u8; HEARTBEAT_LEN],
+    m: &mut impl Meter,
+) {
+    if let Ok(h) = HeartbeatRepr::parse(hb) {
+        let o = g.heartbeat(now, &h);
+        reports(w, g, o, now, m);
+    }
+}
+
+/// A heartbeat into the frame gateway, the TM frames due into the record (as the engine's
+/// `heartbeat_at_server` with `--link frames`).
+#[inline(never)]
+fn frames_heartbeat(
+    g: &mut ReplayFrameGateway,
+    w: &mut RecordWriter,
+    now: u32,
+    hb: &[u8; HEARTBEAT_LEN],
+    m: &mut impl Meter,
+) {
+    if let Ok(h) = HeartbeatRepr::parse(hb) {
+        m.call(Call::Heartbeat, true);
+        g.heartbeat(now, &h);
+        m.call(Call::Heartbeat, false);
+    }
+    tm_frames(w, g, now, m);
+}
+
+/// What a server board's loop works on besides its node: the ground's packets waiting, the
+/// output record, the current visit.
+struct ServerIo<'r> {
+    inbox: &'r mut Deque<Vec<u8, MAX_GROUND_PACKET>, QUEUE>,
+    w: &'r mut RecordWriter,
+    visit: &'r mut Option<Visit>,
+    number: mmic::units::BoardNumber,
+    now: u32,
+}
+
+// Each board's loop in a function of its own, never inlined, so that a call's stack holds the
+// buffers of its own node only (the RV32 runner measures it).
+/// The legacy relay's loop: the ground's commands accepted, the next visit.
+#[inline(never)]
+fn relay_loop(srv: &mut Server<4>, io: &mut ServerIo<'_>, m: &mut impl Meter) {
+    let (number, now) = (io.number, io.now);
+    while let Some(p) = io.inbox.pop_front() {
+        let Ok(packet) = <[u8; COMMAND_LEN]>::try_from(p.as_slice()) else {
+            continue;
+        };
+        let r = srv.accept(&packet);
+        m.enter(Phase::Record);
+        match r {
+            Ok(Accepted::Superseded(old)) => {
+                io.w.debug(Field::Accepted, &"Superseded");
+                io.w.bytes(Field::Accepted, &old);
+            }
+            Ok(a) => io.w.debug(Field::Accepted, &a),
+            Err(e) => io.w.debug(Field::Refused, &e),
+        }
+        m.enter(Phase::Node);
+    }
+    // The replay keeps no deadline: the trace has a heartbeat record only while
+    // the engine's visit was current.
+    if let Some(visit) = Visit::next(srv, now, u32::MAX / 2) {
+        visit.written(srv);
+        let (board, packet) = (visit.board(), *visit.packet());
+        if board == number {
+            *io.visit = Some(visit);
+        }
+        m.enter(Phase::Record);
+        io.w.u8(Field::Visit, board.get());
+        io.w.bytes(Field::Visit, &packet);
+    }
+}
+
+/// The PUS gateway's loop: the telecommands, the tick and its reports, the next visit.
+#[inline(never)]
+fn gateway_loop(g: &mut ReplayGateway, io: &mut ServerIo<'_>, m: &mut impl Meter) {
+    let (number, now) = (io.number, io.now);
+    while let Some(p) = io.inbox.pop_front() {
+        match g.tc_packet(&p) {
+            Ok(o) => reports(io.w, g, o, now, m),
+            Err(e) => {
+                m.enter(Phase::Record);
+                io.w.debug(Field::Refused, &e);
+                m.enter(Phase::Node);
             }
         }
+    }
+    let o = g.tick(now);
+    let visit = o
+        .to_robots
+        .iter()
+        .find(|(b, _)| *b == number)
+        .map(|(_, c)| c.to_bytes());
+    reports(io.w, g, o, now, m);
+    if let Some(packet) = visit {
+        *io.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
+        m.enter(Phase::Record);
+        io.w.u8(Field::Visit, number.get());
+        io.w.bytes(Field::Visit, &packet);
+    } else {
+        let d = g.next_deadline(now);
+        m.enter(Phase::Record);
+        io.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
+    }
+}
+
+/// The frame gateway's loop, as the engine's `frames_loop`: the TC frames through FARM-1 into
+/// the gateway, the tick, the TM frames due, the next visit.
+#[inline(never)]
+fn frames_loop(g: &mut ReplayFrameGateway, io: &mut ServerIo<'_>, m: &mut impl Meter) {
+    let (number, now) = (io.number, io.now);
+    // As the engine's `frames_loop`: the TC frames through FARM-1 into the
+    // gateway, the tick, the TM frames due, the next visit.
+    while let Some(f) = io.inbox.pop_front() {
+        m.call(Call::TcFrame, true);
+        let got = g.tc_frame(now, &f);
+        m.call(Call::TcFrame, false);
+        m.enter(Phase::Record);
+        io.w.debug(Field::TcFrame, &got);
+        m.enter(Phase::Node);
+    }
+    m.call(Call::Tick, true);
+    let to_robots = g.tick(now);
+    m.call(Call::Tick, false);
+    let visit = to_robots
+        .iter()
+        .find(|(b, _)| *b == number)
+        .map(|(_, c)| c.to_bytes());
+    tm_frames(io.w, g, now, m);
+    if let Some(packet) = visit {
+        *io.visit = Some(Visit::new(now, number, packet, u32::MAX / 2));
+        m.enter(Phase::Record);
+        io.w.u8(Field::Visit, number.get());
+        io.w.bytes(Field::Visit, &packet);
+    } else {
+        let d = g.next_deadline(now);
+        m.enter(Phase::Record);
+        io.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
+    }
+}
+
+/// The TM frames due at `now`, each into the record (as the engine's `tm_frames` sends them).
+fn tm_frames(w: &mut RecordWriter, g: &mut ReplayFrameGateway, now: u32, m: &mut impl Meter) {
+    let mut buf = [0u8; TM_FRAME_LEN];
+    loop {
+        m.call(Call::Frame, true);
+        let f = g.frame(now, &mut buf);
+        m.call(Call::Frame, false);
+        let Some((_, n)) = f else {
+            return;
+        };
+        m.enter(Phase::Record);
+        w.bytes(Field::TmFrame, buf.get(..n).unwrap_or(&[]));
+        m.enter(Phase::Node);
     }
 }
 

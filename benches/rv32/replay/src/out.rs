@@ -26,9 +26,10 @@
 use crate::Sink;
 use core::fmt::{self, Write};
 
-/// The largest output record, bytes (a gateway loop's reports; a longer one is cut and says so
-/// in [`Field::Truncated`]).
-pub const RECORD_MAX: usize = 2048;
+/// The largest output record, bytes (a gateway loop's reports, or the frame gateway's TM
+/// frames: its framer holds 4 KiB of packets, 17 frames of 256 octets; a longer one is cut and
+/// says so in [`Field::Truncated`]).
+pub const RECORD_MAX: usize = 8192;
 
 macro_rules! fields {
     ($($name:ident = $id:literal, $text:literal;)*) => {
@@ -82,6 +83,8 @@ fields! {
     Overflow = 29, "server: reports overflowed";
     Error = 30, "replay error";
     Truncated = 31, "output record cut";
+    TcFrame = 32, "server: TC frame (robot, verdict, packets accepted, refused)";
+    TmFrame = 33, "server: TM frame";
 }
 
 /// Builds one output record at a time (the buffer lives here, not on the stack of the tick

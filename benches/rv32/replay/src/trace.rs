@@ -3,13 +3,18 @@
 //! its time and the bytes or readings it was given. Little-endian throughout.
 //!
 //! ```text
-//! header  "MMICRPL1" protocol:u8 board:u8 state:u8
+//! header  "MMICRPL1" protocol:u8 board:u8 state:u8      (protocol: 0 legacy, 1 PUS, 2 PUS over frames)
 //!         period_ms:u32 timeout_ms:u32 max_attempts:u8 poll_ms:u32 hk_interval_ms:u32 hk_enabled:u8
 //! record  tag:u8 t_ms:u32 body            (body by tag, see [`Record`])
 //! reading flags:u8 [adc:8×u16] [accel:3×i16] [encoder:u16]
 //!         flags: 1 adc, 2 accel, 4 encoder, 8 arm contracted, 16 bolter at home
 //! bytes   len:u16 bytes
 //! ```
+//!
+//! The format has one version: a trace of an older build reads the same (protocol 2 only
+//! added a value, and with it the server board's `ServerIn` records carry TC transfer frames
+//! instead of PUS packets; the link's own settings are [`FrameConfig`]'s defaults with the
+//! header's gateway timing, as the engine runs it).
 //!
 //! ```
 //! use mmic_replay::trace::{Header, Protocol, Reading, Record, Trace};
@@ -27,6 +32,7 @@
 use crate::Sink;
 use mmic::motion::State;
 use mmic::node::exactly_once::uplink;
+use mmic::node::server::frames::FrameConfig;
 use mmic::node::server::gateway;
 use mmic::sensors::frontend::Raw;
 use mmic::units::BoardNumber;
@@ -75,6 +81,10 @@ pub enum Protocol {
     Legacy = 0,
     /// PUS-C: the server board is the gateway (`mmic::node::server::gateway`).
     Pus = 1,
+    /// PUS-C behind the space data link (`mmic sim --link frames`): the server board is the
+    /// frame gateway (`mmic::node::server::frames`), the ground's bytes are TC transfer frames
+    /// and what it sends back TM transfer frames.
+    PusFrames = 2,
 }
 
 /// The scenario's fixed settings.
@@ -86,11 +96,20 @@ pub struct Header {
     pub board: BoardNumber,
     /// The state the robot starts in.
     pub start: State,
-    /// The gateway's timing (used with [`Protocol::Pus`]).
+    /// The gateway's timing (used with [`Protocol::Pus`] and [`Protocol::PusFrames`]).
     pub gateway: gateway::Config,
 }
 
 impl Header {
+    /// The frame gateway's settings of a [`Protocol::PusFrames`] trace: the link's defaults
+    /// (`spec/ccsds/link.toml`) around the header's gateway timing, as the engine builds it.
+    pub fn frame_config(&self) -> FrameConfig {
+        FrameConfig {
+            gateway: self.gateway,
+            ..FrameConfig::default()
+        }
+    }
+
     /// Robot 1 in state `a` with the gateway's defaults: the simulator's demo.
     pub fn demo(protocol: Protocol) -> Header {
         Header {
@@ -125,6 +144,7 @@ impl Header {
         let protocol = match r.u8()? {
             0 => Protocol::Legacy,
             1 => Protocol::Pus,
+            2 => Protocol::PusFrames,
             p => return Err(header("protocol", p.into())),
         };
         let b = r.u8()?;
@@ -255,7 +275,8 @@ pub enum Record<'a> {
     WifiBytes { t: u32, bytes: &'a [u8] },
     /// Board A's WiFi task writes the queued heartbeats (or discards them, unconnected).
     WifiDrain { t: u32 },
-    /// Bytes from the ground reach the server board.
+    /// Bytes from the ground reach the server board: a PUS packet (or the legacy serial
+    /// line's bytes), or a TC transfer frame with [`Protocol::PusFrames`].
     ServerIn { t: u32, bytes: &'a [u8] },
     /// The server board's loop runs (between visits).
     ServerLoop { t: u32 },

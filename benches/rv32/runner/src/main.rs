@@ -20,7 +20,7 @@
 use core::ffi::CStr;
 use mmic_replay::cost::{Cost, COST_LEN};
 use mmic_replay::trace::{Record, Trace};
-use mmic_replay::{Meter, Phase, Replay, Sink};
+use mmic_replay::{Call, Meter, Phase, Replay, Sink};
 use riscv::register::minstret;
 use semihosting::fs::File;
 use semihosting::io::{Read, Write};
@@ -206,17 +206,48 @@ fn lowest_dirty(bottom: usize, top: usize) -> usize {
     top
 }
 
+/// The frame gateway's library calls over a trace ([`Call`]): how many, the most
+/// instructions one took and when, and their sum.
+#[derive(Default, Clone, Copy)]
+struct CallStat {
+    calls: u32,
+    max: u32,
+    max_t: u32,
+    sum: u64,
+}
+
 /// Counts instructions per phase and takes the stack depth when the output record starts.
-struct Counter {
+struct Counter<'c> {
     bottom: usize,
     top: usize,
     phase: Phase,
     last: u32,
     acc: [u32; 4],
     stack_node: Option<usize>,
+    t: u32,
+    call_start: u32,
+    calls: &'c mut [CallStat; 4],
 }
 
-impl Meter for Counter {
+impl Meter for Counter<'_> {
+    #[inline(never)]
+    fn call(&mut self, c: Call, start: bool) {
+        let now = minstret::read() as u32;
+        if start {
+            self.call_start = now;
+            return;
+        }
+        let n = now.wrapping_sub(self.call_start);
+        if let Some(s) = self.calls.get_mut(c as usize) {
+            s.calls += 1;
+            s.sum += u64::from(n);
+            if n > s.max {
+                s.max = n;
+                s.max_t = self.t;
+            }
+        }
+    }
+
     #[inline(never)]
     fn enter(&mut self, p: Phase) {
         let now = minstret::read() as u32;
@@ -246,6 +277,7 @@ fn drive(
     // RAM), and nothing else runs (one hart, no interrupts enabled).
     unsafe { paint(bottom, top - 64) };
     let mut n = 0;
+    let mut calls = [CallStat::default(); 4];
     for rec in t.records() {
         let rec = rec.map_err(|_| "a trace record is malformed")?;
         let mut m = Counter {
@@ -255,6 +287,9 @@ fn drive(
             last: 0,
             acc: [0; 4],
             stack_node: None,
+            t: rec.t(),
+            call_start: 0,
+            calls: &mut calls,
         };
         m.last = minstret::read() as u32;
         step(replay, &rec, out, &mut m);
@@ -278,13 +313,27 @@ fn drive(
         unsafe { paint(low, top - 64) };
         n += 1;
     }
+    // The frame gateway's own calls (a frames trace only): each call's instructions, between
+    // two reads of minstret around it.
+    for (c, s) in Call::ALL.iter().zip(calls) {
+        if s.calls > 0 {
+            println!(
+                "mmic-rv32: frame gateway {}: {} calls, instructions max {} (at {} ms), mean {}",
+                c.name(),
+                s.calls,
+                s.max,
+                s.max_t,
+                s.sum / u64::from(s.calls)
+            );
+        }
+    }
     Ok(n)
 }
 
 /// One call, in a frame of its own below `drive`'s stack pointer, so that the call's own
 /// locals (whatever is inlined into it) are counted in its stack depth.
 #[inline(never)]
-fn step(replay: &mut Replay, rec: &Record<'_>, out: &mut Buffered, m: &mut Counter) {
+fn step(replay: &mut Replay, rec: &Record<'_>, out: &mut Buffered, m: &mut Counter<'_>) {
     replay.step(rec, out, m);
 }
 

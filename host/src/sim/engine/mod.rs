@@ -53,7 +53,7 @@ use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::server::frames::{FrameConfig, FrameGateway};
+use mmic::node::server::frames::FrameConfig;
 use mmic::node::server::gateway::{Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -195,8 +195,9 @@ type SimGateway = Gateway<1, 8, 64>;
 const MAX_TM_LEN: usize = mmic::ccsds::tm::TM_MIN_LEN + mmic::node::server::gateway::MAX_TM_DATA;
 
 /// The PUS gateway behind the space data link (`--link frames`): the same sizes, 4 KiB of
-/// TM packets waiting for frames.
-type SimFrameGateway = FrameGateway<1, 8, 64, 4096>;
+/// TM packets waiting for frames. The replay's own type (`mmic_replay::ReplayFrameGateway`),
+/// so that a recorded trace replays with the same sizes.
+type SimFrameGateway = mmic_replay::ReplayFrameGateway;
 
 /// The ground's end of a robot's space data link: FOP-1's window K = 10, 64 packets waiting,
 /// packets of up to 1 KiB reassembled.
@@ -1075,6 +1076,7 @@ fn record_header(cfg: &SimConfig) -> trace::Header {
     trace::Header {
         protocol: match cfg.protocol {
             Protocol::Legacy => trace::Protocol::Legacy,
+            Protocol::Pus if cfg.link == LinkLayer::Frames => trace::Protocol::PusFrames,
             Protocol::Pus => trace::Protocol::Pus,
         },
         board: board_number(0),
