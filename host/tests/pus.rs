@@ -18,7 +18,7 @@ use mmic::pus::verification::{Report, RequestId, Stage};
 use mmic::refusal::Refusal;
 use mmic::units::BoardNumber;
 use mmic_host::sim::lockstep::Robot;
-use mmic_host::sim::{report, run, PlantConfig, Protocol, SimConfig, Summary};
+use mmic_host::sim::{report, run, LinkLayer, PlantConfig, Protocol, SimConfig, Summary};
 use serde_json::Value;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
@@ -689,4 +689,43 @@ fn hip_mismatch_at_power_up_over_pus_refuses_the_next_step() {
         .iter()
         .any(|(_, p)| p["service"] == 5 && p["report"]["event_id"] == hip));
     assert_eq!(report::last_mode(&s), "safed");
+}
+
+#[test]
+fn the_demo_completes_over_the_space_data_link_with_loss_and_runs_nothing_twice() {
+    // The acceptance run: `mmic sim --protocol pus --link frames --wifi-loss 0.3
+    // --serial-loss 0.2` (the serial loss is the ground link's: every TC and TM frame).
+    let cfg = SimConfig {
+        link: LinkLayer::Frames,
+        wifi_loss: 0.3,
+        serial_loss: 0.2,
+        ..SimConfig::demo()
+    };
+    let (s, records) = simulate("pus_frames_lossy", cfg.clone());
+    assert!(s.completed(), "{}", report::text(&s));
+    assert!(report::executed_twice(&s).is_empty());
+    let f = s.frames.expect("the link's figures");
+    assert!(f.retransmissions > 0 && f.tm_lost > 0, "{f:?}");
+    assert_eq!(f.lockout_reports, 0, "{f:?}");
+    assert!(
+        f.clcws * 2 > f.tm_frames,
+        "most TM frames reach the ground: {f:?}"
+    );
+    assert!(report::text(&s).contains("link: frames"));
+    // Frames on the ground link, decoded in the log; packets nowhere else on it.
+    let kinds: BTreeSet<&str> = records
+        .iter()
+        .filter(|r| r["kind"] == "packet" && r["link"] == "udp_ground")
+        .filter_map(|r| r["packet_kind"].as_str())
+        .collect();
+    assert_eq!(kinds, BTreeSet::from(["tc_frame", "tm_frame"]));
+    // Virtual time: the same seed gives the same run.
+    let again = run(&SimConfig {
+        protocol: Protocol::Pus,
+        log_path: None,
+        ..cfg
+    })
+    .unwrap();
+    assert_eq!(again.frames, s.frames);
+    assert_eq!(again.sim_ms, s.sim_ms);
 }

@@ -204,6 +204,10 @@ fn events() -> Vec<FarmEvent> {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "9.5 million cells: days under Miri (the unit tests of link::farm run)"
+)]
 fn farm_follows_table_6_1_cell_by_cell() {
     let cells = table();
     let events = events();

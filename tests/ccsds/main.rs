@@ -12,6 +12,7 @@ mod corruption;
 mod farm_table;
 mod golden;
 mod interop_spacepackets;
+mod link_spec;
 mod tc_frame;
 mod tm_frame;
 mod tm_link;

@@ -104,7 +104,23 @@ pub fn decode(bytes: &[u8]) -> (&'static str, Value) {
         let v = crate::codec::decode_value(bytes).unwrap_or(Value::Null);
         return (name, v);
     }
-    pus(bytes).unwrap_or(("unknown", Value::Null))
+    pus(bytes)
+        .or_else(|| frame(bytes))
+        .unwrap_or(("unknown", Value::Null))
+}
+
+/// A TC or TM transfer frame (`--link frames`) as JSON, `mmic decode tc-frame|tm-frame`'s:
+/// a TM frame is the mission's length, anything else is tried as a TC frame.
+fn frame(bytes: &[u8]) -> Option<(&'static str, Value)> {
+    let options = crate::link::FrameOptions::default();
+    if bytes.len() == mmic::link::tm_frame::TM_FRAME_LEN {
+        if let Ok(v) = crate::link::decode_tm_frame(bytes, &options) {
+            return Some(("tm_frame", v));
+        }
+    }
+    crate::link::decode_tc_frame(bytes, &options)
+        .ok()
+        .map(|v| ("tc_frame", v))
 }
 
 /// Every robot's APID.
