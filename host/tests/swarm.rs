@@ -239,7 +239,10 @@ fn pus_scenarios_draw_packets_or_frames_from_a_stream_of_their_own() {
                 heavier += (any.cfg.serial_loss > 0.1) as u32;
             }
         }
-        assert_eq!(Scenario::from_seed(seed, &Options::default()).describe(), any.describe());
+        assert_eq!(
+            Scenario::from_seed(seed, &Options::default()).describe(),
+            any.describe()
+        );
     }
     assert!(
         (0.4..0.6).contains(&(frames as f64 / pus as f64)),
@@ -276,7 +279,10 @@ fn the_invariants_hold_over_the_space_data_link() {
     assert!(r.checked.commands_ended > 300, "{:?}", r.checked);
     let text = r.text(&opts);
     assert!(
-        text.contains(&format!("space data link: {} runs over frames", r.frame_runs)),
+        text.contains(&format!(
+            "space data link: {} runs over frames",
+            r.frame_runs
+        )),
         "{text}"
     );
     assert_eq!(r.json(&opts)["frame_runs"], r.frame_runs);
