@@ -1,7 +1,9 @@
 """An independent reading of the CCSDS transfer frames, in Python, for the ground tests: TM transfer
 frames (132.0-B-3) with the CLCW in their OCF (232.0-B-4 §4.2) and the packets in them, and the TC
 transfer frames (232.0-B-4) YAMCS sends. Written from the standards' bit layouts, not from the Rust
-code (spacepackets 0.32 on PyPI has USLP frames only, so it cannot be the independent decoder here).
+code. spacepackets 0.32 has a TM frame reader too (`spacepackets.ccsds.tm_frame.TmTransferFrame`: the
+header, data field, OCF and a CRC check, no packet extraction): test_yamcs_frames.py reads every frame
+of the gateway with both and requires them to agree.
 
     frames = [bytes.fromhex(h) for h in captured]
     x = TmExtractor(frame_len=256, spacecraft_id=0x101)

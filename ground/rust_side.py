@@ -79,10 +79,13 @@ def jsonl(path: Path) -> list[dict]:
 
 class RobotProcess:
     """The robot on UDP: TCs on 127.0.0.1:tc_port, TM to 127.0.0.1:tm_port. Its JSON lines
-    ({"dir":"tc"|"tm","hex":..}) arrive on `self.lines`; `tcs()` gets the next TC it received."""
+    ({"dir":"tc"|"tm","hex":..}; with `mmic sim --link frames` {"dir":"tc-frame"|"tm-frame",..})
+    arrive on `self.lines` and are all kept, in order, in `self.log`; `next_tc()` gets the next TC
+    it received, `next_tc_frame()` the next TC frame. `command` (a format string as $GROUND_ROBOT)
+    replaces the command line of $GROUND_ROBOT and the default."""
 
-    def __init__(self, tm_port: int, tc_port: int, seconds: int = 240):
-        template = os.environ.get(
+    def __init__(self, tm_port: int, tc_port: int, seconds: int = 240, command: str | None = None):
+        template = command or os.environ.get(
             "GROUND_ROBOT",
             "{mmic} ground robot --tm-port {tm_port} --tc-port {tc_port} --seconds {seconds}")
         cmd = template.format(mmic=mmic_bin(), tm_port=tm_port, tc_port=tc_port, seconds=seconds)
@@ -90,6 +93,8 @@ class RobotProcess:
                                      text=True, start_new_session=True)
         self.lines: "queue.Queue[dict]" = queue.Queue()
         self.tc_lines: "queue.Queue[dict]" = queue.Queue()
+        self.tc_frame_lines: "queue.Queue[dict]" = queue.Queue()
+        self.log: list[dict] = []
         self.ready = threading.Event()
         threading.Thread(target=self._read, daemon=True).start()
 
@@ -103,10 +108,16 @@ class RobotProcess:
                 self.ready.set()
             elif d.get("dir") == "tc":
                 self.tc_lines.put(d)
+            elif d.get("dir") == "tc-frame":
+                self.tc_frame_lines.put(d)
+            self.log.append(d)
             self.lines.put(d)
 
     def next_tc(self, timeout: float) -> dict:
         return self.tc_lines.get(timeout=timeout)
+
+    def next_tc_frame(self, timeout: float) -> dict:
+        return self.tc_frame_lines.get(timeout=timeout)
 
     def close(self):
         if self.proc.poll() is None:

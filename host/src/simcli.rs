@@ -176,7 +176,8 @@ pub struct SimArgs {
     /// server board sends its telemetry to this UDP address (e.g. 127.0.0.1:18015) and takes
     /// telecommands on --ground-tc-port; no plan runs, the scale is 1 (the ground's timeouts
     /// are wall time) and the run ends after --max-seconds or when killed. Prints one JSON line
-    /// per packet on stdout (ground/README.md).
+    /// per packet on stdout, with --link frames one per TC and TM transfer frame (one frame per
+    /// datagram each way; ground/README.md).
     #[arg(long, value_name = "ADDR", requires = "ground_tc_port")]
     pub ground_tm_to: Option<std::net::SocketAddr>,
     /// The UDP port on 127.0.0.1 where the external ground's telecommands arrive (0: a free

@@ -3,7 +3,7 @@
 //! protocols and a lossy WiFi link, and it runs the same node code as the virtual-time engine
 //! (`host/tests/sim.rs` and `host/tests/engine.rs` test the behaviour, in virtual time).
 
-use mmic_host::sim::{engine, realtime, report, Protocol, SimConfig, Summary};
+use mmic_host::sim::{engine, realtime, report, LinkLayer, Protocol, SimConfig, Summary};
 use serde_json::Value;
 
 fn realtime_demo(protocol: Protocol) -> SimConfig {
@@ -88,6 +88,56 @@ fn thirty_percent_wifi_loss_over_tcp_runs_nothing_twice() {
     assert!(s.completed(), "{}", report::text(&s));
     let copies = events(&s, "duplicate").len() + events(&s, "stale").len();
     assert!(copies > 0, "resends reached board A and were answered");
+    let mut seen = std::collections::BTreeSet::new();
+    for e in events(&s, "executed") {
+        let seq = e["seq"].as_u64().unwrap();
+        assert!(seq == 0 || seen.insert(seq), "{seq} executed twice");
+    }
+}
+
+#[test]
+fn the_space_data_link_over_lossy_udp_completes_the_demo_and_counts_its_frames() {
+    // TC and TM transfer frames, one per datagram, 20 % of them lost each way: FOP-1's
+    // retransmissions and the TM frames' CLCWs carry the demo through, and nothing runs twice.
+    let mut cfg = realtime_demo(Protocol::Pus);
+    cfg.link = LinkLayer::Frames;
+    cfg.serial_loss = 0.2;
+    cfg.seed = 5;
+    let s = realtime::run(&cfg).unwrap();
+    assert!(s.completed(), "{}", report::text(&s));
+    assert!(!s.host_fell_behind());
+    let f = s.frames.expect("the summary has the link's figures");
+    assert!(
+        f.tc_frames > 0 && f.accepted > 0 && f.tm_frames > 0 && f.clcws > 0,
+        "{f:?}"
+    );
+    assert!(
+        f.retransmissions > 0,
+        "20 % loss and no retransmission: {f:?}"
+    );
+    assert!(f.tm_lost > 0, "20 % loss and no TM frame missing: {f:?}");
+    assert!(f.clcws <= f.tm_frames && f.accepted <= f.tc_frames, "{f:?}");
+    assert!(
+        report::text(&s).contains("link: frames"),
+        "{}",
+        report::text(&s)
+    );
+    let json = report::summary_json(&s, 0);
+    assert_eq!(json.link.as_deref(), Some("frames"));
+    assert!(json.frames.is_some());
+    // Lost frames on the UDP link, logged as such.
+    assert!(s
+        .records
+        .iter()
+        .any(|r| r["kind"] == "packet" && r["link"] == "udp_ground" && r["fate"] == "lost"));
+    // Every command the plan needed ran once, in the plan's order, as in virtual time.
+    let virt = engine::run(&SimConfig {
+        realtime: false,
+        ..cfg
+    })
+    .unwrap();
+    assert!(virt.completed(), "{}", report::text(&virt));
+    assert_eq!(commands_run(&s), commands_run(&virt));
     let mut seen = std::collections::BTreeSet::new();
     for e in events(&s, "executed") {
         let seq = e["seq"].as_u64().unwrap();

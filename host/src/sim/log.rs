@@ -200,9 +200,25 @@ pub fn write_lines(records: &[Record], out: &mut dyn Write) -> std::io::Result<(
 }
 
 /// Writes every record until all senders are gone; returns the records for the report.
+///
+/// The output is flushed whenever the writer has caught up with the nodes (nothing waiting in
+/// the channel): a run that is killed (an external ground's robot, stopped by its test) leaves
+/// its log complete up to that moment, and a reader can follow it while it runs; a busy run
+/// still writes in large blocks.
 pub fn write_all(rx: Receiver<Record>, out: &mut dyn Write) -> std::io::Result<Vec<Record>> {
     let mut all = Vec::new();
-    for r in rx {
+    loop {
+        let r = match rx.try_recv() {
+            Ok(r) => r,
+            Err(std::sync::mpsc::TryRecvError::Empty) => {
+                out.flush()?;
+                match rx.recv() {
+                    Ok(r) => r,
+                    Err(_) => break,
+                }
+            }
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => break,
+        };
         serde_json::to_writer(&mut *out, &r)?;
         out.write_all(b"\n")?;
         all.push(r);

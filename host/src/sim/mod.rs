@@ -150,6 +150,62 @@ pub struct FrameStats {
     pub tm_packets_dropped: u64,
 }
 
+impl FrameStats {
+    /// Adds the ground's end of one robot's link: the TC frames FOP-1 sent, its alerts, the
+    /// CLCWs it heard, the TM frames its extractor found missing.
+    pub fn add_ground<const K: usize, const Q: usize, const N: usize>(
+        &mut self,
+        gl: &mmic::node::ground::frames::GroundLink<K, Q, N>,
+    ) {
+        let c = gl.counters();
+        self.tc_frames += u64::from(c.ad_frames) + u64::from(c.bc_frames);
+        self.retransmissions += u64::from(c.retransmissions);
+        self.alerts += c.alerts.iter().map(|&a| u64::from(a)).sum::<u64>();
+        self.clcws += u64::from(c.clcws);
+        self.lockout_reports += u64::from(c.lockouts);
+        let x = gl.extract_counters();
+        self.tm_lost += u64::from(x.lost_frames);
+        self.tm_packets_dropped += u64::from(x.dropped);
+    }
+
+    /// Adds the server board's end of robot `board`'s link: what its FARM-1 accepted and
+    /// discarded, the TM frames it sent.
+    pub fn add_server<const R: usize, const Q: usize, const K: usize, const N: usize>(
+        &mut self,
+        g: &mmic::node::server::frames::FrameGateway<R, Q, K, N>,
+        board: mmic::units::BoardNumber,
+    ) {
+        if let Some(f) = g.farm(board) {
+            self.accepted += u64::from(f.counters().accepted_ad);
+            self.discarded += f
+                .counters()
+                .discarded
+                .iter()
+                .map(|&d| u64::from(d))
+                .sum::<u64>();
+        }
+        if let Some(c) = g.counters(board) {
+            self.tm_frames += u64::from(c.tm_frames);
+        }
+    }
+
+    /// Both ends together: every figure summed.
+    pub fn merged(self, o: FrameStats) -> FrameStats {
+        FrameStats {
+            tc_frames: self.tc_frames + o.tc_frames,
+            retransmissions: self.retransmissions + o.retransmissions,
+            alerts: self.alerts + o.alerts,
+            clcws: self.clcws + o.clcws,
+            lockout_reports: self.lockout_reports + o.lockout_reports,
+            accepted: self.accepted + o.accepted,
+            discarded: self.discarded + o.discarded,
+            tm_frames: self.tm_frames + o.tm_frames,
+            tm_lost: self.tm_lost + o.tm_lost,
+            tm_packets_dropped: self.tm_packets_dropped + o.tm_packets_dropped,
+        }
+    }
+}
+
 /// What to simulate.
 #[derive(Debug, Clone)]
 pub struct SimConfig {
@@ -230,7 +286,9 @@ pub struct SimConfig {
 /// P`): the server board's gateway takes telecommands on 127.0.0.1:`tc_port` and sends its
 /// telemetry to `tm_to`; no plan runs; the run ends after [`SimConfig::max_sim_ms`] of wall
 /// time (the scale is 1, since the ground's timeouts run on the wall clock) or when killed.
-/// One JSON line per packet on `wire` ([`nodes::WireLog`]), after `{"ready":true,"tc_port":P}`.
+/// One JSON line per packet on `wire` ([`nodes::WireLog`]), after `{"ready":true,"tc_port":P}`;
+/// with [`LinkLayer::Frames`] TC and TM transfer frames instead of packets, one per datagram,
+/// and one line per frame ([`nodes::FrameGatewayTask`]).
 #[derive(Clone)]
 pub struct External {
     /// Where telemetry goes (YAMCS's UDP TM link).

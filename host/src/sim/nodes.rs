@@ -2,14 +2,22 @@
 //! node, and does nothing else. Board A runs two threads, as on the ESP32's two cores: the
 //! WiFi task (TCP) and the control loop, joined by the library's SPSC hand-off queues. The
 //! server board runs the legacy relay ([`ServerTask`]) or, with `--protocol pus`, the PUS
-//! gateway ([`GatewayTask`]: telecommands in and telemetry out over UDP).
+//! gateway ([`GatewayTask`]: telecommands in and telemetry out over UDP), or with `--link
+//! frames` the gateway behind the space data link ([`FrameGatewayTask`]: TC transfer frames in,
+//! TM transfer frames out, one per datagram).
 
 use super::clock::{Clock, NodeClock};
 use super::log::Log;
 use super::plant::Plant;
 use super::shell::{SideA, SideB};
+use super::FrameStats;
+use mmic::link::farm::Verdict;
+use mmic::link::tc_frame::{self, SpacecraftId, TcFrame};
+use mmic::link::tm_frame::TM_FRAME_LEN;
+use mmic::link::ControlCommand;
 use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
+use mmic::node::server::frames::{FrameConfig, FrameGateway};
 use mmic::node::server::gateway::{self, Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -465,12 +473,24 @@ fn connect(addr: &SocketAddr, packet: &[u8]) -> Option<TcpStream> {
 /// to the kernel's tick (4–8 ms here), and a blocked server would hold the paced clock back.
 fn await_heartbeat(
     node: &Node<'_>,
+    sock: TcpStream,
+    visit: &mut Visit,
+) -> Option<[u8; HEARTBEAT_LEN]> {
+    await_heartbeat_with(node, sock, visit, || {})
+}
+
+/// [`await_heartbeat`], calling `meanwhile` between polls of the socket (the frame gateway
+/// keeps its link going during a visit: TC frames in, a TM frame at least every idle period).
+fn await_heartbeat_with(
+    node: &Node<'_>,
     mut sock: TcpStream,
     visit: &mut Visit,
+    mut meanwhile: impl FnMut(),
 ) -> Option<[u8; HEARTBEAT_LEN]> {
     let _ = sock.set_nonblocking(true);
     let mut buf = [0u8; 256];
     while node.running() && visit.left_ms(node.poll()).is_some() {
+        meanwhile();
         match sock.read(&mut buf) {
             Ok(0) => return None,
             Ok(n) => {
@@ -547,7 +567,11 @@ pub struct GatewayTask {
 
 /// The packets between an external ground and the gateway, one JSON line each, as
 /// `mmic ground robot` prints them (ground/README.md): `{"dir":"tc","hex":..,"refused":null|check}`
-/// per telecommand datagram, `{"dir":"tm","hex":..}` per telemetry packet sent.
+/// per telecommand datagram, `{"dir":"tm","hex":..}` per telemetry packet sent. Behind the space
+/// data link ([`FrameGatewayTask`]) one line per frame instead:
+/// `{"dir":"tc-frame","hex":..,"refused":null|check,"farm":verdict|null,"packets":[hex,..]}` per TC
+/// frame received (the frame check that refused it, or FARM-1's verdict as [`verdict_name`] writes
+/// it; the packets it carries), `{"dir":"tm-frame","hex":..}` per TM frame sent.
 #[derive(Clone)]
 pub struct WireLog(pub Arc<Mutex<Box<dyn Write + Send>>>);
 
@@ -642,6 +666,150 @@ impl GatewayTask {
         if let Some(hb) = hb {
             let out = g.heartbeat(node.clock.now_ms(), &hb);
             self.reports(node, g, out);
+        }
+    }
+}
+
+/// The server board as the PUS gateway behind the space data link (`--protocol pus --link
+/// frames`): one TC transfer frame per datagram from the ground into
+/// [`FrameGateway::tc_frame`] (FARM-1, then the packets into the gateway), the visits of board
+/// A as [`GatewayTask`]'s, and every TM transfer frame [`FrameGateway::frame`] says is due —
+/// a gathered report, a changed CLCW, and at least one every idle period — to the ground, one
+/// per datagram. The link keeps going during a visit.
+pub struct FrameGatewayTask {
+    /// Where the ground's TC frames arrive (non-blocking).
+    pub from_ground: UdpSocket,
+    /// The ground's UDP socket.
+    pub to_ground: Lossy<UdpOut>,
+    /// The robot's board A and where it listens.
+    pub robot: (BoardNumber, SocketAddr),
+    /// The gateway's timing: its uplink's timeout is how long a visit waits for the heartbeat.
+    pub config: gateway::Config,
+    /// With an external ground: one JSON line per frame crossing the ground link
+    /// ([`WireLog`]: `tc-frame` and `tm-frame` lines).
+    pub wire: Option<WireLog>,
+    /// Where the server board's figures of the link (FARM-1, TM frames) go when the run ends.
+    pub stats: Arc<Mutex<FrameStats>>,
+}
+
+/// One robot, eight waiting telecommands, 64 remembered keys, 4 KiB of TM packets waiting for
+/// frames (as the virtual-time engine's).
+type SimFrameGateway = FrameGateway<1, 8, 64, 4096>;
+
+/// FARM-1's verdict on a frame, for the wire log: `accept`, `discard:<reason>` (the reason's
+/// name), `unlock`, `set-vr:<V(R)>` (with ` (not executed)` when Lockout kept it from acting),
+/// `released`.
+pub fn verdict_name(v: &Verdict) -> String {
+    match v {
+        Verdict::Accept => "accept".into(),
+        Verdict::Discard(r) => format!("discard:{}", r.name()),
+        Verdict::Control { command, executed } => {
+            let c = match command {
+                ControlCommand::Unlock => "unlock".to_string(),
+                ControlCommand::SetVr(v) => format!("set-vr:{v}"),
+            };
+            if *executed {
+                c
+            } else {
+                c + " (not executed)"
+            }
+        }
+        Verdict::Released => "released".into(),
+    }
+}
+
+impl FrameGatewayTask {
+    /// Runs until the run stops; then adds the server board's figures to [`Self::stats`].
+    pub fn run(mut self, node: Node<'_>) {
+        let mut g = Box::new(SimFrameGateway::new(FrameConfig {
+            gateway: self.config,
+            ..FrameConfig::default()
+        }));
+        g.add(self.robot.0);
+        while node.running() {
+            node.poll();
+            let mut busy = self.link(&node, &mut g);
+            let visits = g.tick(node.clock.now_ms());
+            for (board, command) in visits {
+                busy = true;
+                if board == self.robot.0 {
+                    self.visit(&node, &mut g, command.to_bytes());
+                }
+            }
+            self.tm_frames(&node, &mut g);
+            if !busy {
+                std::thread::sleep(Duration::from_micros(300));
+            }
+        }
+        if let Ok(mut s) = self.stats.lock() {
+            s.add_server(&g, self.robot.0);
+        }
+    }
+
+    /// The link's own work: every TC frame waiting taken, the TM frames due sent. Whether a TC
+    /// frame came.
+    fn link(&mut self, node: &Node<'_>, g: &mut SimFrameGateway) -> bool {
+        let mut buf = [0u8; 2048];
+        let mut busy = false;
+        while let Ok(n) = self.from_ground.recv(&mut buf) {
+            busy = true;
+            let now = node.clock.now_ms();
+            let bytes = buf.get(..n).unwrap_or(&[]);
+            let got = g.tc_frame(now, bytes);
+            if let Err(e) = &got.verdict {
+                node.event(
+                    now,
+                    json!({"type": "tc_frame_refused", "check": e.name(),
+                           "hex": super::log::hex(bytes)}),
+                );
+            }
+            if let Some(w) = &self.wire {
+                let config = tc_frame::mission(SpacecraftId::of_board(self.robot.0));
+                let packets: Vec<String> = TcFrame::new_checked(bytes, &config)
+                    .map(|f| {
+                        f.packets()
+                            .filter_map(Result::ok)
+                            .map(super::log::hex)
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                w.line(json!({"dir": "tc-frame", "hex": super::log::hex(bytes),
+                              "refused": got.verdict.as_ref().err().map(|e| e.name()),
+                              "farm": got.verdict.as_ref().ok().map(verdict_name),
+                              "packets": packets}));
+            }
+        }
+        self.tm_frames(node, g);
+        busy
+    }
+
+    /// Every TM frame due now, to the ground.
+    fn tm_frames(&mut self, node: &Node<'_>, g: &mut SimFrameGateway) {
+        let mut buf = [0u8; TM_FRAME_LEN];
+        let now = node.clock.now_ms();
+        while let Some((_, n)) = g.frame(now, &mut buf) {
+            let f = buf.get(..n).unwrap_or(&[]);
+            self.to_ground.send(now, f);
+            if let Some(w) = &self.wire {
+                w.line(json!({"dir": "tm-frame", "hex": super::log::hex(f)}));
+            }
+        }
+    }
+
+    /// One visit of board A, as [`GatewayTask`]'s, the link served while it waits.
+    fn visit(&mut self, node: &Node<'_>, g: &mut SimFrameGateway, packet: [u8; COMMAND_LEN]) {
+        let (now, wait) = (node.clock.now_ms(), self.config.uplink.timeout_ms);
+        let mut visit = Visit::new(now, self.robot.0, packet, wait);
+        let Some(sock) = connect(&self.robot.1, visit.packet()) else {
+            return;
+        };
+        let hb = await_heartbeat_with(node, sock, &mut visit, || {
+            self.link(node, g);
+        })
+        .and_then(|b| mmic::wire::heartbeat::HeartbeatRepr::parse(&b).ok());
+        if let Some(hb) = hb {
+            g.heartbeat(node.clock.now_ms(), &hb);
+            self.tm_frames(node, g);
         }
     }
 }

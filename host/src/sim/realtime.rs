@@ -13,7 +13,8 @@ use super::log;
 use super::nodes::{self, Lossy};
 use super::plant::{self, PlantConfig};
 use super::shell::{Ground, GroundSide, GroundStats, LegacyGround, SideA, SideB};
-use super::{Protocol, SimConfig, Summary, PACE_SLACK_MS};
+use super::{FrameStats, LinkLayer, Protocol, SimConfig, Summary, PACE_SLACK_MS};
+use mmic::node::ground::frames::GroundLink as FopLink;
 use mmic::node::ground::plan_runner::{PlanEnd, PlanRunner};
 use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
@@ -56,6 +57,8 @@ struct RunEnv<'a> {
     /// Events (always), packets (when logged).
     log: Option<log::Log>,
     packet_log: Option<log::Log>,
+    /// The server boards' figures of the space data link, added when their tasks end.
+    frames: Arc<Mutex<FrameStats>>,
 }
 
 impl<'a> RunEnv<'a> {
@@ -216,9 +219,13 @@ impl ServerEnds<'_> {
         env.lossy(out, link, ends, env.cfg.serial_loss, None, self.seed, k)
     }
 
-    /// The PUS gateway's task on a UDP socket on loopback (the ground's own, or an external
-    /// ground's), with the ground's socket and its writer to the gateway.
-    fn gateway(&self, env: &RunEnv<'_>) -> std::io::Result<(nodes::GatewayTask, GroundUdp)> {
+    /// The UDP link on loopback between the ground (its own socket, or an external ground's
+    /// addresses) and the server board: the board's socket and its lossy writer to the ground,
+    /// and the ground's end.
+    fn udp(
+        &self,
+        env: &RunEnv<'_>,
+    ) -> std::io::Result<(UdpSocket, Lossy<nodes::UdpOut>, GroundUdp)> {
         let cfg = env.cfg;
         // UDP on loopback: one socket at the ground, one at the server board.
         let ground = UdpSocket::bind("127.0.0.1:0")?;
@@ -239,14 +246,39 @@ impl ServerEnds<'_> {
             sock: ground.try_clone()?,
             peer: server_addr,
         };
+        let to_ground = self.lossy(env, to_ground, "udp_ground", 3);
+        Ok((server, to_ground, GroundUdp { ground, to_server }))
+    }
+
+    /// The PUS gateway's task on the UDP link, with the ground's end.
+    fn gateway(&self, env: &RunEnv<'_>) -> std::io::Result<(nodes::GatewayTask, GroundUdp)> {
+        let (server, to_ground, udp) = self.udp(env)?;
         let gw = nodes::GatewayTask {
             from_ground: server,
-            to_ground: self.lossy(env, to_ground, "udp_ground", 3),
+            to_ground,
             robot: (self.board, self.addr),
-            config: cfg.gateway,
-            wire: cfg.external.as_ref().map(|x| x.wire.clone()),
+            config: env.cfg.gateway,
+            wire: env.cfg.external.as_ref().map(|x| x.wire.clone()),
         };
-        Ok((gw, GroundUdp { ground, to_server }))
+        Ok((gw, udp))
+    }
+
+    /// The PUS gateway behind the space data link (`--link frames`) on the UDP link, with the
+    /// ground's end.
+    fn frame_gateway(
+        &self,
+        env: &RunEnv<'_>,
+    ) -> std::io::Result<(nodes::FrameGatewayTask, GroundUdp)> {
+        let (server, to_ground, udp) = self.udp(env)?;
+        let gw = nodes::FrameGatewayTask {
+            from_ground: server,
+            to_ground,
+            robot: (self.board, self.addr),
+            config: env.cfg.gateway,
+            wire: env.cfg.external.as_ref().map(|x| x.wire.clone()),
+            stats: env.frames.clone(),
+        };
+        Ok((gw, udp))
     }
 }
 
@@ -256,9 +288,9 @@ struct GroundUdp {
     to_server: nodes::UdpOut,
 }
 
-/// Starts robot `i`'s server board — the legacy relay ([`nodes::ServerTask`]) on a serial line
-/// or the PUS gateway ([`nodes::GatewayTask`]) on UDP — and returns the ground's end of its
-/// link.
+/// Starts robot `i`'s server board — the legacy relay ([`nodes::ServerTask`]) on a serial line,
+/// or the PUS gateway ([`nodes::GatewayTask`]; [`nodes::FrameGatewayTask`] with `--link
+/// frames`) on UDP — and returns the ground's end of its link.
 fn spawn_server<'scope, 'env>(
     scope: &'scope std::thread::Scope<'scope, 'env>,
     env: &RunEnv<'env>,
@@ -280,8 +312,15 @@ fn spawn_server<'scope, 'env>(
             Ok((to_server.boxed(), server_to_ground.read, s.board))
         }
         Protocol::Pus => {
-            let (gw, udp) = s.gateway(env)?;
-            scope.spawn(move || gw.run(node));
+            let udp = if cfg.link == LinkLayer::Frames {
+                let (gw, udp) = s.frame_gateway(env)?;
+                scope.spawn(move || gw.run(node));
+                udp
+            } else {
+                let (gw, udp) = s.gateway(env)?;
+                scope.spawn(move || gw.run(node));
+                udp
+            };
             let (tx, rx) = std::sync::mpsc::channel();
             let stop = env.stop;
             scope.spawn(move || nodes::udp_reader(udp.ground, tx, stop));
@@ -319,6 +358,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         (0..n).map(|_| Arc::new(Mutex::new(Value::Null))).collect();
     let (stop, lateness) = (AtomicBool::new(false), AtomicU32::new(0));
     let writer = spawn_log_writer(cfg.log_path.clone(), log_rx);
+    let server_frames = Arc::new(Mutex::new(FrameStats::default()));
     let env = RunEnv {
         cfg,
         clock,
@@ -326,6 +366,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         late: &lateness,
         log: Some(logger.clone()),
         packet_log: cfg.log_packets.then(|| logger.clone()),
+        frames: server_frames.clone(),
     };
     drop(logger);
     let result = std::thread::scope(|scope| -> std::io::Result<_> {
@@ -341,7 +382,11 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         Ok(out)
     });
     drop(env);
-    let (ends, stats) = result?;
+    let (ends, stats, ground_frames) = result?;
+    let frames = (cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames).then(|| {
+        let server = server_frames.lock().map(|s| *s).unwrap_or_default();
+        ground_frames.merged(server)
+    });
     let records = writer
         .join()
         .map_err(|_| std::io::Error::other("log writer panicked"))??;
@@ -351,6 +396,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         held_ms: clock.held_ms(),
         pace_slack_ms: clock.slack_ms(),
         realtime: true,
+        frames,
         ..Summary::of_run(cfg, ends, stats, records, status, clock.wall_elapsed())
     })
 }
@@ -371,7 +417,10 @@ fn spawn_log_writer(
 }
 
 /// An external ground does the commanding: wait out the run's time.
-fn external_ground(cfg: &SimConfig, clock: &Clock) -> (Vec<Option<PlanEnd>>, GroundStats) {
+fn external_ground(
+    cfg: &SimConfig,
+    clock: &Clock,
+) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
     while clock.now_ms() < cfg.max_sim_ms {
         std::thread::sleep(Duration::from_millis(20));
     }
@@ -379,8 +428,16 @@ fn external_ground(cfg: &SimConfig, clock: &Clock) -> (Vec<Option<PlanEnd>>, Gro
         sim_ms: clock.now_ms(),
         ..GroundStats::default()
     };
-    (vec![None; cfg.robots.max(1) as usize], stats)
+    (
+        vec![None; cfg.robots.max(1) as usize],
+        stats,
+        FrameStats::default(),
+    )
 }
+
+/// The ground's end of a robot's space data link in the realtime engine: FOP-1's window K =
+/// 10, 64 packets waiting, packets of up to 1 KiB reassembled (the virtual-time engine's).
+type SimFopLink = FopLink<10, 64, 1024>;
 
 /// The opsUI over the configured protocol.
 fn ground_loop(
@@ -388,7 +445,7 @@ fn ground_loop(
     links: Vec<GroundLink>,
     clock: clock::NodeClock<'_>,
     log: Option<log::Log>,
-) -> (Vec<Option<PlanEnd>>, GroundStats) {
+) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
     match cfg.protocol {
         Protocol::Legacy => {
             let runners = links
@@ -398,34 +455,53 @@ fn ground_loop(
                     last: None,
                 })
                 .collect();
-            run_ground(cfg, links, runners, clock, log)
+            run_ground(cfg, links, runners, Vec::new(), clock, log)
         }
         Protocol::Pus => {
             let runners = links
                 .iter()
                 .map(|(_, _, b)| PlanRunner::pus(cfg.pus, *b))
                 .collect();
-            run_ground(cfg, links, runners, clock, log)
+            // With --link frames the ground's packets go through each robot's FOP-1.
+            let fops = links
+                .iter()
+                .map(|(_, _, b)| {
+                    (cfg.link == LinkLayer::Frames).then(|| Box::new(SimFopLink::new(*b)))
+                })
+                .collect();
+            run_ground(cfg, links, runners, fops, clock, log)
         }
     }
 }
 
-/// The opsUI: one plan runner per robot, in one thread (one ground process).
+/// The opsUI: one plan runner per robot, in one thread (one ground process). With a robot's
+/// FOP-1 link in `fops` (`--link frames`), its packets go out in TC frames and the TM frames
+/// that come back are taken apart by it (their CLCW to FOP-1, their packets to the runner);
+/// the link's figures are returned.
 fn run_ground<G: Ground>(
     cfg: &SimConfig,
     mut links: Vec<GroundLink>,
     runners: Vec<G>,
+    mut fops: Vec<Option<Box<SimFopLink>>>,
     clock: clock::NodeClock<'_>,
     log: Option<log::Log>,
-) -> (Vec<Option<PlanEnd>>, GroundStats) {
+) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
     let mut ground = GroundSide::new(
         &cfg.steps,
         cfg.start_state,
         &cfg.injections,
         runners,
         cfg.progress,
-        log,
+        log.clone(),
     );
+    // FOP-1 initiates the AD service; it runs once a CLCW confirms it.
+    for ((writer, _, _), fop) in links.iter_mut().zip(fops.iter_mut()) {
+        if let Some(gl) = fop {
+            gl.start(clock.now_ms(), &mut |f: &[u8]| {
+                writer.send(clock.now_ms(), f);
+            });
+        }
+    }
     let mut now;
     loop {
         now = clock.now_ms();
@@ -434,20 +510,64 @@ fn run_ground<G: Ground>(
             break;
         }
         for (i, (writer, rx, _)) in links.iter_mut().enumerate() {
+            let Some(gl) = fops.get_mut(i).and_then(|f| f.as_deref_mut()) else {
+                for p in ground.tick(i, now) {
+                    writer.send(now, &p);
+                }
+                while let Ok(bytes) = rx.try_recv() {
+                    let t = clock.now_ms();
+                    for p in ground.receive(i, t, &bytes) {
+                        writer.send(t, &p);
+                    }
+                }
+                continue;
+            };
+            let mut emit = |f: &[u8]| {
+                writer.send(clock.now_ms(), f);
+            };
+            gl.tick(now, &mut emit);
             for p in ground.tick(i, now) {
-                writer.send(now, &p);
+                if gl.send(&p, now, &mut emit).is_err() {
+                    ground_event(&log, now, json!({"type": "ground_outbox_full"}));
+                }
             }
             while let Ok(bytes) = rx.try_recv() {
                 let t = clock.now_ms();
-                for p in ground.receive(i, t, &bytes) {
-                    writer.send(t, &p);
+                let mut packets = Vec::new();
+                let taken = gl.tm_frame(t, &bytes, &mut emit, &mut |p: &[u8]| {
+                    packets.push(p.to_vec())
+                });
+                if let Err(e) = taken {
+                    ground_event(
+                        &log,
+                        t,
+                        json!({"type": "tm_frame_refused", "check": e.name()}),
+                    );
+                }
+                for p in packets {
+                    for q in ground.receive(i, t, &p) {
+                        if gl.send(&q, t, &mut emit).is_err() {
+                            ground_event(&log, t, json!({"type": "ground_outbox_full"}));
+                        }
+                    }
                 }
             }
         }
         ground.progress(now);
         std::thread::sleep(Duration::from_micros(500));
     }
-    let out = ground.finish(now);
+    let (ends, stats) = ground.finish(now);
+    let mut frames = FrameStats::default();
+    for gl in fops.iter().flatten() {
+        frames.add_ground(gl);
+    }
     let _ = std::io::stderr().flush();
-    out
+    (ends, stats, frames)
+}
+
+/// An event of the ground's end of the space data link.
+fn ground_event(log: &Option<log::Log>, now: u32, what: Value) {
+    if let Some(l) = log {
+        l.event(now, "ground", what);
+    }
 }

@@ -499,3 +499,107 @@ fn the_simulator_takes_telecommands_from_an_external_ground() {
     }
     let _ = std::fs::remove_dir_all(out);
 }
+
+/// `mmic sim --protocol pus --link frames --ground-tm-to`: the same behind the space data link.
+/// The ground here is the library's own FOP-1 end (`GroundLink`): it initiates the AD service on
+/// the robot's first CLCW, sends `mode` operational in an AD frame, and extracts the ST[1]
+/// reports from the 256-octet TM frames; the robot's lines are one per frame (`tc-frame` with
+/// FARM-1's verdict and the packets, `tm-frame` for every frame it sent).
+#[test]
+fn the_simulator_takes_tc_frames_from_an_external_ground() {
+    use mmic::link::fop::FopState;
+    use mmic::link::tm_frame::TM_FRAME_LEN;
+    use mmic::node::ground::frames::GroundLink;
+    use mmic::units::BoardNumber;
+    use std::io::{BufRead, BufReader};
+    use std::net::UdpSocket;
+    use std::time::{Duration, Instant};
+    let ground = UdpSocket::bind("127.0.0.1:0").unwrap();
+    ground
+        .set_read_timeout(Some(Duration::from_millis(50)))
+        .unwrap();
+    let tm_to = ground.local_addr().unwrap().to_string();
+    let out = std::env::temp_dir().join(format!("mmic-ext-frames-{}", std::process::id()));
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mmic"))
+        .args(["sim", "--protocol", "pus", "--link", "frames"])
+        .args(["--ground-tm-to", &tm_to, "--ground-tc-port", "0"])
+        .args(["--max-seconds", "20", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let ready: Value = serde_json::from_str(&lines.next().unwrap().unwrap()).unwrap();
+    assert_eq!(ready["ready"], true);
+    let port = ready["tc_port"].as_u64().unwrap() as u16;
+    let tc = ok(&[
+        "encode",
+        "pus-tc",
+        r#"{"apid":257,"seq_count":5,"source_id":3,"function":"mode","args":{"mode":2}}"#,
+    ]);
+    let packet = mmic_host::codec::from_hex(&tc).unwrap();
+    let start = Instant::now();
+    let now = || start.elapsed().as_millis() as u32;
+    let mut link: GroundLink<10, 8, 1024> = GroundLink::new(BoardNumber::ONE);
+    let mut frames_out: Vec<Vec<u8>> = Vec::new();
+    link.start(now(), &mut |f: &[u8]| frames_out.push(f.to_vec()));
+    let (mut sent, mut stages, mut received) = (false, Vec::new(), Vec::new());
+    let end = Instant::now() + Duration::from_secs(15);
+    while Instant::now() < end && stages.len() < 3 {
+        if !sent && link.state() == FopState::Active {
+            link.send(&packet, now(), &mut |f: &[u8]| frames_out.push(f.to_vec()))
+                .unwrap();
+            sent = true;
+        }
+        for f in frames_out.drain(..) {
+            ground.send_to(&f, ("127.0.0.1", port)).unwrap();
+        }
+        let mut b = [0u8; 512];
+        let Ok(n) = ground.recv(&mut b) else {
+            link.tick(now(), &mut |f: &[u8]| frames_out.push(f.to_vec()));
+            continue;
+        };
+        assert_eq!(n, TM_FRAME_LEN, "one 256-octet TM frame per datagram");
+        received.push(
+            b[..n]
+                .iter()
+                .map(|x| format!("{x:02x}"))
+                .collect::<String>(),
+        );
+        let mut packets = Vec::new();
+        link.tm_frame(
+            now(),
+            &b[..n],
+            &mut |f: &[u8]| frames_out.push(f.to_vec()),
+            &mut |p: &[u8]| packets.push(p.to_vec()),
+        )
+        .unwrap();
+        for p in packets {
+            let hex: String = p.iter().map(|x| format!("{x:02x}")).collect();
+            let d: Value = serde_json::from_str(&ok(&["decode", "pus-tm", &hex])).unwrap();
+            if d["service"] == 1 && d["report"]["request"]["seq_count"] == 5 {
+                stages.push(d["subservice"].as_u64().unwrap());
+            }
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(stages, [1, 3, 7]);
+    assert_eq!(link.counters().confirmed, 1, "{:?}", link.counters());
+    let logged: Vec<Value> = lines
+        .map_while(Result::ok)
+        .filter_map(|l| serde_json::from_str(&l).ok())
+        .collect();
+    let tc_frames: Vec<&Value> = logged.iter().filter(|l| l["dir"] == "tc-frame").collect();
+    assert_eq!(tc_frames.len(), 1, "{tc_frames:?}");
+    assert_eq!(tc_frames[0]["farm"], "accept");
+    assert!(tc_frames[0]["refused"].is_null());
+    assert_eq!(tc_frames[0]["packets"], json!([tc]));
+    for hex in &received {
+        assert!(logged
+            .iter()
+            .any(|l| l["dir"] == "tm-frame" && l["hex"] == hex.as_str()));
+    }
+    assert!(logged.iter().all(|l| l["dir"] != "tc" && l["dir"] != "tm"));
+    let _ = std::fs::remove_dir_all(out);
+}

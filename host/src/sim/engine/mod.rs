@@ -1022,29 +1022,10 @@ impl<'c, G: Ground> Engine<'c, G> {
         let mut s = FrameStats::default();
         for r in &self.robots {
             if let Some(gl) = &r.ground_link {
-                let c = gl.counters();
-                s.tc_frames += u64::from(c.ad_frames) + u64::from(c.bc_frames);
-                s.retransmissions += u64::from(c.retransmissions);
-                s.alerts += c.alerts.iter().map(|&a| u64::from(a)).sum::<u64>();
-                s.clcws += u64::from(c.clcws);
-                s.lockout_reports += u64::from(c.lockouts);
-                let x = gl.extract_counters();
-                s.tm_lost += u64::from(x.lost_frames);
-                s.tm_packets_dropped += u64::from(x.dropped);
+                s.add_ground(gl);
             }
             if let Board::Frames(g) = &r.board {
-                if let Some(f) = g.farm(r.number) {
-                    s.accepted += u64::from(f.counters().accepted_ad);
-                    s.discarded += f
-                        .counters()
-                        .discarded
-                        .iter()
-                        .map(|&d| u64::from(d))
-                        .sum::<u64>();
-                }
-                if let Some(c) = g.counters(r.number) {
-                    s.tm_frames += u64::from(c.tm_frames);
-                }
+                s.add_server(g, r.number);
             }
         }
         Some(s)
