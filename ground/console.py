@@ -49,8 +49,10 @@ class RobotError(RuntimeError):
 
 class Robot:
     """`mmic sim --protocol pus ... --ground-tm-to` in its own process group. Its JSON lines are read
-    by a thread (so its pipe never fills): `ready` is set by {"ready":true}, `tcs`/`tms` count the
-    packets it took and sent, `lines` keeps the last ones for a failure's message."""
+    by a thread (so its pipe never fills): `ready` is set by {"ready":true}; `tcs` counts the TC
+    packets it took ({"dir":"tc"} lines, or with frames the packets FARM-1 passed on from each
+    {"dir":"tc-frame"} line), `tc_frames` the TC frames, `tms` the TM packets or frames it sent;
+    `last` keeps the last lines for a failure's message."""
 
     def __init__(self, tm_port: int, tc_port: int, *, link: str, seconds: int, out: Path):
         self.cmd = [mmic_bin(), "sim", "--protocol", "pus", "--ground-tm-to", f"127.0.0.1:{tm_port}",
@@ -65,7 +67,7 @@ class Robot:
                                      stdin=subprocess.DEVNULL, start_new_session=True)
         self.started = time.time()
         self.ready = threading.Event()
-        self.tcs = self.tms = 0
+        self.tcs = self.tc_frames = self.tms = 0
         self.tc_lines: "queue.Queue[dict]" = queue.Queue()
         self.last: list[str] = []
         threading.Thread(target=self._read, daemon=True).start()
@@ -83,7 +85,11 @@ class Robot:
             elif d.get("dir") == "tc":
                 self.tcs += 1
                 self.tc_lines.put(d)
-            elif d.get("dir") == "tm":
+            elif d.get("dir") == "tc-frame":
+                self.tc_frames += 1
+                self.tcs += len(d.get("packets") or [])
+                self.tc_lines.put(d)
+            elif d.get("dir") in ("tm", "tm-frame"):
                 self.tms += 1
 
     def wait_ready(self, timeout: float) -> None:
@@ -187,7 +193,7 @@ def main(argv=None) -> int:
   housekeeping:  {c.page('/telemetry/parameters', system='/MMIC')}
   send command:  {c.page('/commanding/send')}  (e.g. MMIC/mode, mode 2)
   history:       {c.page('/commanding/history')}
-  links:         {c.page('/links', processor=False)}{'  (COP-1 on tc-frames)' if a.link == 'frames' else ''}
+  links:         {c.page('/links', processor=False)}{'  (COP-1: ' + c.page('/links/tc-frames.vc0', processor=False) + ')' if a.link == 'frames' else ''}
   robot log:     {c.out / 'sim' / 'sim.jsonl'}; YAMCS log: {c.yamcs.log_path}
 console: running for {a.seconds} s; Ctrl-C stops YAMCS and the robot""", flush=True)
         end = time.monotonic() + a.seconds
@@ -198,7 +204,9 @@ console: running for {a.seconds} s; Ctrl-C stops YAMCS and the robot""", flush=T
             pass
         if c.robot.proc.poll() is not None and time.monotonic() < end:
             print(f"console: the robot ended (status {c.robot.proc.returncode})", flush=True)
-        print(f"console: {c.robot.tcs} TCs taken by the robot, {c.robot.tms} TM sent; stopping", flush=True)
+        frames = f" in {c.robot.tc_frames} TC frames" if a.link == "frames" else ""
+        print(f"console: {c.robot.tcs} TCs taken by the robot{frames}, {c.robot.tms} TM "
+              f"{'frames ' if a.link == 'frames' else ''}sent; stopping", flush=True)
     print("console: stopped", flush=True)
     return 0
 

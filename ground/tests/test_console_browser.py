@@ -11,7 +11,8 @@ person would check, read from the pages' text:
 2. a command sent from the browser (/commanding/send/MMIC/mode: the `mode` field set to 2, Send)
    reaches the robot, and its report page shows the ST[1] stages the gateway sent, as the XTCE's
    verifiers: Verifier_Accepted, Verifier_Started and Verifier_Complete OK, Completion SUCCESS;
-3. with frames, the TC link's page (/links/<link>) shows COP-1 in the AD service, TX state ACTIVE.
+3. with frames, the TC virtual channel's page (/links/tc-frames.vc0) shows COP-1 in the AD service,
+   TX state ACTIVE, V(S) and the CLCW's N(R) past 0 (the mode TC went as an AD frame, acknowledged).
 
 Screenshots of each page go to target/ground/screenshots/ (CI keeps them). Every wait is for text
 on the page, bounded (WAIT s each), no sleeps.
@@ -185,12 +186,17 @@ def test_a_command_sent_from_the_browser_completes_with_its_st1_stages(console, 
 @pytest.mark.skipif(LINK != "frames", reason="COP-1 runs with --link frames only (this mmic: packets)")
 def test_the_tc_link_page_shows_cop1_active(console, browser):
     d = browser
-    links = console.yamcs.client.list_links("mmic")
-    names = [l.name for l in links]
-    cop1 = [l.name for l in links if "Cop1" in (l.class_name or "") or "cop1" in l.name.lower()]
-    name = cop1[0] if cop1 else next(n for n in names if n.startswith("tc"))
+    # COP-1 runs on the TC link's virtual channel, a sub-link: tc-frames.vc0 (ground/yamcs/links/).
+    names = [link.name for link in console.yamcs.client.list_links("mmic")]
+    name = next((n for n in names if n.startswith("tc") and ".vc" in n), None)
+    assert name, f"no TC virtual channel among the links {names}"
     d.get(console.page(f"/links/{name}", processor=False))
     wait_text(d, r"COP-1", f"link {name}'s page has its COP-1 section (links: {names})", "6-link")
     wait_text(d, r"TX state\s+ACTIVE", "COP-1's state ACTIVE", "6-link")
     assert "AD (Sequence-controlled service)" in text(d)
+    # The mode TC of the test before went as an AD frame (V(S) past 0), and the robot's FARM-1
+    # acknowledged it in the CLCW (N(R) past 0).
+    if console.robot.tc_frames:
+        wait_text(d, r"V\(S\)\s+[1-9]", "FOP-1 sent an AD frame", "6-link")
+        wait_text(d, r"N\(R\)\s+[1-9]", "the CLCW acknowledged it", "6-link")
     d.save_screenshot(str(SHOTS / "6-link.png"))
