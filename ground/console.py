@@ -185,7 +185,13 @@ def main(argv=None) -> int:
                 ap.error(f"port {http} is taken: --http-port another, or 0 for a free one")
     c = Console(link=a.link, seconds=a.seconds, http_port=http, tm_port=a.tm_port, tc_port=a.tc_port,
                 out=Path(a.out))
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))
+    # Ctrl-C and SIGTERM both end the run the same way (also when started where SIGINT is ignored,
+    # e.g. in the background of a script): YAMCS and the robot are stopped on the way out.
+    def interrupt(*_):
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGINT, interrupt)
+    signal.signal(signal.SIGTERM, interrupt)
     print(f"console: starting YAMCS and the simulated robot (link: {a.link}) ...", flush=True)
     with c:
         assert c.robot is not None
@@ -211,5 +217,13 @@ console: running for {a.seconds} s; Ctrl-C stops YAMCS and the robot""", flush=T
     return 0
 
 
+def run(argv=None) -> int:
+    try:
+        return main(argv)
+    except KeyboardInterrupt:  # during the start: Console.start stopped what it had started
+        print("console: interrupted; stopped", flush=True)
+        return 130
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run())
