@@ -3,7 +3,8 @@
 
 use mmic_host::sim::engine::watch::Invariant;
 use mmic_host::sim::engine::PlantedBug;
-use mmic_host::swarm::scenario::{Options, Scenario};
+use mmic_host::sim::{LinkLayer, Protocol};
+use mmic_host::swarm::scenario::{LinkDraw, Options, Scenario};
 use mmic_host::swarm::{replay_command, run_one, swarm};
 use std::process::Command;
 use std::time::Duration;
@@ -78,6 +79,7 @@ fn a_planted_double_execution_is_found_and_its_seed_replays_it() {
     let opts = Options {
         horizon_ms: 60_000,
         planted_bug: PlantedBug::DoubleExec,
+        ..Options::default()
     };
     let r = swarm(
         1,
@@ -161,6 +163,162 @@ fn mmic_swarm_reports_and_exits_by_its_verdict() {
     assert_eq!(bad.status.code(), Some(2), "{bad:?}");
     let bad = Command::new(bin)
         .args(["swarm", "--plant-bug", "typo"])
+        .output()
+        .unwrap();
+    assert_eq!(bad.status.code(), Some(2), "{bad:?}");
+}
+
+/// The part of a scenario the main stream draws and the link stream leaves alone: everything
+/// but the link layer and the ground link's loss, duplication and reordering.
+fn main_stream(s: &Scenario) -> String {
+    let c = &s.cfg;
+    format!(
+        "{:?} {} {:?} {} {:?} {:?} {} {} {} {:?} {:?} {:?} {:?}",
+        s.protocol,
+        s.plan,
+        c.start_state,
+        c.b_phase_us,
+        c.links.wifi,
+        c.links.ab,
+        c.wifi_loss,
+        c.ab_loss,
+        c.links.ground.latency_us,
+        c.links.ground.jitter_us,
+        c.links.ground.cuts,
+        c.injections,
+        c.max_sim_ms,
+    )
+}
+
+#[test]
+fn pus_scenarios_draw_packets_or_frames_from_a_stream_of_their_own() {
+    let (mut frames, mut pus, mut heavier) = (0, 0, 0);
+    for seed in 0..2_000 {
+        let any = Scenario::from_seed(seed, &Options::default());
+        let packets = Scenario::from_seed(
+            seed,
+            &Options {
+                link: LinkDraw::Packets,
+                ..Options::default()
+            },
+        );
+        let all_frames = Scenario::from_seed(
+            seed,
+            &Options {
+                link: LinkDraw::Frames,
+                ..Options::default()
+            },
+        );
+        // The main stream's draws are the same whatever the link: a seed keeps its protocol,
+        // plan, links, phase and faults.
+        assert_eq!(main_stream(&any), main_stream(&packets), "seed {seed}");
+        assert_eq!(main_stream(&any), main_stream(&all_frames), "seed {seed}");
+        assert_eq!(packets.link, LinkLayer::Packets);
+        assert_eq!(packets.cfg.link, LinkLayer::Packets);
+        if any.protocol == Protocol::Legacy {
+            // Legacy has no frames: its scenario is the packets one, whatever --link says.
+            assert_eq!(any.link, LinkLayer::Packets);
+            assert_eq!(all_frames.link, LinkLayer::Packets);
+            assert_eq!(any.describe(), packets.describe());
+            continue;
+        }
+        pus += 1;
+        assert_eq!(all_frames.link, LinkLayer::Frames, "seed {seed}");
+        assert_eq!(all_frames.cfg.link, LinkLayer::Frames);
+        assert!(all_frames.describe().contains(" pus over frames from "));
+        match any.link {
+            LinkLayer::Packets => assert_eq!(any.describe(), packets.describe()),
+            LinkLayer::Frames => {
+                frames += 1;
+                assert_eq!(any.cfg.link, LinkLayer::Frames);
+                // The drawn frames scenario is --link frames' for that seed.
+                assert_eq!(any.describe(), all_frames.describe());
+                let g = &any.cfg.links.ground;
+                assert!(any.cfg.serial_loss < 0.3 && g.duplicate < 0.3 && g.reorder < 0.2);
+                // Heavier than the packet link's draws (loss up to 0.1): COP-1's business.
+                heavier += (any.cfg.serial_loss > 0.1) as u32;
+            }
+        }
+        assert_eq!(
+            Scenario::from_seed(seed, &Options::default()).describe(),
+            any.describe()
+        );
+    }
+    assert!(
+        (0.4..0.6).contains(&(frames as f64 / pus as f64)),
+        "{frames} of {pus} PUS scenarios over frames"
+    );
+    assert!(heavier > frames / 4, "{heavier} of {frames}");
+}
+
+#[test]
+fn the_invariants_hold_over_the_space_data_link() {
+    let opts = Options {
+        horizon_ms: 60_000,
+        link: LinkDraw::Frames,
+        ..Options::default()
+    };
+    let r = swarm(
+        1,
+        Duration::from_secs(600),
+        Some(40),
+        40,
+        &opts,
+        &mut |_| {},
+    );
+    assert_eq!(r.runs, 40);
+    assert!(r.failures.is_empty(), "{}", r.text(&opts));
+    // About half the seeds are PUS, all of them over frames; the frame link's faults happened
+    // and COP-1 dealt with them.
+    assert!(r.frame_runs >= 10, "{}", r.frame_runs);
+    let f = r.frames;
+    assert!(
+        f.retransmissions > 0 && f.discarded > 0 && f.tm_lost > 0 && f.accepted > 100,
+        "{f:?}"
+    );
+    assert!(r.checked.commands_ended > 300, "{:?}", r.checked);
+    let text = r.text(&opts);
+    assert!(
+        text.contains(&format!(
+            "space data link: {} runs over frames",
+            r.frame_runs
+        )),
+        "{text}"
+    );
+    assert_eq!(r.json(&opts)["frame_runs"], r.frame_runs);
+    assert_eq!(
+        replay_command(85, &opts),
+        "mmic swarm --replay 85 --sim-seconds 60 --link frames"
+    );
+}
+
+#[test]
+fn a_frames_seed_replays_its_scenario_from_the_command_line() {
+    // The first PUS seed drawn over frames, replayed with the default --link (any): the line the
+    // replay prints is its scenario's, frames and all.
+    let opts = Options {
+        horizon_ms: 20_000,
+        ..Options::default()
+    };
+    let s = (1..)
+        .map(|seed| Scenario::from_seed(seed, &opts))
+        .find(|s| s.link == LinkLayer::Frames)
+        .unwrap();
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("swarm-replay-frames");
+    let seed = s.seed.to_string();
+    let out = Command::new(env!("CARGO_BIN_EXE_mmic"))
+        .args(["swarm", "--replay", &seed, "--sim-seconds", "20", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.lines().next(), Some(s.describe().as_str()), "{text}");
+    assert!(text.contains("link: frames -- "), "{text}");
+    let log = std::fs::read_to_string(dir.join("sim.jsonl")).unwrap();
+    assert!(log.contains("tc_frame"), "the log has the frames");
+    let bad = Command::new(env!("CARGO_BIN_EXE_mmic"))
+        .args(["swarm", "--link", "cells"])
         .output()
         .unwrap();
     assert_eq!(bad.status.code(), Some(2), "{bad:?}");

@@ -1,6 +1,6 @@
 //! `mmic swarm`: arguments and output around [`super::swarm`] and its replay.
 
-use super::scenario::{Options, Scenario};
+use super::scenario::{LinkDraw, Options, Scenario};
 use super::{judge, replay_command, swarm};
 use crate::error::CliError;
 use crate::sim::engine::PlantedBug;
@@ -12,7 +12,8 @@ use std::time::Duration;
 pub const HELP: &str = "\
 Run the fault swarm: seed after seed, a random scenario runs in virtual time with its
 invariants checked on every tick. A scenario is drawn from its seed alone: the protocol
-(legacy or PUS), a plan (the demo, or a random walk of reconfigurations, bolts and waits from
+(legacy or PUS; with PUS, bare packets or the space data link's TC and TM frames under COP-1,
+half each, --link), a plan (the demo, or a random walk of reconfigurations, bolts and waits from
 a random state), the links' loss, duplication (resent commands), reordering, latency, jitter
 and cuts, board B's clock phase, and up to three faults (battery sag, obstacles on arm,
 gripper or bolter, a jammed fastener, a stuck switch, an encoder offset, silent sensors, a cut
@@ -41,6 +42,8 @@ Examples:
   mmic swarm --runs 200 --json target/swarm.json
   mmic swarm --replay 85 --out target/swarm-85   one seed again, with its whole log
   mmic swarm --seconds 60 --plant-bug double-exec   the swarm's own test: a planted double execution
+  mmic swarm --seconds 60 --link frames      every PUS scenario over the space data link
+  mmic swarm --seconds 60 --link packets     scenarios as they were before frames were drawn
 
 Exit codes: 0 no invariant broken; 1 an invariant broke (the replay command is printed);
 2 bad arguments; 3 an output could not be written.";
@@ -66,6 +69,10 @@ pub struct SwarmArgs {
     /// Plant a bug in the engine's shells (none, double-exec): the swarm must find it.
     #[arg(long, default_value = "none", value_parser = planted)]
     pub plant_bug: PlantedBug,
+    /// The link layer of PUS scenarios: any (drawn, packets or frames half each), packets, or
+    /// frames (the space data link, COP-1). Part of a seed's scenario: a replay needs the same.
+    #[arg(long, default_value = "any", value_parser = link_draw)]
+    pub link: LinkDraw,
     /// Replay this one seed: print its scenario and violations, write its whole log.
     #[arg(long, value_name = "SEED")]
     pub replay: Option<u64>,
@@ -78,6 +85,10 @@ pub struct SwarmArgs {
 }
 
 fn planted(s: &str) -> Result<PlantedBug, String> {
+    s.parse()
+}
+
+fn link_draw(s: &str) -> Result<LinkDraw, String> {
     s.parse()
 }
 
@@ -98,6 +109,7 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let opts = Options {
         horizon_ms: a.sim_seconds.saturating_mul(1000),
         planted_bug: a.plant_bug,
+        link: a.link,
     };
     if let Some(seed) = a.replay {
         return replay(seed, &opts, &a.out, out);

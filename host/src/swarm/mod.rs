@@ -1,4 +1,5 @@
-//! `mmic swarm`: the fault swarm. Seed after seed, a random scenario ([`scenario`]: a plan, the
+//! `mmic swarm`: the fault swarm. Seed after seed, a random scenario ([`scenario`]: the
+//! protocol and, with PUS, bare packets or the space data link's frames under COP-1, a plan, the
 //! links' loss, duplication, reordering, jitter and cuts, a fault schedule of battery sags,
 //! obstacles, jammed fasteners, stuck switches, encoder offsets, silent sensors, a cut A–B line,
 //! the operator's Stop and Reset, resent commands) runs in virtual time
@@ -21,7 +22,7 @@ pub mod scenario;
 use crate::sim::engine::watch::{Checked, Invariant, Violation, Watch};
 use crate::sim::engine::{self, PlantedBug};
 use crate::sim::inject::{Device, Injection};
-use crate::sim::Summary;
+use crate::sim::{FrameStats, LinkLayer, Summary};
 use mmic::faults::{Fault, Table8};
 use scenario::{Options, Scenario};
 use serde_json::Value;
@@ -137,6 +138,8 @@ pub struct RunOutcome {
     pub seed: u64,
     /// The scenario, in one line.
     pub scenario: String,
+    /// Its link layer (packets; frames with PUS over the space data link).
+    pub link: LinkLayer,
     /// Simulated ms covered.
     pub sim_ms: u32,
     /// Every broken invariant.
@@ -165,6 +168,7 @@ pub fn judge(s: &Scenario) -> RunOutcome {
     let mut out = RunOutcome {
         seed: s.seed,
         scenario: s.describe(),
+        link: s.link,
         sim_ms: 0,
         violations: Vec::new(),
         checked: Checked::default(),
@@ -245,6 +249,9 @@ pub fn replay_command(seed: u64, opts: &Options) -> String {
     if opts.planted_bug == PlantedBug::DoubleExec {
         c.push_str(" --plant-bug double-exec");
     }
+    if opts.link != Options::default().link {
+        c.push_str(&format!(" --link {}", opts.link.name()));
+    }
     c
 }
 
@@ -265,6 +272,24 @@ pub struct Report {
     pub expected: u64,
     /// Runs whose plan completed.
     pub completed: u64,
+    /// Runs over the space data link (PUS in TC and TM frames, COP-1).
+    pub frame_runs: u64,
+    /// What the space data link did, those runs together.
+    pub frames: FrameStats,
+}
+
+/// Adds `b`'s figures to `a`'s.
+fn add_frames(a: &mut FrameStats, b: &FrameStats) {
+    a.tc_frames += b.tc_frames;
+    a.retransmissions += b.retransmissions;
+    a.alerts += b.alerts;
+    a.clcws += b.clcws;
+    a.lockout_reports += b.lockout_reports;
+    a.accepted += b.accepted;
+    a.discarded += b.discarded;
+    a.tm_frames += b.tm_frames;
+    a.tm_lost += b.tm_lost;
+    a.tm_packets_dropped += b.tm_packets_dropped;
 }
 
 impl Report {
@@ -301,6 +326,21 @@ impl Report {
             c.commands_ended,
             self.expected,
         );
+        let f = &self.frames;
+        t.push_str(&format!(
+            "space data link: {} runs over frames: {} TC frames sent ({} retransmitted, {} FOP-1 \
+             alerts), {} AD frames accepted and {} discarded by FARM-1; {} TM frames, {} lost, {} \
+             TM packets cut by a lost frame\n",
+            self.frame_runs,
+            f.tc_frames,
+            f.retransmissions,
+            f.alerts,
+            f.accepted,
+            f.discarded,
+            f.tm_frames,
+            f.tm_lost,
+            f.tm_packets_dropped,
+        ));
         if self.failures.is_empty() {
             t.push_str("result: no invariant broken\n");
         }
@@ -329,6 +369,8 @@ impl Report {
             "runs_per_second": self.runs_per_second(),
             "sim_hours": self.sim_hours(),
             "completed": self.completed,
+            "frame_runs": self.frame_runs,
+            "frames": self.frames,
             "checked": {
                 "admissions": c.admissions, "motion_ticks": c.motion_ticks,
                 "standby_ticks": c.standby_ticks, "faults_raised": c.faults_raised,
@@ -336,6 +378,8 @@ impl Report {
             },
             "failures": self.failures.iter().map(|f| serde_json::json!({
                 "seed": f.seed,
+                "link": f.link.name(),
+                "scenario": f.scenario,
                 "replay": replay_command(f.seed, opts),
                 "violations": f.violations.iter().map(|v| serde_json::json!({
                     "invariant": v.invariant.name(), "t_ms": v.t_ms, "detail": v.detail,
@@ -365,6 +409,12 @@ pub fn swarm(
         r.sim_ms += o.sim_ms as u64;
         r.expected += o.expected;
         r.completed += o.completed as u64;
+        if o.link == LinkLayer::Frames {
+            r.frame_runs += 1;
+        }
+        if let Some(f) = o.summary.as_ref().and_then(|s| s.frames.as_ref()) {
+            add_frames(&mut r.frames, f);
+        }
         let c = &mut r.checked;
         c.admissions += o.checked.admissions;
         c.motion_ticks += o.checked.motion_ticks;

@@ -1,20 +1,34 @@
 //! One seed's scenario: a plan, link impairments and a fault schedule, all drawn from the
 //! seed, so that the seed alone replays the run.
+//!
+//! Two streams of draws per seed. The main stream draws, in this order, the protocol, the plan,
+//! board B's phase, the losses, the links and the faults — as it has since the swarm began, so
+//! a seed's scenario on these is what it always was. The link stream, seeded apart, draws what
+//! came later: with [`Protocol::Pus`], whether the packets travel bare or in the space data
+//! link's frames ([`LinkLayer`], half each unless [`Options::link`] says), and for frames the
+//! ground link's loss, duplication and reordering again, heavier (COP-1 retransmits what is
+//! lost, FARM-1 discards copies and frames out of order, the extractor skips stale TM frames:
+//! these are the faults the frame link exists for). Adding a draw to the link stream leaves
+//! every main-stream draw of every seed alone; `--link packets` gives a seed's scenario as it
+//! was before frames were drawn.
 
 use crate::plan;
 use crate::sim::engine::link::LinkModel;
 use crate::sim::engine::{Links, PlantedBug};
 use crate::sim::inject::{Injection, Scheduled};
-use crate::sim::{Protocol, SimConfig};
+use crate::sim::{LinkLayer, Protocol, SimConfig};
 use mmic::motion::State;
 
-/// What every scenario shares: the simulated span and a planted bug, if any.
+/// What every scenario shares: the simulated span, a planted bug, if any, and the link layers
+/// PUS scenarios draw from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
     /// Simulated ms each run lasts (the robot idles, still watched, after its plan ends).
     pub horizon_ms: u32,
     /// A bug planted in the engine's shells (for the swarm's own test).
     pub planted_bug: PlantedBug,
+    /// The link layer of PUS scenarios: drawn, or always one.
+    pub link: LinkDraw,
 }
 
 impl Default for Options {
@@ -22,6 +36,42 @@ impl Default for Options {
         Options {
             horizon_ms: 200_000,
             planted_bug: PlantedBug::None,
+            link: LinkDraw::Any,
+        }
+    }
+}
+
+/// The link layer a PUS scenario gets (legacy scenarios have none to choose).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LinkDraw {
+    /// Drawn from the seed's link stream: packets or frames, half each.
+    #[default]
+    Any,
+    /// Always bare packets: every seed's scenario as before frames were drawn.
+    Packets,
+    /// Always the space data link's frames.
+    Frames,
+}
+
+impl LinkDraw {
+    /// Its name on the command line.
+    pub const fn name(self) -> &'static str {
+        match self {
+            LinkDraw::Any => "any",
+            LinkDraw::Packets => "packets",
+            LinkDraw::Frames => "frames",
+        }
+    }
+}
+
+impl std::str::FromStr for LinkDraw {
+    type Err = String;
+    fn from_str(s: &str) -> Result<LinkDraw, String> {
+        match s {
+            "any" => Ok(LinkDraw::Any),
+            "packets" => Ok(LinkDraw::Packets),
+            "frames" => Ok(LinkDraw::Frames),
+            _ => Err(format!("{s:?} is no link choice: any, packets or frames")),
         }
     }
 }
@@ -33,6 +83,8 @@ pub struct Scenario {
     pub seed: u64,
     /// The protocol between the ground and the server board.
     pub protocol: Protocol,
+    /// With [`Protocol::Pus`], packets or frames (legacy: packets, the serial line's own).
+    pub link: LinkLayer,
     /// The plan's text (a plan file).
     pub plan: String,
     /// The run's simulator configuration (plan, links, losses, injections).
@@ -108,6 +160,37 @@ fn cuts(rng: &mut fastrand::Rng, p: f64, horizon_ms: u32) -> Vec<(u32, Option<u3
         }
     }
     out
+}
+
+/// The link stream's seed: apart from the main stream's (`seed ^ 0x5_3a4a_0000`).
+const LINK_STREAM: u64 = 0x4c49_4e4b_0000_0000;
+
+/// The link stream's draws for `seed` (module docs): the link layer of a PUS scenario and, for
+/// frames, the ground link's loss (in 0.6 of the runs, up to 0.3), duplication (0.5, up to 0.3)
+/// and reordering (0.5, up to 0.2, by 10..300 ms), which replace the main stream's. Every value
+/// is drawn whatever the outcome, so that the stream stays aligned for draws added after them.
+fn draw_link(seed: u64, protocol: Protocol, choice: LinkDraw, cfg: &mut SimConfig) -> LinkLayer {
+    let mut rng = fastrand::Rng::with_seed(seed ^ LINK_STREAM);
+    let frames = rng.bool();
+    let loss = sometimes(&mut rng, 0.6, 0.3);
+    let duplicate = sometimes(&mut rng, 0.5, 0.3);
+    let reorder = sometimes(&mut rng, 0.5, 0.2);
+    let reorder_us = rng.u64(10_000..300_000);
+    let link = match (protocol, choice) {
+        (Protocol::Legacy, _) | (_, LinkDraw::Packets) => LinkLayer::Packets,
+        (Protocol::Pus, LinkDraw::Frames) => LinkLayer::Frames,
+        (Protocol::Pus, LinkDraw::Any) if frames => LinkLayer::Frames,
+        (Protocol::Pus, LinkDraw::Any) => LinkLayer::Packets,
+    };
+    cfg.link = link;
+    if link == LinkLayer::Frames {
+        cfg.serial_loss = loss;
+        let g = &mut cfg.links.ground;
+        g.duplicate = duplicate;
+        g.reorder = reorder;
+        g.reorder_us = reorder_us;
+    }
+    link
 }
 
 impl Scenario {
@@ -202,15 +285,17 @@ impl Scenario {
                 });
             }
         }
+        let link = draw_link(seed, protocol, opts.link, &mut cfg);
         Scenario {
             seed,
             protocol,
+            link,
             plan: plan_text,
             cfg,
         }
     }
 
-    /// One line: protocol, plan, links, faults.
+    /// One line: protocol (and with PUS its link layer), plan, links, faults.
     pub fn describe(&self) -> String {
         let c = &self.cfg;
         let steps: Vec<&str> = c
@@ -225,11 +310,15 @@ impl Scenario {
             .collect();
         let w = &c.links.wifi;
         format!(
-            "seed {}: {} from {}: [{}]; wifi loss {:.2} dup {:.2} reorder {:.2} latency {:.1} ms \
-             jitter {:.1} ms cuts {:?}; ground loss {:.2} dup {:.2} cuts {:?}; a-b loss {:.3} \
-             cuts {:?}; b phase {:.1} ms; injections [{}]",
+            "seed {}: {}{} from {}: [{}]; wifi loss {:.2} dup {:.2} reorder {:.2} latency {:.1} ms \
+             jitter {:.1} ms cuts {:?}; ground loss {:.2} dup {:.2} reorder {:.2} cuts {:?}; \
+             a-b loss {:.3} cuts {:?}; b phase {:.1} ms; injections [{}]",
             self.seed,
             self.protocol.name(),
+            match self.protocol {
+                Protocol::Pus => format!(" over {}", self.link.name()),
+                Protocol::Legacy => String::new(),
+            },
             c.start_state.letter(),
             steps.join("; "),
             c.wifi_loss,
@@ -240,6 +329,7 @@ impl Scenario {
             w.cuts,
             c.serial_loss,
             c.links.ground.duplicate,
+            c.links.ground.reorder,
             c.links.ground.cuts,
             c.ab_loss,
             c.links.ab.cuts,
