@@ -40,6 +40,10 @@ const PREAMBLE: &str = "
   message type counter, destination ID, CUC time 4 + 2 octets (implicit P-field 0x2E) since the
   gateway's power-on. Every packet ends with the CRC-16/CCITT-FALSE packet error control, checked by
   YAMCS's PusPacketPreprocessor and written by its PusCommandPostprocessor (ground/README.md).
+  The packets travel one per UDP datagram, or in the space data link (spec/ccsds/link.toml): TC
+  transfer frames (CCSDS 232.0-B) under COP-1 and fixed-length TM transfer frames (132.0-B) with the
+  CLCW in every OCF, spacecraft ID = robot n's APID value; YAMCS's frame links in
+  ground/yamcs/links/frames.yaml. The frames carry these packets unchanged.
 ";
 
 /// Why the mission database could not be generated.
