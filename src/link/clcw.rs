@@ -151,7 +151,7 @@ pub enum ClcwError {
         /// Bits 1–2.
         found: u8,
     },
-    /// Bits 6–7 other than `01`: the word reports no COP, or a reserved one.
+    /// Bits 6–7 other than `01`: the word reports no COP, or one the standard does not define.
     #[error("CLCW: COP in effect must be {expected:#04b} (COP-1), found {found:#04b}")]
     CopInEffect {
         /// `0b01`.
