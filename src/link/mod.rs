@@ -17,6 +17,7 @@
 //! | [`tm_frame`] | the TM transfer frame: primary header, data field status, OCF, FECF | 132.0-B-3 §4.1 |
 //! | [`tm_framer`] | packets multiplexed into fixed-length TM frames, idle data, the CLCW in every OCF | 132.0-B-3 §4.1.4, §4.2 |
 //! | [`extract`] | the ground's packet extractor: packets out of TM frames, lost frames detected | 132.0-B-3 §4.1.2.7, §4.1.2.4 |
+//! | [`sdls`] | Space Data Link Security: AES-256-GCM on the frames' data, security associations, anti-replay | 355.0-B-2 |
 //!
 //! The choices the standards leave to a mission (spacecraft IDs, virtual channels, frame
 //! lengths, the FARM window, the idle period) are in `spec/ccsds/link.toml`, each with its
@@ -26,6 +27,7 @@ pub mod clcw;
 pub mod extract;
 pub mod farm;
 pub mod fop;
+pub mod sdls;
 pub mod tc_frame;
 pub mod tm_frame;
 pub mod tm_framer;

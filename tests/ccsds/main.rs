@@ -13,6 +13,7 @@ mod farm_table;
 mod golden;
 mod interop_spacepackets;
 mod link_spec;
+mod sdls;
 mod tc_frame;
 mod tm_frame;
 mod tm_link;
