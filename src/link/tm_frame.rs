@@ -116,6 +116,9 @@ pub struct TmFrameParams {
     vcid: u8,
     ocf: bool,
     fecf: bool,
+    /// Octets of a security header before the packet zone and of a security trailer after it
+    /// (SDLS, `crate::link::sdls`; 0 without).
+    security: (u8, u8),
 }
 
 impl TmFrameParams {
@@ -144,7 +147,32 @@ impl TmFrameParams {
             vcid,
             ocf,
             fecf,
+            security: (0, 0),
         })
+    }
+
+    /// The same channel with a security header of `header` octets and a trailer of
+    /// `trailer` around the packet zone (SDLS, 355.0-B-2 §4.1: `crate::link::sdls` gives the
+    /// lengths). `None` when no packet octet would be left.
+    pub const fn with_security(self, header: u8, trailer: u8) -> Option<TmFrameParams> {
+        if self.data_len() <= header as usize + trailer as usize {
+            return None;
+        }
+        Some(TmFrameParams {
+            security: (header, trailer),
+            ..self
+        })
+    }
+
+    /// Octets of the security header and trailer ((0, 0) without SDLS).
+    pub const fn security(&self) -> (usize, usize) {
+        (self.security.0 as usize, self.security.1 as usize)
+    }
+
+    /// Where the packet zone starts: after the primary header and the security header. The
+    /// first header pointer counts from here (as YAMCS reads it).
+    pub const fn data_start(&self) -> usize {
+        PRIMARY_HEADER_LEN + self.security.0 as usize
     }
 
     /// The mission's (`spec/ccsds/link.toml` `[tm]`) for spacecraft `spacecraft_id`: 256
@@ -173,16 +201,19 @@ impl TmFrameParams {
     pub const fn fecf(&self) -> bool {
         self.fecf
     }
-    /// Octets of the data field: the frame less header, OCF and FECF (at least 1).
+    /// Octets of the packet zone: the frame less header, OCF, FECF and SDLS's security header
+    /// and MAC (at least 1).
     pub const fn data_len(&self) -> usize {
         self.frame_len
             - PRIMARY_HEADER_LEN
             - if self.ocf { OCF_LEN } else { 0 }
             - if self.fecf { FECF_LEN } else { 0 }
+            - self.security.0 as usize
+            - self.security.1 as usize
     }
-    /// Where the OCF starts (if there is one): right after the data field.
+    /// Where the OCF starts (if there is one): right after the data field (the MAC's end).
     pub const fn ocf_start(&self) -> usize {
-        PRIMARY_HEADER_LEN + self.data_len()
+        self.data_start() + self.data_len() + self.security.1 as usize
     }
 }
 
@@ -524,7 +555,7 @@ impl<'a> TmFrame<'a> {
     /// The data field.
     pub fn data(&self) -> &'a [u8] {
         self.bytes
-            .get(field::DATA_START..self.params.ocf_start())
+            .get(self.params.data_start()..self.params.data_start() + self.params.data_len())
             .unwrap_or(&[])
     }
     /// The OCF, when the channel carries one.
@@ -624,7 +655,7 @@ impl<'a> TmFrameRepr<'a> {
             found: out.len(),
         };
         let frame = out.get_mut(..p.frame_len).ok_or(too_small)?;
-        if let Some(d) = frame.get_mut(field::DATA_START..p.ocf_start()) {
+        if let Some(d) = frame.get_mut(p.data_start()..p.data_start() + p.data_len()) {
             d.copy_from_slice(self.data);
         }
         self.seal(p, frame);

@@ -61,9 +61,7 @@
 //! * **The OCF** of every frame is the CLCW the caller hands to [`TmFramer::next_frame`]
 //!   (when the channel carries an OCF), the FECF the CRC of [`crate::ccsds::pec`].
 
-use super::tm_frame::{
-    field, FirstHeaderPointer, TmEmitError, TmFrameParams, TmFrameRepr, OCF_LEN,
-};
+use super::tm_frame::{FirstHeaderPointer, TmEmitError, TmFrameParams, TmFrameRepr, OCF_LEN};
 use crate::ccsds::primary::{PrimaryHeader, PRIMARY_LEN};
 
 /// The data octets of idle packets and of only-idle-data frames (`spec/ccsds/link.toml`
@@ -224,7 +222,7 @@ impl<const N: usize> TmFramer<N> {
         } else {
             FirstHeaderPointer::NoPacketStart
         };
-        if let Some(data) = frame.get_mut(field::DATA_START..p.ocf_start()) {
+        if let Some(data) = frame.get_mut(p.data_start()..p.data_start() + p.data_len()) {
             if only_idle {
                 data.fill(IDLE_OCTET);
             } else {

@@ -11,9 +11,10 @@ use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::ccsds::tm::TmRepr;
 use mmic::link::farm::{DiscardReason, FarmState};
 use mmic::link::fop::FopState;
+use mmic::link::sdls::{mission, Key256};
 use mmic::mode::Mode;
 use mmic::node::ground::frames::GroundLink;
-use mmic::node::server::frames::{FrameConfig, FrameGateway};
+use mmic::node::server::frames::{FrameConfig, FrameGateway, Stored};
 use mmic::node::server::gateway::Config;
 use mmic::pus::verification::{Report, Stage};
 use mmic::units::BoardNumber;
@@ -102,9 +103,29 @@ fn stop(seq: u16) -> Vec<u8> {
     b.to_vec()
 }
 
+/// SDLS on both ends, and an attacker on the uplink.
+#[derive(Clone, Copy, Default)]
+struct Secure {
+    /// Both ends secured (keys made from the seed at run time; no key is in the tree).
+    sdls: bool,
+    /// Of every step, the chance that the attacker sends a captured TC frame again, or a
+    /// copy with one bit flipped (its FECF made good again, so that it reaches SDLS).
+    attack: f64,
+}
+
 struct Run {
     /// Legacy commands board A ran (distinct sequence numbers answered).
     executed: usize,
+    /// Legacy commands board A was given (copies included).
+    given: usize,
+    /// Frames the attacker sent.
+    attacks: u32,
+    /// The TC frames the uplink delivered (with an attacker: the first 1,000).
+    captured: Vec<Vec<u8>>,
+    /// The durable store: (end, SPI) → value.
+    store: std::collections::BTreeMap<(&'static str, u16), u128>,
+    /// The IVs of the TM frames the server sent.
+    tm_ivs: Vec<u128>,
     accepted: Vec<u16>,
     completed: Vec<u16>,
     ground: Ground,
@@ -116,6 +137,18 @@ struct Run {
 /// `n` pings sent at once through channels with `loss`, `dup` and `reorder` each way, for at
 /// most `limit_ms` of simulated time (1 ms steps); board A answers every command 3 ms later.
 fn run(n: u16, seed: u64, loss: f64, dup: f64, reorder: f64, limit_ms: u32) -> Run {
+    run_secure(n, seed, loss, dup, reorder, limit_ms, Secure::default())
+}
+
+fn run_secure(
+    n: u16,
+    seed: u64,
+    loss: f64,
+    dup: f64,
+    reorder: f64,
+    limit_ms: u32,
+    secure: Secure,
+) -> Run {
     let board = BoardNumber::ONE;
     let mut server = Server::new(FrameConfig {
         gateway: Config {
@@ -128,6 +161,21 @@ fn run(n: u16, seed: u64, loss: f64, dup: f64, reorder: f64, limit_ms: u32) -> R
     let mut ground = Ground::new(board);
     let mut up = Channel::new(seed, loss, dup, reorder);
     let mut down = Channel::new(seed ^ 0x5555, loss, dup, reorder);
+    let mut attacker = Channel::new(seed ^ 0xa77a, 0.0, 0.0, 0.0);
+    let mut captured: Vec<Vec<u8>> = Vec::new();
+    let (mut attacks, mut given) = (0u32, 0usize);
+    let mut tm_ivs = Vec::new();
+    // The durable store of both ends' SDLS counters.
+    let mut store = std::collections::BTreeMap::new();
+    if secure.sdls {
+        let key = |k: u64| {
+            let mut c = Channel::new(seed.wrapping_mul(31).wrapping_add(k), 0.0, 0.0, 0.0);
+            let bytes: Vec<u8> = (0..32).map(|_| (c.uniform() * 256.0) as u8).collect();
+            Key256::from_slice(&bytes).unwrap()
+        };
+        assert!(server.secure(board, key(1), key(2), Stored::default()));
+        ground.secure(key(1), key(2), (None, None));
+    }
     let (mut accepted, mut completed) = (Vec::new(), Vec::new());
     let mut answers: Vec<(u32, u16)> = Vec::new();
     let mut ran = std::collections::BTreeSet::new();
@@ -138,7 +186,31 @@ fn run(n: u16, seed: u64, loss: f64, dup: f64, reorder: f64, limit_ms: u32) -> R
             .unwrap();
     }
     for now in 0..limit_ms {
+        for (spi, v) in server.due().collect::<Vec<_>>() {
+            store.insert(("server", spi), v);
+            server.persisted(spi, v);
+        }
+        for (spi, v) in ground.due().collect::<Vec<_>>() {
+            store.insert(("ground", spi), v);
+            ground.persisted(spi, v);
+        }
         for f in up.due(now) {
+            if secure.sdls && captured.len() < 1000 {
+                captured.push(f.clone());
+            }
+            server.tc_frame(now, &f);
+        }
+        if secure.attack > 0.0 && !captured.is_empty() && attacker.uniform() < secure.attack {
+            let pick = (attacker.uniform() * captured.len() as f64) as usize;
+            let mut f = captured[pick.min(captured.len() - 1)].clone();
+            if attacker.uniform() < 0.5 {
+                let bit = (attacker.uniform() * (f.len() - 2) as f64 * 8.0) as usize;
+                f[bit / 8] ^= 0x80 >> (bit % 8);
+                let n = f.len();
+                let crc = mmic::ccsds::pec(&f[..n - 2]);
+                f[n - 2..].copy_from_slice(&crc.to_be_bytes());
+            }
+            attacks += 1;
             server.tc_frame(now, &f);
         }
         for f in down.due(now) {
@@ -167,6 +239,7 @@ fn run(n: u16, seed: u64, loss: f64, dup: f64, reorder: f64, limit_ms: u32) -> R
             assert_eq!(b, board);
             if c.command == mmic::command::Command::Stop {
                 ran.insert(c.seq);
+                given += 1;
             }
             answers.push((now + 3, c.seq));
         }
@@ -182,6 +255,11 @@ fn run(n: u16, seed: u64, loss: f64, dup: f64, reorder: f64, limit_ms: u32) -> R
         }
         let mut buf = [0u8; 256];
         while let Some((_, len)) = server.frame(now, &mut buf) {
+            if secure.sdls {
+                tm_ivs.push(u128::from_be_bytes(
+                    [&[0u8; 4][..], &buf[8..20]].concat().try_into().unwrap(),
+                ));
+            }
             down.send(now, &buf[..len]);
         }
         if completed.len() == n as usize && ground.fop().sent_len() == 0 {
@@ -190,6 +268,11 @@ fn run(n: u16, seed: u64, loss: f64, dup: f64, reorder: f64, limit_ms: u32) -> R
     }
     Run {
         executed: ran.len(),
+        given,
+        attacks,
+        captured,
+        store,
+        tm_ivs,
         accepted,
         completed,
         ground,
@@ -328,4 +411,118 @@ fn a_full_queue_holds_frames_back_with_wait_and_loses_none() {
         .unwrap();
     assert_eq!(ground.state(), FopState::RetransmitWithWait);
     assert!(frames.is_empty());
+}
+
+/// SDLS on both ends over the lossy link, with an attacker on the uplink who sends captured
+/// frames again (replays) or with one bit flipped (the FECF made good): every telecommand is
+/// still given to board A exactly once per request, every attack is refused by SDLS (none
+/// reaches FARM-1 or the PUS layer), and the ground's retransmissions, each under a fresh IV,
+/// get through.
+#[test]
+#[cfg_attr(miri, ignore = "AES under Miri: minutes per seed")]
+fn sdls_under_attack_delivers_once_and_refuses_every_forgery() {
+    let (mut attacks, mut refused) = (0u32, 0u32);
+    for seed in 1..=12 {
+        let secure = Secure {
+            sdls: true,
+            attack: 0.02,
+        };
+        let r = run_secure(12, seed, 0.2, 0.1, 0.1, 120_000, secure);
+        assert_eq!(
+            r.executed, 12,
+            "seed {seed}: board A ran {} commands",
+            r.executed
+        );
+        let link = r.server.counters(BoardNumber::ONE).unwrap();
+        assert_eq!(
+            link.tc_packets_refused, 0,
+            "seed {seed}: a forged packet reached the PUS layer"
+        );
+        let sec = r.server.security(BoardNumber::ONE).unwrap();
+        // Replays and forgeries are refused; a replay that FARM-1 had passed before is
+        // refused as a replay, and no attack frame was accepted: every accepted frame is one
+        // of the ground's transmissions.
+        let ground = r.ground.counters();
+        assert!(
+            sec.accepted <= ground.ad_frames + ground.bc_frames,
+            "seed {seed}: SDLS accepted {} frames, the ground sent {}",
+            sec.accepted,
+            ground.ad_frames
+        );
+        // Every attack frame is refused, by a frame check (a flip in a fixed header field) or
+        // by SDLS (replays, and the channel's own duplicates, too).
+        let checks: u32 = r.server.refused().iter().sum();
+        assert!(
+            sec.refused_total() + checks >= r.attacks,
+            "seed {seed}: {sec:?} {}",
+            r.attacks
+        );
+        assert_eq!(
+            r.given, r.executed,
+            "seed {seed}: board A was given a command twice"
+        );
+        // The ground refuses only the downlink's duplicates and overtaken frames, as replays.
+        let tm = r.ground.security().unwrap();
+        assert_eq!(
+            tm.refused_total(),
+            tm.refused_for("replay"),
+            "seed {seed}: {tm:?}"
+        );
+        attacks += r.attacks;
+        refused += sec.refused_total();
+    }
+    assert!(attacks > 100, "{attacks}");
+    println!("12 runs: {attacks} attack frames, SDLS refused {refused} frames");
+}
+
+/// Counters survive a restart of the server board: a new gateway started from the durable
+/// store refuses every data frame captured before the restart (as a replay), and its TM
+/// counter continues above every IV used before (no IV under the TM key twice).
+#[test]
+#[cfg_attr(miri, ignore = "AES under Miri: minutes")]
+fn sdls_counters_survive_a_restart_of_the_server_board() {
+    let secure = Secure {
+        sdls: true,
+        attack: 0.0,
+    };
+    let r = run_secure(12, 7, 0.0, 0.0, 0.0, 20_000, secure);
+    assert_eq!(r.executed, 12);
+    let board = BoardNumber::ONE;
+    let (tc_spi, tm_spi) = (mission::tc_spi(board), mission::tm_spi(board));
+    let stored = Stored {
+        tc: r.store.get(&("server", tc_spi)).copied(),
+        tm: r.store.get(&("server", tm_spi)).copied(),
+    };
+    assert!(stored.tc.is_some() && stored.tm.is_some(), "{:?}", r.store);
+    let mut again = Server::new(FrameConfig::default());
+    assert!(again.add(board));
+    // The same keys as the run's (made from its seed the same way).
+    let key = |k: u64| {
+        let mut c = Channel::new(7u64.wrapping_mul(31).wrapping_add(k), 0.0, 0.0, 0.0);
+        let bytes: Vec<u8> = (0..32).map(|_| (c.uniform() * 256.0) as u8).collect();
+        Key256::from_slice(&bytes).unwrap()
+    };
+    assert!(again.secure(board, key(1), key(2), stored));
+    for (spi, v) in again.due().collect::<Vec<_>>() {
+        again.persisted(spi, v);
+    }
+    let data_frames: Vec<_> = r.captured.iter().filter(|f| f[0] & 0x10 == 0).collect();
+    assert!(data_frames.len() >= 12);
+    for f in &data_frames {
+        let got = again.tc_frame(0, f);
+        assert_eq!(got.verdict.unwrap_err().name(), "replay", "{f:02x?}");
+    }
+    assert_eq!(
+        again.security(board).unwrap().refused_for("replay") as usize,
+        data_frames.len()
+    );
+    let mut buf = [0u8; 256];
+    let (_, n) = again.frame(1_000, &mut buf).unwrap();
+    let iv = u128::from_be_bytes([&[0u8; 4][..], &buf[8..20]].concat().try_into().unwrap());
+    let before = r.tm_ivs.iter().max().copied().unwrap();
+    assert!(
+        iv > before,
+        "the TM IV after the restart {iv} is not above {before}"
+    );
+    assert_eq!(n, 256);
 }

@@ -52,6 +52,8 @@
 //! | [`sa`] | one security association: protect and verify a frame in place |
 //! | [`table`] | the associations by SPI, with the refusals counted per reason |
 //! | [`mask`] | the authentication masks: the mission's, and YAMCS's defaults for comparison |
+//! | [`frames`] | where SDLS goes in a TC and a TM frame; the FECF over the frame as sent |
+//! | [`mission`] | the mission's associations: SPIs, windows, blocks (`spec/ccsds/sdls.toml`) |
 //!
 //! The layout (355.0-B-2 §4.1, YAMCS's): the security header is the SPI (2 octets) and the IV
 //! (12), right after the frame's headers (a TC frame's segment header, a TM frame's primary
@@ -59,9 +61,11 @@
 //! outside the MAC. The choices (SPIs, masks, windows, blocks) are in `spec/ccsds/sdls.toml`.
 
 pub mod counter;
+pub mod frames;
 pub mod iv;
 pub mod key;
 pub mod mask;
+pub mod mission;
 pub mod sa;
 pub mod table;
 
@@ -232,6 +236,17 @@ pub enum SdlsError {
     /// Every IV of the association was used: it needs a new key.
     #[error("SDLS: every 2^96 IV of the association was used; it needs a new key")]
     CounterExhausted,
+    /// A BC frame: COP-1's control commands go in clear (decision `sdls-clear-bc`).
+    #[error("SDLS: BC frames are not protected")]
+    ControlFrame,
+    /// The data does not fit a protected frame.
+    #[error("SDLS: {found} octets of data, more than a protected frame's {max}")]
+    TooLong {
+        /// The most a protected frame carries.
+        max: usize,
+        /// Octets given.
+        found: usize,
+    },
     /// The cipher refused (a plaintext longer than GCM allows; not reachable with frames).
     #[error("SDLS: the cipher refused the frame")]
     Cipher,

@@ -107,6 +107,15 @@ impl<const N: usize> SaTable<N> {
             .is_some_and(|sa| sa.persisted(value))
     }
 
+    /// Whether `spi`'s association can protect a frame now (a sending one whose next IV is
+    /// reserved).
+    pub fn ready(&self, spi: u16) -> bool {
+        self.get(spi).is_some_and(|sa| match sa.role() {
+            super::Role::Send(c) => c.next() < c.reserved(),
+            super::Role::Receive(_) => false,
+        })
+    }
+
     /// Protects `frame` in place under `spi` (see [`SecurityAssociation::protect`]).
     pub fn protect(
         &mut self,

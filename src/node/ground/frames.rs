@@ -44,6 +44,7 @@
 use crate::link::clcw::Clcw;
 use crate::link::extract::{ExtractCounters, Extractor};
 use crate::link::fop::{AlertCode, Directive, Fop, FopConfig, FopOutput, FopState, FrameData};
+use crate::link::sdls::{self, frames as secured, Key256, SaTable, SdlsCounters, SdlsRefusal};
 use crate::link::tc_frame::{self, MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
 use crate::link::tm_frame::{TmFrameError, TmFrameParams, TmFrameRepr};
 use crate::link::FrameKind;
@@ -54,11 +55,33 @@ use heapless::{Deque, Vec};
 /// A telecommand packet on its way.
 pub type Packet = Vec<u8, MAX_TC_LEN>;
 
-/// The longest TC frame the link writes: headers, one packet, FECF.
+/// The longest TC frame the link writes: headers, one packet, SDLS, FECF.
 pub const MAX_FRAME_LEN: usize = tc_frame::TC_PRIMARY_HEADER_LEN
     + tc_frame::SEGMENT_HEADER_LEN
     + MAX_TC_LEN
+    + sdls::OVERHEAD
     + tc_frame::FECF_LEN;
+
+/// Why a TM frame went no further than the link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+pub enum TmRefusal {
+    /// A frame check ([`TmFrameError`]).
+    #[error(transparent)]
+    Frame(#[from] TmFrameError),
+    /// SDLS ([`SdlsRefusal`]): neither its packets nor its CLCW were used.
+    #[error(transparent)]
+    Security(#[from] SdlsRefusal),
+}
+
+impl TmRefusal {
+    /// The check's name.
+    pub const fn name(&self) -> &'static str {
+        match self {
+            TmRefusal::Frame(e) => e.name(),
+            TmRefusal::Security(e) => e.name(),
+        }
+    }
+}
 
 /// What the link did. Each counter wraps at `u32::MAX`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -90,6 +113,9 @@ pub struct GroundCounters {
     pub tm_refused: u32,
     /// Purged packets that found the outbox full: lost, and counted here.
     pub dropped: u32,
+    /// AD or BD frames SDLS could not protect (the counter's reservation not written yet):
+    /// not sent; FOP-1 sends them again.
+    pub unprotected: u32,
 }
 
 /// Why a packet was not taken: the outbox is full (the packet is handed back).
@@ -110,6 +136,8 @@ pub struct GroundLink<const K: usize, const Q: usize, const N: usize> {
     extractor: Extractor<N>,
     tm: Option<TmFrameParams>,
     counters: GroundCounters,
+    /// SDLS, when the link is secured: the TC (sending) and TM (receiving) associations.
+    sdls: Option<SaTable<2>>,
 }
 
 impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
@@ -129,7 +157,41 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
             extractor: Extractor::new(),
             tm: TmFrameParams::mission(spacecraft_id.get()),
             counters: GroundCounters::default(),
+            sdls: None,
         }
+    }
+
+    /// Secures the link with SDLS (`crate::link::sdls::mission`): AD and BD frames protected
+    /// under `tc_key` (each transmission under a fresh IV), TM frames verified under
+    /// `tm_key` (a frame that does not verify gives neither packets nor CLCW); `stored`, the
+    /// durable counters: the TC reservation and the TM floor.
+    pub fn secure(&mut self, tc_key: Key256, tm_key: Key256, stored: (Option<u128>, Option<u128>)) {
+        let board =
+            BoardNumber::new((self.spacecraft_id.get() - tc_frame::SPACECRAFT_ID_BASE) as u8)
+                .unwrap_or(BoardNumber::ONE);
+        let mut table = SaTable::new();
+        let _ = table.add(sdls::mission::tc_sender(board, tc_key, stored.0));
+        let _ = table.add(sdls::mission::tm_receiver(board, tm_key, stored.1));
+        self.tm = self
+            .tm
+            .and_then(|p| p.with_security(sdls::HEADER_LEN as u8, sdls::MAC_LEN as u8));
+        self.sdls = Some(table);
+    }
+
+    /// SDLS's counters, when the link is secured.
+    pub fn security(&self) -> Option<&SdlsCounters> {
+        self.sdls.as_ref().map(|t| t.counters())
+    }
+
+    /// The durable numbers to write now, (SPI, value); confirm each with
+    /// [`GroundLink::persisted`].
+    pub fn due(&self) -> impl Iterator<Item = (u16, u128)> + '_ {
+        self.sdls.iter().flat_map(|t| t.due())
+    }
+
+    /// The shell wrote `value` for `spi` durably.
+    pub fn persisted(&mut self, spi: u16, value: u128) -> bool {
+        self.sdls.as_mut().is_some_and(|t| t.persisted(spi, value))
     }
 
     /// FOP-1's state.
@@ -190,17 +252,24 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
         bytes: &[u8],
         emit: &mut impl FnMut(&[u8]),
         packet: &mut impl FnMut(&[u8]),
-    ) -> Result<(), TmFrameError> {
+    ) -> Result<(), TmRefusal> {
         let Some(params) = self.tm else {
             return Ok(());
         };
-        let frame = match TmFrameRepr::parse(bytes, &params) {
+        let mut frame = match TmFrameRepr::parse(bytes, &params) {
             Ok(f) => f,
             Err(e) => {
                 self.counters.tm_refused = self.counters.tm_refused.wrapping_add(1);
-                return Err(e);
+                return Err(e.into());
             }
         };
+        let mut plain = [0u8; crate::link::tm_frame::TM_FRAME_LEN];
+        if let Some(table) = self.sdls.as_mut() {
+            match secured::verify_tm(table, &params, &frame, bytes, &mut plain) {
+                Ok((_, f)) => frame = f,
+                Err(e) => return Err(e.into()),
+            }
+        }
         self.extractor.frame(&frame, |p| packet(p));
         if let Some(clcw) = frame.ocf.and_then(|w| Clcw::parse(&w).ok()) {
             self.counters.clcws = self.counters.clcws.wrapping_add(1);
@@ -302,7 +371,22 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
                         content,
                     };
                     let mut buf = [0u8; MAX_FRAME_LEN];
-                    if let Ok(n) = repr.emit(&mut buf) {
+                    let spi = tc_spi(self.spacecraft_id);
+                    let n = match self.sdls.as_mut() {
+                        Some(t) if f.kind != FrameKind::Bc => {
+                            // Each transmission under a fresh IV; one that cannot be
+                            // protected yet (its counter not reserved) is not sent, and
+                            // FOP-1's timer sends it again.
+                            let n = secured::protect_tc(t, spi, &repr, &mut buf);
+                            if n.is_err() {
+                                self.counters.unprotected =
+                                    self.counters.unprotected.wrapping_add(1);
+                            }
+                            n.ok()
+                        }
+                        _ => repr.emit(&mut buf).ok(),
+                    };
+                    if let Some(n) = n {
                         emit(buf.get(..n).unwrap_or(&[]));
                     }
                 }
@@ -366,6 +450,11 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
 }
 
 /// The counter index of an alert code.
+/// The TC SPI of the robot with this spacecraft ID (`sdls::mission::tc_spi`).
+const fn tc_spi(scid: SpacecraftId) -> u16 {
+    scid.get()
+}
+
 const fn alert_index(code: AlertCode) -> usize {
     match code {
         AlertCode::Limit => 0,

@@ -52,6 +52,8 @@ use crate::ccsds::primary::PrimaryHeader;
 use crate::ccsds::tm::TM_MIN_LEN;
 use crate::link::clcw::ClcwVcid;
 use crate::link::farm::{Farm, FarmState, FarmWindow, Verdict};
+use crate::link::sdls::{self, frames as secured, Key256, SaTable, SdlsCounters, SdlsRefusal};
+use crate::link::tc_frame::Packets;
 use crate::link::tc_frame::{self, SpacecraftId, TcFrame, TcFrameError, TcPrimaryHeader};
 use crate::link::tm_frame::{TmFrameParams, TM_FRAME_LEN};
 use crate::link::tm_framer::{TmFramer, IDLE_PERIOD_MS};
@@ -116,6 +118,48 @@ pub struct LinkCounters {
     pub tm_frames: u32,
     /// Reports the framer could not take (it was full): lost, and counted here.
     pub tm_overflow: u32,
+    /// TM frames SDLS could not protect (none expected: a frame waits until its association's
+    /// counter is reserved).
+    pub tm_unprotected: u32,
+}
+
+/// Why a TC frame went no further than the link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+pub enum FrameRefusal {
+    /// A frame check ([`TcFrameError`]).
+    #[error(transparent)]
+    Frame(#[from] TcFrameError),
+    /// SDLS ([`SdlsRefusal`]): nothing of the frame reached FARM-1.
+    #[error(transparent)]
+    Security(#[from] SdlsRefusal),
+}
+
+impl FrameRefusal {
+    /// The check's name ([`TcFrameError::NAMES`] or [`SdlsRefusal::NAMES`]).
+    pub const fn name(&self) -> &'static str {
+        match self {
+            FrameRefusal::Frame(e) => e.name(),
+            FrameRefusal::Security(e) => e.name(),
+        }
+    }
+
+    /// `frame` or `sdls`.
+    pub const fn layer(&self) -> &'static str {
+        match self {
+            FrameRefusal::Frame(_) => "frame",
+            FrameRefusal::Security(_) => "sdls",
+        }
+    }
+}
+
+/// Counters kept in durable storage by the shell, per robot: where the TC window's floor and
+/// the TM counter's reservation stood (`None`: a new association).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Stored {
+    /// The TC floor.
+    pub tc: Option<u128>,
+    /// The TM reservation.
+    pub tm: Option<u128>,
 }
 
 /// What became of one TC frame.
@@ -123,8 +167,8 @@ pub struct LinkCounters {
 pub struct FrameIn {
     /// The robot the frame was for, when it is one of ours.
     pub robot: Option<BoardNumber>,
-    /// The frame check that refused it, or FARM-1's verdict.
-    pub verdict: Result<Verdict, TcFrameError>,
+    /// The check that refused it (the frame's or SDLS's), or FARM-1's verdict.
+    pub verdict: Result<Verdict, FrameRefusal>,
     /// Packets handed to the gateway.
     pub accepted: u8,
     /// Packets refused at the PUS layer (or for another robot's APID).
@@ -142,6 +186,9 @@ struct RobotLink<const N: usize> {
     /// The CLCW of the last frame sent.
     clcw_sent: Option<[u8; 4]>,
     counters: LinkCounters,
+    /// SDLS, when the robot's link is secured: its TC (receiving) and TM (sending)
+    /// associations.
+    sdls: Option<SaTable<2>>,
 }
 
 impl<const N: usize> RobotLink<N> {
@@ -207,8 +254,69 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 oldest: None,
                 clcw_sent: None,
                 counters: LinkCounters::default(),
+                sdls: None,
             })
             .is_ok()
+    }
+
+    /// Secures robot `board`'s link with SDLS (`crate::link::sdls::mission`): its TC frames
+    /// are verified under `tc_key` (and refused unless they verify, BC frames excepted), its
+    /// TM frames protected under `tm_key`; `stored`, the counters the shell kept. Call it
+    /// right after [`FrameGateway::add`], before any frame: the TM framer starts again with
+    /// room for the security header and MAC. False when the robot is not served.
+    pub fn secure(
+        &mut self,
+        board: BoardNumber,
+        tc_key: Key256,
+        tm_key: Key256,
+        stored: Stored,
+    ) -> bool {
+        let idle = self.cfg.idle_period_ms;
+        let Some(link) = self.links.iter_mut().find(|l| l.board == board) else {
+            return false;
+        };
+        let Some(params) = link
+            .framer
+            .params()
+            .with_security(sdls::HEADER_LEN as u8, sdls::MAC_LEN as u8)
+        else {
+            return false;
+        };
+        let mut table = SaTable::new();
+        let tc = sdls::mission::tc_receiver(board, tc_key, stored.tc);
+        let tm = sdls::mission::tm_sender(board, tm_key, stored.tm);
+        if table.add(tc).is_err() || table.add(tm).is_err() {
+            return false;
+        }
+        link.framer = TmFramer::new(params, idle);
+        link.sdls = Some(table);
+        true
+    }
+
+    /// SDLS's counters of robot `board`, when its link is secured.
+    pub fn security(&self, board: BoardNumber) -> Option<&SdlsCounters> {
+        self.links
+            .iter()
+            .find(|l| l.board == board)
+            .and_then(|l| l.sdls.as_ref())
+            .map(|t| t.counters())
+    }
+
+    /// The durable numbers to write now, (SPI, value): the shell writes each and confirms it
+    /// with [`FrameGateway::persisted`] once it is durable.
+    pub fn due(&self) -> impl Iterator<Item = (u16, u128)> + '_ {
+        self.links
+            .iter()
+            .filter_map(|l| l.sdls.as_ref())
+            .flat_map(|t| t.due())
+    }
+
+    /// The shell wrote `value` for `spi` durably.
+    pub fn persisted(&mut self, spi: u16, value: u128) -> bool {
+        self.links
+            .iter_mut()
+            .filter_map(|l| l.sdls.as_mut())
+            .any(|t| t.persisted(spi, value))
     }
 
     /// The gateway behind the link.
@@ -260,7 +368,7 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 }
                 return FrameIn {
                     robot: None,
-                    verdict: Err(e),
+                    verdict: Err(e.into()),
                     accepted: 0,
                     refused: 0,
                 };
@@ -275,8 +383,6 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 refused: 0,
             };
         };
-        let packets = frame.packets().count();
-        let room = self.gateway.queue_room(board).unwrap_or(0);
         let mut result = FrameIn {
             robot: Some(board),
             verdict: Ok(Verdict::Released),
@@ -286,6 +392,25 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         let Some(link) = self.links.get_mut(at) else {
             return result;
         };
+        // SDLS before FARM-1 (355.0-B-2 §2.3.3): a data frame that does not verify changes
+        // nothing but SDLS's counter of its reason; the packets come from the plaintext.
+        let mut plain = [0u8; tc_frame::MAX_FRAME_LEN];
+        let mut data = if frame.kind() == FrameKind::Bc {
+            &[][..]
+        } else {
+            frame.data()
+        };
+        if let (Some(table), true) = (link.sdls.as_mut(), frame.kind() != FrameKind::Bc) {
+            match secured::verify_tc(table, &frame, &mut plain) {
+                Ok((_, range)) => data = plain.get(range).unwrap_or(&[]),
+                Err(e) => {
+                    result.verdict = Err(e.into());
+                    return result;
+                }
+            }
+        }
+        let packets = Packets::new(data).count();
+        let room = self.gateway.queue_room(board).unwrap_or(0);
         link.counters.tc_frames = link.counters.tc_frames.wrapping_add(1);
         let verdict = link.farm.frame(
             frame.kind(),
@@ -301,7 +426,7 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
             return result;
         }
         let apid = robot_apid(board);
-        for packet in frame.packets() {
+        for packet in Packets::new(data) {
             let out = match packet {
                 Ok(p) if PrimaryHeader::read(p).is_some_and(|h| h.apid == apid) => {
                     self.gateway.tc_packet(p).ok()
@@ -354,9 +479,23 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     /// [`TM_FRAME_LEN`] octets): the robot and the frame's length. Call until `None`.
     pub fn frame(&mut self, now: u32, out: &mut [u8]) -> Option<(BoardNumber, usize)> {
         let gather = self.cfg.gather_ms;
-        let link = self.links.iter_mut().find(|l| l.due(now, gather))?;
+        let link = self.links.iter_mut().find(|l| {
+            l.due(now, gather)
+                && l.sdls
+                    .as_ref()
+                    .is_none_or(|t| t.ready(sdls::mission::tm_spi(l.board)))
+        })?;
         let clcw = link.clcw();
         let n = link.framer.next_frame(now, clcw, out).ok()?;
+        if let Some(table) = link.sdls.as_mut() {
+            let params = *link.framer.params();
+            let spi = sdls::mission::tm_spi(link.board);
+            // Unreachable (the association is ready, the layout the framer's): counted.
+            if secured::protect_tm(table, spi, &params, out).is_err() {
+                link.counters.tm_unprotected = link.counters.tm_unprotected.wrapping_add(1);
+                return None;
+            }
+        }
         link.clcw_sent = Some(clcw);
         link.counters.tm_frames = link.counters.tm_frames.wrapping_add(1);
         link.oldest = (link.framer.waiting() > 0).then_some(now);
