@@ -176,3 +176,29 @@ def test_cop1_retransmission_with_the_plugin_carries_the_packet():
     assert all(t["mac"] == "ok" and t["plaintext_is_packet"] for t in ads), ads
     assert ads[0]["dropped"] and ads[1]["verdict"] == "accept"
     assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == 1
+
+
+def test_tm_first_frame_after_start_is_not_window_checked():
+    """YAMCS's TM SA without a persisted counter (fresh data directory) and without `initialSeqNum` skips the
+    window for the first frame and adopts its IV (SecurityAssociationAes256Gcm128's constructor sets
+    skipVerifyingNextSeqNum). So an old recorded frame that arrives first is taken, and the genuine frames,
+    far ahead of it, are then refused until an operator sets the counter (PUT /api/sdls/.../513/seq)."""
+    y = Yamcs(XTCE, link="frames-sdls", max_lifetime=120)
+    y.start()
+    try:
+        with StandIn(y.tm_port, y.tc_port, str(y.sdls_key_dir), period=3600) as robot:  # frames when asked
+            tm = y.client.get_link(INSTANCE, "tm-frames")
+            valid = lambda: int(tm.get_info()._proto.extra.fields["Valid frames"].string_value)
+            robot.tm_iv = 7
+            robot.send_tm()                              # an "old" frame (IV 7) arrives first: taken
+            assert wait(lambda: valid() == 1) and invalid_frames(y) == 0
+            robot.tm_iv = 5_000_000                      # the robot's genuine frames: refused, too far ahead
+            robot.send_tm()
+            assert wait(lambda: invalid_frames(y) == 1)
+            assert tm.sdls_get_ctr(513) == 7
+            tm.sdls_set_ctr(513, 5_000_000)              # the operator's way out
+            robot.send_tm()
+            assert wait(lambda: valid() == 2) and invalid_frames(y) == 1
+            assert tm.sdls_get_ctr(513) == 5_000_001
+    finally:
+        y.stop()
