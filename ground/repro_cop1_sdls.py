@@ -66,7 +66,10 @@ def binary_of(cmd, seconds: float = 5.0) -> bytes | None:
     return wait(get, seconds)
 
 
-def run(reprotect: bool, mdb=DEFAULT_MDB, t1: float = 1.0, extra_seconds: float = 1.5) -> dict:
+def run(reprotect: bool, mdb=DEFAULT_MDB, t1: float = 1.0, extra_seconds: float = 1.5, commands: int = 1) -> dict:
+    """`commands` are issued back to back (AD frames N(S) 0 .. commands-1): the first transmission of N(S) 0 is
+    dropped, the others arrive ahead of V(R) and FARM-1 discards them, so T1 makes YAMCS send them all again
+    (go-back-N)."""
     y = Yamcs(mdb, link="frames-sdls", cop1_t1=t1, sdls_reprotect=reprotect, max_lifetime=120)
     y.start()
     try:
@@ -77,24 +80,25 @@ def run(reprotect: bool, mdb=DEFAULT_MDB, t1: float = 1.0, extra_seconds: float 
                 if not wait(lambda: link.get_cop1_status().state == "ACTIVE", 8):
                     return {"error": f"COP-1 not ACTIVE: {link.get_cop1_status().state}"}
             conn = y.client.get_processor(INSTANCE, "realtime").create_command_connection()
-            cmd = conn.issue("/MMIC/are_you_alive")
-            packet = binary_of(cmd)
-            # the dropped first transmission, then T1 (t1 s), then the retransmission, then FARM-1's CLCW
-            ads = lambda: [r for r in robot.tc if r.frame is None or r.frame.kind == "AD"]
-            wait(lambda: len(ads()) >= 2 and any(not r.dropped for r in ads()), 6 * t1 + 5)
+            cmds = [conn.issue("/MMIC/are_you_alive") for _ in range(commands)]
+            packets = [binary_of(c) for c in cmds]
+            # the dropped first transmission, then T1 (t1 s), then the retransmissions, then FARM-1's CLCW
+            wait(lambda: link.get_cop1_status().nn_r == commands, 6 * t1 + 5)
             time.sleep(extra_seconds)   # further retransmissions, if any
             cop1 = link.get_cop1_status()
             records = list(robot.tc)
-        return analyse(records, packet, y.sdls_key_dir and sdls.SecurityAssociation.from_dir(
+        return analyse(records, packets, y.sdls_key_dir and sdls.SecurityAssociation.from_dir(
             y.sdls_key_dir, sdls.tc_spi(1), sdls.TC_AUTH_MASK), cop1, reprotect, t1)
     finally:
         y.stop()
 
 
-def analyse(records, packet: bytes | None, sa: sdls.SecurityAssociation, cop1, reprotect: bool, t1: float) -> dict:
-    out = {"reprotect": reprotect, "cop1T1_s": t1, "packet_sent_by_yamcs": packet.hex() if packet else None,
+def analyse(records, packets: list, sa: sdls.SecurityAssociation, cop1, reprotect: bool, t1: float) -> dict:
+    """Per TC datagram: kind, N(S), IV, MAC, plaintext; for AD frame N(S) k, whether the plaintext is the k-th
+    packet YAMCS sent and whether it is the ciphertext of the previous transmission of the same N(S)."""
+    out = {"reprotect": reprotect, "cop1T1_s": t1, "packets_sent_by_yamcs": [p.hex() if p else None for p in packets],
            "transmissions": [], "cop1_end": {"state": cop1.state, "v_s": cop1.v_s, "nn_r": cop1.nn_r}}
-    prev_cipher = None
+    prev_cipher = {}
     t0 = records[0].t if records else 0
     for r in records:
         raw = r.raw
@@ -109,15 +113,16 @@ def analyse(records, packet: bytes | None, sa: sdls.SecurityAssociation, cop1, r
                 _, plain = sdls.process_security(raw, sdls.TC_SEC_START, len(raw) - 2, sa)
                 entry["mac"] = "ok"
                 entry["plaintext"] = plain.hex()
-                entry["plaintext_is_packet"] = plain == packet
-                entry["plaintext_is_previous_ciphertext"] = prev_cipher is not None and plain == prev_cipher
+                entry["plaintext_is_packet"] = raw[4] < len(packets) and plain == packets[raw[4]]
+                entry["plaintext_is_previous_ciphertext"] = plain == prev_cipher.get((kind, raw[4]))
             except sdls.SdlsError as e:
                 entry["mac"] = e.check
-            prev_cipher = cipher
+            prev_cipher[(kind, raw[4])] = cipher
         out["transmissions"].append(entry)
     ads = [e for e in out["transmissions"] if e["kind"] == "AD"]
     out["ad_transmissions"] = len(ads)
-    out["retransmitted"] = len(ads) >= 2
+    out["retransmitted"] = len(ads) > len(packets)
+    out["farm_accepted"] = [e["ns"] for e in out["transmissions"] if e["verdict"] == "accept"]
     out["all_carry_the_packet"] = bool(ads) and all(e.get("plaintext_is_packet") for e in ads)
     return out
 
@@ -126,8 +131,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--reprotect", action="store_true", help="use the plug-in's re-protecting SA (ground/yamcs-plugin/)")
     ap.add_argument("--t1", type=float, default=1.0, help="COP-1 timer T1 in seconds (default 1)")
+    ap.add_argument("--commands", type=int, default=1, help="commands issued back to back (default 1)")
     a = ap.parse_args(argv)
-    res = run(a.reprotect, t1=a.t1)
+    res = run(a.reprotect, t1=a.t1, commands=a.commands)
     print(json.dumps(res, indent=1))
     if "error" in res or not res["retransmitted"]:
         return 2

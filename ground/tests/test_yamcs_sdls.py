@@ -8,9 +8,11 @@ minimal FARM-1, protected TM frames with the CLCW). No Rust: these are the facts
 (b) YAMCS takes our protected TM frames (packets archived, link counters), with verifySeqNum on; a
     replayed frame and a forged one are refused (`Invalid frames`, the link's warning event naming
     AntiReplaySequenceNumberFailure / MacVerificationFailure), their packets not archived.
-(c) a COP-1 retransmission (T1 = 1 s, the first transmission dropped): with YAMCS's own SA the MAC of
-    the retransmission verifies but its plaintext is the first transmission's ciphertext; with the
-    plug-in's SA (ground/yamcs-plugin/) it is the packet again, under a fresh IV (repro_cop1_sdls.py).
+(c) COP-1 retransmissions (T1 = 1 s, three commands, the first transmission of N(S) 0 dropped, so all three
+    go again): with YAMCS's own SA the MACs of the retransmissions verify but their plaintexts are the
+    first transmissions' ciphertexts; with the plug-in's SA (ground/yamcs-plugin/) they are the packets
+    again, under fresh IVs (repro_cop1_sdls.py).
+(d) the first TM frame after YAMCS starts is not window-checked.
 """
 from __future__ import annotations
 
@@ -153,29 +155,35 @@ def test_tm_frames_accepted_replay_and_forgery_refused(loop):
 
 
 def test_cop1_retransmission_with_yamcs_sa_is_encrypted_twice():
-    res = repro_cop1_sdls.run(False)
+    """Three commands back to back; the first transmission of N(S) 0 dropped, N(S) 1 and 2 discarded as ahead
+    by FARM-1; T1 expires and YAMCS sends all three again (go-back-N)."""
+    res = repro_cop1_sdls.run(False, commands=3)
     ads = [t for t in res["transmissions"] if t["kind"] == "AD"]
     print(f"\n{[{k: v for k, v in t.items() if k != 'hex'} for t in ads]}")
     assert res["retransmitted"], res
-    first, again = ads[0], ads[1]
-    assert first["dropped"] and first["plaintext_is_packet"] and first["iv"] == 0
-    assert again["ns"] == first["ns"] and again["iv"] == first["iv"] + 1   # a fresh IV ...
-    assert again["mac"] == "ok"                                            # ... the MAC verifies ...
-    assert not again["plaintext_is_packet"] and again["plaintext_is_previous_ciphertext"]  # ... garbage
-    assert again["verdict"] == "accept"                # FARM-1 takes it: COP-1 thinks the TC delivered
-    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == 1
+    first, again = ads[:3], ads[3:]
+    assert [t["ns"] for t in first] == [0, 1, 2] and first[0]["dropped"]
+    assert all(t["plaintext_is_packet"] for t in first)
+    assert [t["ns"] for t in again[:3]] == [0, 1, 2]
+    assert [t["iv"] for t in ads] == list(range(len(ads)))                # a fresh IV each time ...
+    for t in again:
+        assert t["mac"] == "ok"                                            # ... the MAC verifies ...
+        assert not t["plaintext_is_packet"] and t["plaintext_is_previous_ciphertext"], t  # ... garbage
+    assert res["farm_accepted"] == [0, 1, 2]          # FARM-1 takes them: COP-1 thinks the TCs delivered
+    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == 3
 
 
 @pytest.mark.skipif(not PLUGIN_JAR.is_file(), reason="run ground/setup: it builds ground/yamcs-plugin/")
 def test_cop1_retransmission_with_the_plugin_carries_the_packet():
-    res = repro_cop1_sdls.run(True)
+    res = repro_cop1_sdls.run(True, commands=3)
     ads = [t for t in res["transmissions"] if t["kind"] == "AD"]
     print(f"\n{[{k: v for k, v in t.items() if k != 'hex'} for t in ads]}")
     assert res["retransmitted"], res
     assert [t["iv"] for t in ads] == list(range(len(ads)))                 # a fresh IV each time
     assert all(t["mac"] == "ok" and t["plaintext_is_packet"] for t in ads), ads
-    assert ads[0]["dropped"] and ads[1]["verdict"] == "accept"
-    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == 1
+    assert ads[0]["dropped"] and [t["ns"] for t in ads[3:6]] == [0, 1, 2]
+    assert res["farm_accepted"] == [0, 1, 2]
+    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == 3
 
 
 def test_tm_first_frame_after_start_is_not_window_checked():
