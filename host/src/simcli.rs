@@ -5,6 +5,7 @@ use crate::exit::EXIT_OK;
 use crate::sim::inject::{InjectError, Injection, Scheduled};
 use crate::sim::{self, report, SimConfig};
 use mmic::faults::Table8;
+use mmic::link::sdls::Key256;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -184,6 +185,11 @@ pub struct SimArgs {
     /// one, printed in the first line).
     #[arg(long, value_name = "PORT", requires = "ground_tm_to")]
     pub ground_tc_port: Option<u16>,
+    /// SDLS on the space data link with the external ground (--link frames): the directory of
+    /// robot 1's keys, `spi-257.key` (TC) and `spi-513.key` (TM), 32 octets each (YAMCS's
+    /// `keyFile`s). Keys stay out of the source tree, the logs and the output.
+    #[arg(long, value_name = "DIR", requires = "ground_tm_to")]
+    pub sdls_keys: Option<PathBuf>,
     /// Run on the wall clock instead of in virtual time: real threads, OS pipes, TCP and UDP
     /// on loopback, at --scale times real time (the transports' own test; its timing depends
     /// on how busy the host is). The default is the virtual-time engine: deterministic, one
@@ -335,7 +341,8 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     cfg.record = a.record.clone();
     cfg.progress = !a.quiet;
     if let (Some(tm_to), Some(tc_port)) = (a.ground_tm_to, a.ground_tc_port) {
-        return external(cfg, tm_to, tc_port, out);
+        let sdls = a.sdls_keys.as_deref().map(read_keys).transpose()?;
+        return external(cfg, tm_to, tc_port, sdls, out);
     }
     let summary = sim::run(&cfg).map_err(CliError::Sim)?;
     let plots = report::plots(&summary, &a.out).map_err(|source| CliError::Write {
@@ -366,12 +373,16 @@ fn external(
     mut cfg: SimConfig,
     tm_to: std::net::SocketAddr,
     tc_port: u16,
+    sdls: Option<(Key256, Key256)>,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
     if cfg.protocol != sim::Protocol::Pus {
         return Err(CliError::Usage(
             "--ground-tm-to and --ground-tc-port need --protocol pus".into(),
         ));
+    }
+    if sdls.is_some() && cfg.link != sim::LinkLayer::Frames {
+        return Err(CliError::Usage("--sdls-keys needs --link frames".into()));
     }
     cfg.realtime = true;
     cfg.scale = 1.0;
@@ -386,6 +397,7 @@ fn external(
         wire: sim::nodes::WireLog(std::sync::Arc::new(std::sync::Mutex::new(Box::new(Lines(
             tx,
         ))))),
+        sdls,
     });
     let summary = std::thread::scope(|s| -> Result<sim::Summary, CliError> {
         let run = s.spawn(move || sim::run(&cfg));
@@ -458,4 +470,21 @@ pub fn bench(max: u8, seconds: u32, out: &mut dyn Write) -> Result<(), CliError>
     .map_err(CliError::Sim)?;
     writeln!(out, "{result}").map_err(CliError::Output)?;
     Ok(())
+}
+
+/// Robot 1's SDLS keys from `dir` (`spi-257.key`, `spi-513.key`: 32 octets each). The error
+/// names the file and the length found, never the octets.
+fn read_keys(dir: &std::path::Path) -> Result<(Key256, Key256), CliError> {
+    let one = mmic::units::BoardNumber::ONE;
+    let read = |spi: u16| -> Result<Key256, CliError> {
+        let path = dir.join(format!("spi-{spi}.key"));
+        let bytes = std::fs::read(&path)
+            .map_err(|e| CliError::Usage(format!("--sdls-keys: {}: {e}", path.display())))?;
+        Key256::from_slice(&bytes)
+            .map_err(|e| CliError::Usage(format!("--sdls-keys: {}: {e}", path.display())))
+    };
+    Ok((
+        read(mmic::link::sdls::mission::tc_spi(one))?,
+        read(mmic::link::sdls::mission::tm_spi(one))?,
+    ))
 }

@@ -297,6 +297,8 @@ pub struct External {
     pub tc_port: u16,
     /// Where the packet lines go (stdout in the CLI).
     pub wire: nodes::WireLog,
+    /// SDLS on the space data link (`--sdls-keys`): robot 1's TC and TM keys.
+    pub sdls: Option<(mmic::link::sdls::Key256, mmic::link::sdls::Key256)>,
 }
 
 impl std::fmt::Debug for External {
@@ -304,6 +306,7 @@ impl std::fmt::Debug for External {
         f.debug_struct("External")
             .field("tm_to", &self.tm_to)
             .field("tc_port", &self.tc_port)
+            .field("sdls", &self.sdls.is_some())
             .finish_non_exhaustive()
     }
 }

@@ -12,12 +12,13 @@ use super::plant::Plant;
 use super::shell::{SideA, SideB};
 use super::FrameStats;
 use mmic::link::farm::Verdict;
+use mmic::link::sdls::Key256;
 use mmic::link::tc_frame::{self, SpacecraftId, TcFrame};
 use mmic::link::tm_frame::TM_FRAME_LEN;
 use mmic::link::ControlCommand;
 use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::server::frames::{FrameConfig, FrameGateway};
+use mmic::node::server::frames::{FrameConfig, FrameGateway, Stored};
 use mmic::node::server::gateway::{self, Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -690,6 +691,9 @@ pub struct FrameGatewayTask {
     pub wire: Option<WireLog>,
     /// Where the server board's figures of the link (FARM-1, TM frames) go when the run ends.
     pub stats: Arc<Mutex<FrameStats>>,
+    /// SDLS on the link: the robot's TC and TM keys. Its durable counters are kept in memory
+    /// for the run.
+    pub sdls: Option<(Key256, Key256)>,
 }
 
 /// One robot, eight waiting telecommands, 64 remembered keys, 4 KiB of TM packets waiting for
@@ -726,8 +730,17 @@ impl FrameGatewayTask {
             ..FrameConfig::default()
         }));
         g.add(self.robot.0);
+        if let Some((tc, tm)) = self.sdls.take() {
+            g.secure(self.robot.0, tc, tm, Stored::default());
+        }
+        let mut store = std::collections::BTreeMap::new();
         while node.running() {
             node.poll();
+            // The durable counters: written (here, kept for the run) and confirmed.
+            for (spi, v) in g.due().collect::<Vec<_>>() {
+                store.insert(spi, v);
+                g.persisted(spi, v);
+            }
             let mut busy = self.link(&node, &mut g);
             let visits = g.tick(node.clock.now_ms());
             for (board, command) in visits {
@@ -759,7 +772,7 @@ impl FrameGatewayTask {
             if let Err(e) = &got.verdict {
                 node.event(
                     now,
-                    json!({"type": "tc_frame_refused", "check": e.name(),
+                    json!({"type": "tc_frame_refused", "check": e.name(), "layer": e.layer(),
                            "hex": super::log::hex(bytes)}),
                 );
             }

@@ -277,6 +277,7 @@ impl ServerEnds<'_> {
             config: env.cfg.gateway,
             wire: env.cfg.external.as_ref().map(|x| x.wire.clone()),
             stats: env.frames.clone(),
+            sdls: env.cfg.external.as_ref().and_then(|x| x.sdls.clone()),
         };
         Ok((gw, udp))
     }
