@@ -6,6 +6,7 @@
 #![no_std]
 
 pub mod control;
+pub mod counters;
 pub mod drivers;
 pub mod link;
 pub mod sensors;
