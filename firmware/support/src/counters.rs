@@ -162,8 +162,8 @@ impl<F: NorFlash, const S: usize> FlashCounters<F, S> {
         };
         let units_ok = F::WRITE_SIZE > 0
             && F::READ_SIZE > 0
-            && RECORD_LEN % F::WRITE_SIZE == 0
-            && RECORD_LEN % F::READ_SIZE == 0;
+            && RECORD_LEN.is_multiple_of(F::WRITE_SIZE)
+            && RECORD_LEN.is_multiple_of(F::READ_SIZE);
         if !units_ok
             || F::ERASE_SIZE > u32::MAX as usize / 2
             || Self::SLOTS < 2

@@ -10,6 +10,7 @@ pub mod counters;
 pub mod drivers;
 pub mod link;
 pub mod sensors;
+pub mod server;
 
 #[cfg(target_arch = "riscv32")]
 pub mod chip;
