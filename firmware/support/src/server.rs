@@ -19,8 +19,6 @@ use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 
-/// Robots one server board serves at most.
-pub const ROBOTS: usize = 4;
 /// Telecommands waiting per robot (the host simulator's).
 pub const QUEUE: usize = 8;
 /// Request keys remembered per robot (the host simulator's).
@@ -32,8 +30,9 @@ pub const TM_WAITING: usize = 1024;
 /// `max_frame_len`); one octet more shows a longer datagram, which the frame checks refuse.
 pub const TC_DATAGRAM: usize = 257;
 
-/// The gateway the server board runs.
-pub type Gateway = FrameGateway<ROBOTS, QUEUE, KEYS, TM_WAITING>;
+/// The gateway the server board runs, for `R` robots (the image's: one FARM-1, queue, key log
+/// and TM framer each, about 3.7 KB of RAM per robot).
+pub type Gateway<const R: usize> = FrameGateway<R, QUEUE, KEYS, TM_WAITING>;
 
 /// The ground's datagram socket (UDP): TC frames in, TM frames out.
 pub trait Datagrams {
@@ -159,20 +158,20 @@ pub enum GlueError {
         /// The SA's SPI.
         spi: u16,
     },
-    /// More robots than [`ROBOTS`], or one twice.
-    #[error("robot {0} cannot be served ({ROBOTS} at most, each once)")]
+    /// More robots than the glue was built for, or one twice.
+    #[error("robot {0} cannot be served (more robots than places, or twice)")]
     Robot(u8),
 }
 
-/// The server board's state besides its sockets.
-pub struct ServerGlue<Sec, St> {
-    gateway: Gateway,
+/// The server board's state besides its sockets, for `R` robots.
+pub struct ServerGlue<Sec, St, const R: usize> {
+    gateway: Gateway<R>,
     security: Sec,
     store: St,
     counts: Counts,
 }
 
-impl<Sec: FrameSecurity, St: CounterStore> ServerGlue<Sec, St> {
+impl<Sec: FrameSecurity, St: CounterStore, const R: usize> ServerGlue<Sec, St, R> {
     /// The gateway for `robots`, each of which must have both its keys in `keys` (the TC and
     /// TM SAs), with `security` between the socket and the gateway and `store` for its
     /// counters.
@@ -206,7 +205,7 @@ impl<Sec: FrameSecurity, St: CounterStore> ServerGlue<Sec, St> {
     }
 
     /// The library's gateway (FARM-1, the link counters).
-    pub const fn gateway(&self) -> &Gateway {
+    pub const fn gateway(&self) -> &Gateway<R> {
         &self.gateway
     }
 

@@ -155,7 +155,7 @@ struct Heard {
 
 struct Bench<Sec: FrameSecurity> {
     ground: GroundLink<10, 64, 1024>,
-    glue: ServerGlue<Sec, Map>,
+    glue: ServerGlue<Sec, Map, 1>,
     udp: Udp,
     board: BoardA,
     clock: Ms,
@@ -318,7 +318,7 @@ fn a_garbage_datagram_is_refused_by_the_frame_checks_and_reaches_no_robot() {
 #[test]
 fn a_robot_without_both_keys_is_not_served() {
     let only_tc: Vec<SdlsKey> = keys().into_iter().filter(|k| k.spi == 257).collect();
-    let e = ServerGlue::new(
+    let e = ServerGlue::<_, _, 1>::new(
         config(),
         &[BoardNumber::ONE],
         &only_tc,
