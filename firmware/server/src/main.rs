@@ -95,7 +95,7 @@ fn counters_flash(flash: esp_hal::peripherals::FLASH<'static>) -> Flash {
 }
 
 /// The loop: one pass of the glue, then sleep until a datagram, a heartbeat or the gateway's
-/// next deadline (at most [`IDLE_MS`]).
+/// next deadline (1 ms to [`IDLE_MS`]).
 async fn serve(stack: Stack<'static>, glue: &'static mut Glue) -> ! {
     let (mut rx_meta, mut tx_meta) = ([PacketMetadata::EMPTY; 8], [PacketMetadata::EMPTY; 8]);
     let (mut rx_buf, mut tx_buf) = ([0u8; 8 * 256], [0u8; 8 * FRAME_LEN]);
@@ -106,8 +106,7 @@ async fn serve(stack: Stack<'static>, glue: &'static mut Glue) -> ! {
     let (mut clock, mut board) = (Uptime, Visits);
     loop {
         let next = glue.poll(&mut clock, &mut ground, &mut board);
-        let now = wifi::now_ms();
-        let wait = next.map_or(IDLE_MS, |t| t.wrapping_sub(now).min(IDLE_MS));
+        let wait = support::server::sleep_ms(next, wifi::now_ms(), IDLE_MS);
         select3(
             ground.sock.wait_recv_ready(),
             HEARTBEATS.ready_to_receive(),

@@ -277,6 +277,32 @@ impl<Sec: FrameSecurity, St: CounterStore, const R: usize> ServerGlue<Sec, St, R
     }
 }
 
+/// How long the shell may sleep at `now` before the next pass, given the gateway's next
+/// deadline `next` (from [`ServerGlue::poll`]): until the deadline, at most `max_ms`, at least
+/// 1 ms (a deadline already past, which the clock's wrap would otherwise read as far away,
+/// means a pass at once; the 1 ms keeps a deadline that stays due from spinning the CPU, and
+/// a datagram wakes the shell earlier anyway).
+pub const fn sleep_ms(next: Option<u32>, now: u32, max_ms: u32) -> u32 {
+    let wait = match next {
+        None => max_ms,
+        Some(t) => {
+            let d = t.wrapping_sub(now);
+            if d > u32::MAX / 2 {
+                0
+            } else if d < max_ms {
+                d
+            } else {
+                max_ms
+            }
+        }
+    };
+    if wait == 0 {
+        1
+    } else {
+        wait
+    }
+}
+
 /// The frame security the image runs, made from the keys it carries. **Not SDLS yet**: until
 /// the library's `mmic::link::sdls` lands this returns [`Clear`] and the keys go unused; the
 /// lead completes it (per robot a TC receiver SA on [`tc_spi`] and a TM sender SA on

@@ -6,6 +6,9 @@
 
 use std::collections::{BTreeMap, VecDeque};
 
+mod common;
+use common::Ram;
+
 use mmic::ccsds::primary::{Apid, SeqCount};
 use mmic::ccsds::tc::TcRepr;
 use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
@@ -19,9 +22,10 @@ use mmic::pus::verification::{Report, Stage};
 use mmic::units::BoardNumber;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
-use mmic_fw_support::counters::{CounterError, CounterStore};
+use mmic_fw_support::counters::{CounterError, CounterStore, FlashCounters};
 use mmic_fw_support::server::{
-    security, BoardLink, Clear, Clock, Datagrams, FrameSecurity, GlueError, SdlsKey, ServerGlue,
+    security, sleep_ms, BoardLink, Clear, Clock, Datagrams, FrameSecurity, GlueError, SdlsKey,
+    ServerGlue,
 };
 
 /// The mocked UDP socket: datagrams from the ground waiting, datagrams sent to it.
@@ -390,4 +394,60 @@ fn the_frame_security_sits_between_the_socket_and_the_gateway_with_the_store() {
     // Every TM frame sent advanced the stored counter.
     let sent = b.glue.counts().tm_frames;
     assert_eq!(b.glue.store().load(513), Some(u128::from(sent)));
+}
+
+#[test]
+fn the_shell_sleeps_until_the_deadline_within_bounds() {
+    assert_eq!(sleep_ms(None, 5, 10), 10);
+    assert_eq!(sleep_ms(Some(8), 5, 10), 3);
+    assert_eq!(sleep_ms(Some(500), 5, 10), 10);
+    // Due now, or already past (also across the clock's wrap): a pass almost at once.
+    assert_eq!(sleep_ms(Some(5), 5, 10), 1);
+    assert_eq!(sleep_ms(Some(4), 5, 10), 1);
+    assert_eq!(sleep_ms(Some(u32::MAX), 2, 10), 1);
+    assert_eq!(sleep_ms(Some(3), u32::MAX - 1, 10), 5);
+}
+
+#[test]
+fn a_pass_reports_the_gateways_next_deadline() {
+    let mut b = Bench::new(Clear, clear);
+    b.run(50);
+    let now = b.clock.0;
+    let next = b.glue.poll(&mut b.clock, &mut b.udp, &mut b.board).unwrap();
+    // Something is always due within the TM idle period (500 ms) and the poll period (250 ms).
+    let d = next.wrapping_sub(now);
+    assert!(d <= 500, "next deadline {d} ms away");
+}
+
+/// The stand-in security of [`Marked`] with the counters in flash: the TM counter a reset
+/// finds is the one the last frame stored, and passes go on from it.
+#[test]
+fn the_counters_survive_a_reset_of_the_server_board_in_flash() {
+    type Flash = FlashCounters<Ram, 2>;
+    let store = Flash::open(Ram::new(2)).unwrap();
+    let mut glue: ServerGlue<Marked, Flash, 1> =
+        ServerGlue::new(config(), &[BoardNumber::ONE], &keys(), Marked, store).unwrap();
+    let (mut udp, mut board, mut clock) = (Udp::default(), BoardA::default(), Ms(0));
+    // Five seconds of idle link: a TM frame every 500 ms at least, each stored.
+    for _ in 0..5000 {
+        clock.0 += 1;
+        glue.poll(&mut clock, &mut udp, &mut board);
+    }
+    let sent = glue.counts().tm_frames;
+    assert!(sent >= 10, "{sent} TM frames");
+    assert_eq!(udp.sent.len() as u32, sent);
+    // Reset: a new glue on the same flash.
+    let ram = std::mem::replace(glue.store(), Flash::open(Ram::new(2)).unwrap()).release();
+    assert_eq!(ram.overwrites, 0);
+    let store = Flash::open(ram.reset()).unwrap();
+    let mut glue: ServerGlue<Marked, Flash, 1> =
+        ServerGlue::new(config(), &[BoardNumber::ONE], &keys(), Marked, store).unwrap();
+    assert_eq!(glue.store().load(513), Some(u128::from(sent)));
+    for _ in 0..1000 {
+        clock.0 += 1;
+        glue.poll(&mut clock, &mut udp, &mut board);
+    }
+    let more = glue.counts().tm_frames;
+    assert!(more >= 2);
+    assert_eq!(glue.store().load(513), Some(u128::from(sent + more)));
 }
