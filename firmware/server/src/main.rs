@@ -1,91 +1,192 @@
-//! The server board (Figure 4): commands from the opsUI on the USB serial line go into the
-//! library's pending slots (`mmic::node::server::relay`); each loop visits one robot with a pending
-//! command as the library's `Visit` says: connect, send, forward the heartbeat that comes
-//! back by the visit's deadline, disconnect.
+//! The server board towards the ground over the space data link (issue 28): TC transfer frames
+//! arrive on UDP port [`net::TC_PORT`], go through the frame security (SDLS's slot) into the
+//! library's `FrameGateway` (FARM-1 per robot, the PUS gateway); the legacy commands it makes
+//! go to board A in visits (connect, send, the heartbeat by the visit's deadline, disconnect:
+//! the library's `Visit`, as before); the heartbeats go back into the gateway; the TM transfer
+//! frames it says are due go to the ground at [`net::GROUND`]:[`net::TM_PORT`]. The SDLS
+//! counters persist in the flash partition `mmic_ctr` (server/partitions.csv).
 //!
-//! The USB serial line carries the opsUI's packets only: this binary prints nothing after
-//! start-up (a panic message would reach the opsUI, whose deframer drops it as garbage).
+//! Every step is `support::server::ServerGlue::poll` (host-tested in support/tests/server.rs);
+//! this file is the sockets, the flash and the tasks.
 #![no_std]
 #![no_main]
 
+use core::task::{Context, Poll, Waker};
 use embassy_executor::Spawner;
+use embassy_futures::select::select3;
 use embassy_net::tcp::TcpSocket;
-use embassy_net::{Ipv4Address, Stack};
-use embassy_time::{with_timeout, Duration, Ticker};
+use embassy_net::udp::{PacketMetadata, RecvError, UdpSocket};
+use embassy_net::{IpEndpoint, Ipv4Address, Stack};
+use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
+use embassy_sync::channel::Channel;
+use embassy_time::{with_timeout, Duration, Timer};
 use esp_backtrace as _;
-use esp_hal::usb::usb_serial_jtag::{UsbSerialJtag, UsbSerialJtagRx, UsbSerialJtagTx};
-use esp_hal::Blocking;
-use mmic::node::server::relay::{Accepted, Server, ServerError};
+use esp_bootloader_esp_idf::partitions::{self, FlashRegion, PARTITION_TABLE_MAX_LEN};
+use esp_storage::FlashStorage;
+use mmic::node::server::frames::{FrameConfig, FRAME_LEN};
 use mmic::node::server::visit::{Heartbeat, Visit};
+use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
-use mmic::wire::PacketKind;
-use support::link::{ByteSink, ByteSource, Link};
+use mmic::wire::heartbeat::HEARTBEAT_LEN;
+use static_cell::StaticCell;
+use support::counters::FlashCounters;
 use support::net;
+use support::server::{BoardLink, Clock, Datagrams, ServerGlue};
 
 esp_bootloader_esp_idf::esp_app_desc!();
 
-/// How long a visit lasts at most, connecting and waiting for the heartbeat (the host
-/// simulator's `visit_ms`), ms.
-const VISIT_MS: u32 = 200;
-/// The loop's period while no command is pending, and the opsUI line's idle time.
-const IDLE: Duration = Duration::from_millis(10);
+// `ROBOTS` and `KEYS`, from `MMIC_ROBOTS` and `MMIC_SDLS_KEY_DIR` (build.rs).
+include!(concat!(env!("OUT_DIR"), "/keys.rs"));
 
-/// The opsUI's line: USB serial (CDC-ACM of the USB-Serial-JTAG peripheral).
-struct OpsUi(
-    UsbSerialJtagRx<'static, Blocking>,
-    UsbSerialJtagTx<'static, Blocking>,
-);
+/// The flash partition of the SDLS counters (server/partitions.csv): two 4 KiB sectors.
+const COUNTERS_PARTITION: &str = "mmic_ctr";
+/// Robots served.
+const R: usize = ROBOTS.len();
+/// SPIs the counter store holds: two per robot.
+const SPIS: usize = 2 * R;
+/// The longest the main loop sleeps while nothing is due (a heartbeat a visit brought back
+/// waits at most this long), ms.
+const IDLE_MS: u32 = 10;
 
-impl ByteSource for OpsUi {
-    fn read(&mut self, buf: &mut [u8]) -> usize {
-        self.0.drain_rx_fifo(buf)
-    }
-}
+type Flash = partitions::NorFlashRegion<'static, 'static, 'static>;
+type Glue = ServerGlue<support::server::Clear, FlashCounters<Flash, SPIS>, R>;
 
-impl ByteSink for OpsUi {
-    fn write(&mut self, bytes: &[u8]) -> bool {
-        self.1.write(bytes).is_ok()
-    }
-}
+/// Board A visits asked for by the gateway, and the heartbeats they brought back.
+static VISITS: Channel<CriticalSectionRawMutex, (BoardNumber, [u8; COMMAND_LEN]), R> =
+    Channel::new();
+static HEARTBEATS: Channel<CriticalSectionRawMutex, Heartbeat, R> = Channel::new();
+
+static FLASH: StaticCell<FlashStorage<'static>> = StaticCell::new();
+static REGION: StaticCell<FlashRegion<'static, 'static>> = StaticCell::new();
+static GLUE: StaticCell<Glue> = StaticCell::new();
 
 #[esp_rtos::main]
 async fn main(spawner: Spawner) -> ! {
     wifi::boot!(p);
-    let (rx, tx) = UsbSerialJtag::new(p.USB_DEVICE).split();
-    let ops = OpsUi(rx, tx);
+    let store = FlashCounters::open(counters_flash(p.FLASH)).expect("SDLS counters in flash");
+    let mut robots = [BoardNumber::ONE; R];
+    for (r, n) in robots.iter_mut().zip(ROBOTS) {
+        *r = BoardNumber::new(n).expect("MMIC_ROBOTS");
+    }
+    let config = FrameConfig::default();
+    // SDLS slots in here: `security` makes the frame security from the keys (the lead's).
+    let security = support::server::security(&KEYS);
+    let glue = GLUE
+        .init(ServerGlue::new(config, &robots, &KEYS, security, store).expect("robots and keys"));
 
     // Start-up: WiFi station on the lab's access point at the server's fixed address.
     let stack = wifi::start(&spawner, p.WIFI, net::SERVER);
-    serve(stack, ops).await
+    spawner.spawn(visits(stack, config.gateway.uplink.timeout_ms).expect("visit task"));
+    serve(stack, glue).await
 }
 
-/// Figure 4's loop.
-async fn serve(stack: Stack<'static>, mut ops: OpsUi) -> ! {
-    let mut glue = ServerGlue::new();
-    let (mut rx_buf, mut tx_buf) = ([0u8; 256], [0u8; 256]);
-    let mut ticker = Ticker::every(IDLE);
+/// The counters' partition as NOR flash. Start-up only: an image flashed without
+/// server/partitions.csv has no such partition, and must not run without durable counters.
+fn counters_flash(flash: esp_hal::peripherals::FLASH<'static>) -> Flash {
+    let flash = FLASH.init(FlashStorage::new(flash));
+    let mut table = [0u8; PARTITION_TABLE_MAX_LEN];
+    let pt = partitions::read_partition_table(flash, &mut table).expect("partition table");
+    let entry = pt
+        .iter()
+        .find(|e| e.label_as_str() == COUNTERS_PARTITION)
+        .expect("no mmic_ctr partition: flash with --partition-table server/partitions.csv");
+    let region = REGION.init(entry.as_flash_region(flash));
+    region.as_nor_flash().expect("mmic_ctr is not encrypted")
+}
+
+/// The loop: one pass of the glue, then sleep until a datagram, a heartbeat or the gateway's
+/// next deadline (1 ms to [`IDLE_MS`]).
+async fn serve(stack: Stack<'static>, glue: &'static mut Glue) -> ! {
+    let (mut rx_meta, mut tx_meta) = ([PacketMetadata::EMPTY; 8], [PacketMetadata::EMPTY; 8]);
+    let (mut rx_buf, mut tx_buf) = ([0u8; 8 * 256], [0u8; 8 * FRAME_LEN]);
+    let mut sock = UdpSocket::new(stack, &mut rx_meta, &mut rx_buf, &mut tx_meta, &mut tx_buf);
+    sock.bind(net::TC_PORT).expect("TC port");
+    let to = IpEndpoint::new(Ipv4Address::from(net::GROUND).into(), net::TM_PORT);
+    let mut ground = Ground { sock, to };
+    let (mut clock, mut board) = (Uptime, Visits);
     loop {
-        ticker.next().await;
-        glue.take_ground(&mut ops);
-        let Some(mut visit) = Visit::next(&mut glue.srv, wifi::now_ms(), VISIT_MS) else {
-            continue;
-        };
+        let next = glue.poll(&mut clock, &mut ground, &mut board);
+        let wait = support::server::sleep_ms(next, wifi::now_ms(), IDLE_MS);
+        select3(
+            ground.sock.wait_recv_ready(),
+            HEARTBEATS.ready_to_receive(),
+            Timer::after(wifi::ms(wait)),
+        )
+        .await;
+    }
+}
+
+/// The ground's UDP socket, polled without blocking.
+struct Ground<'a> {
+    sock: UdpSocket<'a>,
+    to: IpEndpoint,
+}
+
+impl Datagrams for Ground<'_> {
+    fn recv(&mut self, buf: &mut [u8]) -> Option<usize> {
+        let mut cx = Context::from_waker(Waker::noop());
+        match self.sock.poll_recv_from(buf, &mut cx) {
+            Poll::Ready(Ok((n, _))) => Some(n),
+            // Longer than any TC frame: an empty datagram, which the frame checks refuse.
+            Poll::Ready(Err(RecvError::Truncated)) => Some(0),
+            Poll::Pending => None,
+        }
+    }
+
+    fn send(&mut self, datagram: &[u8]) -> bool {
+        let mut cx = Context::from_waker(Waker::noop());
+        matches!(
+            self.sock.poll_send_to(datagram, self.to, &mut cx),
+            Poll::Ready(Ok(()))
+        )
+    }
+}
+
+/// The clock of the library's state machines.
+struct Uptime;
+
+impl Clock for Uptime {
+    fn now_ms(&mut self) -> u32 {
+        wifi::now_ms()
+    }
+}
+
+/// Board A, through the visit task.
+struct Visits;
+
+impl BoardLink for Visits {
+    fn command(&mut self, board: BoardNumber, packet: [u8; COMMAND_LEN]) -> bool {
+        VISITS.try_send((board, packet)).is_ok()
+    }
+
+    fn heartbeat(&mut self) -> Option<[u8; HEARTBEAT_LEN]> {
+        HEARTBEATS.try_receive().ok()
+    }
+}
+
+/// Figure 4's visits, one at a time: connect to board A of the robot, send the command, take
+/// the first heartbeat by the visit's deadline (`wait_ms`, the gateway's uplink timeout),
+/// disconnect.
+#[embassy_executor::task]
+async fn visits(stack: Stack<'static>, wait_ms: u32) {
+    let (mut rx_buf, mut tx_buf) = ([0u8; 256], [0u8; 256]);
+    loop {
+        let (board, packet) = VISITS.receive().await;
+        let mut visit = Visit::new(wifi::now_ms(), board, packet, wait_ms);
         let mut sock = TcpSocket::new(stack, &mut rx_buf, &mut tx_buf);
-        sock.set_timeout(Some(wifi::ms(VISIT_MS)));
-        let to = (
-            Ipv4Address::from(net::robot(visit.board().get())),
-            net::PORT,
-        );
+        sock.set_timeout(Some(wifi::ms(wait_ms)));
+        let to = (Ipv4Address::from(net::robot(board.get())), net::PORT);
         let left = visit.left_ms(wifi::now_ms()).unwrap_or(0);
         if let Ok(Ok(())) = with_timeout(wifi::ms(left), sock.connect(to)).await {
             if wifi::write_all(&mut sock, visit.packet()).await {
-                visit.written(&mut glue.srv);
                 if let Some(hb) = heartbeat(&mut sock, &mut visit).await {
-                    glue.forward(&mut ops, &hb);
+                    // Full only if the main loop stopped taking them: dropped, and the
+                    // gateway's uplink asks again.
+                    let _ = HEARTBEATS.try_send(hb);
                 }
             }
             sock.close();
-            let _ = with_timeout(IDLE, sock.flush()).await;
+            let _ = with_timeout(Duration::from_millis(IDLE_MS.into()), sock.flush()).await;
         }
         sock.abort();
     }
@@ -103,70 +204,6 @@ async fn heartbeat(sock: &mut TcpSocket<'_>, visit: &mut Visit) -> Option<Heartb
                 }
             }
             _ => return None,
-        }
-    }
-}
-
-/// Robots one server board serves.
-const ROBOTS: usize = 4;
-
-/// What the server glue counts.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-struct Counters {
-    /// Commands the library refused (invalid, or no free slot).
-    refused: u32,
-    /// Pending commands replaced by a newer one from the ground.
-    superseded: u32,
-    /// Heartbeats forwarded to the opsUI.
-    forwarded: u32,
-    /// Heartbeats the opsUI's line did not take.
-    ops_errors: u32,
-}
-
-/// The server board's state besides its sockets.
-struct ServerGlue {
-    /// The library's pending slots.
-    srv: Server<ROBOTS>,
-    /// The opsUI's serial line, receive side.
-    ground: Link,
-    /// Counts.
-    counters: Counters,
-}
-
-impl ServerGlue {
-    /// No robot known.
-    const fn new() -> Self {
-        ServerGlue {
-            srv: Server::new(),
-            ground: Link::new(PacketKind::Command),
-            counters: Counters {
-                refused: 0,
-                superseded: 0,
-                forwarded: 0,
-                ops_errors: 0,
-            },
-        }
-    }
-
-    /// Takes every command the opsUI's line has now into the pending slots.
-    fn take_ground(&mut self, line: &mut impl ByteSource) {
-        while let Some(p) = self.ground.next::<COMMAND_LEN>(line) {
-            match self.srv.accept(&p) {
-                Ok(Accepted::Queued | Accepted::Resend) => {}
-                Ok(Accepted::Superseded(_)) => self.counters.superseded += 1,
-                Err(ServerError::Invalid(_) | ServerError::Full { .. }) => {
-                    self.counters.refused += 1
-                }
-            }
-        }
-    }
-
-    /// The visit's heartbeat, written to the opsUI's line.
-    fn forward(&mut self, ops: &mut impl ByteSink, hb: &Heartbeat) {
-        if ops.write(hb) {
-            self.counters.forwarded += 1;
-        } else {
-            self.counters.ops_errors = self.counters.ops_errors.saturating_add(1);
         }
     }
 }

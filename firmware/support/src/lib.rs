@@ -6,9 +6,11 @@
 #![no_std]
 
 pub mod control;
+pub mod counters;
 pub mod drivers;
 pub mod link;
 pub mod sensors;
+pub mod server;
 
 #[cfg(target_arch = "riscv32")]
 pub mod chip;
@@ -25,6 +27,13 @@ pub mod net {
     pub const PORT: u16 = 5000;
     /// The server board's address.
     pub const SERVER: [u8; 4] = [192, 168, 4, 2];
+    /// The ground station's address (YAMCS), where the server board sends its TM frames.
+    pub const GROUND: [u8; 4] = [192, 168, 4, 3];
+    /// UDP port on the server board where TC transfer frames arrive (YAMCS `UdpTcFrameLink`'s
+    /// `port`). `spec/ccsds/link.toml` gives no port; 10025 and 10015 are YAMCS's own examples'.
+    pub const TC_PORT: u16 = 10025;
+    /// UDP port on the ground where TM transfer frames go (YAMCS `UdpTmFrameLink`'s `port`).
+    pub const TM_PORT: u16 = 10015;
     /// The lab network's name, at build time (`MMIC_SSID`).
     pub const SSID: &str = match option_env!("MMIC_SSID") {
         Some(s) => s,
