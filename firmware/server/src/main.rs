@@ -1,6 +1,6 @@
 //! The server board towards the ground over the space data link (issue 28): TC transfer frames
-//! arrive on UDP port [`net::TC_PORT`], go through the frame security (SDLS's slot) into the
-//! library's `FrameGateway` (FARM-1 per robot, the PUS gateway); the legacy commands it makes
+//! arrive on UDP port [`net::TC_PORT`] and go into the library's `FrameGateway` (SDLS, FARM-1
+//! per robot, the PUS gateway); the legacy commands it makes
 //! go to board A in visits (connect, send, the heartbeat by the visit's deadline, disconnect:
 //! the library's `Visit`, as before); the heartbeats go back into the gateway; the TM transfer
 //! frames it says are due go to the ground at [`net::GROUND`]:[`net::TM_PORT`]. The SDLS
@@ -49,7 +49,7 @@ const SPIS: usize = 2 * R;
 const IDLE_MS: u32 = 10;
 
 type Flash = partitions::NorFlashRegion<'static, 'static, 'static>;
-type Glue = ServerGlue<support::server::Clear, FlashCounters<Flash, SPIS>, R>;
+type Glue = ServerGlue<FlashCounters<Flash, SPIS>, R>;
 
 /// Board A visits asked for by the gateway, and the heartbeats they brought back.
 static VISITS: Channel<CriticalSectionRawMutex, (BoardNumber, [u8; COMMAND_LEN]), R> =
@@ -69,10 +69,9 @@ async fn main(spawner: Spawner) -> ! {
         *r = BoardNumber::new(n).expect("MMIC_ROBOTS");
     }
     let config = FrameConfig::default();
-    // SDLS slots in here: `security` makes the frame security from the keys (the lead's).
-    let security = support::server::security(&KEYS);
-    let glue = GLUE
-        .init(ServerGlue::new(config, &robots, &KEYS, security, store).expect("robots and keys"));
+    // Each robot's link secured with SDLS under the keys built into the image, its counters
+    // restored from flash.
+    let glue = GLUE.init(ServerGlue::new(config, &robots, &KEYS, store).expect("robots and keys"));
 
     // Start-up: WiFi station on the lab's access point at the server's fixed address.
     let stack = wifi::start(&spawner, p.WIFI, net::SERVER);

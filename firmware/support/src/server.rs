@@ -1,20 +1,21 @@
 //! The server board's glue towards the ground over the space data link (issue 28): TC transfer
-//! frames arrive as UDP datagrams, go through the frame security (SDLS, once the library has
-//! it) into the library's [`FrameGateway`] (FARM-1 per robot, the PUS gateway); the legacy
+//! frames arrive as UDP datagrams and go into the library's [`FrameGateway`] (SDLS, FARM-1 per
+//! robot, the PUS gateway); the legacy
 //! commands its `tick` says are due go to board A (one visit each, as the host simulator's
 //! `FrameGatewayTask` makes them); the heartbeats the visits bring back go into the gateway;
-//! every TM transfer frame it says is due goes through the frame security to the ground, one
-//! per datagram.
+//! every TM transfer frame it says is due (protected by SDLS) goes to the ground, one per
+//! datagram; the SDLS counters the gateway asks to keep go to the durable store first.
 //!
-//! Generic over the I/O ([`Datagrams`], [`BoardLink`], [`Clock`]), the frame security
-//! ([`FrameSecurity`]) and the counters' durable store ([`CounterStore`]), so the host tests
+//! Generic over the I/O ([`Datagrams`], [`BoardLink`], [`Clock`]) and the counters' durable
+//! store ([`CounterStore`]), so the host tests
 //! drive it with mocks and the image with embassy-net and flash. It decides nothing the
 //! library does not: the only choices here are the order of the steps (the simulator's) and
 //! what is counted when an I/O fails.
 
 use crate::counters::CounterStore;
 use core::fmt;
-use mmic::node::server::frames::{FrameConfig, FrameGateway, FRAME_LEN};
+use mmic::link::sdls::{mission, Key256};
+use mmic::node::server::frames::{FrameConfig, FrameGateway, Stored, FRAME_LEN};
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
@@ -78,61 +79,16 @@ impl fmt::Debug for SdlsKey {
     }
 }
 
-/// The TC SA's SPI of robot `board` (sdls-plan.md).
-pub const fn tc_spi(board: BoardNumber) -> u16 {
-    0x100 + board.get() as u16
-}
-
-/// The TM SA's SPI of robot `board` (sdls-plan.md).
-pub const fn tm_spi(board: BoardNumber) -> u16 {
-    0x200 + board.get() as u16
-}
-
-/// What stands between the ground's datagrams and the gateway's frames: SDLS's processing of
-/// each TC frame (verify, decrypt, anti-replay) and protection of each TM frame, with the
-/// counters it must keep durable going to `store`.
-pub trait FrameSecurity {
-    /// A TC frame as received (`frame`), processed in place: the length of the clear frame
-    /// now at the start of `frame`, or `None` when the frame is refused (not authentic, a
-    /// replay).
-    fn tc_in<S: CounterStore>(
-        &mut self,
-        store: &mut S,
-        now: u32,
-        frame: &mut [u8],
-    ) -> Option<usize>;
-    /// A clear TM frame of `len` octets at the start of `frame` (which has room for
-    /// [`FRAME_LEN`]), protected in place: the length to send, or `None` when it must not go
-    /// (the sender's IV space or its durable reservation is spent).
-    fn tm_out<S: CounterStore>(
-        &mut self,
-        store: &mut S,
-        frame: &mut [u8],
-        len: usize,
-    ) -> Option<usize>;
-}
-
-/// No frame security: frames pass unchanged (the link as the host simulator runs it today).
-#[derive(Debug, Clone, Copy, Default)]
-pub struct Clear;
-
-impl FrameSecurity for Clear {
-    fn tc_in<S: CounterStore>(&mut self, _: &mut S, _: u32, frame: &mut [u8]) -> Option<usize> {
-        Some(frame.len())
-    }
-    fn tm_out<S: CounterStore>(&mut self, _: &mut S, _: &mut [u8], len: usize) -> Option<usize> {
-        Some(len)
-    }
-}
-
 /// What the glue counts (each wraps at `u32::MAX`); FARM-1's and the gateway's own counts are
 /// the library's ([`Gateway::counters`], [`Gateway::refused`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Counts {
     /// Datagrams from the ground.
     pub tc_datagrams: u32,
-    /// Of those, refused by the frame security.
-    pub tc_insecure: u32,
+    /// Durable counter writes the store refused (the reservation is asked for again at the
+    /// next pass; until one succeeds, frames wait or are refused, never protected or accepted
+    /// beyond what is durable).
+    pub store_failed: u32,
     /// Legacy commands handed to the board link.
     pub commands: u32,
     /// Legacy commands the board link was too busy to take (the uplink resends them).
@@ -143,7 +99,7 @@ pub struct Counts {
     pub heartbeats_unreadable: u32,
     /// TM frames sent.
     pub tm_frames: u32,
-    /// TM frames the frame security held back, or the socket did not send.
+    /// TM frames the socket did not send.
     pub tm_unsent: u32,
 }
 
@@ -164,44 +120,66 @@ pub enum GlueError {
 }
 
 /// The server board's state besides its sockets, for `R` robots.
-pub struct ServerGlue<Sec, St, const R: usize> {
+pub struct ServerGlue<St, const R: usize> {
     gateway: Gateway<R>,
-    security: Sec,
     store: St,
     counts: Counts,
 }
 
-impl<Sec: FrameSecurity, St: CounterStore, const R: usize> ServerGlue<Sec, St, R> {
-    /// The gateway for `robots`, each of which must have both its keys in `keys` (the TC and
-    /// TM SAs), with `security` between the socket and the gateway and `store` for its
-    /// counters.
+impl<St: CounterStore, const R: usize> ServerGlue<St, R> {
+    /// The gateway for `robots`, each secured with SDLS (`mmic::link::sdls::mission`): its TC
+    /// and TM keys from `keys` (both must be there), its counters restored from `store`.
     pub fn new(
         config: FrameConfig,
         robots: &[BoardNumber],
         keys: &[SdlsKey],
-        security: Sec,
-        store: St,
+        mut store: St,
     ) -> Result<Self, GlueError> {
         let mut gateway = Gateway::new(config);
         for &board in robots {
-            for spi in [tc_spi(board), tm_spi(board)] {
-                if !keys.iter().any(|k| k.spi == spi) {
-                    return Err(GlueError::NoKey {
+            let key = |spi: u16| {
+                keys.iter()
+                    .find(|k| k.spi == spi)
+                    .map(|k| Key256::from_bytes(k.key))
+                    .ok_or(GlueError::NoKey {
                         board: board.get(),
                         spi,
-                    });
-                }
-            }
-            if !gateway.add(board) {
+                    })
+            };
+            let (tc_spi, tm_spi) = (mission::tc_spi(board), mission::tm_spi(board));
+            let (tc, tm) = (key(tc_spi)?, key(tm_spi)?);
+            let stored = Stored {
+                tc: store.load(tc_spi),
+                tm: store.load(tm_spi),
+            };
+            if !gateway.add(board) || !gateway.secure(board, tc, tm, stored) {
                 return Err(GlueError::Robot(board.get()));
             }
         }
-        Ok(ServerGlue {
+        let mut glue = ServerGlue {
             gateway,
-            security,
             store,
             counts: Counts::default(),
-        })
+        };
+        glue.persist();
+        Ok(glue)
+    }
+
+    /// Writes the durable counters the gateway asks for, and confirms each write that
+    /// succeeded (nothing is protected or accepted beyond a confirmed write).
+    fn persist(&mut self) {
+        // Two associations per robot: 16 covers the eight robots a server board could serve.
+        let mut due: heapless::Vec<(u16, u128), 16> = heapless::Vec::new();
+        for d in self.gateway.due() {
+            let _ = due.push(d);
+        }
+        for (spi, value) in due {
+            if self.store.store(spi, value).is_ok() {
+                self.gateway.persisted(spi, value);
+            } else {
+                self.counts.store_failed = self.counts.store_failed.wrapping_add(1);
+            }
+        }
     }
 
     /// The library's gateway (FARM-1, the link counters).
@@ -230,16 +208,14 @@ impl<Sec: FrameSecurity, St: CounterStore, const R: usize> ServerGlue<Sec, St, R
         board: &mut impl BoardLink,
     ) -> Option<u32> {
         let mut buf = [0u8; TC_DATAGRAM];
+        self.persist();
         while let Some(n) = ground.recv(&mut buf) {
             self.counts.tc_datagrams = self.counts.tc_datagrams.wrapping_add(1);
             let now = clock.now_ms();
-            let frame = buf.get_mut(..n).unwrap_or(&mut []);
-            match self.security.tc_in(&mut self.store, now, frame) {
-                Some(len) => {
-                    self.gateway.tc_frame(now, frame.get(..len).unwrap_or(&[]));
-                }
-                None => self.counts.tc_insecure = self.counts.tc_insecure.wrapping_add(1),
-            }
+            // SDLS, FARM-1 and the PUS gateway: the library's (a refused frame is counted
+            // there, per reason).
+            self.gateway.tc_frame(now, buf.get(..n).unwrap_or(&[]));
+            self.persist();
         }
         while let Some(hb) = board.heartbeat() {
             match HeartbeatRepr::parse(&hb) {
@@ -262,11 +238,10 @@ impl<Sec: FrameSecurity, St: CounterStore, const R: usize> ServerGlue<Sec, St, R
         }
         let now = clock.now_ms();
         let mut tm = [0u8; FRAME_LEN];
+        self.persist();
         while let Some((_, len)) = self.gateway.frame(now, &mut tm) {
-            let sent = self
-                .security
-                .tm_out(&mut self.store, &mut tm, len)
-                .is_some_and(|n| ground.send(tm.get(..n).unwrap_or(&[])));
+            let sent = ground.send(tm.get(..len).unwrap_or(&[]));
+            self.persist();
             if sent {
                 self.counts.tm_frames = self.counts.tm_frames.wrapping_add(1);
             } else {
@@ -301,14 +276,4 @@ pub const fn sleep_ms(next: Option<u32>, now: u32, max_ms: u32) -> u32 {
     } else {
         wait
     }
-}
-
-/// The frame security the image runs, made from the keys it carries. **Not SDLS yet**: until
-/// the library's `mmic::link::sdls` lands this returns [`Clear`] and the keys go unused; the
-/// lead completes it (per robot a TC receiver SA on [`tc_spi`] and a TM sender SA on
-/// [`tm_spi`], each keyed from `keys`, their counters restored through the [`CounterStore`]
-/// that [`FrameSecurity`]'s calls receive).
-pub fn security(keys: &[SdlsKey]) -> Clear {
-    let _ = keys;
-    Clear
 }

@@ -14,6 +14,7 @@ use mmic::ccsds::tc::TcRepr;
 use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::ccsds::tm::TmRepr;
 use mmic::command::Command;
+use mmic::link::sdls::Key256;
 use mmic::mode::Mode;
 use mmic::node::ground::frames::GroundLink;
 use mmic::node::server::frames::FrameConfig;
@@ -24,8 +25,7 @@ use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 use mmic_fw_support::counters::{CounterError, CounterStore, FlashCounters};
 use mmic_fw_support::server::{
-    security, sleep_ms, BoardLink, Clear, Clock, Datagrams, FrameSecurity, GlueError, SdlsKey,
-    ServerGlue,
+    sleep_ms, BoardLink, Clock, Datagrams, GlueError, SdlsKey, ServerGlue,
 };
 
 /// The mocked UDP socket: datagrams from the ground waiting, datagrams sent to it.
@@ -157,24 +157,35 @@ struct Heard {
     completed: Vec<u16>,
 }
 
-struct Bench<Sec: FrameSecurity> {
+struct Bench {
     ground: GroundLink<10, 64, 1024>,
-    glue: ServerGlue<Sec, Map, 1>,
+    glue: ServerGlue<Map, 1>,
     udp: Udp,
     board: BoardA,
     clock: Ms,
     heard: Heard,
-    /// A datagram wrapper between the ground and the UDP socket (the test's frame security).
+    /// A datagram wrapper between the ground and the UDP socket (an attacker's stand-in).
     wrap: fn(&[u8]) -> Vec<u8>,
+    /// The TC datagrams the ground sent.
+    uplink: Vec<Vec<u8>>,
 }
 
-impl<Sec: FrameSecurity> Bench<Sec> {
-    fn new(sec: Sec, wrap: fn(&[u8]) -> Vec<u8>) -> Self {
-        let glue =
-            ServerGlue::new(config(), &[BoardNumber::ONE], &keys(), sec, Map::default()).unwrap();
+impl Bench {
+    fn new(wrap: fn(&[u8]) -> Vec<u8>) -> Self {
+        let keys = keys();
+        let glue = ServerGlue::new(config(), &[BoardNumber::ONE], &keys, Map::default()).unwrap();
+        // The ground holds the same keys; its counters live with it for the test.
+        let mut ground = GroundLink::new(BoardNumber::ONE);
+        ground.secure(
+            Key256::from_bytes(keys[0].key),
+            Key256::from_bytes(keys[1].key),
+            (None, None),
+        );
+        persist_ground(&mut ground);
         let mut b = Bench {
-            ground: GroundLink::new(BoardNumber::ONE),
+            ground,
             glue,
+            uplink: Vec::new(),
             udp: Udp::default(),
             board: BoardA::default(),
             clock: Ms(0),
@@ -183,6 +194,7 @@ impl<Sec: FrameSecurity> Bench<Sec> {
         };
         let mut up = Vec::new();
         b.ground.start(0, &mut |f: &[u8]| up.push(wrap(f)));
+        b.uplink.extend(up.iter().cloned());
         b.udp.inbox.extend(up);
         b
     }
@@ -193,6 +205,8 @@ impl<Sec: FrameSecurity> Bench<Sec> {
         self.ground
             .send(packet, now, &mut |f: &[u8]| up.push(wrap(f)))
             .unwrap();
+        persist_ground(&mut self.ground);
+        self.uplink.extend(up.iter().cloned());
         self.udp.inbox.extend(up);
     }
 
@@ -234,6 +248,8 @@ impl<Sec: FrameSecurity> Bench<Sec> {
                 }
             }
             self.ground.tick(now, &mut |f: &[u8]| up.push(wrap(f)));
+            persist_ground(&mut self.ground);
+            self.uplink.extend(up.iter().cloned());
             self.udp.inbox.extend(up);
         }
     }
@@ -243,9 +259,16 @@ fn clear(f: &[u8]) -> Vec<u8> {
     f.to_vec()
 }
 
+/// The ground's durable counters, written and confirmed at once.
+fn persist_ground(g: &mut GroundLink<10, 64, 1024>) {
+    for (spi, v) in g.due().collect::<Vec<_>>() {
+        g.persisted(spi, v);
+    }
+}
+
 #[test]
 fn an_are_you_alive_crosses_the_link_and_board_a_answers_it() {
-    let mut b = Bench::new(Clear, clear);
+    let mut b = Bench::new(clear);
     b.run(50);
     b.send(&tc(17, 1, 0, &[]));
     b.run(2000);
@@ -257,7 +280,10 @@ fn an_are_you_alive_crosses_the_link_and_board_a_answers_it() {
     assert!(!b.board.commands.is_empty());
     let c = *b.glue.counts();
     assert_eq!(c.heartbeats as usize, b.board.commands.len());
-    assert_eq!((c.commands_busy, c.tc_insecure, c.tm_unsent), (0, 0, 0));
+    assert_eq!((c.commands_busy, c.store_failed, c.tm_unsent), (0, 0, 0));
+    let sec = b.glue.gateway().security(BoardNumber::ONE).unwrap();
+    assert_eq!(sec.refused_total(), 0, "{sec:?}");
+    assert!(sec.accepted >= 1 && sec.protected >= 4, "{sec:?}");
     assert!(c.tm_frames >= 4, "{c:?}");
     let farm = b.glue.gateway().farm(BoardNumber::ONE).unwrap();
     assert_eq!(farm.vr(), 1);
@@ -265,7 +291,7 @@ fn an_are_you_alive_crosses_the_link_and_board_a_answers_it() {
 
 #[test]
 fn a_stop_reaches_board_a_as_the_legacy_stop_and_completes() {
-    let mut b = Bench::new(Clear, clear);
+    let mut b = Bench::new(clear);
     b.run(50);
     for seq in 0..3 {
         // TC(8,1) perform function 6: Stop (spec/ccsds/functions.toml).
@@ -288,7 +314,7 @@ fn a_stop_reaches_board_a_as_the_legacy_stop_and_completes() {
 
 #[test]
 fn a_busy_board_link_delays_commands_and_the_uplink_sends_them_again() {
-    let mut b = Bench::new(Clear, clear);
+    let mut b = Bench::new(clear);
     b.run(50);
     b.board.busy = true;
     b.send(&tc(8, 1, 0, &[6]));
@@ -304,7 +330,7 @@ fn a_busy_board_link_delays_commands_and_the_uplink_sends_them_again() {
 
 #[test]
 fn a_garbage_datagram_is_refused_by_the_frame_checks_and_reaches_no_robot() {
-    let mut b = Bench::new(Clear, clear);
+    let mut b = Bench::new(clear);
     b.run(50);
     let before = b.board.commands.len();
     let refused_before: u32 = b.glue.gateway().refused().iter().sum();
@@ -322,15 +348,9 @@ fn a_garbage_datagram_is_refused_by_the_frame_checks_and_reaches_no_robot() {
 #[test]
 fn a_robot_without_both_keys_is_not_served() {
     let only_tc: Vec<SdlsKey> = keys().into_iter().filter(|k| k.spi == 257).collect();
-    let e = ServerGlue::<_, _, 1>::new(
-        config(),
-        &[BoardNumber::ONE],
-        &only_tc,
-        Clear,
-        Map::default(),
-    )
-    .err()
-    .unwrap();
+    let e = ServerGlue::<_, 1>::new(config(), &[BoardNumber::ONE], &only_tc, Map::default())
+        .err()
+        .unwrap();
     assert_eq!(e, GlueError::NoKey { board: 1, spi: 513 });
     // And the key never shows in Debug.
     let k = SdlsKey {
@@ -339,61 +359,72 @@ fn a_robot_without_both_keys_is_not_served() {
     };
     let shown = format!("{k:?}");
     assert!(shown.contains("257") && !shown.contains("167") && !shown.contains("a7"));
-    let _ = security(&keys());
 }
 
-/// A stand-in frame security: TC datagrams carry a 2-octet marker in front, which it checks
-/// and strips; each TM frame advances a counter kept in the store (SPI 513), as the SDLS
-/// sender's IV will be.
-struct Marked;
-impl FrameSecurity for Marked {
-    fn tc_in<S: CounterStore>(&mut self, _: &mut S, _: u32, frame: &mut [u8]) -> Option<usize> {
-        if frame.len() < 2 || frame[..2] != [0xAB, 0xCD] {
-            return None;
-        }
-        frame.copy_within(2.., 0);
-        Some(frame.len() - 2)
-    }
-    fn tm_out<S: CounterStore>(
-        &mut self,
-        store: &mut S,
-        _: &mut [u8],
-        len: usize,
-    ) -> Option<usize> {
-        let n = store.load(513).unwrap_or(0) + 1;
-        store.store(513, n).ok()?;
-        Some(len)
-    }
-}
-
-fn marked(f: &[u8]) -> Vec<u8> {
-    let mut d = vec![0xAB, 0xCD];
-    d.extend_from_slice(f);
-    d
-}
-
+/// An attacker on the ground's UDP port: every TC frame the ground sent, sent again (replays),
+/// and each with one bit flipped in its data field (the FECF made good): SDLS refuses every
+/// one before FARM-1, board A is given nothing more, and the link still works.
 #[test]
-fn the_frame_security_sits_between_the_socket_and_the_gateway_with_the_store() {
-    let mut b = Bench::new(Marked, marked);
+fn sdls_refuses_replays_and_forgeries_before_farm() {
+    let mut b = Bench::new(clear);
     b.run(50);
     b.send(&tc(8, 1, 0, &[6]));
     b.run(2000);
     assert_eq!(b.heard.completed, [0]);
-    // A frame without the marker is refused before the gateway sees it.
-    let frames_before = b
+    let stops = |b: &Bench| {
+        b.board
+            .commands
+            .iter()
+            .filter(|c| c.command == Command::Stop)
+            .count()
+    };
+    assert_eq!(stops(&b), 1);
+    let data: Vec<Vec<u8>> = b
+        .uplink
+        .iter()
+        .filter(|f| f[0] & 0x10 == 0)
+        .cloned()
+        .collect();
+    assert!(!data.is_empty());
+    let farm_before = b
         .glue
         .gateway()
-        .counters(BoardNumber::ONE)
+        .farm(BoardNumber::ONE)
         .unwrap()
-        .tc_frames;
-    b.udp.inbox.push_back(tc(8, 1, 1, &[6]));
-    b.run(1);
-    assert_eq!(b.glue.counts().tc_insecure, 1);
-    let c = b.glue.gateway().counters(BoardNumber::ONE).unwrap();
-    assert_eq!(c.tc_frames, frames_before);
-    // Every TM frame sent advanced the stored counter.
-    let sent = b.glue.counts().tm_frames;
-    assert_eq!(b.glue.store().load(513), Some(u128::from(sent)));
+        .counters()
+        .accepted_ad;
+    let mut attacks = 0;
+    for f in &data {
+        b.udp.inbox.push_back(f.clone());
+        attacks += 1;
+        for at in [6, 8, 20, f.len() - 3] {
+            let mut g = f.clone();
+            g[at] ^= 0x01;
+            let n = g.len();
+            let crc = mmic::ccsds::pec(&g[..n - 2]);
+            g[n - 2..].copy_from_slice(&crc.to_be_bytes());
+            b.udp.inbox.push_back(g);
+            attacks += 1;
+        }
+    }
+    b.run(10);
+    let sec = *b.glue.gateway().security(BoardNumber::ONE).unwrap();
+    assert_eq!(sec.refused_total(), attacks, "{sec:?}");
+    assert_eq!(
+        b.glue
+            .gateway()
+            .farm(BoardNumber::ONE)
+            .unwrap()
+            .counters()
+            .accepted_ad,
+        farm_before
+    );
+    assert_eq!(stops(&b), 1, "board A was given a command again");
+    // The ground's next command still goes through.
+    b.send(&tc(8, 1, 1, &[6]));
+    b.run(2000);
+    assert_eq!(b.heard.completed, [0, 1]);
+    assert_eq!(stops(&b), 2);
 }
 
 #[test]
@@ -410,7 +441,7 @@ fn the_shell_sleeps_until_the_deadline_within_bounds() {
 
 #[test]
 fn a_pass_reports_the_gateways_next_deadline() {
-    let mut b = Bench::new(Clear, clear);
+    let mut b = Bench::new(clear);
     b.run(50);
     let now = b.clock.0;
     let next = b.glue.poll(&mut b.clock, &mut b.udp, &mut b.board).unwrap();
@@ -419,35 +450,82 @@ fn a_pass_reports_the_gateways_next_deadline() {
     assert!(d <= 500, "next deadline {d} ms away");
 }
 
-/// The stand-in security of [`Marked`] with the counters in flash: the TM counter a reset
-/// finds is the one the last frame stored, and passes go on from it.
+/// The SDLS counters in flash survive a reset of the server board: a new glue on the same
+/// flash refuses every TC data frame taken before the reset (as a replay), and its TM frames'
+/// IVs continue above every IV used before it.
 #[test]
 fn the_counters_survive_a_reset_of_the_server_board_in_flash() {
     type Flash = FlashCounters<Ram, 2>;
+    let keys = keys();
+    let mut ground = GroundLink::<10, 64, 1024>::new(BoardNumber::ONE);
+    ground.secure(
+        Key256::from_bytes(keys[0].key),
+        Key256::from_bytes(keys[1].key),
+        (None, None),
+    );
+    persist_ground(&mut ground);
     let store = Flash::open(Ram::new(2)).unwrap();
-    let mut glue: ServerGlue<Marked, Flash, 1> =
-        ServerGlue::new(config(), &[BoardNumber::ONE], &keys(), Marked, store).unwrap();
+    let mut glue: ServerGlue<Flash, 1> =
+        ServerGlue::new(config(), &[BoardNumber::ONE], &keys, store).unwrap();
     let (mut udp, mut board, mut clock) = (Udp::default(), BoardA::default(), Ms(0));
-    // Five seconds of idle link: a TM frame every 500 ms at least, each stored.
+    let mut uplink: Vec<Vec<u8>> = Vec::new();
+    let mut tm_ivs: Vec<u128> = Vec::new();
+    let iv =
+        |f: &[u8]| u128::from_be_bytes([&[0u8; 4][..], &f[8..20]].concat().try_into().unwrap());
+    ground.start(0, &mut |f: &[u8]| uplink.push(f.to_vec()));
+    udp.inbox.extend(uplink.iter().cloned());
+    let mut sent_stop = false;
     for _ in 0..5000 {
         clock.0 += 1;
+        let now = clock.0;
         glue.poll(&mut clock, &mut udp, &mut board);
+        let mut up = Vec::new();
+        for f in std::mem::take(&mut udp.sent) {
+            tm_ivs.push(iv(&f));
+            ground
+                .tm_frame(now, &f, &mut |t: &[u8]| up.push(t.to_vec()), &mut |_| {})
+                .unwrap();
+        }
+        if !sent_stop && now == 100 {
+            ground
+                .send(&tc(8, 1, 0, &[6]), now, &mut |f: &[u8]| up.push(f.to_vec()))
+                .unwrap();
+            sent_stop = true;
+        }
+        ground.tick(now, &mut |f: &[u8]| up.push(f.to_vec()));
+        persist_ground(&mut ground);
+        uplink.extend(up.iter().cloned());
+        udp.inbox.extend(up);
     }
-    let sent = glue.counts().tm_frames;
-    assert!(sent >= 10, "{sent} TM frames");
-    assert_eq!(udp.sent.len() as u32, sent);
+    assert!(board.commands.iter().any(|c| c.command == Command::Stop));
+    assert!(tm_ivs.len() >= 10, "{} TM frames", tm_ivs.len());
     // Reset: a new glue on the same flash.
     let ram = std::mem::replace(glue.store(), Flash::open(Ram::new(2)).unwrap()).release();
-    assert_eq!(ram.overwrites, 0);
     let store = Flash::open(ram.reset()).unwrap();
-    let mut glue: ServerGlue<Marked, Flash, 1> =
-        ServerGlue::new(config(), &[BoardNumber::ONE], &keys(), Marked, store).unwrap();
-    assert_eq!(glue.store().load(513), Some(u128::from(sent)));
-    for _ in 0..1000 {
+    let mut glue: ServerGlue<Flash, 1> =
+        ServerGlue::new(config(), &[BoardNumber::ONE], &keys, store).unwrap();
+    let data: Vec<Vec<u8>> = uplink
+        .iter()
+        .filter(|f| f[0] & 0x10 == 0)
+        .cloned()
+        .collect();
+    assert!(!data.is_empty());
+    udp.inbox.extend(data.iter().cloned());
+    udp.sent.clear();
+    for _ in 0..600 {
         clock.0 += 1;
         glue.poll(&mut clock, &mut udp, &mut board);
     }
-    let more = glue.counts().tm_frames;
-    assert!(more >= 2);
-    assert_eq!(glue.store().load(513), Some(u128::from(sent + more)));
+    let sec = glue.gateway().security(BoardNumber::ONE).unwrap();
+    assert_eq!(sec.refused_for("replay") as usize, data.len(), "{sec:?}");
+    assert_eq!(sec.accepted, 0);
+    let before = tm_ivs.iter().max().copied().unwrap();
+    assert!(!udp.sent.is_empty());
+    for f in &udp.sent {
+        assert!(
+            iv(f) > before,
+            "a TM IV {} at or below {before} after the reset",
+            iv(f)
+        );
+    }
 }
