@@ -302,6 +302,13 @@ pub fn event_ids() -> Result<Vec<(u16, String)>, String> {
                     format!("{}_{}", row.name, f.name),
                 ));
             }
+        } else if row.id == "0x0200 + n" {
+            for (n, reason) in mmic::link::sdls::SdlsRefusal::NAMES.iter().enumerate() {
+                out.push((
+                    0x0200 + n as u16,
+                    format!("{}_{}", row.name, reason.replace('-', "_")),
+                ));
+            }
         } else {
             let id = parse_code(&row.id).ok_or(format!("event ID {:?}", row.id))?;
             out.push((id, row.name.clone()));

@@ -31,6 +31,7 @@
 
 use crate::bolter::BolterPair;
 use crate::faults::{Fault, Faults};
+use crate::link::sdls::SdlsRefusal;
 use crate::mode::Mode;
 use crate::safety::policy::fault_action;
 use crate::wire::heartbeat::HeartbeatRepr;
@@ -125,6 +126,19 @@ pub enum Event {
     },
     /// Latched faults were cleared. ID 0x0003; the cleared map.
     Cleared(Faults),
+    /// The server board's SDLS refused TC frames of the robot's link. ID 0x0200 + the
+    /// reason's place in [`SdlsRefusal::NAMES`]; the auxiliary data are how many frames were
+    /// refused for it since the last such report (at least one; reports are rate-limited,
+    /// `node::server::frames`) and the last refused frame's SPI. Not derived from heartbeats:
+    /// the link reports it.
+    Security {
+        /// The reason's place in [`SdlsRefusal::NAMES`].
+        reason: u8,
+        /// Frames refused for it since the last report (≥ 1).
+        refused: u16,
+        /// The last refused frame's SPI (0 when it was too short to carry one).
+        spi: u16,
+    },
 }
 
 /// Source data of an event report, bytes.
@@ -138,6 +152,7 @@ impl Event {
             Event::ModeChanged { .. } => 1,
             Event::Attempt { .. } => 2,
             Event::Cleared(_) => 3,
+            Event::Security { reason, .. } => 0x0200 + *reason as u16,
         }
     }
 
@@ -159,6 +174,9 @@ impl Event {
                 AttemptResult::GaveUp => 3,
             },
             Event::ModeChanged { .. } | Event::Cleared(_) => 1,
+            // Medium: refused frames are an attack or a fault of the link or the ground's
+            // keys, and nothing of them executed.
+            Event::Security { .. } => 3,
         }
     }
 
@@ -173,6 +191,11 @@ impl Event {
                 result,
             } => [pair.number(), *attempt, *result as u8, 0],
             Event::Cleared(f) => f.bits().to_be_bytes(),
+            Event::Security { refused, spi, .. } => {
+                let [r0, r1] = refused.to_be_bytes();
+                let [s0, s1] = spi.to_be_bytes();
+                [r0, r1, s0, s1]
+            }
         };
         let [i0, i1] = self.id().to_be_bytes();
         [i0, i1, aux[0], aux[1], aux[2], aux[3]]
@@ -238,6 +261,17 @@ impl Event {
                     .ok_or(EventError::UnknownId(id))?,
                 mode: mode("mode", b[2])?,
             },
+            0x0200..=0x02FF if usize::from(id - 0x0200) < SdlsRefusal::NAMES.len() => {
+                let refused = u16::from_be_bytes([b[2], b[3]]);
+                if refused == 0 {
+                    return Err(field("refused", 0));
+                }
+                Event::Security {
+                    reason: (id - 0x0200) as u8,
+                    refused,
+                    spi: u16::from_be_bytes([b[4], b[5]]),
+                }
+            }
             _ => return Err(EventError::UnknownId(id)),
         };
         if event.to_bytes() != b {

@@ -126,6 +126,10 @@ struct Run {
     store: std::collections::BTreeMap<(&'static str, u16), u128>,
     /// The IVs of the TM frames the server sent.
     tm_ivs: Vec<u128>,
+    /// When the last telecommand completed (the ground heard it), ms.
+    done_ms: u32,
+    /// The ST[5] SDLS reports the ground heard: (when, refused, reason).
+    security_events: Vec<(u32, u16, u8)>,
     accepted: Vec<u16>,
     completed: Vec<u16>,
     ground: Ground,
@@ -165,6 +169,8 @@ fn run_secure(
     let mut captured: Vec<Vec<u8>> = Vec::new();
     let (mut attacks, mut given) = (0u32, 0usize);
     let mut tm_ivs = Vec::new();
+    let mut done_ms = 0;
+    let mut security_events = Vec::new();
     // The durable store of both ends' SDLS counters.
     let mut store = std::collections::BTreeMap::new();
     if secure.sdls {
@@ -223,6 +229,15 @@ fn run_secure(
             );
             for p in tms {
                 let tm = TmRepr::parse(&p, &[0x101]).unwrap();
+                if tm.header.service == 5 {
+                    let e = mmic::pus::event::Event::parse(tm.header.subservice, tm.source_data);
+                    if let Ok(mmic::pus::event::Event::Security {
+                        reason, refused, ..
+                    }) = e
+                    {
+                        security_events.push((now, refused, reason));
+                    }
+                }
                 if tm.header.service == 1 {
                     let r = Report::parse(tm.header.subservice, tm.source_data).unwrap();
                     match (r.stage, r.failure) {
@@ -262,6 +277,9 @@ fn run_secure(
             }
             down.send(now, &buf[..len]);
         }
+        if completed.len() == n as usize && done_ms == 0 {
+            done_ms = now;
+        }
         if completed.len() == n as usize && ground.fop().sent_len() == 0 {
             break;
         }
@@ -273,6 +291,8 @@ fn run_secure(
         captured,
         store,
         tm_ivs,
+        done_ms,
+        security_events,
         accepted,
         completed,
         ground,
@@ -525,4 +545,102 @@ fn sdls_counters_survive_a_restart_of_the_server_board() {
         "the TM IV after the restart {iv} is not above {before}"
     );
     assert_eq!(n, 256);
+}
+
+/// A flood of bad frames does not delay the good ones: the same run (seed, channels, the
+/// ground's commands) with an attacker sending a replayed or forged TC frame every
+/// millisecond (1,000 a second, about 20 times the ground's own frames) completes its
+/// telecommands in the same order, FARM-1 accepting each frame once, and no later than a TM
+/// frame's gathering time (20 ms) after the quiet run (the ST[5] reports the flood causes
+/// share the TM frames, which moves the downlink's timing by a few ms either way); the
+/// refusals are reported in ST[5] at most once per reason a second, and the reports count
+/// every refused frame.
+#[test]
+#[cfg_attr(miri, ignore = "AES under Miri: minutes")]
+fn a_flood_of_bad_frames_does_not_delay_good_ones() {
+    let quiet = run_secure(
+        12,
+        3,
+        0.0,
+        0.0,
+        0.0,
+        60_000,
+        Secure {
+            sdls: true,
+            attack: 0.0,
+        },
+    );
+    let flood = run_secure(
+        12,
+        3,
+        0.0,
+        0.0,
+        0.0,
+        60_000,
+        Secure {
+            sdls: true,
+            attack: 1.0,
+        },
+    );
+    assert_eq!(quiet.completed, (0..12).collect::<Vec<u16>>());
+    assert_eq!(flood.completed, quiet.completed);
+    assert!(
+        flood.done_ms <= quiet.done_ms + 20,
+        "the flood delayed the telecommands: {} ms against {} ms",
+        flood.done_ms,
+        quiet.done_ms
+    );
+    let accepted = |r: &Run| {
+        r.server
+            .farm(BoardNumber::ONE)
+            .unwrap()
+            .counters()
+            .accepted_ad
+    };
+    assert_eq!((accepted(&flood), accepted(&quiet)), (12, 12));
+    let sec = *flood.server.security(BoardNumber::ONE).unwrap();
+    assert!(
+        flood.attacks >= flood.done_ms / 2,
+        "{} attacks in {} ms",
+        flood.attacks,
+        flood.done_ms
+    );
+    // Rate-limited: at most one report per reason per second (7 reasons).
+    let secs = flood.done_ms / 1000 + 2;
+    assert!(
+        flood.security_events.len() as u32 <= 7 * secs,
+        "{} reports in {secs} s",
+        flood.security_events.len()
+    );
+    for reason in 0..7u8 {
+        let mut times = flood
+            .security_events
+            .iter()
+            .filter(|e| e.2 == reason)
+            .map(|e| e.0);
+        if let Some(mut prev) = times.next() {
+            for t in times {
+                assert!(
+                    t - prev >= 990,
+                    "reason {reason}: reports {prev} and {t} ms"
+                );
+                prev = t;
+            }
+        }
+    }
+    // Every refusal counted in a report, but those of the last second still waiting.
+    let reported: u32 = flood.security_events.iter().map(|e| u32::from(e.1)).sum();
+    let checks: u32 = flood.server.refused().iter().sum();
+    assert!(reported <= sec.refused_total(), "{reported} > {sec:?}");
+    assert!(reported > 0 && sec.refused_total() + checks >= flood.attacks);
+    assert!(quiet.security_events.is_empty());
+    println!(
+        "flood: {} attack frames in {} ms, {} refused by SDLS, {} ST[5] reports counting {reported}; done at {} ms (quiet: {} ms)",
+        flood.attacks,
+        flood.done_ms,
+        sec.refused_total(),
+        flood.security_events.len(),
+        flood.done_ms,
+        quiet.done_ms
+    );
 }

@@ -239,6 +239,7 @@ fn services_toml_is_what_the_gateway_serves() {
             ("0x0001", "mode_changed"),
             ("0x0002", "bolting_attempt"),
             ("0x0003", "faults_cleared"),
+            ("0x0200 + n", "sdls_refused"),
             ("0x0100 + n", "fault")
         ]
     );

@@ -70,7 +70,7 @@ const REQUEST_ID: [(&str, &str, &str); 6] = [
 ];
 
 /// The ST\[1\] failure report's and the ST\[5\] event reports' parameters after their headers.
-const REPORT_DATA: [(&str, &str, &str); 13] = [
+const REPORT_DATA: [(&str, &str, &str); 15] = [
     ("failure_code", "failure_code_type", "ST[1] failure code"),
     (
         "failure_data",
@@ -97,6 +97,16 @@ const REPORT_DATA: [(&str, &str, &str); 13] = [
         "faults_cleared: the cleared fault map",
     ),
     ("event_fault_mode", "mode_type", "fault: the mode after it"),
+    (
+        "event_sdls_refused",
+        "uint16",
+        "sdls_refused: TC frames refused for this reason since the last such report",
+    ),
+    (
+        "event_sdls_spi",
+        "uint16",
+        "sdls_refused: the last refused frame's SPI",
+    ),
     ("event_spare8", "uint8", "zero"),
     ("event_spare16", "uint16", "zero"),
     ("event_spare24", "uint24", "zero"),
@@ -474,11 +484,15 @@ fn containers() -> Vec<Container> {
 }
 
 /// The ST\[5\] event report and one container per event's auxiliary data.
-fn event_containers() -> [Container; 5] {
+fn event_containers() -> [Container; 6] {
     let severities = tm_subservices(|t| t.service == 5);
     let fault = vec![
         Comparison::new("event_id", Op::Ge, 0x100),
         Comparison::new("event_id", Op::Le, 0x1FF),
+    ];
+    let sdls = vec![
+        Comparison::new("event_id", Op::Ge, 0x200),
+        Comparison::new("event_id", Op::Le, 0x2FF),
     ];
     [
         container(
@@ -515,6 +529,12 @@ fn event_containers() -> [Container; 5] {
             "events 0x0100 + n: fault n raised",
             &["event_fault_mode", "event_spare24"],
             when("event-report", fault),
+        ),
+        container(
+            "event-sdls-refused",
+            "events 0x0200 + n: the server board's SDLS refused TC frames for reason n",
+            &["event_sdls_refused", "event_sdls_spi"],
+            when("event-report", sdls),
         ),
     ]
 }

@@ -58,6 +58,7 @@ use crate::link::tc_frame::{self, SpacecraftId, TcFrame, TcFrameError, TcPrimary
 use crate::link::tm_frame::{TmFrameParams, TM_FRAME_LEN};
 use crate::link::tm_framer::{TmFramer, IDLE_PERIOD_MS};
 use crate::link::FrameKind;
+use crate::pus::event::Event;
 use crate::pus::robot_apid;
 use crate::units::BoardNumber;
 use crate::wire::command::CommandRepr;
@@ -100,6 +101,41 @@ impl Default for FrameConfig {
 
 /// How long a report waits for others to share its TM frame, ms (`spec/ccsds/link.toml`).
 pub const GATHER_MS: u32 = 20;
+
+/// SDLS refusals are reported in ST\[5\] at most once per reason per robot in this period,
+/// ms (`spec/ccsds/sdls.toml`): each report counts the frames refused since the last one, so
+/// none goes unreported, and a flood of bad frames makes at most seven reports a second.
+pub const SECURITY_EVENT_PERIOD_MS: u32 = 1000;
+
+/// One reason's refusals waiting to be reported.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+struct Alarm {
+    /// Frames refused since the last report.
+    pending: u16,
+    /// The last one's SPI.
+    spi: u16,
+    /// When the last report went.
+    last: Option<u32>,
+}
+
+impl Alarm {
+    /// Whether a report waits and may go at `now`.
+    fn ready(&self, now: u32) -> bool {
+        self.pending > 0
+            && self
+                .last
+                .is_none_or(|t| now.wrapping_sub(t) >= SECURITY_EVENT_PERIOD_MS)
+    }
+
+    /// How long from `now` until the waiting report may go, if one waits.
+    fn wait(&self, now: u32) -> Option<u32> {
+        (self.pending > 0).then(|| {
+            self.last.map_or(0, |t| {
+                SECURITY_EVENT_PERIOD_MS.saturating_sub(now.wrapping_sub(t))
+            })
+        })
+    }
+}
 
 /// What the link did, per robot. Each counter wraps at `u32::MAX`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -189,6 +225,8 @@ struct RobotLink<const N: usize> {
     /// SDLS, when the robot's link is secured: its TC (receiving) and TM (sending)
     /// associations.
     sdls: Option<SaTable<2>>,
+    /// SDLS refusals waiting for their ST\[5\] report, by reason.
+    alarms: [Alarm; SdlsRefusal::NAMES.len()],
 }
 
 impl<const N: usize> RobotLink<N> {
@@ -255,6 +293,7 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 clcw_sent: None,
                 counters: LinkCounters::default(),
                 sdls: None,
+                alarms: [Alarm::default(); SdlsRefusal::NAMES.len()],
             })
             .is_ok()
     }
@@ -405,6 +444,13 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 Ok((_, range)) => data = plain.get(range).unwrap_or(&[]),
                 Err(e) => {
                     result.verdict = Err(e.into());
+                    if let Some(a) = link.alarms.get_mut(e.position()) {
+                        a.pending = a.pending.saturating_add(1);
+                        a.spi = bytes
+                            .get(6..8)
+                            .map_or(0, |b| u16::from_be_bytes([b[0], b[1]]));
+                    }
+                    self.security_reports(now);
                     return result;
                 }
             }
@@ -465,7 +511,32 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         }
         self.downlink(now, out);
         self.release_buffers();
+        self.security_reports(now);
         to_robots
+    }
+
+    /// The ST\[5\] reports of SDLS refusals due now: per robot and reason, at most one per
+    /// [`SECURITY_EVENT_PERIOD_MS`], counting every frame refused since the last.
+    fn security_reports(&mut self, now: u32) {
+        let mut due: Vec<(u16, Event), 16> = Vec::new();
+        for l in self.links.iter_mut() {
+            for (reason, a) in l.alarms.iter_mut().enumerate() {
+                if a.ready(now) {
+                    let e = Event::Security {
+                        reason: reason as u8,
+                        refused: a.pending,
+                        spi: a.spi,
+                    };
+                    if due.push((robot_apid(l.board), e)).is_ok() {
+                        a.pending = 0;
+                        a.last = Some(now);
+                    }
+                }
+            }
+        }
+        for (apid, e) in due {
+            self.report(now, &TmOut::new(apid, 5, e.severity(), 0, &e.to_bytes()));
+        }
     }
 
     /// A heartbeat from board A of `hb.board`; the reports go into the TM framer.
@@ -526,6 +597,8 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                     .map_or(0, |t| wait(t.wrapping_add(idle)));
                 gathered.map_or(idle_at, |g| g.min(idle_at))
             };
+            let alarm = l.alarms.iter().filter_map(|a| a.wait(now)).min();
+            let d = alarm.map_or(d, |a| a.min(d));
             best = Some(best.map_or(d, |b| b.min(d)));
         }
         best.map(|d| now.wrapping_add(d))

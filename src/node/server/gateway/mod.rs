@@ -96,7 +96,13 @@ pub struct TmOut {
 }
 
 impl TmOut {
-    fn new(apid: u16, service: u8, subservice: u8, destination: u16, data: &[u8]) -> TmOut {
+    pub(crate) fn new(
+        apid: u16,
+        service: u8,
+        subservice: u8,
+        destination: u16,
+        data: &[u8],
+    ) -> TmOut {
         let mut v = Vec::new();
         // Every report the gateway builds fits (MAX_TM_DATA is the longest).
         let _ = v.extend_from_slice(data.get(..data.len().min(MAX_TM_DATA)).unwrap_or(&[]));
