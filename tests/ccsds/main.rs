@@ -14,6 +14,7 @@ mod golden;
 mod interop_spacepackets;
 mod link_spec;
 mod sdls;
+mod sdls_spec;
 mod tc_frame;
 mod tm_frame;
 mod tm_link;

@@ -189,7 +189,9 @@ fn receiver(k: Key256, mask: AuthMask, last: u128, ahead: u128) -> SaTable<2> {
 /// refused and left as it came.
 #[test]
 fn nist_vectors_through_security_associations() {
-    for (i, v) in KATS.iter().enumerate() {
+    // Under Miri (minutes per AES-GCM call chain), every fifth vector.
+    let step = if cfg!(miri) { 5 } else { 1 };
+    for (i, v) in KATS.iter().enumerate().step_by(step) {
         let (aad, pt) = (hex(v.aad), hex(v.plaintext));
         let iv = Iv::from_bytes(hex(v.iv).try_into().unwrap());
         let sec_start = aad.len();
@@ -485,7 +487,9 @@ fn each_refusal_is_counted_and_changes_nothing() {
     };
     assert_eq!(refused(&mut rx, &mut sent.clone(), other), "wrong-channel");
     // Each header bit the mask covers, and each bit of the IV, the data and the MAC.
-    for bit in 0..n * 8 {
+    // Under Miri, one bit of each octet instead of all eight.
+    let stride = if cfg!(miri) { 8 } else { 1 };
+    for bit in (0..n * 8).step_by(stride) {
         if (6..8).contains(&(bit / 8)) {
             continue; // the SPI: unknown-spi above
         }
@@ -518,11 +522,13 @@ fn each_refusal_is_counted_and_changes_nothing() {
     assert_eq!(c.refused_for("unknown-spi"), 1);
     assert_eq!(c.refused_for("wrong-channel"), 1);
     assert_eq!(c.refused_for("truncated"), 1);
-    // 1 + 1 above, (44 − 2) × 8 = 336 flipped bits, the wrong key, the replay, the short one.
-    assert_eq!(c.refused_total(), 341);
+    // 1 + 1 above, (44 − 2) × 8 = 336 flipped bits (42 under Miri), the wrong key, the
+    // replay, the short one.
+    let flips = (n as u32 - 2) * 8 / stride as u32;
+    assert_eq!(c.refused_total(), 5 + flips);
     // Every flip of the header, the data and the MAC (and the IV's in-window ones) is a bad
     // MAC; IV flips out of the window are refused before any cryptography.
-    assert!(c.refused_for("bad-mac") > (6 + 8 + 16) * 8, "{c:?}");
+    assert!(c.refused_for("bad-mac") > (6 + 8 + 16) * 8 / stride as u32, "{c:?}");
 }
 
 /// A counter far ahead of the window and one beyond the durable floor.

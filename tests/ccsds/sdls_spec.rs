@@ -1,0 +1,116 @@
+//! spec/ccsds/sdls.toml against the code (src/link/sdls/) and YAMCS's SDLS configuration
+//! (ground/yamcs/links/frames-sdls.yaml): the suite's sizes, the SPIs, the masks, the windows
+//! and blocks, the events' ID and period; every section names a decision of spec/decisions.toml.
+
+use mmic::link::sdls::{self, mask, mission};
+use mmic::node::server::frames::SECURITY_EVENT_PERIOD_MS;
+use mmic::pus::event::Event;
+use mmic::units::BoardNumber;
+use std::path::PathBuf;
+
+fn repo(path: &str) -> String {
+    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path);
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn spec() -> toml::Table {
+    toml::from_str(&repo("spec/ccsds/sdls.toml")).unwrap()
+}
+
+fn int(t: &toml::Table, section: &str, key: &str) -> i64 {
+    t[section][key]
+        .as_integer()
+        .unwrap_or_else(|| panic!("[{section}] {key}"))
+}
+
+fn text<'a>(t: &'a toml::Table, section: &str, key: &str) -> &'a str {
+    t[section][key]
+        .as_str()
+        .unwrap_or_else(|| panic!("[{section}] {key}"))
+}
+
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[test]
+#[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
+fn the_choices_are_the_codes() {
+    let t = spec();
+    assert_eq!(int(&t, "suite", "iv_octets") as usize, sdls::IV_LEN);
+    assert_eq!(int(&t, "suite", "mac_octets") as usize, sdls::MAC_LEN);
+    assert_eq!(sdls::HEADER_LEN, 2 + sdls::IV_LEN);
+    assert_eq!(sdls::KEY_LEN, 32, "AES-256");
+    assert_eq!(text(&t, "sa", "tc_spi"), "0x100 + n");
+    assert_eq!(text(&t, "sa", "tm_spi"), "0x200 + n");
+    for n in [1u8, 2, 255] {
+        let b = BoardNumber::new(n).unwrap();
+        assert_eq!(mission::tc_spi(b), 0x100 + u16::from(n));
+        assert_eq!(mission::tm_spi(b), 0x200 + u16::from(n));
+        assert_eq!(
+            mission::tc_spi(b),
+            mmic::link::tc_frame::SpacecraftId::of_board(b).get(),
+            "the TC SPI is the spacecraft ID"
+        );
+    }
+    assert_eq!(text(&t, "mask", "tc"), hex(mask::TC.as_bytes()));
+    assert_eq!(text(&t, "mask", "tm"), hex(mask::TM.as_bytes()));
+    assert_eq!(int(&t, "counters", "tc_window"), i64::from(mission::TC_WINDOW));
+    assert_eq!(int(&t, "counters", "tc_rx_block"), i64::from(mission::TC_RX_BLOCK));
+    assert_eq!(int(&t, "counters", "tc_tx_block"), i64::from(mission::TC_TX_BLOCK));
+    assert_eq!(int(&t, "counters", "tm_tx_block"), i64::from(mission::TM_TX_BLOCK));
+    assert_eq!(int(&t, "counters", "tm_window"), i64::from(mission::TM_WINDOW));
+    assert_eq!(int(&t, "counters", "tm_rx_block"), i64::from(mission::TM_RX_BLOCK));
+    assert_eq!(int(&t, "events", "period_ms"), i64::from(SECURITY_EVENT_PERIOD_MS));
+    assert_eq!(text(&t, "events", "id"), "0x0200 + n");
+    let e = Event::Security { reason: 5, refused: 1, spi: 257 };
+    assert_eq!((e.id(), e.severity()), (0x0205, 3));
+    assert_eq!(sdls::SdlsRefusal::NAMES[5], "bad-mac");
+}
+
+#[test]
+#[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
+fn every_section_names_a_decision() {
+    let t = spec();
+    let decisions: toml::Table = toml::from_str(&repo("spec/decisions.toml")).unwrap();
+    let ids: Vec<&str> = decisions["decision"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|d| d["id"].as_str())
+        .collect();
+    for (section, v) in &t {
+        let d = v["decision"]
+            .as_str()
+            .unwrap_or_else(|| panic!("[{section}] has no decision"));
+        assert!(ids.contains(&d), "[{section}] names {d}, which decisions.toml lacks");
+    }
+    assert!(ids.contains(&"sdls-scope"));
+    assert_eq!(t.len(), 6);
+}
+
+/// YAMCS's SDLS links: the same SPIs, masks and TM window; TM verified; the keys from files.
+#[test]
+fn yamcs_is_configured_with_the_same_choices() {
+    let y = repo("ground/yamcs/links/frames-sdls.yaml");
+    let one = BoardNumber::ONE;
+    let mask_tm = format!("authMask: \"{}\"", hex(mask::TM.as_bytes()));
+    let mask_tc = format!("authMask: \"{}\"", hex(mask::TC.as_bytes()));
+    let tm = y.find("name: tm-frames").unwrap();
+    let tc = y.find("name: tc-frames").unwrap();
+    let (tm_part, tc_part) = if tm < tc {
+        (&y[tm..tc], &y[tc..])
+    } else {
+        (&y[tm..], &y[tc..tm])
+    };
+    assert!(tm_part.contains(&format!("spi: {}", mission::tm_spi(one))));
+    assert!(tm_part.contains(&mask_tm), "{tm_part}");
+    assert!(tm_part.contains("verifySeqNum: true"));
+    assert!(tm_part.contains(&format!("seqNumWindow: {}", mission::TM_WINDOW)));
+    assert!(tm_part.contains(&format!("encryptionSpis: [{}]", mission::tm_spi(one))));
+    assert!(tm_part.contains(&format!("spi-{}.key", mission::tm_spi(one))));
+    assert!(tc_part.contains(&format!("spi: {}", mission::tc_spi(one))));
+    assert!(tc_part.contains(&mask_tc), "{tc_part}");
+    assert!(tc_part.contains(&format!("encryptionSpi: {}", mission::tc_spi(one))));
+    assert!(tc_part.contains(&format!("spi-{}.key", mission::tc_spi(one))));
+}
