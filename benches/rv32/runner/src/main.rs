@@ -103,6 +103,9 @@ fn run() -> Result<(), &'static str> {
     if first == "--parsers" {
         return parsers();
     }
+    if first == "--sdls" {
+        return sdls();
+    }
     let (trace_path, out_path, cost_path) = (first, next()?, next()?);
 
     let mut p = [0u8; 512];
@@ -166,6 +169,119 @@ fn parsers() -> Result<(), &'static str> {
         }
         println!("| {} | {best} |", k.name());
     }
+    Ok(())
+}
+
+/// `mmic-rv32 --sdls`: SDLS on the server board, each operation's instructions (the fewest of
+/// 16 runs) and stack, as Markdown rows: verifying a protected TC frame (YAMCS's first frame:
+/// one 13-octet TC(17,1), 51 octets), refusing one with a flipped data bit (the MAC's cost)
+/// and a replay (no cryptography), protecting a 256-octet TM frame. Each run starts from a
+/// copy of the same association, made before the count starts; the key schedule is part of
+/// every operation (the library builds it per frame). The key is a fixed test pattern.
+fn sdls() -> Result<(), &'static str> {
+    use mmic::ccsds::primary::{Apid, SeqCount};
+    use mmic::ccsds::tc::TcRepr;
+    use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
+    use mmic::link::sdls::{frames, mission, Key256, SaTable, HEADER_LEN, MAC_LEN};
+    use mmic::link::tc_frame::{self, MapId, SpacecraftId, TcContent, TcFrame, TcFrameRepr, Vcid};
+    use mmic::link::tm_frame::{TmFrameParams, TM_FRAME_LEN};
+    use mmic::units::BoardNumber;
+
+    let one = BoardNumber::ONE;
+    let key = || Key256::from_bytes([0x3c; 32]);
+    let reserve = |t: &mut SaTable<1>| {
+        let due: Option<(u16, u128)> = t.due().next();
+        if let Some((spi, v)) = due {
+            t.persisted(spi, v);
+        }
+    };
+    let mut ground: SaTable<1> = SaTable::new();
+    ground.add(mission::tc_sender(one, key(), None)).map_err(|_| "table")?;
+    reserve(&mut ground);
+    let mut robot: SaTable<1> = SaTable::new();
+    robot.add(mission::tc_receiver(one, key(), None)).map_err(|_| "table")?;
+    reserve(&mut robot);
+    let mut packet = [0u8; 13];
+    TcRepr {
+        apid: Apid::new(0x101).map_err(|_| "apid")?,
+        seq_count: SeqCount::new(0).map_err(|_| "seq")?,
+        header: TcSecondaryHeader { ack: AckFlags::ALL, service: 17, subservice: 1, source_id: 0 },
+        app_data: &[],
+    }
+    .emit(&mut packet)
+    .map_err(|_| "packet")?;
+    let repr = TcFrameRepr {
+        spacecraft_id: SpacecraftId::of_board(one),
+        vcid: Vcid::new(0).map_err(|_| "vcid")?,
+        seq: 0,
+        content: TcContent::Ad { map_id: MapId::new(0).ok(), data: &packet },
+    };
+    let mut good = [0u8; 64];
+    let n = frames::protect_tc(&mut ground, mission::tc_spi(one), &repr, &mut good)
+        .map_err(|_| "protect")?;
+    let mut bad = good;
+    bad[6 + HEADER_LEN] ^= 1;
+    let crc = mmic::ccsds::pec(&bad[..n - 2]);
+    bad[n - 2..n].copy_from_slice(&crc.to_be_bytes());
+    let config = tc_frame::mission(SpacecraftId::of_board(one));
+    let mut replayed = robot.clone();
+    {
+        let f = TcFrame::new_checked(&good[..n], &config).map_err(|_| "frame")?;
+        let mut plain = [0u8; tc_frame::MAX_FRAME_LEN];
+        frames::verify_tc(&mut replayed, &f, &mut plain).map_err(|_| "first verify")?;
+    }
+    let top = sp() & !3;
+    let bottom = top - PAINT;
+    let measure = |f: &mut dyn FnMut(usize) -> bool| -> Result<(u32, usize), &'static str> {
+        let mut best = u32::MAX;
+        let mut stack = 0;
+        for k in 0..16 {
+            // SAFETY: as in `drive`: [bottom, top - 64) is unused stack below this frame.
+            unsafe { paint(bottom, top - 64) };
+            let a = minstret::read() as u32;
+            let ok = f(k);
+            let b = minstret::read() as u32;
+            stack = stack.max(top - lowest_dirty(bottom, top - 64));
+            if !ok {
+                return Err("an SDLS operation did not give the expected outcome");
+            }
+            best = best.min(b.wrapping_sub(a));
+        }
+        Ok((best, stack))
+    };
+    // One copy of the association per run, made before any count starts.
+    fn copies<T: Clone>(t: &T) -> [T; 16] {
+        core::array::from_fn(|_| t.clone())
+    }
+    let verify = |tables: &mut [SaTable<1>; 16], bytes: &[u8], accept: bool, k: usize| {
+        let Ok(f) = TcFrame::new_checked(bytes, &config) else {
+            return false;
+        };
+        let mut plain = [0u8; tc_frame::MAX_FRAME_LEN];
+        frames::verify_tc(&mut tables[k], &f, &mut plain).is_ok() == accept
+    };
+    println!("| SDLS operation on the server board | RV32IMC instructions | stack, bytes |\n|---|--:|--:|");
+    let mut t = copies(&robot);
+    let (i, st) = measure(&mut |k| verify(&mut t, &good[..n], true, k))?;
+    println!("| verify and decrypt a TC frame ({n} octets: a 13-octet TC(17,1)), frame checks included | {i} | {st} |");
+    let mut t = copies(&robot);
+    let (i, st) = measure(&mut |k| verify(&mut t, &bad[..n], false, k))?;
+    println!("| refuse it with one data bit flipped (bad MAC) | {i} | {st} |");
+    let mut t = copies(&replayed);
+    let (i, st) = measure(&mut |k| verify(&mut t, &good[..n], false, k))?;
+    println!("| refuse it replayed (before any cryptography) | {i} | {st} |");
+    let params = TmFrameParams::mission(0x101)
+        .and_then(|p| p.with_security(HEADER_LEN as u8, MAC_LEN as u8))
+        .ok_or("params")?;
+    let mut tm: SaTable<1> = SaTable::new();
+    tm.add(mission::tm_sender(one, key(), None)).map_err(|_| "table")?;
+    reserve(&mut tm);
+    let mut t = copies(&tm);
+    let mut frame = [0x55u8; TM_FRAME_LEN];
+    let (i, st) = measure(&mut |k| {
+        frames::protect_tm(&mut t[k], mission::tm_spi(one), &params, &mut frame).is_ok()
+    })?;
+    println!("| protect a 256-octet TM frame (214 octets encrypted, FECF again) | {i} | {st} |");
     Ok(())
 }
 
