@@ -27,20 +27,13 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import sdls  # noqa: E402
+from rust_side import wait  # noqa: E402
 from sdls_standin import StandIn  # noqa: E402
 from yamcs_harness import DEFAULT_MDB, INSTANCE, Yamcs  # noqa: E402
 
 TC_LINK = "tc-frames.vc0"
 
 
-def wait(pred, seconds: float, step: float = 0.1):
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        v = pred()
-        if v:
-            return v
-        time.sleep(step)
-    return pred()
 
 
 def first_ad_dropper():

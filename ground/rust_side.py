@@ -19,12 +19,24 @@ import shlex
 import signal
 import subprocess
 import threading
+import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 XTCE = REPO / "spec" / "ccsds" / "mmic.xtce.xml"
 CCSDSPY_CSV = REPO / "spec" / "ccsds" / "hk-3-25.ccsdspy.csv"
 ROBOT_APID = 0x101  # robot 1 (spec/ccsds/services.toml: 0x100 + n)
+
+
+def wait(pred, seconds: float = 10.0, step: float = 0.1):
+    """Polls `pred` every `step` s until it returns something true or `seconds` pass; its last value."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        v = pred()
+        if v:
+            return v
+        time.sleep(step)
+    return pred()
 
 
 def crc16_ccitt_false(data: bytes) -> int:

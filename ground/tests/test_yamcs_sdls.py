@@ -22,6 +22,11 @@ import pytest
 import repro_cop1_sdls
 import sdls
 from rust_side import XTCE, crc16_ccitt_false
+from rust_side import wait as _wait
+
+
+def wait(pred, seconds=10.0, step=0.05):
+    return _wait(pred, seconds, step)
 from sdls_standin import StandIn, pus_tm
 from yamcs_harness import INSTANCE, PLUGIN_JAR, Yamcs
 
@@ -30,14 +35,6 @@ STEP = 10.0
 YAMCS_DEFAULT_TC_MASK = bytes([0, 0, 0xFC, 0, 0, 0xFF, 0xFF, 0xFF]) + bytes(12)
 
 
-def wait(pred, seconds=STEP, step=0.05):
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        v = pred()
-        if v:
-            return v
-        time.sleep(step)
-    return pred()
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 import pytest
-from rust_side import XTCE, RobotProcess
+from rust_side import XTCE, RobotProcess, wait
 from yamcs_harness import INSTANCE, Yamcs
 
 STEP = 10.0
@@ -24,14 +24,6 @@ SIM = ("{{mmic}} sim --protocol pus --link frames --ground-tm-to 127.0.0.1:{{tm_
        "--ground-tc-port {{tc_port}} --max-seconds {{seconds}} --quiet --out {out} --sdls-keys {keys}")
 
 
-def wait(pred, seconds=STEP, step=0.1):
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        v = pred()
-        if v:
-            return v
-        time.sleep(step)
-    return pred()
 
 
 @pytest.fixture(scope="module")

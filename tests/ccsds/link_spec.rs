@@ -6,12 +6,8 @@
 use mmic::link::{fop, tc_frame, tm_frame, tm_framer};
 use mmic::node::server::frames::{FrameConfig, GATHER_MS};
 use mmic::units::BoardNumber;
-use std::path::PathBuf;
 
-fn repo(path: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path);
-    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-}
+use crate::repo;
 
 fn link() -> toml::Table {
     toml::from_str(&repo("spec/ccsds/link.toml")).unwrap()
@@ -118,22 +114,7 @@ fn the_managed_parameters_are_the_codes() {
 #[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
 fn every_section_names_a_decision() {
     let t = link();
-    let decisions: toml::Table = toml::from_str(&repo("spec/decisions.toml")).unwrap();
-    let ids: Vec<&str> = decisions["decision"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|d| d["id"].as_str())
-        .collect();
-    for (section, v) in &t {
-        let d = v["decision"]
-            .as_str()
-            .unwrap_or_else(|| panic!("[{section}] has no decision"));
-        assert!(
-            ids.contains(&d),
-            "[{section}] names {d}, which decisions.toml lacks"
-        );
-    }
+    crate::assert_sections_name_decisions("spec/ccsds/link.toml", &t);
     assert_eq!(t.len(), 4);
 }
 

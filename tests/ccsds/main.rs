@@ -25,6 +25,32 @@ use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::ccsds::tm::TmRepr;
 use mmic::ccsds::tm_header::{TimeRefStatus, TmSecondaryHeader};
 
+/// A file of the repository.
+pub fn repo(path: &str) -> String {
+    let p = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path);
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+/// Every section of the spec table `t` (`file`) names a decision of spec/decisions.toml.
+pub fn assert_sections_name_decisions(file: &str, t: &toml::Table) {
+    let decisions: toml::Table = toml::from_str(&repo("spec/decisions.toml")).unwrap();
+    let ids: Vec<&str> = decisions["decision"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|d| d["id"].as_str())
+        .collect();
+    for (section, v) in t {
+        let d = v["decision"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{file} [{section}] has no decision"));
+        assert!(
+            ids.contains(&d),
+            "{file} [{section}] names {d}, which decisions.toml lacks"
+        );
+    }
+}
+
 /// The APID of the reference packets.
 pub const APID: u16 = 0x042;
 

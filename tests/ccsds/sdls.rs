@@ -528,7 +528,10 @@ fn each_refusal_is_counted_and_changes_nothing() {
     assert_eq!(c.refused_total(), 5 + flips);
     // Every flip of the header, the data and the MAC (and the IV's in-window ones) is a bad
     // MAC; IV flips out of the window are refused before any cryptography.
-    assert!(c.refused_for("bad-mac") > (6 + 8 + 16) * 8 / stride as u32, "{c:?}");
+    assert!(
+        c.refused_for("bad-mac") > (6 + 8 + 16) * 8 / stride as u32,
+        "{c:?}"
+    );
 }
 
 /// A counter far ahead of the window and one beyond the durable floor.

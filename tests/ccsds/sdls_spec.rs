@@ -6,12 +6,8 @@ use mmic::link::sdls::{self, mask, mission};
 use mmic::node::server::frames::SECURITY_EVENT_PERIOD_MS;
 use mmic::pus::event::Event;
 use mmic::units::BoardNumber;
-use std::path::PathBuf;
 
-fn repo(path: &str) -> String {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path);
-    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-}
+use crate::repo;
 
 fn spec() -> toml::Table {
     toml::from_str(&repo("spec/ccsds/sdls.toml")).unwrap()
@@ -55,15 +51,40 @@ fn the_choices_are_the_codes() {
     }
     assert_eq!(text(&t, "mask", "tc"), hex(mask::TC.as_bytes()));
     assert_eq!(text(&t, "mask", "tm"), hex(mask::TM.as_bytes()));
-    assert_eq!(int(&t, "counters", "tc_window"), i64::from(mission::TC_WINDOW));
-    assert_eq!(int(&t, "counters", "tc_rx_block"), i64::from(mission::TC_RX_BLOCK));
-    assert_eq!(int(&t, "counters", "tc_tx_block"), i64::from(mission::TC_TX_BLOCK));
-    assert_eq!(int(&t, "counters", "tm_tx_block"), i64::from(mission::TM_TX_BLOCK));
-    assert_eq!(int(&t, "counters", "tm_window"), i64::from(mission::TM_WINDOW));
-    assert_eq!(int(&t, "counters", "tm_rx_block"), i64::from(mission::TM_RX_BLOCK));
-    assert_eq!(int(&t, "events", "period_ms"), i64::from(SECURITY_EVENT_PERIOD_MS));
+    assert_eq!(
+        int(&t, "counters", "tc_window"),
+        i64::from(mission::TC_WINDOW)
+    );
+    assert_eq!(
+        int(&t, "counters", "tc_rx_block"),
+        i64::from(mission::TC_RX_BLOCK)
+    );
+    assert_eq!(
+        int(&t, "counters", "tc_tx_block"),
+        i64::from(mission::TC_TX_BLOCK)
+    );
+    assert_eq!(
+        int(&t, "counters", "tm_tx_block"),
+        i64::from(mission::TM_TX_BLOCK)
+    );
+    assert_eq!(
+        int(&t, "counters", "tm_window"),
+        i64::from(mission::TM_WINDOW)
+    );
+    assert_eq!(
+        int(&t, "counters", "tm_rx_block"),
+        i64::from(mission::TM_RX_BLOCK)
+    );
+    assert_eq!(
+        int(&t, "events", "period_ms"),
+        i64::from(SECURITY_EVENT_PERIOD_MS)
+    );
     assert_eq!(text(&t, "events", "id"), "0x0200 + n");
-    let e = Event::Security { reason: 5, refused: 1, spi: 257 };
+    let e = Event::Security {
+        reason: 5,
+        refused: 1,
+        spi: 257,
+    };
     assert_eq!((e.id(), e.severity()), (0x0205, 3));
     assert_eq!(sdls::SdlsRefusal::NAMES[5], "bad-mac");
 }
@@ -72,20 +93,8 @@ fn the_choices_are_the_codes() {
 #[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
 fn every_section_names_a_decision() {
     let t = spec();
-    let decisions: toml::Table = toml::from_str(&repo("spec/decisions.toml")).unwrap();
-    let ids: Vec<&str> = decisions["decision"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|d| d["id"].as_str())
-        .collect();
-    for (section, v) in &t {
-        let d = v["decision"]
-            .as_str()
-            .unwrap_or_else(|| panic!("[{section}] has no decision"));
-        assert!(ids.contains(&d), "[{section}] names {d}, which decisions.toml lacks");
-    }
-    assert!(ids.contains(&"sdls-scope"));
+    crate::assert_sections_name_decisions("spec/ccsds/sdls.toml", &t);
+    assert!(crate::repo("spec/decisions.toml").contains("id = \"sdls-scope\""));
     assert_eq!(t.len(), 6);
 }
 

@@ -82,6 +82,10 @@ impl<const N: usize> SaTable<N> {
         self.sas.iter().find(|sa| sa.spi() == spi)
     }
 
+    fn get_mut(&mut self, spi: u16) -> Option<&mut SecurityAssociation> {
+        self.sas.iter_mut().find(|sa| sa.spi() == spi)
+    }
+
     /// Every association.
     pub fn iter(&self) -> impl Iterator<Item = &SecurityAssociation> {
         self.sas.iter()
@@ -101,10 +105,7 @@ impl<const N: usize> SaTable<N> {
 
     /// The shell wrote `value` for `spi` durably.
     pub fn persisted(&mut self, spi: u16, value: u128) -> bool {
-        self.sas
-            .iter_mut()
-            .find(|sa| sa.spi() == spi)
-            .is_some_and(|sa| sa.persisted(value))
+        self.get_mut(spi).is_some_and(|sa| sa.persisted(value))
     }
 
     /// Whether `spi`'s association can protect a frame now (a sending one whose next IV is
@@ -124,11 +125,7 @@ impl<const N: usize> SaTable<N> {
         sec_start: usize,
         mac_end: usize,
     ) -> Result<Iv, SdlsError> {
-        let sa = self
-            .sas
-            .iter_mut()
-            .find(|sa| sa.spi() == spi)
-            .ok_or(SdlsError::NoSuchSpi { spi })?;
+        let sa = self.get_mut(spi).ok_or(SdlsError::NoSuchSpi { spi })?;
         let iv = sa.protect(frame, sec_start, mac_end)?;
         self.counters.protected = self.counters.protected.wrapping_add(1);
         Ok(iv)
@@ -171,11 +168,7 @@ impl<const N: usize> SaTable<N> {
                 needed: sec_start + super::OVERHEAD,
                 found: frame.len(),
             })?;
-        let sa = self
-            .sas
-            .iter_mut()
-            .find(|sa| sa.spi() == spi)
-            .ok_or(SdlsRefusal::UnknownSpi { spi })?;
+        let sa = self.get_mut(spi).ok_or(SdlsRefusal::UnknownSpi { spi })?;
         let iv = sa.verify(frame, sec_start, mac_end, channel)?;
         Ok(Verified { spi, iv })
     }
