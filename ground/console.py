@@ -54,12 +54,16 @@ class Robot:
     {"dir":"tc-frame"} line), `tc_frames` the TC frames, `tms` the TM packets or frames it sent;
     `last` keeps the last lines for a failure's message."""
 
-    def __init__(self, tm_port: int, tc_port: int, *, link: str, seconds: int, out: Path):
+    def __init__(self, tm_port: int, tc_port: int, *, link: str, seconds: int, out: Path,
+                 sdls_keys: Path | None = None):
         self.cmd = [mmic_bin(), "sim", "--protocol", "pus", "--ground-tm-to", f"127.0.0.1:{tm_port}",
                     "--ground-tc-port", str(tc_port), "--max-seconds", str(seconds), "--quiet",
                     "--out", str(out)]
         if link != "packets":
-            self.cmd[4:4] = ["--link", link]
+            # frames-sdls: the robot's frames with SDLS, under the keys YAMCS was given.
+            self.cmd[4:4] = ["--link", "frames"]
+        if sdls_keys is not None:
+            self.cmd += ["--sdls-keys", str(sdls_keys)]
         out.mkdir(parents=True, exist_ok=True)
         self.stderr_path = out / "console-robot.stderr"
         self._stderr = open(self.stderr_path, "w")
@@ -126,7 +130,8 @@ class Console:
         self.out = Path(out) if out else REPO / "target" / "console"
         self.start_timeout = start_timeout
         self.yamcs = Yamcs(mdb, http_port=http_port, tm_port=tm_port, tc_port=tc_port, link=link,
-                           max_lifetime=seconds + 60, start_timeout=start_timeout)
+                           max_lifetime=seconds + 60, start_timeout=start_timeout,
+                           **({"sdls_reprotect": True} if link == "frames-sdls" else {}))
         self.robot: Robot | None = None
 
     @property
@@ -141,8 +146,9 @@ class Console:
     def start(self) -> "Console":
         self.yamcs.start()
         try:
+            keys = self.yamcs.sdls_key_dir if self.link == "frames-sdls" else None
             self.robot = Robot(self.yamcs.tm_port, self.yamcs.tc_port, link=self.link,
-                               seconds=self.seconds, out=self.out / "sim")
+                               seconds=self.seconds, out=self.out / "sim", sdls_keys=keys)
             self.robot.wait_ready(self.start_timeout)
             # MET -> UTC: the robot's gateway powered on when the process started (to ~0.1 s).
             tco = self.yamcs.client.get_tco_client(INSTANCE, "tco0")
@@ -169,8 +175,9 @@ class Console:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--link", choices=("packets", "frames"), default="packets",
-                    help="bare PUS packets over UDP, or TC/TM transfer frames with COP-1 (default packets)")
+    ap.add_argument("--link", choices=("packets", "frames", "frames-sdls"), default="packets",
+                    help="bare PUS packets over UDP, TC/TM transfer frames with COP-1, or those frames "
+                         "under SDLS with keys made for the run (default packets)")
     ap.add_argument("--seconds", type=int, default=3600, help="stop after this long (default 3600)")
     ap.add_argument("--http-port", type=int, default=8090, help="YAMCS's web UI and API (default 8090; 0: a free port)")
     ap.add_argument("--tm-port", type=int, default=None, help="UDP TM into YAMCS (default: a free port)")
@@ -199,7 +206,7 @@ def main(argv=None) -> int:
   housekeeping:  {c.page('/telemetry/parameters', system='/MMIC')}
   send command:  {c.page('/commanding/send')}  (e.g. MMIC/mode, mode 2)
   history:       {c.page('/commanding/history')}
-  links:         {c.page('/links', processor=False)}{'  (COP-1: ' + c.page('/links/tc-frames.vc0', processor=False) + ')' if a.link == 'frames' else ''}
+  links:         {c.page('/links', processor=False)}{'  (COP-1: ' + c.page('/links/tc-frames.vc0', processor=False) + ')' if a.link.startswith('frames') else ''}
   robot log:     {c.out / 'sim' / 'sim.jsonl'}; YAMCS log: {c.yamcs.log_path}
 console: running for {a.seconds} s; Ctrl-C stops YAMCS and the robot""", flush=True)
         end = time.monotonic() + a.seconds
@@ -210,9 +217,9 @@ console: running for {a.seconds} s; Ctrl-C stops YAMCS and the robot""", flush=T
             pass
         if c.robot.proc.poll() is not None and time.monotonic() < end:
             print(f"console: the robot ended (status {c.robot.proc.returncode})", flush=True)
-        frames = f" in {c.robot.tc_frames} TC frames" if a.link == "frames" else ""
+        frames = f" in {c.robot.tc_frames} TC frames" if a.link.startswith("frames") else ""
         print(f"console: {c.robot.tcs} TCs taken by the robot{frames}, {c.robot.tms} TM "
-              f"{'frames ' if a.link == 'frames' else ''}sent; stopping", flush=True)
+              f"{'frames ' if a.link.startswith('frames') else ''}sent; stopping", flush=True)
     print("console: stopped", flush=True)
     return 0
 
