@@ -162,7 +162,7 @@ impl SdlsRefusal {
         "not-reserved",
     ];
 
-    /// The reason's name (`spec/ccsds/bad-inputs.toml`, the counters, ST[5] events).
+    /// The reason's name (the counters, the ST\[5\] events).
     pub const fn name(&self) -> &'static str {
         Self::NAMES[self.position()]
     }
