@@ -1265,8 +1265,15 @@ impl Robot {
             )
         };
         let ground_stream = cfg.protocol == Protocol::Legacy;
+        // With SDLS the uplink keeps order under jitter, as a space link does: the receiver's
+        // anti-replay window takes only IVs above the last accepted one, so a datagram link
+        // that lets frames sent together overtake each other would refuse the earlier ones as
+        // replays, and FOP-1's go-back-N, sending its window again under fresh IVs each time,
+        // could find it shuffled every round (seen: 590 TC frames for 14 accepted). The
+        // reordering fault model (a frame held back) still applies.
+        let secured = cfg.sdls.is_some() && cfg.link == LinkLayer::Frames;
         let links = [
-            link(&cfg.links.ground, cfg.serial_loss, 4, ground_stream),
+            link(&cfg.links.ground, cfg.serial_loss, 4, ground_stream || secured),
             link(&cfg.links.ground, cfg.serial_loss, 3, ground_stream),
             link(&cfg.links.wifi, cfg.wifi_loss, 5, true),
             link(&cfg.links.wifi, cfg.wifi_loss, 6, true),
