@@ -541,7 +541,10 @@ pub fn bench(max: u8, seconds: u32, out: &mut dyn Write) -> Result<(), CliError>
 /// Robot `one`'s SDLS keys from `dir` (`spi-<TC SPI>.key`, `spi-<TM SPI>.key`: 32 octets
 /// each; robot 1's are `spi-257.key` and `spi-513.key`). The error names the file and the
 /// length found, never the octets.
-fn read_keys(dir: &std::path::Path, one: mmic::units::BoardNumber) -> Result<(Key256, Key256), CliError> {
+fn read_keys(
+    dir: &std::path::Path,
+    one: mmic::units::BoardNumber,
+) -> Result<(Key256, Key256), CliError> {
     let read = |spi: u16| -> Result<Key256, CliError> {
         let path = dir.join(format!("spi-{spi}.key"));
         let bytes = std::fs::read(&path)

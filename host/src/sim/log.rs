@@ -162,7 +162,8 @@ pub fn sdls_header(bytes: &[u8]) -> Value {
     } else {
         match mmic::link::tc_frame::TcPrimaryHeader::read(bytes) {
             Some(h) if !h.control => {
-                mmic::link::tc_frame::TC_PRIMARY_HEADER_LEN + mmic::link::tc_frame::SEGMENT_HEADER_LEN
+                mmic::link::tc_frame::TC_PRIMARY_HEADER_LEN
+                    + mmic::link::tc_frame::SEGMENT_HEADER_LEN
             }
             _ => return Value::Null,
         }
@@ -177,7 +178,9 @@ pub fn sdls_header(bytes: &[u8]) -> Value {
         return Value::Null;
     };
     let spi = u16::from_be_bytes([h[0], h[1]]);
-    let ciphertext = bytes.len().saturating_sub(start + HEADER_LEN + MAC_LEN + trailer);
+    let ciphertext = bytes
+        .len()
+        .saturating_sub(start + HEADER_LEN + MAC_LEN + trailer);
     json!({"spi": spi, "iv": hex(&h[SPI_LEN..]), "ciphertext_len": ciphertext})
 }
 

@@ -1056,7 +1056,11 @@ impl<'c, G: Ground> Engine<'c, G> {
             };
             let got = g.tc_frame(now, &f);
             // The security header as sent (never the key; the data stays ciphertext).
-            let sec = if secured { log::sdls_header(&f) } else { Value::Null };
+            let sec = if secured {
+                log::sdls_header(&f)
+            } else {
+                Value::Null
+            };
             if attack {
                 self.attack_outcome(i, now, &f, &got.verdict);
             }
@@ -1273,7 +1277,12 @@ impl Robot {
         // reordering fault model (a frame held back) still applies.
         let secured = cfg.sdls.is_some() && cfg.link == LinkLayer::Frames;
         let links = [
-            link(&cfg.links.ground, cfg.serial_loss, 4, ground_stream || secured),
+            link(
+                &cfg.links.ground,
+                cfg.serial_loss,
+                4,
+                ground_stream || secured,
+            ),
             link(&cfg.links.ground, cfg.serial_loss, 3, ground_stream),
             link(&cfg.links.wifi, cfg.wifi_loss, 5, true),
             link(&cfg.links.wifi, cfg.wifi_loss, 6, true),
