@@ -279,7 +279,7 @@ fn the_swarm_draws_sdls_for_half_the_frames_runs_and_leaves_other_scenarios_alon
         let without = match s.sdls {
             Some(a) => s
                 .describe()
-                .replace(&format!(" with SDLS (attacker rate {a:.2})"), ""),
+                .replace(&format!("; SDLS, attacker rate {a:.2}"), ""),
             None => s.describe(),
         };
         assert_eq!(o.describe(), without, "seed {seed}");

@@ -71,7 +71,11 @@ pub struct SummaryJson {
     /// With `--protocol pus`: "packets" or "frames" (absent with the legacy protocol).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub link: Option<String>,
-    /// With `--link frames`: the space data link's figures (retransmissions, alerts, CLCWs).
+    /// With `--link frames`: the space data link's figures (retransmissions, alerts, CLCWs);
+    /// with `--sdls` also `sdls` ([`crate::sim::SdlsStats`]): `server` and `ground`, each
+    /// `verified`, `protected` and `refused` by reason (`SdlsRefusal::NAMES`), and the
+    /// attacker's `attack_frames`, `attacks_refused_sdls`, `attacks_refused_frame` and
+    /// `attacks_passed`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frames: Option<serde_json::Value>,
 }

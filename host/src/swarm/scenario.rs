@@ -354,7 +354,8 @@ impl Scenario {
         }
     }
 
-    /// One line: protocol (and with PUS its link layer), plan, links, faults.
+    /// One line: protocol (and with PUS its link layer), plan, links, faults; SDLS and the
+    /// attacker's rate last, when drawn.
     pub fn describe(&self) -> String {
         let c = &self.cfg;
         let steps: Vec<&str> = c
@@ -374,13 +375,9 @@ impl Scenario {
              a-b loss {:.3} cuts {:?}; b phase {:.1} ms; injections [{}]",
             self.seed,
             self.protocol.name(),
-            match (self.protocol, self.sdls) {
-                (Protocol::Pus, None) => format!(" over {}", self.link.name()),
-                (Protocol::Pus, Some(a)) => format!(
-                    " over {} with SDLS (attacker rate {a:.2})",
-                    self.link.name()
-                ),
-                (Protocol::Legacy, _) => String::new(),
+            match self.protocol {
+                Protocol::Pus => format!(" over {}", self.link.name()),
+                Protocol::Legacy => String::new(),
             },
             c.start_state.letter(),
             steps.join("; "),
@@ -398,6 +395,9 @@ impl Scenario {
             c.links.ab.cuts,
             c.b_phase_us as f64 / 1000.0,
             inj.join(", ")
-        )
+        ) + &match self.sdls {
+            Some(a) => format!("; SDLS, attacker rate {a:.2}"),
+            None => String::new(),
+        }
     }
 }
