@@ -185,11 +185,30 @@ pub struct SimArgs {
     /// one, printed in the first line).
     #[arg(long, value_name = "PORT", requires = "ground_tm_to")]
     pub ground_tc_port: Option<u16>,
-    /// SDLS on the space data link with the external ground (--link frames): the directory of
-    /// robot 1's keys, `spi-257.key` (TC) and `spi-513.key` (TM), 32 octets each (YAMCS's
-    /// `keyFile`s). Keys stay out of the source tree, the logs and the output.
-    #[arg(long, value_name = "DIR", requires = "ground_tm_to")]
+    /// SDLS on the space data link (--link frames; implies --sdls): the directory of the keys,
+    /// `spi-<TC SPI>.key` and `spi-<TM SPI>.key` of each robot n (TC SPI 256 + n, TM SPI
+    /// 512 + n: robot 1's are `spi-257.key` and `spi-513.key`), 32 octets each (YAMCS's
+    /// `keyFile`s). With an external ground (--ground-tm-to), robot 1's. Keys stay out of the
+    /// source tree, the logs and the output.
+    #[arg(long, value_name = "DIR")]
     pub sdls_keys: Option<PathBuf>,
+    /// SDLS (CCSDS 355.0, AES-256-GCM) on the space data link of the simulator's own ground
+    /// (--protocol pus --link frames): the ground protects its TC data frames and verifies the
+    /// TM frames, the server board verifies the TC frames before FARM-1 and protects its TM
+    /// frames; both ends' durable counters are kept for the run. Keys from --sdls-keys, else
+    /// made at run time: in virtual time derived from --seed, so that a run stays
+    /// deterministic (such keys are for simulation only: anyone with the seed has them); with
+    /// --realtime, random. The summary gains both ends' SDLS figures (frames verified,
+    /// protected, refused by reason); the log shows a protected frame's headers, SPI and IV,
+    /// never its packets or a key.
+    #[arg(long)]
+    pub sdls: bool,
+    /// With --sdls, virtual time: an attacker on each robot's uplink. For each TC frame the
+    /// uplink delivers, the chance (0..1) that the attacker also sends a captured TC data frame
+    /// again or a copy with one bit flipped (its FECF made good), half each. Every such frame
+    /// must be refused before FARM-1; the summary counts them.
+    #[arg(long, value_name = "P", default_value_t = 0.0)]
+    pub sdls_attack: f64,
     /// Run on the wall clock instead of in virtual time: real threads, OS pipes, TCP and UDP
     /// on loopback, at --scale times real time (the transports' own test; its timing depends
     /// on how busy the host is). The default is the virtual-time engine: deterministic, one
@@ -341,8 +360,55 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     cfg.record = a.record.clone();
     cfg.progress = !a.quiet;
     if let (Some(tm_to), Some(tc_port)) = (a.ground_tm_to, a.ground_tc_port) {
-        let sdls = a.sdls_keys.as_deref().map(read_keys).transpose()?;
+        let one = mmic::units::BoardNumber::ONE;
+        let sdls = a
+            .sdls_keys
+            .as_deref()
+            .map(|d| read_keys(d, one))
+            .transpose()?;
         return external(cfg, tm_to, tc_port, sdls, out);
+    }
+    if a.sdls || a.sdls_keys.is_some() {
+        if cfg.link != sim::LinkLayer::Frames {
+            return Err(CliError::Usage(
+                "--sdls needs --protocol pus --link frames".into(),
+            ));
+        }
+        if !(0.0..=1.0).contains(&a.sdls_attack) {
+            return Err(CliError::Usage(format!(
+                "--sdls-attack {}: a chance, 0..1",
+                a.sdls_attack
+            )));
+        }
+        if a.sdls_attack > 0.0 && cfg.realtime {
+            return Err(CliError::Usage(
+                "--sdls-attack runs in virtual time (not with --realtime)".into(),
+            ));
+        }
+        if cfg.record.is_some() {
+            return Err(CliError::Usage(
+                "--record runs without --sdls (a replay trace has no keys)".into(),
+            ));
+        }
+        let keys = match &a.sdls_keys {
+            Some(dir) => sim::SdlsKeys::Given(
+                (0..cfg.robots.max(1))
+                    .map(|i| {
+                        let n = mmic::units::BoardNumber::new((i % 255) as u8 + 1)
+                            .unwrap_or(mmic::units::BoardNumber::ONE);
+                        read_keys(dir, n)
+                    })
+                    .collect::<Result<_, _>>()?,
+            ),
+            None if cfg.realtime => sim::SdlsKeys::Random,
+            None => sim::SdlsKeys::Seeded,
+        };
+        cfg.sdls = Some(sim::SdlsConfig {
+            keys,
+            attack: a.sdls_attack,
+        });
+    } else if a.sdls_attack > 0.0 {
+        return Err(CliError::Usage("--sdls-attack needs --sdls".into()));
     }
     let summary = sim::run(&cfg).map_err(CliError::Sim)?;
     let plots = report::plots(&summary, &a.out).map_err(|source| CliError::Write {
@@ -472,10 +538,13 @@ pub fn bench(max: u8, seconds: u32, out: &mut dyn Write) -> Result<(), CliError>
     Ok(())
 }
 
-/// Robot 1's SDLS keys from `dir` (`spi-257.key`, `spi-513.key`: 32 octets each). The error
-/// names the file and the length found, never the octets.
-fn read_keys(dir: &std::path::Path) -> Result<(Key256, Key256), CliError> {
-    let one = mmic::units::BoardNumber::ONE;
+/// Robot `one`'s SDLS keys from `dir` (`spi-<TC SPI>.key`, `spi-<TM SPI>.key`: 32 octets
+/// each; robot 1's are `spi-257.key` and `spi-513.key`). The error names the file and the
+/// length found, never the octets.
+fn read_keys(
+    dir: &std::path::Path,
+    one: mmic::units::BoardNumber,
+) -> Result<(Key256, Key256), CliError> {
     let read = |spi: u16| -> Result<Key256, CliError> {
         let path = dir.join(format!("spi-{spi}.key"));
         let bytes = std::fs::read(&path)

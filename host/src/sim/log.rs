@@ -26,6 +26,9 @@ pub type Record = Value;
 #[derive(Clone)]
 pub struct Log {
     sink: Sink,
+    /// The run's space data link is secured with SDLS: TC data frames and TM frames are
+    /// decoded as far as they are in clear ([`decode_secured`]).
+    sdls: bool,
 }
 
 #[derive(Clone)]
@@ -41,6 +44,7 @@ impl Log {
         (
             Log {
                 sink: Sink::Channel(tx),
+                sdls: false,
             },
             rx,
         )
@@ -50,7 +54,14 @@ impl Log {
     pub fn memory() -> Log {
         Log {
             sink: Sink::Memory(Arc::new(Mutex::new(Vec::new()))),
+            sdls: false,
         }
+    }
+
+    /// The same log, its frames decoded as SDLS-protected ones when `sdls`.
+    pub fn secured(mut self, sdls: bool) -> Log {
+        self.sdls = sdls;
+        self
     }
 
     /// The records of a memory log so far, oldest first (none for a channel's).
@@ -63,7 +74,11 @@ impl Log {
 
     /// Logs a packet on a link.
     pub fn packet(&self, t_ms: u32, link: &str, from: &str, to: &str, fate: &str, bytes: &[u8]) {
-        let (kind, decoded) = decode(bytes);
+        let (kind, decoded) = if self.sdls {
+            decode_secured(bytes)
+        } else {
+            decode(bytes)
+        };
         self.send(json!({
             "t_ms": t_ms, "kind": "packet", "link": link, "from": from, "to": to,
             "fate": fate, "packet_kind": kind, "hex": hex(bytes), "packet": decoded,
@@ -121,6 +136,90 @@ fn frame(bytes: &[u8]) -> Option<(&'static str, Value)> {
     crate::link::decode_tc_frame(bytes, &options)
         .ok()
         .map(|v| ("tc_frame", v))
+}
+
+/// A packet's kind and JSON form on a link secured with SDLS: TC data frames and TM frames by
+/// what is in clear (their headers, the security header, and a TM frame's CLCW: the OCF is
+/// outside the MAC), never the ciphertext read as packets; anything else as [`decode`] does.
+pub fn decode_secured(bytes: &[u8]) -> (&'static str, Value) {
+    let legacy = bytes
+        .get(..mmic::wire::HEADER_LEN)
+        .and_then(mmic::wire::PacketKind::from_header)
+        .is_some();
+    if legacy {
+        return decode(bytes);
+    }
+    secured_frame(bytes).unwrap_or_else(|| decode(bytes))
+}
+
+/// The security header of a protected TC data frame or TM frame as JSON: its SPI and IV (the
+/// IV is the anti-replay counter, sent in clear), and the length of the ciphertext between it
+/// and the MAC. Null for anything else (a BC frame, which goes in clear).
+pub fn sdls_header(bytes: &[u8]) -> Value {
+    use mmic::link::sdls::{HEADER_LEN, MAC_LEN, SPI_LEN};
+    let start = if bytes.len() == mmic::link::tm_frame::TM_FRAME_LEN {
+        mmic::link::tm_frame::PRIMARY_HEADER_LEN
+    } else {
+        match mmic::link::tc_frame::TcPrimaryHeader::read(bytes) {
+            Some(h) if !h.control => {
+                mmic::link::tc_frame::TC_PRIMARY_HEADER_LEN
+                    + mmic::link::tc_frame::SEGMENT_HEADER_LEN
+            }
+            _ => return Value::Null,
+        }
+    };
+    // The MAC ends before the OCF and the FECF of a TM frame, before the FECF of a TC frame.
+    let trailer = if start == mmic::link::tm_frame::PRIMARY_HEADER_LEN {
+        mmic::link::tm_frame::OCF_LEN + mmic::link::tm_frame::FECF_LEN
+    } else {
+        mmic::link::tc_frame::FECF_LEN
+    };
+    let Some(h) = bytes.get(start..start + HEADER_LEN) else {
+        return Value::Null;
+    };
+    let spi = u16::from_be_bytes([h[0], h[1]]);
+    let ciphertext = bytes
+        .len()
+        .saturating_sub(start + HEADER_LEN + MAC_LEN + trailer);
+    json!({"spi": spi, "iv": hex(&h[SPI_LEN..]), "ciphertext_len": ciphertext})
+}
+
+fn secured_frame(bytes: &[u8]) -> Option<(&'static str, Value)> {
+    let options = crate::link::FrameOptions::default();
+    if bytes.len() == mmic::link::tm_frame::TM_FRAME_LEN {
+        // The frame's fields by the mission's TM layout with room for SDLS.
+        let id = u16::from_be_bytes([*bytes.first()?, *bytes.get(1)?]);
+        let params = mmic::link::tm_frame::TmFrameParams::mission((id >> 4) & 0x3ff)?
+            .with_security(
+                mmic::link::sdls::HEADER_LEN as u8,
+                mmic::link::sdls::MAC_LEN as u8,
+            )?;
+        let mut v = crate::link::decode_tm_with(bytes, &params).ok()?;
+        v["data"] = Value::Null;
+        v["sdls"] = sdls_header(bytes);
+        return Some(("tm_frame", v));
+    }
+    let header = mmic::link::tc_frame::TcPrimaryHeader::read(bytes)?;
+    if header.control {
+        return None; // a BC frame: in clear
+    }
+    // The header fields by the plain decoder over a frame whose data it does not read as
+    // packets: the frame check needs only the header, the length and the FECF.
+    let mut v = crate::link::decode_tc_frame(bytes, &options).unwrap_or_else(|_| {
+        // The decoder refused the ciphertext as packets: the header alone.
+        json!({
+            "kind": if header.bypass { "bd" } else { "ad" },
+            "spacecraft_id": header.spacecraft_id, "vcid": header.vcid,
+            "length": header.frame_length, "seq": header.seq, "len": bytes.len(),
+        })
+    });
+    for k in ["data_field", "data", "packets"] {
+        if v.get(k).is_some() {
+            v[k] = Value::Null;
+        }
+    }
+    v["sdls"] = sdls_header(bytes);
+    Some(("tc_frame", v))
 }
 
 /// Every robot's APID.

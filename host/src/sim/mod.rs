@@ -47,6 +47,7 @@ pub mod report;
 pub mod shell;
 pub mod steps;
 
+use mmic::link::sdls::{Key256, SdlsRefusal};
 use mmic::motion::State;
 use mmic::node::exactly_once::uplink;
 use mmic::node::ground::plan_runner::PlanEnd;
@@ -148,6 +149,116 @@ pub struct FrameStats {
     pub tm_lost: u64,
     /// TM packets dropped because a lost frame cut them.
     pub tm_packets_dropped: u64,
+    /// SDLS on the link (`--sdls`): both ends' figures, and the attacker's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sdls: Option<SdlsStats>,
+}
+
+/// One end's SDLS figures ([`mmic::link::sdls::SdlsCounters`], summed over robots).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SdlsEnd {
+    /// Frames that verified.
+    pub verified: u64,
+    /// Frames protected.
+    pub protected: u64,
+    /// Frames refused, by reason ([`SdlsRefusal::NAMES`]).
+    #[serde(serialize_with = "by_reason")]
+    pub refused: [u64; SdlsRefusal::NAMES.len()],
+}
+
+impl SdlsEnd {
+    fn add(&mut self, c: &mmic::link::sdls::SdlsCounters) {
+        self.verified += u64::from(c.accepted);
+        self.protected += u64::from(c.protected);
+        for (a, b) in self.refused.iter_mut().zip(c.refused) {
+            *a += u64::from(b);
+        }
+    }
+
+    fn merged(self, o: SdlsEnd) -> SdlsEnd {
+        let mut refused = self.refused;
+        for (a, b) in refused.iter_mut().zip(o.refused) {
+            *a += b;
+        }
+        SdlsEnd {
+            verified: self.verified + o.verified,
+            protected: self.protected + o.protected,
+            refused,
+        }
+    }
+
+    /// Frames refused for any reason.
+    pub fn refused_total(&self) -> u64 {
+        self.refused.iter().sum()
+    }
+
+    /// The refusals as `name n, ...` (the reasons counted only), or `none`.
+    pub fn refusals_text(&self) -> String {
+        let parts: Vec<String> = SdlsRefusal::NAMES
+            .iter()
+            .zip(self.refused)
+            .filter(|(_, n)| *n > 0)
+            .map(|(name, n)| format!("{name} {n}"))
+            .collect();
+        if parts.is_empty() {
+            "none".into()
+        } else {
+            parts.join(", ")
+        }
+    }
+}
+
+fn by_reason<S: serde::Serializer>(
+    refused: &[u64; SdlsRefusal::NAMES.len()],
+    s: S,
+) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeMap;
+    let mut m = s.serialize_map(Some(refused.len()))?;
+    for (name, n) in SdlsRefusal::NAMES.iter().zip(refused) {
+        m.serialize_entry(name, n)?;
+    }
+    m.end()
+}
+
+/// SDLS's figures of a run with [`SimConfig::sdls`], all robots.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+pub struct SdlsStats {
+    /// The server boards' end: TC frames verified (and refused), TM frames protected.
+    pub server: SdlsEnd,
+    /// The ground's end: TC frames protected, TM frames verified (and refused).
+    pub ground: SdlsEnd,
+    /// Frames the attacker on the uplink sent (replays and bit-flipped copies of captured TC
+    /// data frames, [`SdlsConfig::attack`]).
+    pub attack_frames: u64,
+    /// Of those, refused by SDLS.
+    pub attacks_refused_sdls: u64,
+    /// Of those, refused by a frame check before SDLS (a flipped bit in a field the frame
+    /// checks read: the version, the flags, the length, the spacecraft ID, ...).
+    pub attacks_refused_frame: u64,
+    /// Of those, passed on to FARM-1: none may be.
+    pub attacks_passed: u64,
+}
+
+impl SdlsStats {
+    /// Both together: every figure summed.
+    pub fn merged(self, o: SdlsStats) -> SdlsStats {
+        SdlsStats {
+            server: self.server.merged(o.server),
+            ground: self.ground.merged(o.ground),
+            attack_frames: self.attack_frames + o.attack_frames,
+            attacks_refused_sdls: self.attacks_refused_sdls + o.attacks_refused_sdls,
+            attacks_refused_frame: self.attacks_refused_frame + o.attacks_refused_frame,
+            attacks_passed: self.attacks_passed + o.attacks_passed,
+        }
+    }
+}
+
+/// Merges two optional SDLS figures (none when neither end had SDLS).
+fn merge_sdls(a: Option<SdlsStats>, b: Option<SdlsStats>) -> Option<SdlsStats> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(a.merged(b)),
+        (a, b) => a.or(b),
+    }
 }
 
 impl FrameStats {
@@ -166,6 +277,9 @@ impl FrameStats {
         let x = gl.extract_counters();
         self.tm_lost += u64::from(x.lost_frames);
         self.tm_packets_dropped += u64::from(x.dropped);
+        if let Some(c) = gl.security() {
+            self.sdls.get_or_insert_default().ground.add(c);
+        }
     }
 
     /// Adds the server board's end of robot `board`'s link: what its FARM-1 accepted and
@@ -187,6 +301,9 @@ impl FrameStats {
         if let Some(c) = g.counters(board) {
             self.tm_frames += u64::from(c.tm_frames);
         }
+        if let Some(c) = g.security(board) {
+            self.sdls.get_or_insert_default().server.add(c);
+        }
     }
 
     /// Both ends together: every figure summed.
@@ -202,6 +319,7 @@ impl FrameStats {
             tm_frames: self.tm_frames + o.tm_frames,
             tm_lost: self.tm_lost + o.tm_lost,
             tm_packets_dropped: self.tm_packets_dropped + o.tm_packets_dropped,
+            sdls: merge_sdls(self.sdls, o.sdls),
         }
     }
 }
@@ -276,6 +394,9 @@ pub struct SimConfig {
     /// Virtual time: run on to [`SimConfig::max_sim_ms`] after every plan ended (the robots
     /// idle, still watched), instead of stopping there.
     pub run_to_end: bool,
+    /// SDLS on the space data link (`--sdls`, with [`LinkLayer::Frames`]): both ends of every
+    /// robot's link secured, and an attacker on the uplink if [`SdlsConfig::attack`] says.
+    pub sdls: Option<SdlsConfig>,
     /// Virtual time: write robot 1's replay trace here (`mmic sim --record`): every call of
     /// its nodes with its time, readings and bytes, for `mmic replay` and the RV32 runner
     /// (`benches/rv32`).
@@ -308,6 +429,76 @@ impl std::fmt::Debug for External {
             .field("tc_port", &self.tc_port)
             .field("sdls", &self.sdls.is_some())
             .finish_non_exhaustive()
+    }
+}
+
+/// Where a run's SDLS keys come from.
+#[derive(Clone)]
+pub enum SdlsKeys {
+    /// Derived from the run's seed (the virtual-time engine's default: a run stays
+    /// deterministic). For simulation only: anyone with the seed has the keys.
+    Seeded,
+    /// Made at run time from the operating system's random source (the realtime engine's
+    /// default).
+    Random,
+    /// Read from files (`--sdls-keys DIR`): each robot's (TC, TM) keys, by robot index.
+    Given(Vec<(Key256, Key256)>),
+}
+
+/// SDLS in a run's own grounds ([`SimConfig::sdls`]).
+#[derive(Clone)]
+pub struct SdlsConfig {
+    /// The keys.
+    pub keys: SdlsKeys,
+    /// Virtual time: the attacker on each robot's uplink. For each TC frame the uplink
+    /// delivers, the chance that the attacker also sends one frame: a captured TC data frame
+    /// again (a replay) or a copy with one bit flipped and its FECF made good again (so that
+    /// it gets past the FECF check to SDLS), half each. 0: no attacker.
+    pub attack: f64,
+}
+
+impl std::fmt::Debug for SdlsConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let keys = match &self.keys {
+            SdlsKeys::Seeded => "seeded",
+            SdlsKeys::Random => "random",
+            SdlsKeys::Given(_) => "given",
+        };
+        f.debug_struct("SdlsConfig")
+            .field("keys", &keys)
+            .field("attack", &self.attack)
+            .finish()
+    }
+}
+
+/// Mixes the seeded keys' stream apart from every other draw of a run.
+const SDLS_KEY_STREAM: u64 = 0x5d15_6b65_7900_0000;
+
+impl SdlsConfig {
+    /// Robot `i`'s (TC, TM) keys in a run seeded `seed`: given, derived from the seed, or
+    /// random. Given keys for fewer robots than the run has: the rest are derived from the
+    /// seed.
+    pub fn keys(&self, seed: u64, i: usize) -> std::io::Result<(Key256, Key256)> {
+        let seeded = |k: u64| {
+            let mut rng = fastrand::Rng::with_seed(
+                seed ^ SDLS_KEY_STREAM ^ (i as u64).wrapping_mul(0x9e37_79b9) ^ (k << 40),
+            );
+            let mut b = [0u8; mmic::link::sdls::KEY_LEN];
+            rng.fill(&mut b);
+            Key256::from_bytes(b)
+        };
+        match &self.keys {
+            SdlsKeys::Given(v) if i < v.len() => Ok(v[i].clone()),
+            SdlsKeys::Given(_) | SdlsKeys::Seeded => Ok((seeded(1), seeded(2))),
+            SdlsKeys::Random => {
+                let read = || -> std::io::Result<Key256> {
+                    let mut b = [0u8; mmic::link::sdls::KEY_LEN];
+                    std::io::Read::read_exact(&mut std::fs::File::open("/dev/urandom")?, &mut b)?;
+                    Ok(Key256::from_bytes(b))
+                };
+                Ok((read()?, read()?))
+            }
+        }
     }
 }
 
@@ -364,6 +555,7 @@ impl SimConfig {
             planted_bug: engine::PlantedBug::None,
             run_to_end: false,
             record: None,
+            sdls: None,
         }
     }
 }

@@ -730,7 +730,7 @@ impl FrameGatewayTask {
             ..FrameConfig::default()
         }));
         g.add(self.robot.0);
-        if let Some((tc, tm)) = self.sdls.take() {
+        if let Some((tc, tm)) = self.sdls.clone() {
             g.secure(self.robot.0, tc, tm, Stored::default());
         }
         let mut store = std::collections::BTreeMap::new();
@@ -769,12 +769,20 @@ impl FrameGatewayTask {
             let now = node.clock.now_ms();
             let bytes = buf.get(..n).unwrap_or(&[]);
             let got = g.tc_frame(now, bytes);
+            // With SDLS a data frame's packets are ciphertext: its security header instead.
+            let secured = self.sdls.is_some();
+            let sec = if secured {
+                super::log::sdls_header(bytes)
+            } else {
+                Value::Null
+            };
             if let Err(e) = &got.verdict {
-                node.event(
-                    now,
-                    json!({"type": "tc_frame_refused", "check": e.name(), "layer": e.layer(),
-                           "hex": super::log::hex(bytes)}),
-                );
+                let mut ev = json!({"type": "tc_frame_refused", "check": e.name(),
+                                    "layer": e.layer(), "hex": super::log::hex(bytes)});
+                if secured {
+                    ev["sdls"] = sec.clone();
+                }
+                node.event(now, ev);
             }
             if let Some(w) = &self.wire {
                 let config = tc_frame::mission(SpacecraftId::of_board(self.robot.0));
@@ -786,10 +794,15 @@ impl FrameGatewayTask {
                             .collect()
                     })
                     .unwrap_or_default();
-                w.line(json!({"dir": "tc-frame", "hex": super::log::hex(bytes),
+                let mut line = json!({"dir": "tc-frame", "hex": super::log::hex(bytes),
                               "refused": got.verdict.as_ref().err().map(|e| e.name()),
                               "farm": got.verdict.as_ref().ok().map(verdict_name),
-                              "packets": packets}));
+                              "packets": packets});
+                if secured && !sec.is_null() {
+                    line["packets"] = Value::Null;
+                    line["sdls"] = sec;
+                }
+                w.line(line);
             }
         }
         self.tm_frames(node, g);

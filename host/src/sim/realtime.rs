@@ -59,6 +59,8 @@ struct RunEnv<'a> {
     packet_log: Option<log::Log>,
     /// The server boards' figures of the space data link, added when their tasks end.
     frames: Arc<Mutex<FrameStats>>,
+    /// With SDLS in the run's own ground: every robot's (TC, TM) keys, by index.
+    keys: &'a [(mmic::link::sdls::Key256, mmic::link::sdls::Key256)],
 }
 
 impl<'a> RunEnv<'a> {
@@ -277,7 +279,11 @@ impl ServerEnds<'_> {
             config: env.cfg.gateway,
             wire: env.cfg.external.as_ref().map(|x| x.wire.clone()),
             stats: env.frames.clone(),
-            sdls: env.cfg.external.as_ref().and_then(|x| x.sdls.clone()),
+            sdls: match (&env.cfg.external, &env.cfg.sdls) {
+                (Some(x), _) => x.sdls.clone(),
+                (None, Some(_)) => env.keys.get(self.board.get() as usize - 1).cloned(),
+                (None, None) => None,
+            },
         };
         Ok((gw, udp))
     }
@@ -335,6 +341,16 @@ fn spawn_server<'scope, 'env>(
 pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     let n = cfg.robots.max(1) as usize;
     let (logger, log_rx) = log::Log::new();
+    let secured = cfg.link == LinkLayer::Frames
+        && (cfg.sdls.is_some() || cfg.external.as_ref().is_some_and(|x| x.sdls.is_some()));
+    let logger = logger.secured(secured);
+    // With SDLS in the run's own ground, each robot's keys, for both ends.
+    let keys = match (&cfg.sdls, &cfg.external) {
+        (Some(c), None) if cfg.link == LinkLayer::Frames => (0..n)
+            .map(|i| c.keys(cfg.seed, i))
+            .collect::<std::io::Result<Vec<_>>>()?,
+        _ => Vec::new(),
+    };
     let robots = (0..n)
         .map(|_| {
             let listener = TcpListener::bind("127.0.0.1:0")?;
@@ -368,6 +384,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         log: Some(logger.clone()),
         packet_log: cfg.log_packets.then(|| logger.clone()),
         frames: server_frames.clone(),
+        keys: &keys,
     };
     drop(logger);
     let result = std::thread::scope(|scope| -> std::io::Result<_> {
@@ -376,7 +393,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
             ground_links.push(spawn_robot(scope, &env, i, robot, q, statuses[i].clone())?);
         }
         let out = match &cfg.external {
-            None => ground_loop(cfg, ground_links, clock.node(), env.log.clone()),
+            None => ground_loop(cfg, ground_links, &keys, clock.node(), env.log.clone()),
             Some(_) => external_ground(cfg, &clock),
         };
         stop.store(true, Ordering::Relaxed);
@@ -444,6 +461,7 @@ type SimFopLink = FopLink<10, 64, 1024>;
 fn ground_loop(
     cfg: &SimConfig,
     links: Vec<GroundLink>,
+    keys: &[(mmic::link::sdls::Key256, mmic::link::sdls::Key256)],
     clock: clock::NodeClock<'_>,
     log: Option<log::Log>,
 ) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
@@ -464,10 +482,18 @@ fn ground_loop(
                 .map(|(_, _, b)| PlanRunner::pus(cfg.pus, *b))
                 .collect();
             // With --link frames the ground's packets go through each robot's FOP-1.
+            // With SDLS, each secured with its robot's keys.
             let fops = links
                 .iter()
-                .map(|(_, _, b)| {
-                    (cfg.link == LinkLayer::Frames).then(|| Box::new(SimFopLink::new(*b)))
+                .enumerate()
+                .map(|(i, (_, _, b))| {
+                    (cfg.link == LinkLayer::Frames).then(|| {
+                        let mut gl = Box::new(SimFopLink::new(*b));
+                        if let Some((tc, tm)) = keys.get(i) {
+                            gl.secure(tc.clone(), tm.clone(), (None, None));
+                        }
+                        gl
+                    })
                 })
                 .collect();
             run_ground(cfg, links, runners, fops, clock, log)
@@ -495,9 +521,18 @@ fn run_ground<G: Ground>(
         cfg.progress,
         log.clone(),
     );
+    // The ground's durable SDLS counters, (robot, SPI) → value: kept for the run.
+    let mut store = std::collections::BTreeMap::new();
+    let mut persist = |i: usize, gl: &mut SimFopLink| {
+        for (spi, v) in gl.due().collect::<Vec<_>>() {
+            store.insert((i, spi), v);
+            gl.persisted(spi, v);
+        }
+    };
     // FOP-1 initiates the AD service; it runs once a CLCW confirms it.
-    for ((writer, _, _), fop) in links.iter_mut().zip(fops.iter_mut()) {
+    for (i, ((writer, _, _), fop)) in links.iter_mut().zip(fops.iter_mut()).enumerate() {
         if let Some(gl) = fop {
+            persist(i, gl);
             gl.start(clock.now_ms(), &mut |f: &[u8]| {
                 writer.send(clock.now_ms(), f);
             });
@@ -526,6 +561,7 @@ fn run_ground<G: Ground>(
             let mut emit = |f: &[u8]| {
                 writer.send(clock.now_ms(), f);
             };
+            persist(i, gl);
             gl.tick(now, &mut emit);
             for p in ground.tick(i, now) {
                 if gl.send(&p, now, &mut emit).is_err() {
@@ -542,9 +578,11 @@ fn run_ground<G: Ground>(
                     ground_event(
                         &log,
                         t,
-                        json!({"type": "tm_frame_refused", "check": e.name()}),
+                        json!({"type": "tm_frame_refused", "check": e.name(),
+                               "sdls": log::sdls_header(&bytes)}),
                     );
                 }
+                persist(i, gl);
                 for p in packets {
                     for q in ground.receive(i, t, &p) {
                         if gl.send(&q, t, &mut emit).is_err() {

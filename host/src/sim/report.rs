@@ -71,7 +71,11 @@ pub struct SummaryJson {
     /// With `--protocol pus`: "packets" or "frames" (absent with the legacy protocol).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub link: Option<String>,
-    /// With `--link frames`: the space data link's figures (retransmissions, alerts, CLCWs).
+    /// With `--link frames`: the space data link's figures (retransmissions, alerts, CLCWs);
+    /// with `--sdls` also `sdls` ([`crate::sim::SdlsStats`]): `server` and `ground`, each
+    /// `verified`, `protected` and `refused` by reason (`SdlsRefusal::NAMES`), and the
+    /// attacker's `attack_frames`, `attacks_refused_sdls`, `attacks_refused_frame` and
+    /// `attacks_passed`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frames: Option<serde_json::Value>,
 }
@@ -405,6 +409,9 @@ fn pus_lines(t: &mut String, s: &Summary) {
             f.clcws,
             f.lockout_reports
         );
+        if let Some(x) = &f.sdls {
+            let _ = writeln!(t, "{}", sdls_text(x));
+        }
     }
     if let Some(c) = pus_counts(s) {
         let _ = writeln!(
@@ -590,4 +597,29 @@ pub fn plots(s: &Summary, dir: &Path) -> std::io::Result<Vec<std::path::PathBuf>
     std::fs::write(&p1, eff)?;
     std::fs::write(&p2, bars)?;
     Ok(vec![p1, p2])
+}
+
+/// The SDLS line of a run's summary: both ends' figures, and the attacker's.
+pub fn sdls_text(x: &crate::sim::SdlsStats) -> String {
+    let mut t = format!(
+        "sdls: AES-256-GCM both ways -- server verified {} TC frames, refused {} ({}), \
+         protected {} TM frames; ground protected {} TC frames, verified {} TM frames, refused {} \
+         ({})",
+        x.server.verified,
+        x.server.refused_total(),
+        x.server.refusals_text(),
+        x.server.protected,
+        x.ground.protected,
+        x.ground.verified,
+        x.ground.refused_total(),
+        x.ground.refusals_text(),
+    );
+    if x.attack_frames > 0 {
+        t.push_str(&format!(
+            "; attacker sent {} frames (replays, bit flips): {} refused by SDLS, {} by a frame \
+             check, {} passed to FARM-1",
+            x.attack_frames, x.attacks_refused_sdls, x.attacks_refused_frame, x.attacks_passed
+        ));
+    }
+    t
 }

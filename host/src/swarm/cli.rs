@@ -1,6 +1,6 @@
 //! `mmic swarm`: arguments and output around [`super::swarm`] and its replay.
 
-use super::scenario::{LinkDraw, Options, Scenario};
+use super::scenario::{LinkDraw, Options, Scenario, SdlsDraw};
 use super::{judge, replay_command, swarm};
 use crate::error::CliError;
 use crate::sim::engine::PlantedBug;
@@ -13,7 +13,8 @@ pub const HELP: &str = "\
 Run the fault swarm: seed after seed, a random scenario runs in virtual time with its
 invariants checked on every tick. A scenario is drawn from its seed alone: the protocol
 (legacy or PUS; with PUS, bare packets or the space data link's TC and TM frames under COP-1,
-half each, --link), a plan (the demo, or a random walk of reconfigurations, bolts and waits from
+half each, --link; half the frames runs secured with SDLS, most of those with an attacker on
+the uplink, --sdls), a plan (the demo, or a random walk of reconfigurations, bolts and waits from
 a random state), the links' loss, duplication (resent commands), reordering, latency, jitter
 and cuts, board B's clock phase, and up to three faults (battery sag, obstacles on arm,
 gripper or bolter, a jammed fastener, a stuck switch, an encoder offset, silent sensors, a cut
@@ -29,7 +30,8 @@ battery and assembly system at the motion's end), and no fault raises power; eve
 ground sent ends (accepted, refused, or reported unacknowledged); every injected fault the
 firmware must see whatever it is doing is latched in time (sagging battery, obstacles, cut A-B
 line, silent sensors; the System fault command and a misstated reconfiguration when board A
-takes them); no panic.
+takes them); with SDLS, no attack frame (a replayed or bit-flipped TC frame) reaches FARM-1 and
+the server board verifies no more TC frames than the ground protected; no panic.
 
 A failing seed prints the one command that replays it: `mmic swarm --replay SEED` runs the same
 scenario, prints it and its violations, and writes the whole log to --out.";
@@ -44,6 +46,7 @@ Examples:
   mmic swarm --seconds 60 --plant-bug double-exec   the swarm's own test: a planted double execution
   mmic swarm --seconds 60 --link frames      every PUS scenario over the space data link
   mmic swarm --seconds 60 --link packets     scenarios as they were before frames were drawn
+  mmic swarm --seconds 60 --link frames --sdls on   every PUS run over frames secured, most attacked
 
 Exit codes: 0 no invariant broken; 1 an invariant broke (the replay command is printed);
 2 bad arguments; 3 an output could not be written.";
@@ -73,6 +76,11 @@ pub struct SwarmArgs {
     /// frames (the space data link, COP-1). Part of a seed's scenario: a replay needs the same.
     #[arg(long, default_value = "any", value_parser = link_draw)]
     pub link: LinkDraw,
+    /// SDLS on frames scenarios: any (drawn: half of them, most with an attacker on the
+    /// uplink replaying and bit-flipping captured TC frames), off, or on. Part of a seed's
+    /// scenario: a replay needs the same.
+    #[arg(long, default_value = "any", value_parser = sdls_draw)]
+    pub sdls: SdlsDraw,
     /// Replay this one seed: print its scenario and violations, write its whole log.
     #[arg(long, value_name = "SEED")]
     pub replay: Option<u64>,
@@ -89,6 +97,10 @@ fn planted(s: &str) -> Result<PlantedBug, String> {
 }
 
 fn link_draw(s: &str) -> Result<LinkDraw, String> {
+    s.parse()
+}
+
+fn sdls_draw(s: &str) -> Result<SdlsDraw, String> {
     s.parse()
 }
 
@@ -110,6 +122,7 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
         horizon_ms: a.sim_seconds.saturating_mul(1000),
         planted_bug: a.plant_bug,
         link: a.link,
+        sdls: a.sdls,
     };
     if let Some(seed) = a.replay {
         return replay(seed, &opts, &a.out, out);

@@ -140,6 +140,8 @@ pub struct RunOutcome {
     pub scenario: String,
     /// Its link layer (packets; frames with PUS over the space data link).
     pub link: LinkLayer,
+    /// With SDLS on the frames: the attacker's rate (0: none).
+    pub sdls: Option<f64>,
     /// Simulated ms covered.
     pub sim_ms: u32,
     /// Every broken invariant.
@@ -169,6 +171,7 @@ pub fn judge(s: &Scenario) -> RunOutcome {
         seed: s.seed,
         scenario: s.describe(),
         link: s.link,
+        sdls: s.sdls,
         sim_ms: 0,
         violations: Vec::new(),
         checked: Checked::default(),
@@ -252,6 +255,9 @@ pub fn replay_command(seed: u64, opts: &Options) -> String {
     if opts.link != Options::default().link {
         c.push_str(&format!(" --link {}", opts.link.name()));
     }
+    if opts.sdls != Options::default().sdls {
+        c.push_str(&format!(" --sdls {}", opts.sdls.name()));
+    }
     c
 }
 
@@ -276,6 +282,10 @@ pub struct Report {
     pub frame_runs: u64,
     /// What the space data link did, those runs together.
     pub frames: FrameStats,
+    /// Frames runs secured with SDLS.
+    pub sdls_runs: u64,
+    /// Of those, runs with an attacker on the uplink.
+    pub attacked_runs: u64,
 }
 
 /// Adds `b`'s figures to `a`'s.
@@ -290,6 +300,10 @@ fn add_frames(a: &mut FrameStats, b: &FrameStats) {
     a.tm_frames += b.tm_frames;
     a.tm_lost += b.tm_lost;
     a.tm_packets_dropped += b.tm_packets_dropped;
+    a.sdls = match (a.sdls, b.sdls) {
+        (Some(x), Some(y)) => Some(x.merged(y)),
+        (x, y) => x.or(y),
+    };
 }
 
 impl Report {
@@ -341,6 +355,15 @@ impl Report {
             f.tm_lost,
             f.tm_packets_dropped,
         ));
+        if let Some(x) = &f.sdls {
+            t.push_str(&format!(
+                "{} of them with SDLS ({} with an attacker, {} attack frames judged): {}\n",
+                self.sdls_runs,
+                self.attacked_runs,
+                c.attack_frames,
+                crate::sim::report::sdls_text(x)
+            ));
+        }
         if self.failures.is_empty() {
             t.push_str("result: no invariant broken\n");
         }
@@ -370,11 +393,14 @@ impl Report {
             "sim_hours": self.sim_hours(),
             "completed": self.completed,
             "frame_runs": self.frame_runs,
+            "sdls_runs": self.sdls_runs,
+            "attacked_runs": self.attacked_runs,
             "frames": self.frames,
             "checked": {
                 "admissions": c.admissions, "motion_ticks": c.motion_ticks,
                 "standby_ticks": c.standby_ticks, "faults_raised": c.faults_raised,
                 "commands_ended": c.commands_ended, "injected_faults_raised": self.expected,
+                "attack_frames": c.attack_frames,
             },
             "failures": self.failures.iter().map(|f| serde_json::json!({
                 "seed": f.seed,
@@ -412,6 +438,10 @@ pub fn swarm(
         if o.link == LinkLayer::Frames {
             r.frame_runs += 1;
         }
+        if let Some(a) = o.sdls {
+            r.sdls_runs += 1;
+            r.attacked_runs += u64::from(a > 0.0);
+        }
         if let Some(f) = o.summary.as_ref().and_then(|s| s.frames.as_ref()) {
             add_frames(&mut r.frames, f);
         }
@@ -421,6 +451,7 @@ pub fn swarm(
         c.standby_ticks += o.checked.standby_ticks;
         c.faults_raised += o.checked.faults_raised;
         c.commands_ended += o.checked.commands_ended;
+        c.attack_frames += o.checked.attack_frames;
         if !o.violations.is_empty() {
             o.summary = None;
             progress(format!(

@@ -8,15 +8,19 @@
 //! link's frames ([`LinkLayer`], half each unless [`Options::link`] says), and for frames the
 //! ground link's loss, duplication and reordering again, heavier (COP-1 retransmits what is
 //! lost, FARM-1 discards copies and frames out of order, the extractor skips stale TM frames:
-//! these are the faults the frame link exists for). Adding a draw to the link stream leaves
-//! every main-stream draw of every seed alone; `--link packets` gives a seed's scenario as it
-//! was before frames were drawn.
+//! these are the faults the frame link exists for), and then for frames whether the link is
+//! secured with SDLS (half of them, unless [`Options::sdls`] says) and the rate of an attacker
+//! on its uplink (in 0.7 of the secured runs, up to 0.3: replays and bit-flipped copies of
+//! captured TC data frames). Adding a draw to the link stream leaves every main-stream draw of
+//! every seed alone; `--link packets` gives a seed's scenario as it was before frames were
+//! drawn, and the SDLS draws come after every earlier link-stream draw, so a frames run
+//! without SDLS is the scenario it was before SDLS was drawn.
 
 use crate::plan;
 use crate::sim::engine::link::LinkModel;
 use crate::sim::engine::{Links, PlantedBug};
 use crate::sim::inject::{Injection, Scheduled};
-use crate::sim::{LinkLayer, Protocol, SimConfig};
+use crate::sim::{LinkLayer, Protocol, SdlsConfig, SdlsKeys, SimConfig};
 use mmic::motion::State;
 
 /// What every scenario shares: the simulated span, a planted bug, if any, and the link layers
@@ -29,6 +33,8 @@ pub struct Options {
     pub planted_bug: PlantedBug,
     /// The link layer of PUS scenarios: drawn, or always one.
     pub link: LinkDraw,
+    /// SDLS on frames scenarios: drawn, or always or never.
+    pub sdls: SdlsDraw,
 }
 
 impl Default for Options {
@@ -37,6 +43,42 @@ impl Default for Options {
             horizon_ms: 200_000,
             planted_bug: PlantedBug::None,
             link: LinkDraw::Any,
+            sdls: SdlsDraw::Any,
+        }
+    }
+}
+
+/// Whether a frames scenario's link is secured with SDLS.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SdlsDraw {
+    /// Drawn from the seed's link stream: half of the frames runs.
+    #[default]
+    Any,
+    /// Never: frames runs as they were before SDLS was drawn.
+    Off,
+    /// Every frames run.
+    On,
+}
+
+impl SdlsDraw {
+    /// Its name on the command line.
+    pub const fn name(self) -> &'static str {
+        match self {
+            SdlsDraw::Any => "any",
+            SdlsDraw::Off => "off",
+            SdlsDraw::On => "on",
+        }
+    }
+}
+
+impl std::str::FromStr for SdlsDraw {
+    type Err = String;
+    fn from_str(s: &str) -> Result<SdlsDraw, String> {
+        match s {
+            "any" => Ok(SdlsDraw::Any),
+            "off" => Ok(SdlsDraw::Off),
+            "on" => Ok(SdlsDraw::On),
+            _ => Err(format!("{s:?} is no SDLS choice: any, off or on")),
         }
     }
 }
@@ -85,6 +127,8 @@ pub struct Scenario {
     pub protocol: Protocol,
     /// With [`Protocol::Pus`], packets or frames (legacy: packets, the serial line's own).
     pub link: LinkLayer,
+    /// With frames: SDLS on the link, and the attacker's rate (0: none).
+    pub sdls: Option<f64>,
     /// The plan's text (a plan file).
     pub plan: String,
     /// The run's simulator configuration (plan, links, losses, injections).
@@ -168,14 +212,19 @@ const LINK_STREAM: u64 = 0x4c49_4e4b_0000_0000;
 /// The link stream's draws for `seed` (module docs): the link layer of a PUS scenario and, for
 /// frames, the ground link's loss (in 0.6 of the runs, up to 0.3), duplication (0.5, up to 0.3)
 /// and reordering (0.5, up to 0.2, by 10..300 ms), which replace the main stream's. Every value
-/// is drawn whatever the outcome, so that the stream stays aligned for draws added after them.
-fn draw_link(seed: u64, protocol: Protocol, choice: LinkDraw, cfg: &mut SimConfig) -> LinkLayer {
+/// is drawn whatever the outcome, so that the stream stays aligned for draws added after them;
+/// then SDLS (half the frames runs) and the attacker's rate (0.7 of those, up to 0.3), with
+/// keys derived from the seed.
+fn draw_link(seed: u64, protocol: Protocol, opts: &Options, cfg: &mut SimConfig) -> LinkLayer {
+    let choice = opts.link;
     let mut rng = fastrand::Rng::with_seed(seed ^ LINK_STREAM);
     let frames = rng.bool();
     let loss = sometimes(&mut rng, 0.6, 0.3);
     let duplicate = sometimes(&mut rng, 0.5, 0.3);
     let reorder = sometimes(&mut rng, 0.5, 0.2);
     let reorder_us = rng.u64(10_000..300_000);
+    let secured = rng.bool();
+    let attack = sometimes(&mut rng, 0.7, 0.3);
     let link = match (protocol, choice) {
         (Protocol::Legacy, _) | (_, LinkDraw::Packets) => LinkLayer::Packets,
         (Protocol::Pus, LinkDraw::Frames) => LinkLayer::Frames,
@@ -189,6 +238,15 @@ fn draw_link(seed: u64, protocol: Protocol, choice: LinkDraw, cfg: &mut SimConfi
         g.duplicate = duplicate;
         g.reorder = reorder;
         g.reorder_us = reorder_us;
+        let secured = match opts.sdls {
+            SdlsDraw::Any => secured,
+            SdlsDraw::Off => false,
+            SdlsDraw::On => true,
+        };
+        cfg.sdls = secured.then_some(SdlsConfig {
+            keys: SdlsKeys::Seeded,
+            attack,
+        });
     }
     link
 }
@@ -285,17 +343,19 @@ impl Scenario {
                 });
             }
         }
-        let link = draw_link(seed, protocol, opts.link, &mut cfg);
+        let link = draw_link(seed, protocol, opts, &mut cfg);
         Scenario {
             seed,
             protocol,
             link,
+            sdls: cfg.sdls.as_ref().map(|s| s.attack),
             plan: plan_text,
             cfg,
         }
     }
 
-    /// One line: protocol (and with PUS its link layer), plan, links, faults.
+    /// One line: protocol (and with PUS its link layer), plan, links, faults; SDLS and the
+    /// attacker's rate last, when drawn.
     pub fn describe(&self) -> String {
         let c = &self.cfg;
         let steps: Vec<&str> = c
@@ -335,6 +395,9 @@ impl Scenario {
             c.links.ab.cuts,
             c.b_phase_us as f64 / 1000.0,
             inj.join(", ")
-        )
+        ) + &match self.sdls {
+            Some(a) => format!("; SDLS, attacker rate {a:.2}"),
+            None => String::new(),
+        }
     }
 }

@@ -53,7 +53,7 @@ use mmic::node::robot::board_a::{self, BoardA};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::server::frames::FrameConfig;
+use mmic::node::server::frames::{FrameConfig, Stored};
 use mmic::node::server::gateway::{Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -243,6 +243,57 @@ struct Robot {
     /// The ground's end of the space data link (`--link frames`).
     ground_link: Option<Box<SimGroundLink>>,
     links: [Link; 6],
+    /// With SDLS: the durable store of both ends' counters, (end, SPI) → value. It is the
+    /// run's (memory): a server board or ground that started again would boot from it.
+    store: std::collections::BTreeMap<(&'static str, u16), u128>,
+    /// With SDLS and an attacker: the attacker on the uplink.
+    attacker: Option<Attacker>,
+}
+
+/// The attacker on a robot's uplink ([`super::SdlsConfig::attack`]): it captures the TC data
+/// frames the uplink delivers and, at its rate, sends one of them again or a copy with one bit
+/// flipped (its FECF made good again). Its draws are its own stream, seeded from the robot's.
+struct Attacker {
+    rate: f64,
+    rng: fastrand::Rng,
+    /// The last [`Attacker::KEPT`] data frames the uplink delivered.
+    captured: VecDeque<Vec<u8>>,
+    /// Attack frames waiting for the server board's loop.
+    waiting: VecDeque<Vec<u8>>,
+    sent: u64,
+    refused_sdls: u64,
+    refused_frame: u64,
+    passed: u64,
+}
+
+impl Attacker {
+    const KEPT: usize = 64;
+
+    /// The uplink delivered `frame`: captured if a data frame (BC frames go in clear by
+    /// decision `sdls-clear-bc`), and maybe an attack frame made.
+    fn delivered(&mut self, frame: &[u8]) {
+        let data_frame = frame.first().is_some_and(|b| b & 0x10 == 0);
+        if data_frame && frame.len() > 2 {
+            if self.captured.len() == Self::KEPT {
+                self.captured.pop_front();
+            }
+            self.captured.push_back(frame.to_vec());
+        }
+        if self.captured.is_empty() || self.rng.f64() >= self.rate {
+            return;
+        }
+        let pick = self.rng.usize(..self.captured.len());
+        let mut f = self.captured[pick].clone();
+        if self.rng.bool() {
+            let n = f.len();
+            let bit = self.rng.usize(..(n - 2) * 8);
+            f[bit / 8] ^= 0x80 >> (bit % 8);
+            let crc = mmic::ccsds::pec(&f[..n - 2]);
+            f[n - 2..].copy_from_slice(&crc.to_be_bytes());
+        }
+        self.sent += 1;
+        self.waiting.push_back(f);
+    }
 }
 
 /// The engine's state for one run.
@@ -276,6 +327,11 @@ pub fn run_watched(cfg: &SimConfig, watched: bool) -> std::io::Result<(Summary, 
             "an external ground runs on the wall clock: use the realtime engine",
         ));
     }
+    if cfg.sdls.is_some() && cfg.record.is_some() {
+        return Err(std::io::Error::other(
+            "a replay trace has no keys: --record runs without --sdls",
+        ));
+    }
     let n = cfg.robots.max(1) as usize;
     match cfg.protocol {
         Protocol::Legacy => {
@@ -306,7 +362,9 @@ fn board_number(i: usize) -> BoardNumber {
 impl<'c, G: Ground> Engine<'c, G> {
     fn new(cfg: &'c SimConfig, runners: Vec<G>, watched: bool) -> Engine<'c, G> {
         let n = runners.len();
-        let log = (cfg.log_events || cfg.log_packets || cfg.log_path.is_some()).then(Log::memory);
+        let secured = cfg.sdls.is_some() && cfg.link == LinkLayer::Frames;
+        let log = (cfg.log_events || cfg.log_packets || cfg.log_path.is_some())
+            .then(|| Log::memory().secured(secured));
         let ground = GroundSide::new(
             &cfg.steps,
             cfg.start_state,
@@ -389,6 +447,21 @@ impl<'c, G: Ground> Engine<'c, G> {
         if let Some(w) = &mut self.watch {
             for i in 0..self.robots.len() {
                 w.finish(i, now, &self.ground.open_commands(i));
+            }
+            // SDLS: the server board verified no more TC frames than the ground protected.
+            for (i, r) in self.robots.iter().enumerate() {
+                let server = match &r.board {
+                    Board::Frames(g) => g.security(r.number).map(|c| c.accepted),
+                    _ => None,
+                };
+                let ground = r
+                    .ground_link
+                    .as_ref()
+                    .and_then(|gl| gl.security())
+                    .map(|c| c.protected);
+                if let (Some(s), Some(g)) = (server, ground) {
+                    w.sdls_checked(i, now, s, g);
+                }
             }
         }
         if let Some(r) = self.robots.first() {
@@ -524,6 +597,7 @@ impl<'c, G: Ground> Engine<'c, G> {
             }
         }
         let now = self.now_ms();
+        self.robots[i].persist();
         if let Some(gl) = self.robots[i].ground_link.as_mut() {
             let mut frames = Vec::new();
             if gl
@@ -545,6 +619,7 @@ impl<'c, G: Ground> Engine<'c, G> {
     fn tm_frame_at_ground(&mut self, i: usize, bytes: &[u8]) -> Vec<Vec<u8>> {
         let now = self.now_ms();
         let (mut frames, mut packets) = (Vec::new(), Vec::new());
+        self.robots[i].persist();
         if let Some(gl) = self.robots[i].ground_link.as_mut() {
             let refused = gl.tm_frame(
                 now,
@@ -567,6 +642,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         let now = self.now_ms();
         for i in 0..self.robots.len() {
             let mut frames = Vec::new();
+            self.robots[i].persist();
             if let Some(gl) = self.robots[i].ground_link.as_mut() {
                 gl.tick(now, &mut |f: &[u8]| frames.push(f.to_vec()));
             }
@@ -587,7 +663,13 @@ impl<'c, G: Ground> Engine<'c, G> {
                             r.inbox.push_back(f.as_bytes().to_vec());
                         }
                     }
-                    Board::Gateway(_) | Board::Frames(_) => r.inbox.push_back(bytes),
+                    Board::Gateway(_) => r.inbox.push_back(bytes),
+                    Board::Frames(_) => {
+                        if let Some(a) = &mut r.attacker {
+                            a.delivered(&bytes);
+                        }
+                        r.inbox.push_back(bytes);
+                    }
                 }
                 self.server_loop(i);
             }
@@ -957,26 +1039,53 @@ impl<'c, G: Ground> Engine<'c, G> {
     fn frames_loop(&mut self, i: usize, inbox: Vec<Vec<u8>>) {
         let now = self.now_ms();
         let number = self.robots[i].number;
-        for f in inbox {
+        self.robots[i].persist();
+        let attacks: Vec<Vec<u8>> = self.robots[i]
+            .attacker
+            .as_mut()
+            .map(|a| a.waiting.drain(..).collect())
+            .unwrap_or_default();
+        let secured = self.cfg.sdls.is_some();
+        let frames = inbox
+            .into_iter()
+            .map(|f| (f, false))
+            .chain(attacks.into_iter().map(|f| (f, true)));
+        for (f, attack) in frames {
             let Board::Frames(g) = &mut self.robots[i].board else {
                 return;
             };
             let got = g.tc_frame(now, &f);
+            // The security header as sent (never the key; the data stays ciphertext).
+            let sec = if secured {
+                log::sdls_header(&f)
+            } else {
+                Value::Null
+            };
+            if attack {
+                self.attack_outcome(i, now, &f, &got.verdict);
+            }
             match got.verdict {
-                Err(e) => self.node_event(
-                    i,
-                    2,
-                    json!({"type": "tc_frame_refused", "check": e.name(), "hex": log::hex(&f)}),
-                ),
-                Ok(v) if self.packet_log => self.node_event(
-                    i,
-                    2,
-                    json!({"type": "tc_frame", "farm": format!("{v:?}"),
-                           "packets": got.accepted, "refused": got.refused}),
-                ),
+                Err(e) => {
+                    let mut ev = json!({"type": "tc_frame_refused", "check": e.name(),
+                                        "layer": e.layer(), "hex": log::hex(&f)});
+                    if secured {
+                        ev["sdls"] = sec;
+                        ev["attack"] = json!(attack);
+                    }
+                    self.node_event(i, 2, ev);
+                }
+                Ok(v) if self.packet_log => {
+                    let mut ev = json!({"type": "tc_frame", "farm": format!("{v:?}"),
+                                        "packets": got.accepted, "refused": got.refused});
+                    if secured {
+                        ev["sdls"] = sec;
+                    }
+                    self.node_event(i, 2, ev);
+                }
                 Ok(_) => {}
             }
         }
+        self.robots[i].persist();
         let Board::Frames(g) = &mut self.robots[i].board else {
             return;
         };
@@ -1000,9 +1109,41 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
     }
 
+    /// What became of an attack frame: counted, and none may reach FARM-1 (the watch's
+    /// `forged-frame`).
+    fn attack_outcome(
+        &mut self,
+        i: usize,
+        now: u32,
+        f: &[u8],
+        verdict: &Result<mmic::link::farm::Verdict, mmic::node::server::frames::FrameRefusal>,
+    ) {
+        let Some(a) = self.robots[i].attacker.as_mut() else {
+            return;
+        };
+        if let Some(w) = &mut self.watch {
+            w.attack_judged();
+        }
+        match verdict {
+            Err(e) if e.layer() == "sdls" => a.refused_sdls += 1,
+            Err(_) => a.refused_frame += 1,
+            Ok(v) => {
+                a.passed += 1;
+                let detail = format!(
+                    "an attack frame reached FARM-1 ({v:?}): {}",
+                    log::hex(f.get(..24).unwrap_or(f))
+                );
+                if let Some(w) = &mut self.watch {
+                    w.forged(i, now, detail);
+                }
+            }
+        }
+    }
+
     /// The TM frames due at robot `i`'s server board, sent to the ground.
     fn tm_frames(&mut self, i: usize) {
         let now = self.now_ms();
+        self.robots[i].persist();
         let mut out = Vec::new();
         if let Board::Frames(g) = &mut self.robots[i].board {
             let mut buf = [0u8; mmic::link::tm_frame::TM_FRAME_LEN];
@@ -1027,6 +1168,12 @@ impl<'c, G: Ground> Engine<'c, G> {
             }
             if let Board::Frames(g) = &r.board {
                 s.add_server(g, r.number);
+            }
+            if let (Some(a), Some(sdls)) = (&r.attacker, s.sdls.as_mut()) {
+                sdls.attack_frames += a.sent;
+                sdls.attacks_refused_sdls += a.refused_sdls;
+                sdls.attacks_refused_frame += a.refused_frame;
+                sdls.attacks_passed += a.passed;
             }
         }
         Some(s)
@@ -1122,8 +1269,20 @@ impl Robot {
             )
         };
         let ground_stream = cfg.protocol == Protocol::Legacy;
+        // With SDLS the uplink keeps order under jitter, as a space link does: the receiver's
+        // anti-replay window takes only IVs above the last accepted one, so a datagram link
+        // that lets frames sent together overtake each other would refuse the earlier ones as
+        // replays, and FOP-1's go-back-N, sending its window again under fresh IVs each time,
+        // could find it shuffled every round (seen: 590 TC frames for 14 accepted). The
+        // reordering fault model (a frame held back) still applies.
+        let secured = cfg.sdls.is_some() && cfg.link == LinkLayer::Frames;
         let links = [
-            link(&cfg.links.ground, cfg.serial_loss, 4, ground_stream),
+            link(
+                &cfg.links.ground,
+                cfg.serial_loss,
+                4,
+                ground_stream || secured,
+            ),
             link(&cfg.links.ground, cfg.serial_loss, 3, ground_stream),
             link(&cfg.links.wifi, cfg.wifi_loss, 5, true),
             link(&cfg.links.wifi, cfg.wifi_loss, 6, true),
@@ -1146,8 +1305,29 @@ impl Robot {
                 Board::Gateway(g)
             }
         };
-        let ground_link = (cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames)
-            .then(|| Box::new(SimGroundLink::new(number)));
+        let frames = cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames;
+        let mut ground_link = frames.then(|| Box::new(SimGroundLink::new(number)));
+        let mut board = board;
+        let sdls = cfg.sdls.as_ref().filter(|_| frames);
+        let mut attacker = None;
+        if let (Some(sdls), Board::Frames(g), Some(gl)) = (sdls, &mut board, &mut ground_link) {
+            // Keys the configuration cannot give (an unreadable random source) leave the link
+            // in clear: the run's SDLS figures then stay absent.
+            if let Ok((tc, tm)) = sdls.keys(cfg.seed, i) {
+                g.secure(number, tc.clone(), tm.clone(), Stored::default());
+                gl.secure(tc, tm, (None, None));
+            }
+            attacker = (sdls.attack > 0.0).then(|| Attacker {
+                rate: sdls.attack,
+                rng: fastrand::Rng::with_seed(seed ^ 0xa77a_c4e5_0000),
+                captured: VecDeque::new(),
+                waiting: VecDeque::new(),
+                sent: 0,
+                refused_sdls: 0,
+                refused_frame: 0,
+                passed: 0,
+            });
+        }
         Robot {
             number,
             names: [
@@ -1181,7 +1361,32 @@ impl Robot {
             ground_reader: Deframer::new(),
             ground_link,
             links,
+            store: std::collections::BTreeMap::new(),
+            attacker,
         }
+        .persisted()
+    }
+
+    /// Writes both ends' due SDLS counters to the store and confirms them (the store is
+    /// memory: written at once).
+    fn persist(&mut self) {
+        if let Board::Frames(g) = &mut self.board {
+            for (spi, v) in g.due().collect::<Vec<_>>() {
+                self.store.insert(("server", spi), v);
+                g.persisted(spi, v);
+            }
+        }
+        if let Some(gl) = &mut self.ground_link {
+            for (spi, v) in gl.due().collect::<Vec<_>>() {
+                self.store.insert(("ground", spi), v);
+                gl.persisted(spi, v);
+            }
+        }
+    }
+
+    fn persisted(mut self) -> Robot {
+        self.persist();
+        self
     }
 
     /// A hop's link name and its two ends' names in the log (as the realtime engine names them).

@@ -63,19 +63,23 @@ pub enum Invariant {
     CommandLost,
     /// An injected fault the firmware must see was not raised in time.
     InjectedFaultMissed,
+    /// With SDLS: a TC frame that did not verify reached FARM-1 (an attack frame passed), or
+    /// the server board verified more TC frames than the ground protected.
+    ForgedFrame,
     /// The run panicked.
     Panic,
 }
 
 impl Invariant {
     /// Every invariant, in the order reports list them.
-    pub const ALL: [Invariant; 7] = [
+    pub const ALL: [Invariant; 8] = [
         Invariant::ExecutedTwice,
         Invariant::GripperOpenInMotion,
         Invariant::MovedInStandby,
         Invariant::FaultMode,
         Invariant::CommandLost,
         Invariant::InjectedFaultMissed,
+        Invariant::ForgedFrame,
         Invariant::Panic,
     ];
 
@@ -88,6 +92,7 @@ impl Invariant {
             Invariant::FaultMode => "fault-mode",
             Invariant::CommandLost => "command-lost",
             Invariant::InjectedFaultMissed => "injected-fault-missed",
+            Invariant::ForgedFrame => "forged-frame",
             Invariant::Panic => "panic",
         }
     }
@@ -119,6 +124,8 @@ pub struct Checked {
     pub faults_raised: u64,
     /// Commands the ground sent and saw end.
     pub commands_ended: u64,
+    /// With SDLS and an attacker: attack frames judged (each refused, or a violation).
+    pub attack_frames: u64,
 }
 
 /// What board A drives (its outputs that power something).
@@ -302,6 +309,29 @@ impl Watch {
                 invariant,
                 detail,
             });
+        }
+    }
+
+    /// With SDLS: an attack frame on robot `i`'s uplink reached FARM-1.
+    pub fn forged(&mut self, i: usize, now: u32, detail: String) {
+        self.violation(now, i, Invariant::ForgedFrame, detail);
+    }
+
+    /// With SDLS: an attack frame on robot `i`'s uplink was judged (refused, or [`Watch::forged`]).
+    pub fn attack_judged(&mut self) {
+        self.checked.attack_frames += 1;
+    }
+
+    /// With SDLS, at the end of a run: robot `i`'s server board verified `verified` TC frames,
+    /// its ground protected `protected`; every verified frame must be one the ground sent.
+    pub fn sdls_checked(&mut self, i: usize, now: u32, verified: u32, protected: u32) {
+        if verified > protected {
+            self.violation(
+                now,
+                i,
+                Invariant::ForgedFrame,
+                format!("SDLS verified {verified} TC frames, the ground protected {protected}"),
+            );
         }
     }
 
