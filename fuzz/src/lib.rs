@@ -37,7 +37,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 15] = [
+pub const TARGETS: [&str; 17] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -53,6 +53,8 @@ pub const TARGETS: [&str; 15] = [
     "tc_frame_parser",
     "link_clcw",
     "link_cop",
+    "sdls_tc_verify",
+    "sdls_tm_verify",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -528,6 +530,7 @@ pub fn seeds() -> Vec<SeedFile> {
         });
     }
     out.extend(tm_seeds());
+    out.extend(sdls_seeds());
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.
     let packet = |k: PacketKind| {
         valid
@@ -705,4 +708,166 @@ pub fn tm_seeds() -> Vec<SeedFile> {
         bytes: two,
     });
     out
+}
+
+/// Seeds of the SDLS targets, under the fixed test keys of `mmic_proofs::sdls::test_key`
+/// (made at run time, not secrets), with the verdict a fresh secured end gives each (`None`:
+/// accepted): for `sdls_tc_verify`, AD and BD frames with a ping protected under IVs 0 and 3
+/// (the fresh gateway's floor takes 0..=15), the AD frame under IV 2^95 (a replay), under 40
+/// (authentic, beyond the durable floor), under 5000 (beyond the window of 4096), with its
+/// MAC's last bit flipped (FECF rewritten), under the TM key, in clear, and BC Unlock (in
+/// clear by design); for `sdls_tm_verify`, an idle TM frame and one with a packet under IVs 0
+/// and 1, one with a bit of its data flipped (FECF rewritten), under the TC key, and one in
+/// clear.
+pub fn sdls_seed_frames() -> Vec<(&'static str, String, Option<&'static str>, Vec<u8>)> {
+    use mmic::link::tc_frame::{MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
+    use mmic::link::ControlCommand;
+    use mmic_proofs::sdls::{ping, protected_tc, protected_tm, refresh_fecf};
+    let (tc, tm) = (TARGETS[15], TARGETS[16]);
+    let mut out = Vec::new();
+    let frame = |iv: u128, bd: bool| {
+        let mut b = [0u8; 256];
+        let n = protected_tc(iv, bd, 0, &ping(1), &mut b);
+        b[..n].to_vec()
+    };
+    out.push((tc, "ad-ping-iv-0".to_string(), None, frame(0, false)));
+    out.push((tc, "bd-ping-iv-3".into(), None, frame(3, true)));
+    out.push((
+        tc,
+        "ad-ping-iv-2-95".into(),
+        Some("replay"),
+        frame(1 << 95, false),
+    ));
+    out.push((
+        tc,
+        "ad-ping-iv-40".into(),
+        Some("not-reserved"),
+        frame(40, false),
+    ));
+    out.push((
+        tc,
+        "ad-ping-iv-5000".into(),
+        Some("too-far-ahead"),
+        frame(5000, false),
+    ));
+    let mut bad = frame(0, false);
+    let n = bad.len();
+    bad[n - 3] ^= 1;
+    refresh_fecf(&mut bad);
+    out.push((tc, "ad-ping-bad-mac".into(), Some("bad-mac"), bad));
+    // Protected under the TM key (the TC SPI written back: the MAC is the other key's).
+    let mut other = [0u8; 256];
+    let p = ping(1);
+    let repr = |content| TcFrameRepr {
+        spacecraft_id: SpacecraftId::new(0x101).expect("10 bits"),
+        vcid: Vcid::new(0).expect("VC 0"),
+        seq: 0,
+        content,
+    };
+    let ad = repr(TcContent::Ad {
+        map_id: MapId::new(0).ok(),
+        data: &p,
+    });
+    let mut t: mmic::link::sdls::SaTable<1> = mmic::link::sdls::SaTable::new();
+    let _ = t.add(mmic::link::sdls::SecurityAssociation::new(
+        mmic_proofs::sdls::TC_SPI,
+        mmic_proofs::sdls::test_key(1),
+        mmic_proofs::sdls::tc_channel(),
+        mmic::link::sdls::mask::TC,
+        mmic::link::sdls::Role::Send(mmic::link::sdls::TxCounter::boot(None, 16)),
+    ));
+    let due: Vec<_> = t.due().collect();
+    for (spi, v) in due {
+        t.persisted(spi, v);
+    }
+    let n =
+        mmic::link::sdls::frames::protect_tc(&mut t, mmic_proofs::sdls::TC_SPI, &ad, &mut other)
+            .expect("protected");
+    out.push((
+        tc,
+        "ad-ping-other-key".into(),
+        Some("bad-mac"),
+        other[..n].to_vec(),
+    ));
+    let mut clear = [0u8; 64];
+    let n = ad.emit(&mut clear).expect("fits");
+    out.push((
+        tc,
+        "ad-ping-clear".into(),
+        Some("unknown-spi"),
+        clear[..n].to_vec(),
+    ));
+    let n = repr(TcContent::Bc(ControlCommand::Unlock))
+        .emit(&mut clear)
+        .expect("fits");
+    out.push((tc, "bc-unlock".into(), None, clear[..n].to_vec()));
+
+    let clcw = [0x01, 0x00, 0x00, 0x00];
+    out.push((
+        tm,
+        "idle-iv-0".into(),
+        None,
+        protected_tm(0, &[], clcw).to_vec(),
+    ));
+    let mut report = [0u8; 18];
+    report[..6].copy_from_slice(&[0x09, 0x01, 0xc0, 0x00, 0x00, 0x0b]);
+    out.push((
+        tm,
+        "packet-iv-1".into(),
+        None,
+        protected_tm(1, &report, clcw).to_vec(),
+    ));
+    let mut bad = protected_tm(1, &report, clcw);
+    bad[30] ^= 0x10;
+    mmic_proofs::link_tm::reseal(&mut bad);
+    out.push((tm, "packet-bad-mac".into(), Some("bad-mac"), bad.to_vec()));
+    // The same frame under the TC key: emitted, then protected by a TM association with it.
+    let mut t: mmic::link::sdls::SaTable<1> = mmic::link::sdls::SaTable::new();
+    let _ = t.add(mmic::link::sdls::mission::tm_sender(
+        mmic::units::BoardNumber::ONE,
+        mmic_proofs::sdls::test_key(0),
+        Some(0),
+    ));
+    let due: Vec<_> = t.due().collect();
+    for (spi, v) in due {
+        t.persisted(spi, v);
+    }
+    let mut other = protected_tm(0, &report, clcw);
+    let params = mmic_proofs::sdls::tm_params();
+    mmic::link::sdls::frames::protect_tm(&mut t, mmic_proofs::sdls::TM_SPI, &params, &mut other)
+        .expect("protected");
+    out.push((
+        tm,
+        "packet-other-key".into(),
+        Some("bad-mac"),
+        other.to_vec(),
+    ));
+    // In clear: the mission's TM frame without SDLS (its first octets are no SPI of ours).
+    let plain = mmic::link::tm_frame::TmFrameParams::mission(0x101).expect("params");
+    let data = [0x55u8; 244];
+    let f = mmic::link::tm_frame::TmFrameRepr {
+        spacecraft_id: 0x101,
+        vcid: 0,
+        mc_frame_count: 0,
+        vc_frame_count: 0,
+        first_header_pointer: mmic::link::tm_frame::FirstHeaderPointer::OnlyIdleData,
+        data: &data,
+        ocf: Some(clcw),
+    };
+    let mut b = [0u8; 256];
+    f.emit(&plain, &mut b).expect("emits");
+    out.push((tm, "idle-clear".into(), Some("unknown-spi"), b.to_vec()));
+    out
+}
+
+/// [`sdls_seed_frames`] as seed files.
+pub fn sdls_seeds() -> Vec<SeedFile> {
+    sdls_seed_frames()
+        .into_iter()
+        .map(|(target, name, _, bytes)| SeedFile {
+            target,
+            name,
+            bytes,
+        })
+        .collect()
 }

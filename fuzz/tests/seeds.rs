@@ -118,3 +118,30 @@ fn tc_frame_seeds_are_what_their_names_say() {
         assert!(seeds.iter().any(|(_, e, _)| *e == Some(check)), "{check}");
     }
 }
+
+#[test]
+fn sdls_seeds_are_what_their_names_say() {
+    use mmic_proofs::sdls::{check_secured_tc_frame, check_secured_tm_frame};
+    let seeds = mmic_fuzz::sdls_seed_frames();
+    assert_eq!(seeds.len(), 14);
+    for (target, name, expected, bytes) in &seeds {
+        let got = if *target == "sdls_tc_verify" {
+            let mut g = mmic_proofs::sdls::secured_gateway();
+            let r = g.tc_frame(0, bytes);
+            // The property holds, and a genuine frame's packet runs.
+            let ran = check_secured_tc_frame(bytes);
+            assert_eq!(
+                ran,
+                expected.is_none() && !name.starts_with("bc-"),
+                "{name}"
+            );
+            r.verdict.err().map(|e| e.name())
+        } else {
+            let mut g = mmic_proofs::sdls::secured_ground();
+            let r = g.tm_frame(0, bytes, &mut |_: &[u8]| {}, &mut |_: &[u8]| {});
+            assert_eq!(check_secured_tm_frame(bytes), expected.is_none(), "{name}");
+            r.err().map(|e| e.name())
+        };
+        assert_eq!(got, *expected, "{target}/{name}");
+    }
+}

@@ -31,6 +31,11 @@
 //!   with the smallest (66) and a larger (256) buffer, and once more after `build_stream` has
 //!   turned it into packets with sound framing, garbage and near misses; `run_deframer` checks
 //!   byte conservation, frame contents and offsets, and that nothing is left after `resync`.
+//! * `sdls_tc_verify`, `sdls_tm_verify`: Space Data Link Security (`mmic_proofs::sdls`): any
+//!   octets through a secured gateway's `tc_frame` and through the receiving `SaTable`
+//!   directly, and through a secured ground link's `tm_frame`, as they are and with the frame
+//!   checks' fields and FECF written over them: refused and counted, nothing changed, no
+//!   packet handed on, unless exactly a frame the (fixed, test) key's holder protected.
 //! * `link_clcw`, `link_cop`: COP-1 of the space data link (`mmic_proofs::link_cop`): the
 //!   CLCW's verdict and round trip; FARM-1 taking AD frames once and in order, FOP-1 keeping
 //!   its window and confirming in order, over any sequence of events.
@@ -237,5 +242,30 @@ fn link_cop() {
                 .collect();
             mmic_proofs::link_cop::check_fop_inputs(*param, &inputs);
         }
+    });
+}
+
+/// SDLS on the uplink: the octets (cut to 264) through a fresh secured `FrameGateway`'s
+/// `tc_frame` and through its receiving `SaTable` directly (`check_secured_tc_frame`), as they
+/// are and with spacecraft, VC, length field and FECF written over them (past the frame
+/// checks, into SDLS's). The keys are fixed test keys made at run time
+/// (`mmic_proofs::sdls::test_key`), not secrets.
+#[test]
+fn sdls_tc_verify() {
+    bolero::check!().for_each(|input: &[u8]| {
+        mmic_proofs::sdls::check_secured_tc_frame(input);
+        mmic_proofs::sdls::check_secured_tc_frame_resealed(input);
+    });
+}
+
+/// SDLS on the downlink: the octets (cut to 300) through a fresh secured `GroundLink`'s
+/// `tm_frame` (`check_secured_tm_frame`), then their first 256 with spacecraft 0x101 and the
+/// FECF written over them.
+#[test]
+fn sdls_tm_verify() {
+    bolero::check!().for_each(|input: &[u8]| {
+        let input = &input[..input.len().min(300)];
+        mmic_proofs::sdls::check_secured_tm_frame(input);
+        mmic_proofs::sdls::check_secured_tm_frame_resealed(input);
     });
 }

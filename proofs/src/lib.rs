@@ -35,6 +35,7 @@ pub mod link;
 pub mod link_cop;
 pub mod link_tm;
 pub mod pus;
+pub mod sdls;
 
 use core::fmt::Debug;
 use mmic::arbitrary::for_each_variant_class;

@@ -17,6 +17,7 @@ mod node;
 mod packets;
 mod pus;
 mod safety_timers;
+mod sdls;
 mod sensors_frontend;
 mod sensors_moving_average;
 mod transport;
