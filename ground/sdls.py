@@ -50,7 +50,7 @@ TM_DATA_LEN = TM_FRAME_LEN - TM_PRIMARY - OVERHEAD - TM_TRAILER  # 214
 TC_AUTH_MASK = bytes.fromhex("ffffffffff" "ff" "ffff") + bytes(IV_LEN)
 TM_AUTH_MASK = bytes.fromhex("ffffffffffff" "ffff") + bytes(IV_LEN)
 
-TC_WINDOW = 4096     # the gateway's TC receiver window (the plan)
+TC_WINDOW = 1 << 20  # the gateway's TC receiver window (spec/ccsds/sdls.toml tc_window)
 TM_WINDOW = 100000   # YAMCS's TM receiver (`seqNumWindow`)
 
 

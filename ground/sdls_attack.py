@@ -10,13 +10,13 @@ What an attacker can do without the key:
   MAC; each with the FECF recomputed (the frame reaches SDLS) and with the FECF left as is (the frame
   checks refuse it first); and of the FECF itself;
 - send frames under a key of its own (`wrong-key`: the files of another key directory);
-- move the counter: an IV far ahead (last + 2^20) keeping the old MAC (`far-ahead-no-key`);
+- move the counter: an IV far ahead (last + 2^24, beyond the window of 2^20) keeping the old MAC (`far-ahead-no-key`);
 - change the SPI to one the robot has no SA for (`unknown-spi`);
 - readdress the frame to another robot (SCID 258: `other-robot-scid`) or make one under another robot's
   SA (`other-robot-spi`: SPI 258 under the other key, to robot 1's SCID);
 - replay frames captured earlier (`earlier-N`: older IVs).
 With the key (a leak, modelled by `key_dir`): a valid frame re-made with an IV below the last accepted
-one (`old-counter`) and one at last + 2^20 with a valid MAC (`far-ahead-with-key`): the window refuses both.
+one (`old-counter`) and one at last + 2^24 with a valid MAC (`far-ahead-with-key`): the window refuses both.
 
     python ground/sdls_attack.py --frame HEX --wrong-keys DIR [--keys DIR] [--earlier HEX ...]
 
@@ -36,7 +36,7 @@ import sdls  # noqa: E402
 from rust_side import crc16_ccitt_false  # noqa: E402
 
 OTHER_SCID = 0x102
-FAR = 1 << 20
+FAR = 1 << 24         # beyond the gateway's window (2^20)
 
 
 @dataclass(frozen=True)

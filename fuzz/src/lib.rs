@@ -714,7 +714,7 @@ pub fn tm_seeds() -> Vec<SeedFile> {
 /// (made at run time, not secrets), with the verdict a fresh secured end gives each (`None`:
 /// accepted): for `sdls_tc_verify`, AD and BD frames with a ping protected under IVs 0 and 3
 /// (the fresh gateway's floor takes 0..=15), the AD frame under IV 2^95 (a replay), under 40
-/// (authentic, beyond the durable floor), under 5000 (beyond the window of 4096), with its
+/// (authentic, beyond the durable floor), under 2^21 (beyond the window of 2^20), with its
 /// MAC's last bit flipped (FECF rewritten), under the TM key, in clear, and BC Unlock (in
 /// clear by design); for `sdls_tm_verify`, an idle TM frame and one with a packet under IVs 0
 /// and 1, one with a bit of its data flipped (FECF rewritten), under the TC key, and one in
@@ -746,9 +746,9 @@ pub fn sdls_seed_frames() -> Vec<(&'static str, String, Option<&'static str>, Ve
     ));
     out.push((
         tc,
-        "ad-ping-iv-5000".into(),
+        "ad-ping-iv-2-21".into(),
         Some("too-far-ahead"),
-        frame(5000, false),
+        frame(1 << 21, false),
     ));
     let mut bad = frame(0, false);
     let n = bad.len();

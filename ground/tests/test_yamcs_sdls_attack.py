@@ -32,7 +32,7 @@ STEP = 10.0
 SIM = ("{{mmic}} sim --protocol pus --link frames --ground-tm-to 127.0.0.1:{{tm_port}} "
        "--ground-tc-port {{tc_port}} --max-seconds {{seconds}} --quiet --out {out} --sdls-keys {keys}")
 SCID = 257
-TC_WINDOW = 4096
+TC_WINDOW = 1 << 20   # spec/ccsds/sdls.toml tc_window
 
 
 def wait(pred, seconds=STEP, step=0.1):
@@ -165,7 +165,7 @@ def test_every_attack_frame_is_refused_and_cop1_still_works(loop):
                         "other-robot-scid", "old-counter", "far-ahead-with-key") or a.name.startswith("earlier-"):
             expect = rust_names[a.expect]
             if a.name == "wrong-key-same-iv" or a.name == "far-ahead-no-key":
-                # The window runs before the MAC: an IV already used is a replay, one 2^20 ahead too far.
+                # The window runs before the MAC: an IV already used is a replay, one 2^24 ahead too far.
                 expect = "replay" if a.name == "wrong-key-same-iv" else "too-far-ahead"
             frames.append((a.name, a.frame, expect))
     # The MAC, on a frame the robot has not seen: made with the key at the next IV, every bit flipped.

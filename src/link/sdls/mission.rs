@@ -27,8 +27,12 @@ pub const fn tm_spi(board: BoardNumber) -> u16 {
     0x200 + board.get() as u16
 }
 
-/// The server board's anti-replay window for telecommands, W.
-pub const TC_WINDOW: u32 = 4096;
+/// The server board's anti-replay window for telecommands, W = 2^20: an authentic frame up to
+/// this far ahead of the last accepted one is followed. Every COP-1 transmission takes a fresh
+/// IV, so a long outage moves the ground's counter ahead; beyond W the receiver refuses every
+/// frame for good (only a new key or its stored floor rewritten recovers): at the ground's
+/// worst, about 110 transmissions per 30 s FOP-1 cycle, 2^20 is some 80 hours of outage.
+pub const TC_WINDOW: u32 = 1 << 20;
 /// The server board's TC floor is reserved 16 counters at a time (a flash write per 16
 /// frames; a restart refuses at most 24 of the ground's next frames, which COP-1 sends again).
 pub const TC_RX_BLOCK: u32 = 16;
