@@ -196,16 +196,25 @@ fn sdls() -> Result<(), &'static str> {
         }
     };
     let mut ground: SaTable<1> = SaTable::new();
-    ground.add(mission::tc_sender(one, key(), None)).map_err(|_| "table")?;
+    ground
+        .add(mission::tc_sender(one, key(), None))
+        .map_err(|_| "table")?;
     reserve(&mut ground);
     let mut robot: SaTable<1> = SaTable::new();
-    robot.add(mission::tc_receiver(one, key(), None)).map_err(|_| "table")?;
+    robot
+        .add(mission::tc_receiver(one, key(), None))
+        .map_err(|_| "table")?;
     reserve(&mut robot);
     let mut packet = [0u8; 13];
     TcRepr {
         apid: Apid::new(0x101).map_err(|_| "apid")?,
         seq_count: SeqCount::new(0).map_err(|_| "seq")?,
-        header: TcSecondaryHeader { ack: AckFlags::ALL, service: 17, subservice: 1, source_id: 0 },
+        header: TcSecondaryHeader {
+            ack: AckFlags::ALL,
+            service: 17,
+            subservice: 1,
+            source_id: 0,
+        },
         app_data: &[],
     }
     .emit(&mut packet)
@@ -214,7 +223,10 @@ fn sdls() -> Result<(), &'static str> {
         spacecraft_id: SpacecraftId::of_board(one),
         vcid: Vcid::new(0).map_err(|_| "vcid")?,
         seq: 0,
-        content: TcContent::Ad { map_id: MapId::new(0).ok(), data: &packet },
+        content: TcContent::Ad {
+            map_id: MapId::new(0).ok(),
+            data: &packet,
+        },
     };
     let mut good = [0u8; 64];
     let n = frames::protect_tc(&mut ground, mission::tc_spi(one), &repr, &mut good)
@@ -274,7 +286,8 @@ fn sdls() -> Result<(), &'static str> {
         .and_then(|p| p.with_security(HEADER_LEN as u8, MAC_LEN as u8))
         .ok_or("params")?;
     let mut tm: SaTable<1> = SaTable::new();
-    tm.add(mission::tm_sender(one, key(), None)).map_err(|_| "table")?;
+    tm.add(mission::tm_sender(one, key(), None))
+        .map_err(|_| "table")?;
     reserve(&mut tm);
     let mut t = copies(&tm);
     let mut frame = [0x55u8; TM_FRAME_LEN];
