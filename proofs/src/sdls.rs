@@ -595,7 +595,7 @@ fn genuine_tc(frame: &[u8], fecf: bool) -> bool {
 ///   one by SDLS in the robot's SDLS counters under its reason; nothing else moves: no TC
 ///   frame counted by the link, no packet reaches the PUS gateway;
 /// * a frame that gets past SDLS is a BC frame (in clear by design, `sdls-clear-bc`: no
-///   packet), or exactly a frame the key's holder protected ([`genuine_tc`]);
+///   packet), or exactly a frame the key's holder protected (`genuine_tc`);
 /// * the same octets through the receiving table directly (the SDLS layer alone, the
 ///   security header after the segment header, the MAC before the last two octets) are
 ///   refused, the octets left as they came and the window as it was, unless genuine.
@@ -751,7 +751,7 @@ pub fn protected_tm(iv: u128, zone: &[u8], ocf: [u8; 4]) -> [u8; TM_FRAME_LEN] {
 }
 
 /// Whether a TM frame is exactly what the board's TM association would send (see
-/// [`genuine_tc`]).
+/// `genuine_tc`).
 fn genuine_tm(frame: &[u8]) -> bool {
     let params = tm_params();
     let Ok(parsed) = TmFrameRepr::parse(frame, &params) else {
@@ -771,7 +771,7 @@ fn genuine_tm(frame: &[u8]) -> bool {
 
 /// Property of the fuzz target `sdls_tm_verify`: any octets through a fresh
 /// [`secured_ground`]'s `tm_frame` return, and unless they are exactly a frame the board's TM
-/// association protected ([`genuine_tm`]): refused (by a frame check, counted in
+/// association protected (`genuine_tm`): refused (by a frame check, counted in
 /// `tm_refused`, or by SDLS, counted under its reason), no packet handed on, no CLCW given to
 /// FOP-1, no TC frame sent. Returns whether the frame was taken.
 pub fn check_secured_tm_frame(bytes: &[u8]) -> bool {
