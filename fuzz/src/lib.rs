@@ -37,7 +37,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 17] = [
+pub const TARGETS: [&str; 18] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -55,6 +55,7 @@ pub const TARGETS: [&str; 17] = [
     "link_cop",
     "sdls_tc_verify",
     "sdls_tm_verify",
+    "pus_event",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -519,6 +520,38 @@ pub fn seeds() -> Vec<SeedFile> {
         out.push(SeedFile {
             target: TARGETS[9],
             name: name.into(),
+            bytes: v,
+        });
+    }
+    // TM(5,x): the severity, then the source data of an event of each kind, and near misses.
+    for (name, e) in [
+        (
+            "mode-changed",
+            mmic::pus::event::Event::ModeChanged {
+                from: mmic::mode::Mode::Standby,
+                to: mmic::mode::Mode::Operational,
+            },
+        ),
+        (
+            "security",
+            mmic::pus::event::Event::Security {
+                reason: 5,
+                refused: 3,
+                spi: 0x101,
+            },
+        ),
+    ] {
+        let mut v = vec![e.severity()];
+        v.extend_from_slice(&e.to_bytes());
+        out.push(SeedFile {
+            target: TARGETS[17],
+            name: name.into(),
+            bytes: v.clone(),
+        });
+        v[0] = 4 - (v[0] % 4); // another severity
+        out.push(SeedFile {
+            target: TARGETS[17],
+            name: format!("{name}-wrong-severity"),
             bytes: v,
         });
     }

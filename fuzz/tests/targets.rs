@@ -20,8 +20,8 @@
 //! * `pus_request`: service, subservice and application data through the services layer's
 //!   `Request::parse` (`mmic_proofs::pus::check_request`): refused by a named check, or read
 //!   canonically (an accepted function encodes back to the same octets).
-//! * `pus_housekeeping`, `pus_verification`: TM(3,25) and TM(1,x) source data through the
-//!   ground side's readers: refused, or read into a value that writes back exactly the input.
+//! * `pus_housekeeping`, `pus_verification`, `pus_event`: TM(3,25), TM(1,x) and TM(5,x) source
+//!   data through the ground side's readers: refused, or read into a value that writes back exactly the input.
 //! * `tm_frame_parser`: the input (cut to 300 octets) through the TM frame parser under the
 //!   mission's parameters, exactly the oracle's verdict (`check_tm_frame_parse`); then its
 //!   first 256 octets with the spacecraft ID set and the FECF rewritten (the later checks).
@@ -130,6 +130,16 @@ fn pus_verification() {
     bolero::check!().for_each(|input: &[u8]| {
         if let [subservice, data @ ..] = input {
             mmic_proofs::pus::check_verification(*subservice, data);
+        }
+    });
+}
+
+/// A subservice octet, then TM(5,x) source data through `event::Event::parse`.
+#[test]
+fn pus_event() {
+    bolero::check!().for_each(|input: &[u8]| {
+        if let [subservice, data @ ..] = input {
+            mmic_proofs::pus::check_event(*subservice, data);
         }
     });
 }

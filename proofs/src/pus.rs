@@ -2,6 +2,7 @@
 //! data read every input one way or refuse it by a named check, and what they accept is the
 //! canonical encoding of what they return.
 
+use mmic::pus::event::{Event, EventError};
 use mmic::pus::request::{Request, RequestError};
 use mmic::pus::{function, housekeeping, verification};
 
@@ -59,6 +60,36 @@ pub fn check_verification(subservice: u8, data: &[u8]) -> bool {
             let mut buf = [0u8; verification::FAILURE_LEN];
             let n = r.emit(&mut buf);
             assert_eq!(&buf[..n], data);
+            true
+        }
+    }
+}
+
+/// Any source data of a TM(5,x): refused with the error's numbers (a subservice outside 1..=4,
+/// a length other than the event's six octets, a severity other than the event's own, or a
+/// named field), or read into an event of exactly that severity that writes it back exactly.
+pub fn check_event(subservice: u8, data: &[u8]) -> bool {
+    match Event::parse(subservice, data) {
+        Err(EventError::Subservice(s)) => {
+            assert_eq!(s, subservice);
+            assert!(!(1..=4).contains(&s));
+            false
+        }
+        Err(EventError::Length { expected, found }) => {
+            assert_eq!((expected, found), (mmic::pus::event::EVENT_LEN, data.len()));
+            false
+        }
+        Err(EventError::Severity { found, .. }) => {
+            assert_eq!(found, subservice);
+            false
+        }
+        Err(e) => {
+            assert_eq!(data.len(), mmic::pus::event::EVENT_LEN, "{e}");
+            false
+        }
+        Ok(e) => {
+            assert_eq!(e.severity(), subservice);
+            assert_eq!(&e.to_bytes()[..], data);
             true
         }
     }
