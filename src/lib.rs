@@ -41,7 +41,7 @@
 //! | ccsds | `ccsds` | the CCSDS space packets and PUS headers the services travel in |
 //! | wire | `wire` | the paper's packets (Tables 2–4, the A→B command), byte by byte |
 //! | behaviour | `sensors`, `control`, `motion`, `safety` | the robot's logic: filters, servo and hip control, the motion sequencer, the safety supervisor; it speaks only the vocabulary, never a packet |
-//! | vocabulary | `mode`, `faults`, `refusal`, `pose`, `bolter`, `command` | what the robot and its operator talk about: modes, faults, refusal codes, states and primitives, the bolter's steps, the command set |
+//! | vocabulary | `mode`, `faults`, `refusal`, `restart`, `pose`, `bolter`, `command` | what the robot and its operator talk about: modes, faults, refusal codes, reset causes and boot counts, states and primitives, the bolter's steps, the command set |
 //! | ground | `units`, `wire_enum` | checked quantities (pulse widths, angles, board numbers) and the C-like enum macro |
 //!
 //! The behaviour stands below the packets because nothing in it needs one, while the services
@@ -81,6 +81,7 @@ pub mod node;
 pub mod pose;
 pub mod pus;
 pub mod refusal;
+pub mod restart;
 pub mod safety;
 pub mod sensors;
 pub mod units;

@@ -16,7 +16,9 @@ const ORDER: &[(&str, &[&str])] = &[
     ("ground", &["units", "wire_enum"]),
     (
         "vocabulary",
-        &["mode", "faults", "refusal", "pose", "bolter", "command"],
+        &[
+            "mode", "faults", "refusal", "restart", "pose", "bolter", "command",
+        ],
     ),
     ("behaviour", &["sensors", "control", "motion", "safety"]),
     ("wire", &["wire"]),

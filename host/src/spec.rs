@@ -10,7 +10,7 @@
 use mmic::faults::Fault;
 use mmic::pus::function::FunctionId;
 use mmic::pus::request::RequestError;
-use mmic::pus::verification::{ABANDONED, KEY_REUSED, QUEUE_FULL, UNACKNOWLEDGED};
+use mmic::pus::verification::{ABANDONED, KEY_REUSED, QUEUE_FULL, RESTARTED, UNACKNOWLEDGED};
 use mmic::refusal::Refusal;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -261,6 +261,7 @@ pub fn failure_codes() -> Result<Vec<(u16, String)>, String> {
                 let name = match code {
                     UNACKNOWLEDGED => "UNACKNOWLEDGED".to_string(),
                     ABANDONED => "ABANDONED".to_string(),
+                    RESTARTED => "RESTARTED".to_string(),
                     QUEUE_FULL => "QUEUE_FULL".to_string(),
                     KEY_REUSED => "KEY_REUSED".to_string(),
                     0x0301..=0x0306 => RequestError::NAMES

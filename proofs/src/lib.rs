@@ -317,6 +317,7 @@ fn sample_heartbeat(s: &mut Seed<'_>) -> HeartbeatRepr {
         refusal: Refusal::from_wire(s.u8() % (Refusal::ALL.len() as u8 + 1)),
         mode: s.pick(&Mode::ALL),
         last_seq: s.u16(),
+        boot: mmic::restart::Boot::from_wire(s.u8()),
     }
 }
 

@@ -307,7 +307,7 @@ arbitrary_boxed!(
             any::<PulseWidth>(),
             any::<PulseWidth>(),
         ],
-        (any::<Electrical>(), any::<Electrical>(), any::<u16>()),
+        (any::<Electrical>(), any::<Electrical>(), any::<u16>(), any::<u8>()),
         (
             option::of(any::<State>()),
             any::<bool>(),
@@ -322,7 +322,7 @@ arbitrary_boxed!(
             |(
                 (board, hip_target, hip_now),
                 [arm_a_target, arm_a_now, arm_b_target, arm_b_now, gripper_a_target, gripper_a_now, gripper_b_target, gripper_b_now],
-                (electrical_a, electrical_b, last_seq),
+                (electrical_a, electrical_b, last_seq, boot),
                 (target_state, command_complete, active_bolter, bolter_attempt, faults, refusal, mode),
             )| HeartbeatRepr {
                 board,
@@ -346,6 +346,7 @@ arbitrary_boxed!(
                 refusal,
                 mode,
                 last_seq,
+                boot: crate::restart::Boot::from_wire(boot),
             }
         )
 );

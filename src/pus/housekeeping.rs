@@ -24,7 +24,7 @@ use crate::mode::Mode;
 use crate::pose::State;
 use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
-use crate::wire::heartbeat::HeartbeatRepr;
+use crate::wire::heartbeat::{Boot, HeartbeatRepr};
 
 /// The robot's one housekeeping report structure.
 pub const ROBOT_SID: u8 = 1;
@@ -108,8 +108,11 @@ macro_rules! side_rows {
     };
 }
 
-/// `head`, then side A's readings, then side B's: the report's order.
-const fn with_sides<const H: usize, const N: usize>(head: [Field; H]) -> [Field; N] {
+/// `head`, then side A's readings, then side B's, then `tail`: the report's order.
+const fn with_sides<const H: usize, const T: usize, const N: usize>(
+    head: [Field; H],
+    tail: [Field; T],
+) -> [Field; N] {
     let (a, b): ([Field; 7], [Field; 7]) = (side_rows!("a", "A"), side_rows!("b", "B"));
     let mut out = [head[0]; N];
     let mut i = 0;
@@ -118,16 +121,30 @@ const fn with_sides<const H: usize, const N: usize>(head: [Field; H]) -> [Field;
             head[i]
         } else if i < H + 7 {
             a[i - H]
-        } else {
+        } else if i < H + 14 {
             b[i - H - 7]
+        } else {
+            tail[i - H - 14]
         };
         i += 1;
     }
     out
 }
 
+/// The number of parameters.
+pub const N_FIELDS: usize = 34;
+
 /// The parameters after the structure ID, in order.
-pub const FIELDS: [Field; 33] = with_sides(HEAD);
+pub const FIELDS: [Field; N_FIELDS] = with_sides(HEAD, TAIL);
+
+/// The parameters after the two sides' readings: added after the first layout, at the end, so
+/// that every earlier parameter keeps its offset.
+const TAIL: [Field; 1] = [f(
+    "boot",
+    1,
+    "number",
+    "heartbeat byte 59: board A's last start, reset cause in bits 7..5 (spec/decisions.toml heartbeat-boot), boot count modulo 32 in bits 4..0; 0 = not reported",
+)];
 
 /// The parameters before the two sides' electrical readings.
 const HEAD: [Field; 19] = [
@@ -242,7 +259,7 @@ const fn electrical(e: &Electrical) -> [u32; 7] {
 }
 
 /// The parameter values of a heartbeat, in [`FIELDS`] order.
-pub fn values(hb: &HeartbeatRepr) -> [u32; 33] {
+pub fn values(hb: &HeartbeatRepr) -> [u32; N_FIELDS] {
     let pw = |p: PulseWidth| u32::from(p.micros());
     let head = [
         u32::from(hb.board.get()),
@@ -265,11 +282,13 @@ pub fn values(hb: &HeartbeatRepr) -> [u32; 33] {
         pw(hb.gripper_b_target),
         pw(hb.gripper_b_now),
     ];
-    let mut out = [0u32; 33];
+    let tail = [u32::from(hb.boot.to_wire())];
+    let mut out = [0u32; N_FIELDS];
     for (o, v) in out.iter_mut().zip(
         head.iter()
             .chain(&electrical(&hb.electrical_a))
-            .chain(&electrical(&hb.electrical_b)),
+            .chain(&electrical(&hb.electrical_b))
+            .chain(&tail),
     ) {
         *o = *v;
     }
@@ -331,17 +350,18 @@ pub fn parse(data: &[u8]) -> Result<HeartbeatRepr, HousekeepingError> {
         gripper_b_now: v.pulse(18)?,
         electrical_a: v.electrical(19)?,
         electrical_b: v.electrical(26)?,
+        boot: Boot::from_wire(v.byte(33)?),
     })
 }
 
 /// The report's parameter values, in [`FIELDS`] order, and the checked reading of each: a
 /// value its type refuses is a [`HousekeepingError::Parameter`] naming the field.
-struct Values([u32; 33]);
+struct Values([u32; N_FIELDS]);
 
 impl Values {
     /// The values of `data`, whose length is checked.
     fn read(data: &[u8]) -> Values {
-        let mut v = [0u32; 33];
+        let mut v = [0u32; N_FIELDS];
         let mut at = 1;
         for (field, slot) in FIELDS.iter().zip(v.iter_mut()) {
             for b in data.get(at..at + field.len).unwrap_or(&[]) {

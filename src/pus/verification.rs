@@ -76,6 +76,9 @@ pub struct Failure {
 pub const UNACKNOWLEDGED: u16 = 0x0200;
 /// Code of a command abandoned before completion.
 pub const ABANDONED: u16 = 0x0201;
+/// Code of a copy of a telecommand the gateway took before it restarted: it ran at most once,
+/// and what became of it is not known any more (decision `restart-server`).
+pub const RESTARTED: u16 = 0x0202;
 /// The gateway's robot queue is full.
 pub const QUEUE_FULL: u16 = 0x0307;
 /// A request ID already used by a different telecommand.

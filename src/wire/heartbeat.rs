@@ -5,7 +5,8 @@
 //! let hb = HeartbeatRepr::default();
 //! let bytes = hb.to_bytes();
 //! assert_eq!(bytes.len(), HEARTBEAT_LEN);
-//! assert_eq!(&bytes[57..60], &[0, 0, 0]); // the paper's "empty" bytes: no sequenced command yet
+//! assert_eq!(&bytes[57..60], &[0, 0, 0]); // the paper's "empty" bytes: no sequenced command yet,
+//!                                          // no start reported
 //! let acked = HeartbeatRepr { last_seq: 0x0102, ..hb };
 //! assert_eq!(&acked.to_bytes()[57..60], &[2, 1, 0]); // bytes 57–58 acknowledge command 0x0102
 //! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
@@ -18,6 +19,7 @@ use crate::faults::Faults;
 use crate::mode::Mode;
 use crate::pose::State;
 use crate::refusal::Refusal;
+pub use crate::restart::{Boot, ResetCause};
 use crate::units::{BoardNumber, Electrical, HipAngle, PulseWidth};
 use zerocopy::byteorder::little_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -52,7 +54,7 @@ pub struct HeartbeatPacket {
     pub active_bolter: u8,
     pub bolter_attempt: u8,
     pub last_seq: U16,
-    pub empty: u8,
+    pub boot: u8,
     pub faults: [u8; 2],
     pub refusal: u8,
     pub mode: u8,
@@ -96,7 +98,7 @@ fields! {
     ACTIVE_BOLTER: ("active_bolter", active_bolter, u8, Enum, "active bolter"),
     BOLTER_ATTEMPT: ("bolter_attempt", bolter_attempt, u8, Enum, "bolter attempt"),
     LAST_SEQ: ("last_seq", last_seq, U16, Sequence16, "empty", cells &["empty", "empty"]),
-    EMPTY: ("empty", empty, u8, Reserved, "empty"),
+    BOOT: ("boot", boot, u8, Bits, "empty"),
     FAULTS: (
         "faults", faults, [u8; 2], Bits, "fault byte0-1",
         cells &["fault byte0", "fault byte1"]
@@ -165,6 +167,11 @@ pub struct HeartbeatRepr {
     #[cfg_attr(feature = "serde", serde(default))]
     #[cfg_attr(feature = "serde", serde(deserialize_with = "crate::units::de::seq16"))]
     pub last_seq: u16,
+    /// Byte 59 (paper: "empty"): board A's last start, its reset cause and boot count modulo
+    /// 32 ([`Boot`]); 0 = not reported (a paper-era robot). Every byte is valid. A change
+    /// between two heartbeats means board A restarted (decision `heartbeat-boot`).
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub boot: Boot,
 }
 
 impl Default for HeartbeatRepr {
@@ -193,6 +200,7 @@ impl Default for HeartbeatRepr {
             refusal: None,
             mode: Mode::Standby,
             last_seq: 0,
+            boot: Boot::UNREPORTED,
         }
     }
 }
@@ -225,7 +233,6 @@ impl HeartbeatRepr {
                 BolterPair::from_number(p.active_bolter).is_some(),
             )
             & BolterAttempt::new(p.bolter_attempt).is_ok()
-            & (p.empty == 0)
             & Faults::from_wire(p.faults).is_ok()
             & opt(p.refusal, Refusal::from_wire(p.refusal).is_some())
             & Mode::from_wire(p.mode).is_some()
@@ -267,6 +274,7 @@ impl HeartbeatRepr {
             refusal: Refusal::from_wire(p.refusal),
             mode: Mode::from_wire(p.mode).unwrap_or(Mode::Standby),
             last_seq: p.last_seq.get(),
+            boot: Boot::from_wire(p.boot),
         })
     }
 
@@ -293,9 +301,6 @@ impl HeartbeatRepr {
         let active_bolter = opt!(active_bolter, "0..=4", BolterPair::from_number);
         let bolter_attempt =
             BolterAttempt::new(p.bolter_attempt).map_err(|_| refuse!(bolter_attempt, "0..=3"))?;
-        if p.empty != 0 {
-            return Err(refuse!(empty, "0"));
-        }
         let faults = Faults::from_wire(p.faults)
             .map_err(|e| field_err(KIND, at!(faults), "faults", "bits 0..=14 only", e.reserved))?;
         let refusal = opt!(refusal, "0 (accepted) or 1..=8", Refusal::from_wire);
@@ -334,6 +339,7 @@ impl HeartbeatRepr {
             refusal,
             mode,
             last_seq: p.last_seq.get(),
+            boot: Boot::from_wire(p.boot),
         })
     }
 
@@ -361,7 +367,7 @@ impl HeartbeatRepr {
             active_bolter: self.active_bolter.map_or(0, BolterPair::number),
             bolter_attempt: self.bolter_attempt.get(),
             last_seq: U16::new(self.last_seq),
-            empty: 0,
+            boot: self.boot.to_wire(),
             faults: self.faults.to_wire(),
             refusal: self.refusal.map_or(0, Refusal::to_wire),
             mode: self.mode.to_wire(),

@@ -48,12 +48,17 @@ fn a_field_out_of_range_is_refused_by_name() {
         })
     );
     // Every field set to all ones: refused by its name unless all ones is in range
-    // (the currents and voltages, the sequence number, robot 255).
+    // (the currents and voltages, the sequence number, robot 255, the boot byte: every value
+    // is a reset cause and a count).
     let mut at = 1;
     for f in FIELDS {
         let mut b = good;
         b[at..at + f.len].fill(0xFF);
-        let free = f.unit == "mV" || f.unit == "mA" || f.name == "last_seq" || f.name == "board";
+        let free = f.unit == "mV"
+            || f.unit == "mA"
+            || f.name == "last_seq"
+            || f.name == "board"
+            || f.name == "boot";
         match housekeeping::parse(&b) {
             Ok(_) => assert!(free, "{} accepted all ones", f.name),
             Err(HousekeepingError::Parameter { name, .. }) => {

@@ -21,7 +21,7 @@ use mmic::refusal::Refusal;
 use mmic::units::{Axis, BoardNumber, Electrical, Gravity, HipAngle, PulseWidth, Side, Sign};
 use mmic::wire::b_command::{BCommandRepr, BPower, BolterOrder, B_COMMAND_LEN};
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
-use mmic::wire::heartbeat::{BolterAttempt, HeartbeatRepr, HEARTBEAT_LEN};
+use mmic::wire::heartbeat::{BolterAttempt, Boot, HeartbeatRepr, ResetCause, HEARTBEAT_LEN};
 use mmic::wire::internal_heartbeat::{BolterAux, InternalHeartbeatRepr, INTERNAL_HEARTBEAT_LEN};
 use mmic::wire::opcode::CommandError;
 use mmic::wire::WireError;
@@ -228,11 +228,11 @@ const HEARTBEAT: [u8; HEARTBEAT_LEN] = [
     0x02,       // 55 active bolter: pair 2
     0x01,       // 56 bolter attempt 1
     0x34, 0x12, // 57-58 last sequenced command 0x1234 (paper: empty)
-    0x00,       // 59 empty
+    0xa3,       // 59 boot: watchdog reset (5 << 5), boot count 3 (paper: empty)
     0x02, 0x08, // 60-61 faults: bit 1 (arm not contracted) | bit 11 (low battery)
     0x05,       // 62 outcome of the command reported on: 5, invalid parameter
     0x02,       // 63 mode: operational
-    0x30, 0x72, // 64-65 CRC-16 0x7230
+    0x86, 0xb6, // 64-65 CRC-16 0xb686
 ];
 
 #[test]
@@ -277,6 +277,10 @@ fn golden_heartbeat() {
         refusal: Some(Refusal::InvalidParameter),
         mode: Mode::Operational,
         last_seq: 0x1234,
+        boot: Boot {
+            cause: ResetCause::Watchdog,
+            count: 3,
+        },
     };
     assert_crc(&HEARTBEAT);
     assert_eq!(repr.to_bytes(), HEARTBEAT);

@@ -101,7 +101,8 @@ fn other_kinds_round_trip_with_non_default_values() {
         "electrical_a": electrical(11000), "electrical_b": electrical(10500),
         "target_state": "n", "command_complete": true, "active_bolter": 3, "bolter_attempt": 2,
         "faults": ["hip_mismatch", "low_battery"], "refusal": "not_allowed_in_mode", "mode": "safed",
-        "last_seq": 65535
+        "last_seq": 65535,
+        "boot": {"cause": "watchdog", "count": 31}
     });
     round_trip("heartbeat", &hb);
     let ihb = json!({

@@ -11,8 +11,6 @@ use std::collections::BTreeSet;
 fn not_in_json(kind: PacketKind, name: &str) -> bool {
     // Framing: fixed or computed, never chosen by an operator.
     matches!(name, "header" | "checksum")
-        // Heartbeat reserved bytes: always zero, refused otherwise ("field" check).
-        || (kind == PacketKind::Heartbeat && name == "empty")
         // Table 2's parameter slots: their meaning depends on the opcode, so they live inside
         // `command` (e.g. `{"arm":{"side":"a","target":{"position":1200}}}` fills arm_a).
         || (kind == PacketKind::Command && matches!(name, "hip" | "arm_a" | "arm_b"))
@@ -24,6 +22,8 @@ fn json_only(kind: PacketKind, key: &str) -> bool {
     // free (`mmic::wire::opcode::seq_slot`), so like the other slot contents it has no byte range
     // of its own.
     kind == PacketKind::Command && key == "seq"
+        // The heartbeat's boot byte (59) is two bit fields: the reset cause and the count.
+        || (kind == PacketKind::Heartbeat && matches!(key, "boot.cause" | "boot.count"))
 }
 
 /// Every key path (intermediate objects included) and the leaf paths.
@@ -59,7 +59,7 @@ fn sample(kind: PacketKind) -> Value {
             "gripper_b_target": 1500, "gripper_b_now": 1500, "electrical_a": el, "electrical_b": el,
             "target_state": "c", "command_complete": true, "active_bolter": 1, "bolter_attempt": 1,
             "faults": ["low_battery"], "refusal": "not_allowed_in_mode", "mode": "standby",
-            "last_seq": 513
+            "last_seq": 513, "boot": {"cause": "brown_out", "count": 2}
         }),
         PacketKind::InternalHeartbeat => json!({
             "arm_b_target": 1500, "arm_b_now": 1500, "gripper_b_target": 1500, "gripper_b_now": 1500,

@@ -153,6 +153,9 @@ pub struct Uplink {
     out: Option<Outstanding>,
     last_send: Option<Instant>,
     eff: Efficiency,
+    /// After a restart: the outstanding command is a probe (a sequenced Heartbeat poll) until a
+    /// heartbeat acknowledges it ([`Uplink::after_restart`]).
+    syncing: bool,
 }
 
 /// [`Uplink::submit`] while a command is outstanding: the command is handed back.
@@ -182,7 +185,53 @@ impl Uplink {
             out: None,
             last_send: None,
             eff: Efficiency { bits: 0, len: 0 },
+            syncing: false,
         }
+    }
+
+    /// The uplink of a sender that restarted (the ground, or the server board's gateway) and
+    /// does not know which numbers board A has taken: numbering from 1 could hand a new command
+    /// a number board A took before (answered as a copy, never run, yet acknowledged) or an
+    /// older one (refused as stale until the numbers pass it). It first *probes*: it sends the
+    /// Heartbeat poll (which does nothing but answer) sequenced, numbered 1, then one past
+    /// any newer number a heartbeat reports, until a heartbeat acknowledges the probe; numbering
+    /// continues after it. A probe board A runs, or answers as the copy of its last command,
+    /// does nothing either way. Until then [`Uplink::submit`] is refused, no probe ends as a
+    /// [`Done`], and it never gives up (the robot may be off).
+    ///
+    /// ```
+    /// use mmic::command::Command;
+    /// use mmic::node::exactly_once::uplink::{Config, Uplink};
+    /// use mmic::units::BoardNumber;
+    /// use mmic::wire::heartbeat::HeartbeatRepr;
+    ///
+    /// let mut up = Uplink::after_restart(Config::default(), BoardNumber::ONE);
+    /// assert!(up.submit(Command::Stop).is_err()); // not synchronised yet
+    /// let probe = up.tick(0).send.unwrap();
+    /// assert_eq!((probe.command, probe.seq), (Command::Heartbeat, 1));
+    /// // Board A has taken 500 before: the probe is stale, its heartbeat says 500.
+    /// let t = up.heartbeat(20, &HeartbeatRepr { last_seq: 500, ..HeartbeatRepr::default() });
+    /// assert!(t.done.is_none());
+    /// let probe = up.tick(1200).send.unwrap();
+    /// assert_eq!(probe.seq, 501);
+    /// up.heartbeat(1220, &HeartbeatRepr { last_seq: 501, ..HeartbeatRepr::default() });
+    /// assert_eq!(up.submit(Command::Stop), Ok(502));
+    /// ```
+    pub const fn after_restart(cfg: Config, board: BoardNumber) -> Uplink {
+        let mut up = Uplink::starting_at(cfg, board, 2);
+        up.out = Some(Outstanding {
+            command: Command::Heartbeat,
+            seq: 1,
+            attempts: 0,
+            open_since: None,
+        });
+        up.syncing = true;
+        up
+    }
+
+    /// Still probing after a restart ([`Uplink::after_restart`]).
+    pub const fn is_syncing(&self) -> bool {
+        self.syncing
     }
 
     /// Queues `command` as the next one; returns its number. Refused while one is outstanding.
@@ -250,6 +299,9 @@ impl Uplink {
             .last_send
             .is_none_or(|l| Instant::from_millis(now).since(l).millis() >= self.cfg.period_ms);
         if o.open_since.is_none() && slot_due {
+            if self.syncing && o.attempts >= self.cfg.max_attempts.max(1) {
+                o.attempts = 0; // a probe never gives up
+            }
             if o.attempts >= self.cfg.max_attempts.max(1) {
                 self.out = None;
                 t.done = Some(Done {
@@ -275,10 +327,33 @@ impl Uplink {
 
     /// A heartbeat arrived at `now`. It acknowledges the outstanding command when it is from
     /// this robot and its bytes 57–58 carry the command's number.
+    ///
+    /// A heartbeat reporting a number newer than any this uplink gave out (board A took it
+    /// from an earlier life of this sender) moves the numbering past it; a probe after a
+    /// restart is renumbered past it.
     pub fn heartbeat(&mut self, now: u32, hb: &HeartbeatRepr) -> Tick {
         let mut t = Tick::default();
-        let Some(o) = self.out else { return t };
-        if hb.board != self.board || hb.last_seq != o.seq || o.attempts == 0 {
+        if hb.board != self.board {
+            return t;
+        }
+        let issued = self.next_seq.wrapping_sub(1);
+        if super::newer(hb.last_seq, issued) {
+            self.next_seq = match hb.last_seq.wrapping_add(1) {
+                0 => 1,
+                s => s,
+            };
+        }
+        let Some(mut o) = self.out else { return t };
+        if self.syncing && super::newer(hb.last_seq, o.seq) {
+            o.seq = self.next_seq;
+            self.next_seq = match o.seq.wrapping_add(1) {
+                0 => 1,
+                s => s,
+            };
+            self.out = Some(o);
+            return t;
+        }
+        if hb.last_seq != o.seq || o.attempts == 0 {
             return t;
         }
         if let Some(sent) = o.open_since {
@@ -287,6 +362,10 @@ impl Uplink {
             t.attempt = Some(ok);
         }
         self.out = None;
+        if self.syncing {
+            self.syncing = false; // the probe is acknowledged: numbering continues after it
+            return t;
+        }
         t.done = Some(Done {
             seq: o.seq,
             command: o.command,

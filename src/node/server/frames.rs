@@ -47,7 +47,7 @@
 //! assert_eq!(Clcw::parse(&f.ocf.unwrap()).unwrap().report_value, 1);
 //! ```
 
-use super::gateway::{Config as GatewayConfig, Gateway, Out, TmOut, MAX_TM_DATA};
+use super::gateway::{Config as GatewayConfig, Gateway, Kept, Out, TmOut, MAX_TM_DATA};
 use crate::ccsds::primary::PrimaryHeader;
 use crate::ccsds::tm::TM_MIN_LEN;
 use crate::link::clcw::ClcwVcid;
@@ -277,11 +277,33 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     /// Serves robot `board` (its spacecraft ID `0x100 + n`); false when all `R` places are
     /// taken or it is served already.
     pub fn add(&mut self, board: BoardNumber) -> bool {
+        self.add_link(board, None)
+    }
+
+    /// Serves robot `board` after the server board restarted, with what its gateway kept
+    /// ([`Gateway::add_restarted`]). FARM-1 starts again as at power-on (V(R) = 0, no flags):
+    /// the ground's FOP-1 finds N(R) unexpected, re-initiates with Set V(R) and sends the
+    /// packets of its unconfirmed frames again, which the kept keys answer without running
+    /// them twice. Then [`FrameGateway::secure`] with the stored SDLS counters.
+    pub fn add_restarted(&mut self, board: BoardNumber, kept: Kept) -> bool {
+        self.add_link(board, Some(kept))
+    }
+
+    /// What to keep of robot `board`'s gateway across a restart ([`Gateway::kept`]).
+    pub fn kept(&self, board: BoardNumber) -> Option<Kept> {
+        self.gateway.kept(board)
+    }
+
+    fn add_link(&mut self, board: BoardNumber, kept: Option<Kept>) -> bool {
         let scid = SpacecraftId::of_board(board).get();
         let Some(params) = TmFrameParams::mission(scid) else {
             return false;
         };
-        if !self.gateway.add(board) {
+        let added = match kept {
+            Some(k) => self.gateway.add_restarted(board, k),
+            None => self.gateway.add(board),
+        };
+        if !added {
             return false;
         }
         self.links

@@ -196,7 +196,7 @@ impl BoardA {
 
     /// A packet's sequence number and command, or why it is no command (answered as a
     /// refusal), or the event of a packet that is not ours to answer.
-    fn unpack(&self, bytes: &[u8]) -> Result<(u16, Result<Command, Refusal>), Event> {
+    pub(super) fn unpack(&self, bytes: &[u8]) -> Result<(u16, Result<Command, Refusal>), Event> {
         match CommandRepr::parse(bytes) {
             Ok(r) if r.board != self.cfg.board => Err(Event::OtherRobot { board: r.board }),
             Ok(r) => Ok((r.seq, Ok(r.command))),

@@ -43,9 +43,11 @@ mod command_path;
 pub mod interface;
 mod motion;
 mod report;
+mod restart;
 
 pub use interface::{Config, Event, Inputs, Outputs, EVENTS};
 use motion::{Motion, Watch};
+pub use restart::Durable;
 
 use super::b_link::BLink;
 use crate::bolter::{BolterSide, Sensed};
@@ -57,6 +59,7 @@ use crate::motion::sequencer::{Feedback, Targets};
 use crate::motion::State;
 use crate::node::exactly_once::CommandLog;
 use crate::refusal::Refusal;
+use crate::restart::Boot;
 use crate::safety::detect::{CommMonitor, LowBattery};
 use crate::safety::supervisor::Supervisor;
 use crate::units::{HipAngle, Instant, Module, PerSide, PulseWidth};
@@ -96,6 +99,10 @@ pub struct BoardA {
     hip_seen: HipAngle,
     /// The deadline of the module motion in progress outside a primitive or a bolting job.
     watch: Watch,
+    /// This start as heartbeat byte 59 reports it ([`BoardA::restarted`]).
+    boot: Boot,
+    /// Starts in all, this one included (0: started by [`BoardA::new`], not counted).
+    boots: u16,
 }
 
 impl BoardA {
@@ -128,6 +135,8 @@ impl BoardA {
             hold_b: false,
             hip_seen: cfg.safety.hip_home,
             watch: Watch::Idle,
+            boot: Boot::UNREPORTED,
+            boots: 0,
         }
     }
 

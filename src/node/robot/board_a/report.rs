@@ -88,6 +88,7 @@ impl BoardA {
             refusal: self.refusal,
             mode: self.sup.mode(),
             last_seq,
+            boot: self.boot,
         }
     }
 }

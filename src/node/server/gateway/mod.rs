@@ -44,6 +44,8 @@
 
 mod robot;
 
+pub use robot::{Kept, KEPT_SOURCES};
+
 use crate::ccsds::cuc::Cuc;
 use crate::ccsds::primary::{Apid, SeqCount};
 use crate::ccsds::tc::TcRepr;
@@ -216,13 +218,58 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
 
     /// Serves robot `board`; false when all `R` places are taken (or it is served already).
     pub fn add(&mut self, board: BoardNumber) -> bool {
+        self.add_robot(board, Uplink::new(self.cfg.uplink, board), Kept::new())
+    }
+
+    /// Serves robot `board` after the server board restarted, with what it kept of it
+    /// ([`Gateway::kept`], from flash): a copy of a telecommand taken before the restart (its
+    /// sequence count not newer than the source's kept one) is never run again, and is
+    /// reported failed with [`crate::pus::verification::RESTARTED`]; the legacy uplink first
+    /// learns which numbers board A has taken ([`Uplink::after_restart`]). False as [`Gateway::add`].
+    ///
+    /// ```
+    /// use mmic::command::Command;
+    /// use mmic::node::server::gateway::{Gateway, Kept, Tc};
+    /// use mmic::pus::request::Request;
+    /// use mmic::pus::verification::{RequestId, Stage, RESTARTED};
+    /// use mmic::units::BoardNumber;
+    ///
+    /// let tc = |seq_count| Tc { request: RequestId { apid: 0x101, seq_count }, source_id: 7,
+    ///                           ack: 0b1001, request_of: Ok(Request::Function(Command::Stop)) };
+    /// let mut g: Gateway<1, 4, 8> = Gateway::new(Default::default());
+    /// g.add(BoardNumber::ONE);
+    /// g.tc(&tc(41));
+    /// let kept = g.kept(BoardNumber::ONE).unwrap(); // written to flash before any tick
+    /// // The server board restarts; the ground sends telecommand 41 again, then 42.
+    /// let mut g: Gateway<1, 4, 8> = Gateway::new(Default::default());
+    /// g.add_restarted(BoardNumber::ONE, kept);
+    /// let out = g.tc(&tc(41));
+    /// assert_eq!(out.reports[0].stage(), Some((Stage::Start, false))); // 0x0202: not run again
+    /// let out = g.tc(&tc(42));
+    /// assert_eq!(out.reports[0].stage(), Some((Stage::Acceptance, true)));
+    /// ```
+    pub fn add_restarted(&mut self, board: BoardNumber, kept: Kept) -> bool {
+        let uplink = Uplink::after_restart(self.cfg.uplink, board);
+        self.add_robot(board, uplink, kept)
+    }
+
+    /// What to keep of robot `board` across a restart; write it whenever it changed, before
+    /// the next [`Gateway::tick`].
+    pub fn kept(&self, board: BoardNumber) -> Option<Kept> {
+        self.robots
+            .iter()
+            .find(|r| r.board == board)
+            .map(|r| r.marks.clone())
+    }
+
+    fn add_robot(&mut self, board: BoardNumber, uplink: Uplink, kept: Kept) -> bool {
         if self.robots.iter().any(|r| r.board == board) {
             return false;
         }
         self.robots
             .push(Robot {
                 board,
-                uplink: Uplink::new(self.cfg.uplink, board),
+                uplink,
                 queue: Vec::new(),
                 sent: None,
                 running: Vec::new(),
@@ -235,6 +282,8 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
                 next_poll: None,
                 tm_seq: SeqCount::default(),
                 counters: [0; 16],
+                marks: kept.clone(),
+                restored: kept,
             })
             .is_ok()
     }

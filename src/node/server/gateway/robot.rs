@@ -10,7 +10,7 @@ use crate::pus::housekeeping::{self, REPORT_LEN};
 use crate::pus::request::{Request, ST_HOUSEKEEPING, ST_TEST, ST_VERIFICATION};
 use crate::pus::robot_apid;
 use crate::pus::verification::{
-    Failure, Report, RequestId, Stage, ABANDONED, FAILURE_LEN, KEY_REUSED, QUEUE_FULL,
+    Failure, Report, RequestId, Stage, ABANDONED, FAILURE_LEN, KEY_REUSED, QUEUE_FULL, RESTARTED,
     UNACKNOWLEDGED,
 };
 use crate::units::{BoardNumber, Instant};
@@ -59,6 +59,25 @@ pub(super) struct Robot<const Q: usize, const K: usize> {
     /// ([`TmOut::type_index`]).
     pub(super) tm_seq: SeqCount,
     pub(super) counters: [u16; 16],
+    /// The newest key taken from each source ([`Kept`]): what the server board keeps across a
+    /// restart. After one, `restored` holds what was kept then.
+    pub(super) marks: Kept,
+    pub(super) restored: Kept,
+}
+
+/// How many sources (ground stations, operators) a robot's kept keys remember.
+pub const KEPT_SOURCES: usize = 4;
+
+/// What the gateway keeps of one robot across a restart: the newest telecommand key (source
+/// ID, packet sequence count) taken from each source, at most [`KEPT_SOURCES`] (the source
+/// heard from least recently forgotten first). Written to the server board's flash before
+/// the telecommand can reach board A (decision `restart-server`).
+pub type Kept = Vec<(u16, u16), KEPT_SOURCES>;
+
+/// `a` is newer than `b` in the 14-bit packet sequence count (RFC 1982 arithmetic).
+const fn newer14(a: u16, b: u16) -> bool {
+    let d = a.wrapping_sub(b) & 0x3FFF;
+    d != 0 && d < 0x2000
 }
 
 impl<const Q: usize, const K: usize> Robot<Q, K> {
@@ -90,15 +109,41 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
             }
             return None;
         }
+        if let Some(&(_, mark)) = self.restored.iter().find(|(src, _)| *src == tc.source_id) {
+            if !newer14(tc.request.seq_count, mark) {
+                // Taken before the restart, or older: it may have run; never again.
+                let f = Failure {
+                    code: RESTARTED,
+                    data: u32::from(mark),
+                };
+                let rep = report(Stage::Start, tc.request, Some(f));
+                self.log_entry(key, request, Some(rep));
+                self.verify(out, rep, tc.ack, tc.source_id);
+                return None;
+            }
+        }
+        self.log_entry(key, request, None);
+        self.mark(key);
+        Some(request)
+    }
+
+    /// Logs a new key (the oldest forgotten when the log is full).
+    fn log_entry(&mut self, key: (u16, u16), request: Request, last: Option<Report>) {
         if self.log.is_full() {
             self.log.remove(0);
         }
-        let _ = self.log.push(Entry {
-            key,
-            request,
-            last: None,
-        });
-        Some(request)
+        let _ = self.log.push(Entry { key, request, last });
+    }
+
+    /// `key` is the newest taken from its source: the kept marks move (the source moves to
+    /// the end; the least recently heard one is forgotten when they are full).
+    fn mark(&mut self, (source, seq): (u16, u16)) {
+        if let Some(i) = self.marks.iter().position(|(s, _)| *s == source) {
+            self.marks.remove(i);
+        } else if self.marks.is_full() {
+            self.marks.remove(0);
+        }
+        let _ = self.marks.push((source, seq));
     }
 
     /// A new telecommand's request: housekeeping settings are done at once (accepted,
