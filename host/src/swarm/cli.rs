@@ -1,11 +1,13 @@
 //! `mmic swarm`: arguments and output around [`super::swarm`] and its replay.
 
 use super::scenario::{LinkDraw, Options, Scenario, SdlsDraw};
-use super::{judge, replay_command, swarm};
+use super::shard::{self, SeedDigest, SeedRange, Shard};
+use super::{judge, replay_command, swarm_over};
 use crate::error::CliError;
 use crate::sim::engine::PlantedBug;
+use serde_json::Value;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 /// `mmic swarm --help`'s description.
@@ -34,7 +36,13 @@ takes them); with SDLS, no attack frame (a replayed or bit-flipped TC frame) rea
 the server board verifies no more TC frames than the ground protected; no panic.
 
 A failing seed prints the one command that replays it: `mmic swarm --replay SEED` runs the same
-scenario, prints it and its violations, and writes the whole log to --out.";
+scenario, prints it and its violations, and writes the whole log to --out.
+
+A campaign over N machines: `--shard K/N --runs R` runs the seeds of --seed-start..+R whose
+offset is K-1 modulo N (its whole share: no wall-clock budget, so --seconds is refused), and its
+--json says which shard it is and which seeds it ran (count and digest). `--merge` adds the N
+shards' reports up into the report the single `--runs R` run writes (its wall-clock fields
+aside), refusing a shard missing or given twice, or shards whose options differ.";
 
 /// `mmic swarm --help`'s examples and exit codes.
 pub const AFTER: &str = "\
@@ -47,9 +55,15 @@ Examples:
   mmic swarm --seconds 60 --link frames      every PUS scenario over the space data link
   mmic swarm --seconds 60 --link packets     scenarios as they were before frames were drawn
   mmic swarm --seconds 60 --link frames --sdls on   every PUS run over frames secured, most attacked
+  mmic swarm --runs 100000 --shard 3/8 --json shard-3.json   machine 3 of 8's share of seeds 1..=100000
+  mmic swarm --merge shard-*.json --json swarm.json   the 8 shards' reports as the single run's
+    (array jobs: K8s Indexed Job K=$((JOB_COMPLETION_INDEX+1)), Slurm K=$SLURM_ARRAY_TASK_ID;
+     docs/swarm-and-fleets.md, \"Sharding a campaign\")
 
-Exit codes: 0 no invariant broken; 1 an invariant broke (the replay command is printed);
-2 bad arguments; 3 an output could not be written.";
+Exit codes: 0 no invariant broken; 1 an invariant broke (the replay command is printed; with
+--merge, in any shard); 2 bad arguments, or shard reports that do not merge (the message says
+which shard is missing or twice, or which option differs); 3 a file could not be read or
+written.";
 
 /// Arguments of `mmic swarm`.
 #[derive(Debug, clap::Args)]
@@ -90,6 +104,22 @@ pub struct SwarmArgs {
     /// Write the report as JSON to this file.
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
+    /// Run shard K of N of the campaign --seed-start S --runs R: the seeds S+K-1, S+K-1+N, ...
+    /// below S+R, all of them (needs --runs; --seconds is refused: a budget would make the
+    /// shards' union depend on each machine's speed).
+    #[arg(long, value_name = "K/N", value_parser = shard_arg,
+          conflicts_with_all = ["seconds", "replay"])]
+    pub shard: Option<Shard>,
+    /// Merge the --json reports of a sharded campaign's N shards into the single run's report
+    /// (printed; --json writes it): every shard once, all with the same options.
+    #[arg(long, value_name = "FILE", num_args = 1..,
+          conflicts_with_all = ["seconds", "runs", "seed_start", "sim_seconds", "max_failures",
+                                "plant_bug", "link", "sdls", "replay", "out", "shard"])]
+    pub merge: Vec<PathBuf>,
+}
+
+fn shard_arg(s: &str) -> Result<Shard, shard::ShardError> {
+    s.parse()
 }
 
 fn planted(s: &str) -> Result<PlantedBug, String> {
@@ -106,6 +136,9 @@ fn sdls_draw(s: &str) -> Result<SdlsDraw, String> {
 
 /// Runs `mmic swarm`.
 pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    if !a.merge.is_empty() {
+        return merge(&a.merge, a.json.as_deref(), out);
+    }
     if !(a.seconds.is_finite() && a.seconds >= 0.0) {
         return Err(CliError::Usage(format!(
             "--seconds {}: expected a number of seconds >= 0",
@@ -127,22 +160,79 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
     if let Some(seed) = a.replay {
         return replay(seed, &opts, &a.out, out);
     }
-    let report = swarm(
-        a.seed_start,
-        Duration::from_secs_f64(a.seconds),
-        a.runs,
-        a.max_failures.max(1),
-        &opts,
-        &mut |line| eprintln!("swarm: {line}"),
-    );
-    write!(out, "{}", report.text(&opts)).map_err(CliError::Output)?;
+    // A shard's seeds are a fixed share of a fixed range; a single run's, the range (or every
+    // seed from --seed-start) cut by the budget.
+    let (seeds, budget, range): (Box<dyn Iterator<Item = u64>>, Duration, _) = match a.shard {
+        Some(s) => {
+            let runs = a.runs.ok_or_else(|| {
+                CliError::Usage(format!(
+                    "--shard {s} needs --runs R: the shards split the seeds --seed-start .. \
+                     --seed-start + R between them, and a wall-clock budget (--seconds) would \
+                     make their union depend on each machine's speed"
+                ))
+            })?;
+            let range =
+                SeedRange::new(a.seed_start, runs).map_err(|e| CliError::Usage(e.to_string()))?;
+            eprintln!(
+                "swarm: shard {s}: {} of the {runs} seeds from {} (offset {} modulo {})",
+                s.share(range),
+                a.seed_start,
+                s.k() - 1,
+                s.n(),
+            );
+            (Box::new(s.seeds(range)), Duration::MAX, Some(range))
+        }
+        None => {
+            let runs = a
+                .runs
+                .map_or(usize::MAX, |r| usize::try_from(r).unwrap_or(usize::MAX));
+            let seeds = Box::new((a.seed_start..=u64::MAX).take(runs));
+            (seeds, Duration::from_secs_f64(a.seconds), None)
+        }
+    };
+    let mut digest = SeedDigest::default();
+    let report = {
+        let mut seeds = seeds.inspect(|s| digest.add(*s));
+        swarm_over(
+            &mut seeds,
+            budget,
+            a.max_failures.max(1),
+            &opts,
+            &mut |line| eprintln!("swarm: {line}"),
+        )
+    };
+    let mut text = report.text(&opts);
+    let mut json = report.json(&opts);
+    json["options"] = serde_json::json!({
+        "seed_start": a.seed_start,
+        "runs": a.runs,
+        "sim_seconds": a.sim_seconds,
+        "link": opts.link.name(),
+        "sdls": opts.sdls.name(),
+        "plant_bug": match opts.planted_bug {
+            PlantedBug::None => "none",
+            PlantedBug::DoubleExec => "double-exec",
+        },
+    });
+    json["seeds"] = digest.json();
+    if let (Some(s), Some(range)) = (a.shard, range) {
+        let share = s.share(range);
+        json["shard"] = serde_json::json!({
+            "k": s.k(), "n": s.n(), "share": share, "complete": digest.count() == share,
+        });
+        text.push_str(&format!(
+            "shard {s}: {} of its {share} seeds run{}\n",
+            digest.count(),
+            if digest.count() == share {
+                ""
+            } else {
+                " (stopped at --max-failures)"
+            }
+        ));
+    }
+    write!(out, "{text}").map_err(CliError::Output)?;
     if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&report.json(&opts))
-            .map_err(|e| CliError::Output(e.into()))?;
-        std::fs::write(path, text + "\n").map_err(|source| CliError::Write {
-            path: path.clone(),
-            source,
-        })?;
+        write_json(path, &json)?;
     }
     match report.failures.first() {
         None => Ok(()),
@@ -155,6 +245,50 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 .collect::<Vec<_>>()
                 .join(", "),
             replay_command(f.seed, &opts)
+        ))),
+    }
+}
+
+/// Writes `v` to `path`, pretty, with a final newline.
+fn write_json(path: &Path, v: &Value) -> Result<(), CliError> {
+    let text = serde_json::to_string_pretty(v).map_err(|e| CliError::Output(e.into()))?;
+    std::fs::write(path, text + "\n").map_err(|source| CliError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// `mmic swarm --merge FILE...`: the shards' reports as the single run's.
+fn merge(files: &[PathBuf], json: Option<&Path>, out: &mut dyn Write) -> Result<(), CliError> {
+    let mut reports = Vec::new();
+    for f in files {
+        let text = std::fs::read_to_string(f).map_err(|source| CliError::Read {
+            path: f.clone(),
+            source,
+        })?;
+        let v: Value = serde_json::from_str(&text)
+            .map_err(|e| CliError::Usage(format!("{}: not JSON: {e}", f.display())))?;
+        reports.push((f.display().to_string(), v));
+    }
+    let merged = shard::merge(&reports).map_err(|e| CliError::Usage(e.to_string()))?;
+    write!(out, "{}", shard::merged_text(&merged)).map_err(CliError::Output)?;
+    if let Some(path) = json {
+        write_json(path, &merged)?;
+    }
+    match merged["failures"].as_array().and_then(|f| f.first()) {
+        None => Ok(()),
+        Some(f) => Err(CliError::Invariant(format!(
+            "seed {} broke {}; replay: {}",
+            f["seed"],
+            f["violations"]
+                .as_array()
+                .map(Vec::as_slice)
+                .unwrap_or(&[])
+                .iter()
+                .filter_map(|v| v["invariant"].as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            f["replay"].as_str().unwrap_or("?")
         ))),
     }
 }

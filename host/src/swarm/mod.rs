@@ -18,6 +18,7 @@
 
 pub mod cli;
 pub mod scenario;
+pub mod shard;
 
 use crate::sim::engine::watch::{Checked, Invariant, Violation, Watch};
 use crate::sim::engine::{self, PlantedBug};
@@ -388,6 +389,7 @@ impl Report {
         let c = &self.checked;
         serde_json::json!({
             "runs": self.runs,
+            "sim_ms": self.sim_ms,
             "wall_s": self.wall.as_secs_f64(),
             "runs_per_second": self.runs_per_second(),
             "sim_hours": self.sim_hours(),
@@ -425,11 +427,32 @@ pub fn swarm(
     opts: &Options,
     progress: &mut dyn FnMut(String),
 ) -> Report {
+    let runs = max_runs.map_or(usize::MAX, |m| usize::try_from(m).unwrap_or(usize::MAX));
+    swarm_over(
+        &mut (seed_start..=u64::MAX).take(runs),
+        budget,
+        stop_at_failures,
+        opts,
+        progress,
+    )
+}
+
+/// Runs the seeds `seeds` gives, in its order, until it ends or `budget` of wall time is spent
+/// (or `stop_at_failures` failures); `progress` gets a line every few seconds. A seed is taken
+/// from `seeds` only to be run: what it has given is what ran (`mmic swarm --shard` counts
+/// and digests the seeds this way).
+pub fn swarm_over(
+    seeds: &mut dyn Iterator<Item = u64>,
+    budget: Duration,
+    stop_at_failures: usize,
+    opts: &Options,
+    progress: &mut dyn FnMut(String),
+) -> Report {
     let start = Instant::now();
     let mut last = start;
     let mut r = Report::default();
-    let mut seed = seed_start;
-    while start.elapsed() < budget && max_runs.is_none_or(|m| r.runs < m) {
+    while start.elapsed() < budget {
+        let Some(seed) = seeds.next() else { break };
         let mut o = run_one(seed, opts);
         r.runs += 1;
         r.sim_ms += o.sim_ms as u64;
@@ -470,15 +493,20 @@ pub fn swarm(
         }
         if last.elapsed() >= Duration::from_secs(10) {
             last = Instant::now();
+            // A shard has no budget: it runs its share.
+            let left = if budget < Duration::MAX {
+                let left = budget.saturating_sub(start.elapsed());
+                format!(", {:.0} s left", left.as_secs_f64())
+            } else {
+                String::new()
+            };
             progress(format!(
-                "{} runs, {:.1} simulated hours, {} failed, {:.0} s left",
+                "{} runs, {:.1} simulated hours, {} failed{left}",
                 r.runs,
                 r.sim_ms as f64 / 3_600_000.0,
                 r.failures.len(),
-                budget.saturating_sub(start.elapsed()).as_secs_f64()
             ));
         }
-        seed += 1;
     }
     r.wall = start.elapsed();
     r
