@@ -504,6 +504,7 @@ fn event_json(subservice: u8, data: &[u8]) -> Result<Value, PusCodecError> {
                     "result": ATTEMPT_RESULTS.iter().find(|(r, _)| *r == result).map(|(_, n)| *n)}),
         Event::Cleared(f) => json!({"faults": f.iter().map(|x| x.name()).collect::<Vec<_>>()}),
         Event::Fault { fault, mode } => json!({"fault": fault.name(), "mode": mode.name()}),
+        Event::Restarted(b) => json!({"cause": b.cause.name(), "count": b.count}),
         Event::Security {
             reason,
             refused,

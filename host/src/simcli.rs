@@ -48,14 +48,17 @@ Before anything is sent, the plan is checked against the robot's state, from its
 /// refusal names in place of `REFUSALS`.
 const SUMMARY_JSON_HELP: &str = r#"--summary-json FILE writes one JSON object when the run ends:
   {"completed": false, "mode": "safed", "faults": ["bolter-overcurrent"],
-   "refusals": ["not_allowed_in_mode"], "exit": 1}
+   "refusals": ["not_allowed_in_mode"], "exit": 1, "executed_twice": 0,
+   "restarts": {"board_a": 1, "board_b": 0, "server": 0}}
 completed: every step of the plan done. mode: standby, safed or operational, as the robot
 last reported it (the last heartbeat the ground received). faults: the Table 8 faults board A
 raised, in the order raised, each once, by their --inject names (a module's idle-check and
 operational-check overcurrent bits are both that module's name). refusals: every command
 board A refused, in order, by the names of spec/modes.toml [refusals]:
   REFUSALS.
-exit: the exit code this run of mmic sim returns."#;
+exit: the exit code this run of mmic sim returns. executed_twice: sequenced commands board A
+accepted more than once (0 unless exactly-once broke: a script checks it). restarts: the
+restarts injected with --inject reboot-a/-b/-server, all robots."#;
 
 /// `mmic sim --help`'s part on `--summary-json`, with the refusal names of the library
 /// (spec/modes.toml `[refusals]`).
@@ -71,6 +74,7 @@ pub fn summary_json_help() -> String {
 pub fn sim_help() -> String {
     let width = Injection::ALL
         .iter()
+        .chain(&Injection::REBOOTS)
         .map(|i| i.name().len())
         .max()
         .unwrap_or(0);
@@ -81,7 +85,7 @@ pub fn sim_help() -> String {
          at that time.\n\
          Each acts physically where it can, and the firmware must detect it as the robot would:\n"
     );
-    for i in Injection::ALL {
+    for i in Injection::ALL.iter().chain(&Injection::REBOOTS) {
         t.push_str(&format!("  {:width$}  {}\n", i.name(), i.effect()));
     }
     t.push_str(

@@ -953,6 +953,8 @@ fn stop_during_a_reconfiguration_then_reset_resumes_it_and_the_demo_completes() 
             exit: 0,
             link: None,
             frames: None,
+            executed_twice: 0,
+            restarts: serde_json::json!({"board_a": 0, "board_b": 0, "server": 0}),
         }
     );
 }

@@ -33,6 +33,7 @@ use crate::bolter::BolterPair;
 use crate::faults::{Fault, Faults};
 use crate::link::sdls::SdlsRefusal;
 use crate::mode::Mode;
+use crate::restart::Boot;
 use crate::safety::policy::fault_action;
 use crate::wire::heartbeat::HeartbeatRepr;
 
@@ -126,6 +127,10 @@ pub enum Event {
     },
     /// Latched faults were cleared. ID 0x0003; the cleared map.
     Cleared(Faults),
+    /// Board A restarted between two heartbeats (their boot bytes differ: heartbeat byte 59,
+    /// decision `heartbeat-boot`): it is in Standby, its motion lost. ID 0x0004; the new boot
+    /// byte (reset cause and boot count modulo 32).
+    Restarted(Boot),
     /// The server board's SDLS refused TC frames of the robot's link. ID 0x0200 + the
     /// reason's place in [`SdlsRefusal::NAMES`]; the auxiliary data are how many frames were
     /// refused for it since the last such report (at least one; reports are rate-limited,
@@ -152,6 +157,7 @@ impl Event {
             Event::ModeChanged { .. } => 1,
             Event::Attempt { .. } => 2,
             Event::Cleared(_) => 3,
+            Event::Restarted(_) => 4,
             Event::Security { reason, .. } => 0x0200 + *reason as u16,
         }
     }
@@ -175,8 +181,8 @@ impl Event {
             },
             Event::ModeChanged { .. } | Event::Cleared(_) => 1,
             // Medium: refused frames are an attack or a fault of the link or the ground's
-            // keys, and nothing of them executed.
-            Event::Security { .. } => 3,
+            // keys, and nothing of them executed. A restart stopped what the robot was doing.
+            Event::Security { .. } | Event::Restarted(_) => 3,
         }
     }
 
@@ -191,6 +197,7 @@ impl Event {
                 result,
             } => [pair.number(), *attempt, *result as u8, 0],
             Event::Cleared(f) => f.bits().to_be_bytes(),
+            Event::Restarted(b) => [b.to_wire(), 0, 0, 0],
             Event::Security { refused, spi, .. } => {
                 let [r0, r1] = refused.to_be_bytes();
                 let [s0, s1] = spi.to_be_bytes();
@@ -254,6 +261,7 @@ impl Event {
                     _ => return Err(field("faults", bits)),
                 }
             }
+            4 => Event::Restarted(Boot::from_wire(b[2])),
             0x0100..=0x01FF => Event::Fault {
                 fault: Fault::ALL
                     .into_iter()
@@ -288,8 +296,8 @@ impl Event {
     }
 }
 
-/// The events between two consecutive heartbeats `a` then `b`: new faults (bit order), the
-/// mode change, the bolting attempts that ended, faults cleared. `stopped`: the gateway
+/// The events between two consecutive heartbeats `a` then `b`: board A's restart, new faults
+/// (bit order), the mode change, the bolting attempts that ended, faults cleared. `stopped`: the gateway
 /// forwarded a Stop between them (a pair that ended then was interrupted, not done).
 pub fn between<'h>(
     a: &'h HeartbeatRepr,
@@ -307,7 +315,10 @@ pub fn between<'h>(
         to: b.mode,
     });
     let cleared = (!cleared.is_empty()).then_some(Event::Cleared(cleared));
-    faults
+    let restarted = a.boot.differs(b.boot).then_some(Event::Restarted(b.boot));
+    restarted
+        .into_iter()
+        .chain(faults)
         .chain(mode)
         .chain(attempts(a, b, stopped, raised))
         .chain(cleared)

@@ -222,6 +222,7 @@ fn services_toml_is_what_the_gateway_serves() {
     for c in [
         mmic::pus::verification::UNACKNOWLEDGED,
         mmic::pus::verification::ABANDONED,
+        mmic::pus::verification::RESTARTED,
         mmic::pus::verification::QUEUE_FULL,
         mmic::pus::verification::KEY_REUSED,
     ] {
@@ -239,6 +240,7 @@ fn services_toml_is_what_the_gateway_serves() {
             ("0x0001", "mode_changed"),
             ("0x0002", "bolting_attempt"),
             ("0x0003", "faults_cleared"),
+            ("0x0004", "board_a_restarted"),
             ("0x0200 + n", "sdls_refused"),
             ("0x0100 + n", "fault")
         ]

@@ -1,6 +1,7 @@
 //! Fault injection: each of Table 8's ten faults, a sensor that stops answering (the ADC of
 //! either side, the hip encoder: the project's sensor loss), and the operator's Stop and
-//! Reset, at a simulated time (`mmic sim --inject NAME@SECONDS`).
+//! Reset, and the restart of a node (board A, board B, the server board), at a simulated time
+//! (`mmic sim --inject NAME@SECONDS`).
 //!
 //! A fault acts physically where it can, so that the firmware has to detect it the way the
 //! robot would: a jammed fastener, a dead contraction switch, an obstacle on a bolter, a
@@ -16,6 +17,7 @@
 //! assert_eq!(s.injection.name(), "low-battery");
 //! assert!("low-batery@3".parse::<Scheduled>().unwrap_err().to_string().contains("valid names: bolting-failure, "));
 //! assert_eq!(Injection::ALL.len(), 15);
+//! assert_eq!("reboot-server@12".parse::<Scheduled>().unwrap().at_ms, 12_000);
 //! ```
 
 use super::SimConfig;
@@ -34,7 +36,27 @@ pub enum Injection {
     Stop,
     /// The operator's Reset (Table 1: after a stop, resume motion), out of band.
     Reset,
+    /// A node of every robot restarts (a power cycle: RAM and RTC memory lost, flash kept;
+    /// spec/decisions.toml `restart-*`), down for [`BOOT_MS`].
+    Reboot(Node),
 }
+
+/// A node that can restart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Node {
+    /// Board A (keeps its exactly-once log and boot count: decision `restart-board-a`).
+    A,
+    /// Board B (keeps nothing: decision `restart-board-b`).
+    B,
+    /// The server board (keeps the gateway's newest TC key per source and the SDLS counters:
+    /// decision `restart-server`).
+    Server,
+}
+
+/// How long a restarting node is down before its first tick, ms: the ESP32's boot (ROM
+/// bootloader, second-stage bootloader, image check, WiFi bring-up on the server board and
+/// board A) takes some hundreds of ms.
+pub const BOOT_MS: u32 = 300;
 
 /// A sensor that can fall silent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -78,13 +100,25 @@ impl Injection {
             Injection::Silent(Device::Encoder) => "encoder-silent".to_string(),
             Injection::Stop => "stop".to_string(),
             Injection::Reset => "reset".to_string(),
+            Injection::Reboot(Node::A) => "reboot-a".to_string(),
+            Injection::Reboot(Node::B) => "reboot-b".to_string(),
+            Injection::Reboot(Node::Server) => "reboot-server".to_string(),
         }
     }
+
+    /// The restarts, one per node. Not in [`Injection::ALL`] (the faults the swarm's main
+    /// stream draws from): the swarm draws restarts from a stream of their own.
+    pub const REBOOTS: [Injection; 3] = [
+        Injection::Reboot(Node::A),
+        Injection::Reboot(Node::B),
+        Injection::Reboot(Node::Server),
+    ];
 
     /// Every valid name, comma-separated (for error messages and `--help`).
     pub fn names() -> String {
         Injection::ALL
             .iter()
+            .chain(&Injection::REBOOTS)
             .map(|i| i.name())
             .collect::<Vec<_>>()
             .join(", ")
@@ -128,6 +162,13 @@ impl Injection {
             }
             Injection::Stop => "the ground sends Stop",
             Injection::Reset => "the ground sends Reset",
+            Injection::Reboot(Node::A) => {
+                "board A restarts: down 300 ms, then Standby with its exactly-once log from flash"
+            }
+            Injection::Reboot(Node::B) => "board B restarts: down 300 ms, then as at power-on",
+            Injection::Reboot(Node::Server) => {
+                "the server board restarts: down 300 ms, then its gateway with the kept TC keys and SDLS counters"
+            }
         }
     }
 
@@ -137,7 +178,7 @@ impl Injection {
             Injection::Fault(Table8::AssemblySystem) => Some(Command::SystemFault),
             Injection::Stop => Some(Command::Stop),
             Injection::Reset => Some(Command::Reset),
-            Injection::Fault(_) | Injection::Silent(_) => None,
+            Injection::Fault(_) | Injection::Silent(_) | Injection::Reboot(_) => None,
         }
     }
 
@@ -221,6 +262,7 @@ impl FromStr for Injection {
     fn from_str(name: &str) -> Result<Injection, InjectError> {
         Injection::ALL
             .into_iter()
+            .chain(Injection::REBOOTS)
             .find(|i| i.name() == name)
             .ok_or_else(|| InjectError::UnknownName {
                 name: name.to_string(),
@@ -314,7 +356,7 @@ impl SimConfig {
             Injection::Silent(Device::AdcA) => once(&mut p.adc_silent_at[0], s)?,
             Injection::Silent(Device::AdcB) => once(&mut p.adc_silent_at[1], s)?,
             Injection::Silent(Device::Encoder) => once(&mut p.encoder_silent_at, s)?,
-            Injection::Stop | Injection::Reset => {}
+            Injection::Stop | Injection::Reset | Injection::Reboot(_) => {}
         }
         self.injections.push(s);
         self.injections.sort_by_key(|s| s.at_ms);
@@ -333,6 +375,11 @@ mod tests {
             assert_eq!(i.name().parse::<Injection>(), Ok(i));
             assert!(seen.insert(i.name()), "{i} twice");
             assert!(!i.effect().is_empty());
+        }
+        for i in Injection::REBOOTS {
+            assert_eq!(i.name().parse::<Injection>(), Ok(i));
+            assert!(seen.insert(i.name()), "{i} twice");
+            assert!(!Injection::ALL.contains(&i));
         }
         // Every Table 8 row is injectable.
         for r in Table8::ALL {

@@ -606,6 +606,12 @@ pub struct Summary {
     pub last_heartbeat: Option<HeartbeatRepr>,
     /// The engine: the wall clock ([`realtime`]) or virtual time ([`engine`]).
     pub realtime: bool,
+    /// Sequenced commands board A accepted more than once (per robot and number): 0 unless
+    /// exactly-once broke. Counted by the virtual-time engine; the realtime engine counts from
+    /// its log ([`Summary::events`]).
+    pub executed_twice: u64,
+    /// Restarts of board A, board B and the server board, all robots (`--inject reboot-*`).
+    pub restarts: [u32; 3],
 }
 
 impl Summary {
@@ -644,6 +650,8 @@ impl Summary {
             pace_slack_ms: None,
             last_heartbeat: stats.last_heartbeat,
             realtime: false,
+            executed_twice: 0,
+            restarts: [0; 3],
         }
     }
 

@@ -124,6 +124,19 @@ pub struct Drives {
     pub mux: MuxLines,
 }
 
+impl Drives {
+    /// Nothing driven: a board that is down (restarting) powers nothing.
+    pub fn off() -> Drives {
+        Drives {
+            arm: None,
+            gripper: None,
+            regulator: false,
+            bolter: Drive::Idle,
+            mux: MuxLines::default(),
+        }
+    }
+}
+
 /// What one side's sensors read: the raw readings the library's front end
 /// ([`mmic::sensors::frontend`]) filters, and the digital inputs.
 #[derive(Debug, Clone, Copy)]

@@ -339,6 +339,17 @@ fn spawn_server<'scope, 'env>(
 
 /// Runs the simulation on the wall clock to the end of every robot's plan (or the time limit).
 pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
+    if let Some(r) = cfg
+        .injections
+        .iter()
+        .find(|s| matches!(s.injection, super::inject::Injection::Reboot(_)))
+    {
+        return Err(std::io::Error::other(format!(
+            "{} is injected in the virtual-time engine only (the default): the realtime \
+             engine's nodes are threads that cannot restart yet",
+            r.injection
+        )));
+    }
     let n = cfg.robots.max(1) as usize;
     let (logger, log_rx) = log::Log::new();
     let secured = cfg.link == LinkLayer::Frames

@@ -78,6 +78,10 @@ pub struct SummaryJson {
     /// `attacks_passed`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frames: Option<serde_json::Value>,
+    /// Sequenced commands board A took more than once (0 unless exactly-once broke).
+    pub executed_twice: u64,
+    /// Restarts injected (`--inject reboot-*`), all robots: `board_a`, `board_b`, `server`.
+    pub restarts: serde_json::Value,
 }
 
 /// The run's [`SummaryJson`], given the exit code the process returns.
@@ -90,6 +94,16 @@ pub fn summary_json(s: &Summary, exit: u8) -> SummaryJson {
         exit,
         link: (s.protocol == super::Protocol::Pus).then(|| s.link.name().to_string()),
         frames: s.frames.and_then(|f| serde_json::to_value(f).ok()),
+        // The virtual-time engine counts as board A takes them, logged or not; the realtime
+        // engine's count comes from its log.
+        executed_twice: if s.realtime {
+            executed_twice(s).len() as u64
+        } else {
+            s.executed_twice
+        },
+        restarts: serde_json::json!({
+            "board_a": s.restarts[0], "board_b": s.restarts[1], "server": s.restarts[2],
+        }),
     }
 }
 
@@ -110,7 +124,7 @@ pub fn executed_twice(s: &Summary) -> Vec<u64> {
     let mut count = std::collections::BTreeMap::new();
     for e in s.events("executed") {
         let seq = e["event"]["seq"].as_u64().unwrap_or(0);
-        if seq != 0 {
+        if seq != 0 && e["event"]["command"] != "heartbeat" {
             *count.entry((e["node"].to_string(), seq)).or_insert(0u32) += 1;
         }
     }

@@ -1,6 +1,6 @@
 //! `mmic swarm`: arguments and output around [`super::swarm`] and its replay.
 
-use super::scenario::{LinkDraw, Options, Scenario, SdlsDraw};
+use super::scenario::{LinkDraw, Options, RestartDraw, Scenario, SdlsDraw};
 use super::shard::{self, SeedDigest, SeedRange, Shard};
 use super::{judge, replay_command, swarm_over};
 use crate::error::CliError;
@@ -83,7 +83,8 @@ pub struct SwarmArgs {
     /// Stop after this many failing seeds.
     #[arg(long, default_value_t = 5)]
     pub max_failures: usize,
-    /// Plant a bug in the engine's shells (none, double-exec): the swarm must find it.
+    /// Plant a bug in the engine's shells (none, double-exec, log-not-restored): the swarm
+    /// must find it.
     #[arg(long, default_value = "none", value_parser = planted)]
     pub plant_bug: PlantedBug,
     /// The link layer of PUS scenarios: any (drawn, packets or frames half each), packets, or
@@ -95,6 +96,11 @@ pub struct SwarmArgs {
     /// scenario: a replay needs the same.
     #[arg(long, default_value = "any", value_parser = sdls_draw)]
     pub sdls: SdlsDraw,
+    /// Node restarts: any (drawn: 0.4 of the runs restart board A, board B or the server board
+    /// one to three times), off, or on (every run). Part of a seed's scenario: a replay needs
+    /// the same.
+    #[arg(long, default_value = "any", value_parser = restart_draw)]
+    pub restarts: RestartDraw,
     /// Replay this one seed: print its scenario and violations, write its whole log.
     #[arg(long, value_name = "SEED")]
     pub replay: Option<u64>,
@@ -114,7 +120,8 @@ pub struct SwarmArgs {
     /// (printed; --json writes it): every shard once, all with the same options.
     #[arg(long, value_name = "FILE", num_args = 1..,
           conflicts_with_all = ["seconds", "runs", "seed_start", "sim_seconds", "max_failures",
-                                "plant_bug", "link", "sdls", "replay", "out", "shard"])]
+                                "plant_bug", "link", "sdls", "restarts", "replay", "out",
+                                "shard"])]
     pub merge: Vec<PathBuf>,
 }
 
@@ -131,6 +138,10 @@ fn link_draw(s: &str) -> Result<LinkDraw, String> {
 }
 
 fn sdls_draw(s: &str) -> Result<SdlsDraw, String> {
+    s.parse()
+}
+
+fn restart_draw(s: &str) -> Result<RestartDraw, String> {
     s.parse()
 }
 
@@ -156,6 +167,7 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
         planted_bug: a.plant_bug,
         link: a.link,
         sdls: a.sdls,
+        restarts: a.restarts,
     };
     if let Some(seed) = a.replay {
         return replay(seed, &opts, &a.out, out);
@@ -209,9 +221,11 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
         "sim_seconds": a.sim_seconds,
         "link": opts.link.name(),
         "sdls": opts.sdls.name(),
+        "restarts": opts.restarts.name(),
         "plant_bug": match opts.planted_bug {
             PlantedBug::None => "none",
             PlantedBug::DoubleExec => "double-exec",
+            PlantedBug::LogNotRestored => "log-not-restored",
         },
     });
     json["seeds"] = digest.json();

@@ -35,6 +35,8 @@ pub struct Options {
     pub link: LinkDraw,
     /// SDLS on frames scenarios: drawn, or always or never.
     pub sdls: SdlsDraw,
+    /// Node restarts: drawn, or never, or in every run.
+    pub restarts: RestartDraw,
 }
 
 impl Default for Options {
@@ -44,9 +46,75 @@ impl Default for Options {
             planted_bug: PlantedBug::None,
             link: LinkDraw::Any,
             sdls: SdlsDraw::Any,
+            restarts: RestartDraw::Any,
         }
     }
 }
+
+/// Whether a scenario's nodes restart (`--inject reboot-*`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RestartDraw {
+    /// Drawn from the seed's restart stream: 0.4 of the runs, one to three restarts.
+    #[default]
+    Any,
+    /// Never: every seed's scenario as before restarts were drawn.
+    Off,
+    /// In every run: one to three restarts.
+    On,
+}
+
+impl RestartDraw {
+    /// Its name on the command line.
+    pub const fn name(self) -> &'static str {
+        match self {
+            RestartDraw::Any => "any",
+            RestartDraw::Off => "off",
+            RestartDraw::On => "on",
+        }
+    }
+}
+
+impl std::str::FromStr for RestartDraw {
+    type Err = String;
+    fn from_str(s: &str) -> Result<RestartDraw, String> {
+        match s {
+            "any" => Ok(RestartDraw::Any),
+            "off" => Ok(RestartDraw::Off),
+            "on" => Ok(RestartDraw::On),
+            _ => Err(format!("{s:?} is no restart choice: any, off or on")),
+        }
+    }
+}
+
+/// The restart stream's draws for `seed`, seeded apart from the others (so that every earlier
+/// draw of every seed stays what it was): whether the run has restarts (0.4 of them, unless
+/// [`Options::restarts`] says), then one to three, each of board A, board B or the server board
+/// (a third each) at a time in the run's fault window. All drawn whatever the choice, so the
+/// stream stays aligned.
+fn draw_restarts(seed: u64, opts: &Options, cfg: &mut SimConfig, latest: u32) {
+    let mut rng = fastrand::Rng::with_seed(seed ^ RESTART_STREAM);
+    let wanted = rng.f64() < 0.4;
+    let n = rng.usize(1..=3);
+    let draws: Vec<(Injection, u32)> = (0..3)
+        .map(|_| {
+            let node = Injection::REBOOTS[rng.usize(..Injection::REBOOTS.len())];
+            (node, rng.u32(1_000..latest.max(1_001)))
+        })
+        .collect();
+    let on = match opts.restarts {
+        RestartDraw::Any => wanted,
+        RestartDraw::Off => false,
+        RestartDraw::On => true,
+    };
+    if on {
+        for (injection, at_ms) in draws.into_iter().take(n) {
+            let _ = cfg.inject(Scheduled { injection, at_ms });
+        }
+    }
+}
+
+/// The restart stream's seed mask.
+const RESTART_STREAM: u64 = 0x5245_5354_0000_0000;
 
 /// Whether a frames scenario's link is secured with SDLS.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -344,6 +412,7 @@ impl Scenario {
             }
         }
         let link = draw_link(seed, protocol, opts, &mut cfg);
+        draw_restarts(seed, opts, &mut cfg, latest);
         Scenario {
             seed,
             protocol,

@@ -230,12 +230,13 @@ fn mix(seed: u64) -> u64 {
 
 /// The JSON `options` of a swarm report: what decides which seeds run and what each one's
 /// scenario and verdict are. Shards of one campaign must agree on all of them.
-pub const OPTION_FLAGS: [(&str, &str); 6] = [
+pub const OPTION_FLAGS: [(&str, &str); 7] = [
     ("seed_start", "--seed-start"),
     ("runs", "--runs"),
     ("sim_seconds", "--sim-seconds"),
     ("link", "--link"),
     ("sdls", "--sdls"),
+    ("restarts", "--restarts"),
     ("plant_bug", "--plant-bug"),
 ];
 
@@ -601,11 +602,12 @@ pub fn merged_text(v: &Value) -> String {
     let n = |x: &Value| x.as_u64().unwrap_or(0);
     let mut t = format!(
         "swarm merge: {} shards of the {} seeds from {} (--sim-seconds {}, --link {}, --sdls {}, \
-         --plant-bug {}): {} runs, {:.2} simulated hours, {:.1} machine seconds (longest shard \
+         --restarts {}, --plant-bug {}): {} runs, {:.2} simulated hours, {:.1} machine seconds (longest shard \
          {:.1} s); {} plans completed, {} ended otherwise\n\
          checked: {} admissions, {} board A ticks in motion, {} ticks in Standby, {} faults \
          raised, {} commands ended, {} injected faults expected in time, {} attack frames\n\
          space data link: {} runs over frames, {} with SDLS, {} attacked\n\
+         restarts: {} runs with a node restarting; commands executed twice: {}\n\
          seeds: {} run, digest {}\n",
         n(&v["merged"]["shards"]),
         n(&o["runs"]),
@@ -613,6 +615,7 @@ pub fn merged_text(v: &Value) -> String {
         n(&o["sim_seconds"]),
         o["link"].as_str().unwrap_or("?"),
         o["sdls"].as_str().unwrap_or("?"),
+        o["restarts"].as_str().unwrap_or("?"),
         o["plant_bug"].as_str().unwrap_or("?"),
         n(&v["runs"]),
         v["sim_hours"].as_f64().unwrap_or(0.0),
@@ -630,6 +633,8 @@ pub fn merged_text(v: &Value) -> String {
         n(&v["frame_runs"]),
         n(&v["sdls_runs"]),
         n(&v["attacked_runs"]),
+        n(&v["restart_runs"]),
+        n(&v["executed_twice"]),
         n(&v["seeds"]["count"]),
         v["seeds"]["digest"].as_str().unwrap_or("?"),
     );

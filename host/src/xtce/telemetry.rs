@@ -70,7 +70,7 @@ const REQUEST_ID: [(&str, &str, &str); 6] = [
 ];
 
 /// The ST\[1\] failure report's and the ST\[5\] event reports' parameters after their headers.
-const REPORT_DATA: [(&str, &str, &str); 15] = [
+const REPORT_DATA: [(&str, &str, &str); 16] = [
     ("failure_code", "failure_code_type", "ST[1] failure code"),
     (
         "failure_data",
@@ -97,6 +97,11 @@ const REPORT_DATA: [(&str, &str, &str); 15] = [
         "faults_cleared: the cleared fault map",
     ),
     ("event_fault_mode", "mode_type", "fault: the mode after it"),
+    (
+        "event_boot",
+        "uint8",
+        "board_a_restarted: the new boot byte (reset cause in bits 7..5, boot count modulo 32)",
+    ),
     (
         "event_sdls_refused",
         "uint16",
@@ -484,7 +489,7 @@ fn containers() -> Vec<Container> {
 }
 
 /// The ST\[5\] event report and one container per event's auxiliary data.
-fn event_containers() -> [Container; 6] {
+fn event_containers() -> [Container; 7] {
     let severities = tm_subservices(|t| t.service == 5);
     let fault = vec![
         Comparison::new("event_id", Op::Ge, 0x100),
@@ -523,6 +528,12 @@ fn event_containers() -> [Container; 6] {
             "event 0x0003 faults_cleared",
             &["event_cleared_faults"],
             when("event-report", event_is(3)),
+        ),
+        container(
+            "event-board-a-restarted",
+            "event 0x0004 board_a_restarted",
+            &["event_boot", "event_spare24"],
+            when("event-report", event_is(4)),
         ),
         container(
             "event-fault",

@@ -53,7 +53,9 @@ use crate::pus::function::{self, FunctionError};
 use crate::pus::housekeeping;
 use crate::pus::request::{ST_EVENT, ST_FUNCTION, ST_HOUSEKEEPING, ST_TEST, ST_VERIFICATION};
 use crate::pus::robot_apid;
-use crate::pus::verification::{Failure, Report, RequestId, Stage, ABANDONED, UNACKNOWLEDGED};
+use crate::pus::verification::{
+    Failure, Report, RequestId, Stage, ABANDONED, RESTARTED, UNACKNOWLEDGED,
+};
 use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Instant};
 use crate::wire::heartbeat::HeartbeatRepr;
@@ -392,7 +394,11 @@ impl TcLink {
                     let refusal = u8::try_from(f.code).ok().and_then(Refusal::from_wire);
                     match (f.code, refusal) {
                         (_, Some(r)) => heard.done = Some(p.done(Outcome::Refused(r))),
-                        (UNACKNOWLEDGED, _) => heard.done = Some(p.done(Outcome::Unacknowledged)),
+                        // Board A never answered, or the gateway restarted after taking it
+                        // (it ran at most once): either way the outcome is not known.
+                        (UNACKNOWLEDGED | RESTARTED, _) => {
+                            heard.done = Some(p.done(Outcome::Unacknowledged))
+                        }
                         _ => heard.rejected = Some((seq, f)),
                     }
                 }
@@ -407,7 +413,11 @@ impl TcLink {
         } else if let Some(mut p) = self.running.filter(|p| p.tc.request.seq_count == seq) {
             heard.attempt = p.answered();
             self.running = Some(p);
-            if r.stage == Stage::Completion {
+            let restarted =
+                r.stage == Stage::Start && r.failure.is_some_and(|f| f.code == RESTARTED);
+            if r.stage == Stage::Completion || restarted {
+                // A motion whose gateway restarted under it is not followed any more: its
+                // end is not known (the robot may have finished it or stopped).
                 self.running = None;
                 heard.ended = Some((seq, self.motion_end(r.failure)));
             }

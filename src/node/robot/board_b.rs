@@ -134,7 +134,14 @@ pub struct BoardB {
     heard: Option<Instant>,
     sent: Option<Instant>,
     holding: bool,
+    /// After a restart: heartbeats still to send reporting "nothing received" (0) before any
+    /// command is taken ([`BoardB::restarted`]).
+    announce: u8,
 }
+
+/// Heartbeats a restarted board B sends reporting 0 before it takes a command: board A must
+/// hear one to know B restarted, and the A–B line may lose one or two.
+pub const RESTART_ANNOUNCEMENTS: u8 = 3;
 
 impl BoardB {
     /// Startup: servos at home — arm contracted, gripper closed — as on board A (Section 7:
@@ -150,7 +157,42 @@ impl BoardB {
             heard: None,
             sent: None,
             holding: false,
+            announce: 0,
         }
+    }
+
+    /// Board B after a restart (a power cycle, a watchdog, a brown-out): as at power-on, but
+    /// it first says so. It cannot know where its servos stopped (they have no feedback), and
+    /// what it would report from its start-up pose could tell board A that a gripper holds when
+    /// it hangs open; so it takes no command until it has sent [`RESTART_ANNOUNCEMENTS`]
+    /// heartbeats whose "command received" is 0, which board A, having heard a number before,
+    /// takes as B's restart: internal communication loss, Safed (decision `restart-board-b`).
+    /// B keeps nothing across a restart.
+    ///
+    /// ```
+    /// use mmic::node::robot::board_b::{BoardB, Config, Inputs, RESTART_ANNOUNCEMENTS};
+    /// use mmic::units::PulseWidth;
+    /// use mmic::wire::b_command::{BCommandRepr, BPower};
+    /// use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
+    /// let mut b = BoardB::restarted(Config::default());
+    /// let cmd = BCommandRepr {
+    ///     seq: 7, power: BPower::default(), stop: false, arm_target: PulseWidth::CENTER,
+    ///     gripper_target: PulseWidth::CENTER, bolter: None,
+    /// };
+    /// let mut zeros = 0;
+    /// for t in (0..2000).step_by(10) {
+    ///     // A's refreshes keep coming; none is taken until the announcements are out.
+    ///     let out = b.tick(t, &Inputs { command: Some(cmd.to_bytes()), ..Inputs::default() });
+    ///     if let Some(hb) = out.heartbeat {
+    ///         if InternalHeartbeatRepr::parse(&hb).unwrap().command_received == 0 { zeros += 1 }
+    ///     }
+    /// }
+    /// assert_eq!(zeros, RESTART_ANNOUNCEMENTS);
+    /// ```
+    pub const fn restarted(cfg: Config) -> BoardB {
+        let mut b = BoardB::new(cfg);
+        b.announce = RESTART_ANNOUNCEMENTS;
+        b
     }
 
     /// Starts with the servos at these pulses (the host simulator's initial pose).
@@ -169,7 +211,10 @@ impl BoardB {
 
     /// One tick at `now` (ms).
     pub fn tick(&mut self, now: u32, inp: &Inputs) -> Outputs {
-        let rejected = inp.command.and_then(|bytes| self.take(now, &bytes));
+        let rejected = match self.announce {
+            0 => inp.command.and_then(|bytes| self.take(now, &bytes)),
+            _ => None, // restarted: announcing, nothing taken yet
+        };
         let silent = match self.heard {
             Some(t) => Instant::from_millis(now).since(t).millis() > self.cfg.link_timeout_ms,
             None => false,
@@ -242,6 +287,7 @@ impl BoardB {
             _ if blind => None,
             _ => {
                 self.sent = Some(Instant::from_millis(now));
+                self.announce = self.announce.saturating_sub(1);
                 Some(self.report(inp).to_bytes())
             }
         }

@@ -42,21 +42,24 @@
 pub mod link;
 pub mod watch;
 
+use super::inject::{Injection, Node, BOOT_MS};
 use super::log::{self, Log};
-use super::plant::Plant;
+use super::plant::{Drives, Plant};
 use super::shell::{frames, Ground, GroundSide, LegacyGround, SideA, SideB};
 use super::{FrameStats, LinkLayer, Protocol, SimConfig, Summary};
 use link::{Fate, Link, LinkModel};
+use mmic::link::sdls::{self, Key256};
 use mmic::node::ground::frames::GroundLink;
 use mmic::node::ground::plan_runner::PlanRunner;
-use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::robot::board_a::{self, BoardA, Durable};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::node::server::frames::{FrameConfig, Stored};
-use mmic::node::server::gateway::{Gateway, Out};
+use mmic::node::server::gateway::{Gateway, Kept, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
+use mmic::restart::ResetCause;
 use mmic::units::BoardNumber;
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::deframer::Deframer;
@@ -113,6 +116,9 @@ pub enum PlantedBug {
     /// task with its sequence number cleared (an unsequenced command, which board A runs
     /// whatever its log says: the paper's scheme): a double execution on a duplicated packet.
     DoubleExec,
+    /// Board A restarts without its exactly-once log (as if the shell never read flash back):
+    /// a command resent after a restart runs again.
+    LogNotRestored,
 }
 
 impl std::str::FromStr for PlantedBug {
@@ -121,7 +127,10 @@ impl std::str::FromStr for PlantedBug {
         match s {
             "none" => Ok(PlantedBug::None),
             "double-exec" => Ok(PlantedBug::DoubleExec),
-            _ => Err(format!("{s:?} is no planted bug: none or double-exec")),
+            "log-not-restored" => Ok(PlantedBug::LogNotRestored),
+            _ => Err(format!(
+                "{s:?} is no planted bug: none, double-exec or log-not-restored"
+            )),
         }
     }
 }
@@ -163,6 +172,10 @@ enum Ev {
     Server { robot: usize, token: u64 },
     /// The ground's loop ticks every plan runner.
     GroundTick,
+    /// A node of every robot restarts: it goes down now.
+    Reboot(Node),
+    /// Robot `robot`'s node comes up again after its boot.
+    Up { robot: usize, node: Node },
 }
 
 struct Queued {
@@ -248,6 +261,16 @@ struct Robot {
     store: std::collections::BTreeMap<(&'static str, u16), u128>,
     /// With SDLS and an attacker: the attacker on the uplink.
     attacker: Option<Attacker>,
+    /// Board A's flash: its exactly-once log and boot count (decision `restart-board-a`).
+    kept_a: Option<Durable>,
+    /// The server board's flash: its gateway's newest TC key per source (`restart-server`).
+    kept_server: Kept,
+    /// With SDLS: the robot's (TC, TM) keys, as provisioned in the server board's image.
+    keys: Option<(Key256, Key256)>,
+    /// Board A, board B, the server board: down (restarting) until their `Up` event.
+    down: [bool; 3],
+    /// The restarts of each node so far.
+    restarts: [u32; 3],
 }
 
 /// The attacker on a robot's uplink ([`super::SdlsConfig::attack`]): it captures the TC data
@@ -312,6 +335,8 @@ struct Engine<'c, G: Ground> {
     status: Value,
     /// Robot 1's replay trace, when recording.
     trace: Option<Vec<u8>>,
+    /// Accepted executions of each (robot, sequence number ≠ 0) by board A.
+    executions: std::collections::HashMap<(usize, u16), u32>,
 }
 
 /// Runs the simulation to the end of every robot's plan (or the time limit) in virtual time.
@@ -387,6 +412,7 @@ impl<'c, G: Ground> Engine<'c, G> {
             tokens: 0,
             watch: watched.then(|| Watch::new(cfg, n)),
             status: Value::Null,
+            executions: Default::default(),
             trace: cfg.record.as_ref().map(|_| {
                 let mut t = Vec::new();
                 record_header(cfg).emit(&mut t);
@@ -405,6 +431,11 @@ impl<'c, G: Ground> Engine<'c, G> {
             }
         }
         e.at(0, Ev::GroundTick);
+        for s in &cfg.injections {
+            if let Injection::Reboot(node) = s.injection {
+                e.at(u64::from(s.at_ms) * 1000, Ev::Reboot(node));
+            }
+        }
         e
     }
 
@@ -477,8 +508,16 @@ impl<'c, G: Ground> Engine<'c, G> {
             let f = std::fs::File::create(p)?;
             log::write_lines(&records, &mut std::io::BufWriter::new(f))?;
         }
+        let mut restarts = [0u32; 3];
+        for r in &self.robots {
+            for (t, n) in restarts.iter_mut().zip(r.restarts) {
+                *t += n;
+            }
+        }
         let summary = Summary {
             frames,
+            executed_twice: self.executions.values().filter(|&&n| n > 1).count() as u64,
+            restarts,
             ..Summary::of_run(self.cfg, ends, stats, records, self.status, wall.elapsed())
         };
         Ok((summary, self.watch))
@@ -506,7 +545,10 @@ impl<'c, G: Ground> Engine<'c, G> {
                 conn,
                 bytes,
             } => self.deliver(robot, hop, conn, bytes),
-            Ev::Open { robot, conn } => self.wifi_opened(robot, conn),
+            Ev::Open { robot, conn } if !self.robots[robot].down[Node::A as usize] => {
+                self.wifi_opened(robot, conn)
+            }
+            Ev::Open { .. } => {}
             Ev::Close { robot, conn } => {
                 let r = &mut self.robots[robot];
                 if r.wifi_conn == conn && r.wifi.close() {
@@ -528,8 +570,103 @@ impl<'c, G: Ground> Engine<'c, G> {
                 }
             }
             Ev::GroundTick => return self.ground_tick(),
+            Ev::Reboot(node) => {
+                for i in 0..self.robots.len() {
+                    self.down(i, node);
+                }
+            }
+            Ev::Up { robot, node } => self.up(robot, node),
         }
         true
+    }
+
+    /// Robot `i`'s `node` goes down (a power cycle): what it held in RAM is gone, its
+    /// connections drop, its outputs are unpowered; it comes up [`BOOT_MS`] later.
+    fn down(&mut self, i: usize, node: Node) {
+        let now = self.now_ms();
+        let r = &mut self.robots[i];
+        let k = node as usize;
+        if r.down[k] {
+            return; // already restarting: one boot
+        }
+        r.down[k] = true;
+        r.restarts[k] += 1;
+        match node {
+            Node::A => {
+                r.commands = PacketQueue::new();
+                r.heartbeats = PacketQueue::new();
+                r.a_reader = Deframer::new();
+                r.a_from_b.clear();
+                r.wifi = WifiSession::new(WifiConfig::default());
+                r.wifi_conn = 0;
+                r.plant.advance(now);
+                r.plant.drive_a(Drives::off(), None);
+                if let Some(w) = &mut self.watch {
+                    w.restarted_a(i, now);
+                }
+            }
+            Node::B => {
+                r.b_reader = Deframer::new();
+                r.b_from_a.clear();
+                r.plant.advance(now);
+                r.plant.drive_b(Drives::off());
+            }
+            Node::Server => {
+                r.visit = None;
+                r.inbox.clear();
+                r.server_reader = Deframer::new();
+                r.server_wake = None;
+                if let Some(a) = &mut r.attacker {
+                    a.waiting.clear();
+                }
+            }
+        }
+        self.node_event(i, k, json!({"type": "restart", "down_ms": BOOT_MS}));
+        self.at(
+            self.now + u64::from(BOOT_MS) * 1000,
+            Ev::Up { robot: i, node },
+        );
+    }
+
+    /// Robot `i`'s `node` boots from what it kept (decisions `restart-*`).
+    fn up(&mut self, i: usize, node: Node) {
+        let cfg = self.cfg;
+        let r = &mut self.robots[i];
+        r.down[node as usize] = false;
+        match node {
+            Node::A => {
+                let kept = match cfg.planted_bug {
+                    PlantedBug::LogNotRestored => None,
+                    _ => r.kept_a,
+                };
+                let board = BoardA::restarted(
+                    board_a::Config {
+                        board: r.number,
+                        ..board_a::Config::default()
+                    },
+                    kept,
+                    ResetCause::PowerOn,
+                );
+                r.kept_a = Some(board.durable());
+                r.a = SideA::new(board);
+            }
+            Node::B => r.b = SideB::new(BoardB::restarted(board_b::Config::default())),
+            Node::Server => {
+                r.board = server_board(
+                    cfg,
+                    r.number,
+                    Some(r.kept_server.clone()),
+                    &r.store,
+                    r.keys.clone(),
+                );
+                self.wake_server(i, self.now);
+            }
+        }
+        let boot = match node {
+            Node::A => json!(self.robots[i].a.board.boot().to_wire()),
+            _ => Value::Null,
+        };
+        self.node_event(i, node as usize, json!({"type": "boot", "boot": boot}));
     }
 
     /// Logs robot `i`'s event from its node `node` (0 board A, 1 board B, 2 the server board).
@@ -653,6 +790,24 @@ impl<'c, G: Ground> Engine<'c, G> {
     }
 
     fn deliver(&mut self, i: usize, hop: Hop, conn: u64, bytes: Vec<u8>) {
+        // A node that is down (restarting) hears nothing.
+        let to = match hop {
+            Hop::GroundToServer | Hop::AToServer => Some(Node::Server),
+            Hop::ServerToA | Hop::BToA => Some(Node::A),
+            Hop::AToB => Some(Node::B),
+            Hop::ServerToGround => None,
+        };
+        if let Some(n) = to {
+            if self.robots[i].down[n as usize] {
+                if self.packet_log {
+                    if let Some(l) = &self.log {
+                        let (link, from, to) = self.robots[i].ends(hop, self.cfg.protocol);
+                        l.packet(self.now_ms(), link, from, to, "node_down", &bytes);
+                    }
+                }
+                return;
+            }
+        }
         match hop {
             Hop::GroundToServer => {
                 self.record(i, |t| Record::ServerIn { t, bytes: &bytes });
@@ -714,13 +869,38 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
     }
 
-    /// Board A's control task: one tick.
+    /// Board A's control task: one tick (while board A is down, the plant alone moves on).
     fn tick_a(&mut self, i: usize) {
         let now = self.now_ms();
         let r = &mut self.robots[i];
+        if r.down[Node::A as usize] {
+            r.plant.advance(now);
+            return;
+        }
         let command = r.commands.split().1.pop();
+        // Board A's flash: the record written before a tick that may run a new sequenced
+        // command, then after the tick (decision `restart-board-a`).
+        if let Some(d) = r.a.board.ahead(command.as_ref()) {
+            r.kept_a = Some(d);
+        }
         let from_b = r.a_from_b.pop_front();
         let out = r.a.tick(&mut r.plant, now, command, from_b);
+        r.kept_a = Some(r.a.board.durable());
+        for e in &out.events {
+            // A Heartbeat poll does nothing: running one again after a restart is allowed
+            // (decision `restart-board-a`), so it is not counted.
+            if let board_a::Event::Executed {
+                seq,
+                refusal: None,
+                command,
+            } = e
+            {
+                if *seq != 0 && *command != Some(mmic::command::Command::Heartbeat) {
+                    *self.executions.entry((i, *seq)).or_default() += 1;
+                }
+            }
+        }
+        let r = &mut self.robots[i];
         if let Some(s) = r.a.sensed {
             self.record(i, |t| Record::TickA {
                 t,
@@ -756,10 +936,13 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
     }
 
-    /// Board B: one tick.
+    /// Board B: one tick (none while it is down).
     fn tick_b(&mut self, i: usize) {
         let now = self.now_ms();
         let r = &mut self.robots[i];
+        if r.down[Node::B as usize] {
+            return;
+        }
         let command = r.b_from_a.pop_front();
         let out = r.b.tick(&mut r.plant, now, command);
         if let Some(s) = r.b.sensed {
@@ -953,7 +1136,7 @@ impl<'c, G: Ground> Engine<'c, G> {
 
     /// The server board's loop, between visits: the ground's packets, then the next visit.
     fn server_loop(&mut self, i: usize) {
-        if self.robots[i].visit.is_some() {
+        if self.robots[i].visit.is_some() || self.robots[i].down[Node::Server as usize] {
             return;
         }
         self.record(i, |t| Record::ServerLoop { t });
@@ -1241,6 +1424,50 @@ fn reading(s: &super::plant::Senses) -> trace::Reading {
     }
 }
 
+/// Robot `i`'s server board as it starts: at power-on (`kept` none), or after a restart from
+/// what its flash kept (the gateway's TC keys, the SDLS counters in `store`).
+fn server_board(
+    cfg: &SimConfig,
+    number: BoardNumber,
+    kept: Option<Kept>,
+    store: &std::collections::BTreeMap<(&'static str, u16), u128>,
+    keys: Option<(Key256, Key256)>,
+) -> Board {
+    match cfg.protocol {
+        Protocol::Legacy => Board::Relay(Server::new()),
+        Protocol::Pus if cfg.link == LinkLayer::Frames => {
+            let mut g = Box::new(SimFrameGateway::new(FrameConfig {
+                gateway: cfg.gateway,
+                ..FrameConfig::default()
+            }));
+            match kept {
+                Some(k) => g.add_restarted(number, k),
+                None => g.add(number),
+            };
+            if let Some((tc, tm)) = keys {
+                let stored = Stored {
+                    tc: store
+                        .get(&("server", sdls::mission::tc_spi(number)))
+                        .copied(),
+                    tm: store
+                        .get(&("server", sdls::mission::tm_spi(number)))
+                        .copied(),
+                };
+                g.secure(number, tc, tm, stored);
+            }
+            Board::Frames(g)
+        }
+        Protocol::Pus => {
+            let mut g = Box::new(SimGateway::new(cfg.gateway));
+            match kept {
+                Some(k) => g.add_restarted(number, k),
+                None => g.add(number),
+            };
+            Board::Gateway(g)
+        }
+    }
+}
+
 /// Marks the copy of a duplicated packet in its delivery's connection number (connection
 /// numbers count up from 1 and stay far below this bit).
 const DUPLICATE: u64 = 1 << 63;
@@ -1289,32 +1516,17 @@ impl Robot {
             link(&ab, cfg.ab_loss, 1, true),
             link(&ab, cfg.ab_loss, 2, true),
         ];
-        let board = match cfg.protocol {
-            Protocol::Legacy => Board::Relay(Server::new()),
-            Protocol::Pus if cfg.link == LinkLayer::Frames => {
-                let mut g = Box::new(SimFrameGateway::new(FrameConfig {
-                    gateway: cfg.gateway,
-                    ..FrameConfig::default()
-                }));
-                g.add(number);
-                Board::Frames(g)
-            }
-            Protocol::Pus => {
-                let mut g = Box::new(SimGateway::new(cfg.gateway));
-                g.add(number);
-                Board::Gateway(g)
-            }
-        };
         let frames = cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames;
         let mut ground_link = frames.then(|| Box::new(SimGroundLink::new(number)));
-        let mut board = board;
         let sdls = cfg.sdls.as_ref().filter(|_| frames);
+        // Keys the configuration cannot give (an unreadable random source) leave the link in
+        // clear: the run's SDLS figures then stay absent. Made once: both ends (and the
+        // server board after a restart, as from its flash) share them.
+        let keys = sdls.and_then(|s| s.keys(cfg.seed, i).ok());
+        let board = server_board(cfg, number, None, &Default::default(), keys.clone());
         let mut attacker = None;
-        if let (Some(sdls), Board::Frames(g), Some(gl)) = (sdls, &mut board, &mut ground_link) {
-            // Keys the configuration cannot give (an unreadable random source) leave the link
-            // in clear: the run's SDLS figures then stay absent.
-            if let Ok((tc, tm)) = sdls.keys(cfg.seed, i) {
-                g.secure(number, tc.clone(), tm.clone(), Stored::default());
+        if let (Some(sdls), Some(gl)) = (sdls, &mut ground_link) {
+            if let Some((tc, tm)) = keys.clone() {
                 gl.secure(tc, tm, (None, None));
             }
             attacker = (sdls.attack > 0.0).then(|| Attacker {
@@ -1363,6 +1575,11 @@ impl Robot {
             links,
             store: std::collections::BTreeMap::new(),
             attacker,
+            kept_a: None,
+            kept_server: Kept::new(),
+            keys,
+            down: [false; 3],
+            restarts: [0; 3],
         }
         .persisted()
     }
@@ -1370,6 +1587,14 @@ impl Robot {
     /// Writes both ends' due SDLS counters to the store and confirms them (the store is
     /// memory: written at once).
     fn persist(&mut self) {
+        let kept = match &self.board {
+            Board::Gateway(g) => g.kept(self.number),
+            Board::Frames(g) => g.kept(self.number),
+            Board::Relay(_) => None,
+        };
+        if let Some(k) = kept {
+            self.kept_server = k;
+        }
         if let Board::Frames(g) = &mut self.board {
             for (spi, v) in g.due().collect::<Vec<_>>() {
                 self.store.insert(("server", spi), v);

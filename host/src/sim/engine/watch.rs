@@ -47,6 +47,10 @@ pub const GRIP_TOLERANCE_US: f64 = 20.0;
 /// of the mode within one A→B period (50 ms) plus the line's latency and a tick, and a
 /// servo stops at once when unpowered.
 pub const STANDBY_GRACE_MS: u32 = 100;
+/// How long after board A goes down side B may still be moving, beyond the Standby grace, ms:
+/// board B holds once A has been silent past its link timeout (board B's default, 500 ms)
+/// and a tick.
+pub const RESTART_GRACE_MS: u32 = 500 + 10;
 
 /// The invariants.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -126,6 +130,11 @@ pub struct Checked {
     pub commands_ended: u64,
     /// With SDLS and an attacker: attack frames judged (each refused, or a violation).
     pub attack_frames: u64,
+    /// Restarts of board A watched through.
+    pub restarts: u64,
+    /// Commands board A admitted a second time (or more): each such admission counts, every
+    /// one (the violations keep only the first few).
+    pub executed_twice: u64,
 }
 
 /// What board A drives (its outputs that power something).
@@ -406,6 +415,14 @@ impl Watch {
         }
     }
 
+    /// Board A restarted at `now` (it comes up in Standby): nothing may move from when board
+    /// B, no longer hearing A, holds its side ([`RESTART_GRACE_MS`]).
+    pub fn restarted_a(&mut self, i: usize, now: u32) {
+        self.robots[i].standby_since = Some(now.saturating_add(RESTART_GRACE_MS));
+        self.robots[i].last_mode = Some(Mode::Standby);
+        self.checked.restarts += 1;
+    }
+
     /// Board B's tick at `now`: side B of the plant as it left it.
     pub fn tick_b(&mut self, i: usize, now: u32, side: &SideMotion) {
         if let Some(since) = self.robots[i].standby_since {
@@ -455,8 +472,16 @@ impl Watch {
             );
             return;
         };
+        // A Heartbeat poll does nothing: board A may run one again after a restart (its
+        // flash keeps no poll: decision `restart-board-a`).
+        let poll = mmic::wire::command::CommandRepr::parse(p)
+            .is_ok_and(|c| c.command == mmic::command::Command::Heartbeat);
+        if poll {
+            return;
+        }
         if let Some(first) = r.admitted.insert(origin, now) {
             r.admitted.insert(origin, first);
+            self.checked.executed_twice += 1;
             let what = mmic::wire::command::CommandRepr::parse(p)
                 .map(|c| format!("{:?} (this copy numbered {})", c.command, c.seq))
                 .unwrap_or_else(|e| e.to_string());

@@ -25,6 +25,11 @@ impl BoardA {
         if let Some(bytes) = from_b {
             match InternalHeartbeatRepr::parse(&bytes) {
                 Ok(hb) => {
+                    // B reports 0 only before it took any command: after a number, B
+                    // restarted (`BoardB::restarted`) and lost what A had told it.
+                    if hb.command_received == 0 && self.b.command_received != 0 {
+                        self.b_restarted = true;
+                    }
                     self.comm.heartbeat(now, hb.command_received);
                     self.b = hb;
                     self.b_heard = true;

@@ -62,6 +62,12 @@ impl BoardA {
         out: &mut Outputs,
     ) {
         self.log.record(seq, refusal);
+        // What flash keeps: every sequenced command but the Heartbeat poll, which does
+        // nothing and which the gateway sends four times a second when idle (a flash write per
+        // poll would wear the sector out in months: decision `restart-board-a`).
+        if seq != 0 && command != Some(Command::Heartbeat) {
+            self.kept = (seq, refusal);
+        }
         self.refusal = refusal;
         out.push(Event::Executed {
             seq,

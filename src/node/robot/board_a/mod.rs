@@ -101,6 +101,11 @@ pub struct BoardA {
     watch: Watch,
     /// This start as heartbeat byte 59 reports it ([`BoardA::restarted`]).
     boot: Boot,
+    /// Board B announced a restart since the last tick's fault detection.
+    b_restarted: bool,
+    /// The last sequenced command other than a Heartbeat poll, and its outcome: what flash
+    /// keeps of the exactly-once log ([`BoardA::durable`]).
+    kept: (u16, Option<Refusal>),
     /// Starts in all, this one included (0: started by [`BoardA::new`], not counted).
     boots: u16,
 }
@@ -136,6 +141,8 @@ impl BoardA {
             hip_seen: cfg.safety.hip_home,
             watch: Watch::Idle,
             boot: Boot::UNREPORTED,
+            b_restarted: false,
+            kept: (0, None),
             boots: 0,
         }
     }

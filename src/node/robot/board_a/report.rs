@@ -52,7 +52,8 @@ impl BoardA {
                 conditions = conditions.with(Fault::LowBattery);
             }
         }
-        if self.comm.lost(&self.cfg.safety) {
+        // Board B restarted: what A had told it is gone (decision `restart-board-b`).
+        if self.comm.lost(&self.cfg.safety) || core::mem::take(&mut self.b_restarted) {
             conditions = conditions.with(Fault::InternalCommLoss);
         }
         conditions

@@ -37,7 +37,7 @@ use crate::refusal::Refusal;
 use crate::restart::{Boot, ResetCause};
 
 /// What board A keeps across a restart: the exactly-once log's last entry and the boot count.
-/// Seven octets in flash ([`Durable::to_bytes`]).
+/// Five octets in flash ([`Durable::to_bytes`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Durable {
@@ -87,14 +87,17 @@ impl BoardA {
         let mut log = CommandLog::new();
         log.record(kept.last_seq, kept.outcome);
         a.log = log;
+        a.kept = (kept.last_seq, kept.outcome);
         a.boots = kept.boots.wrapping_add(1);
         a.boot = Boot::after(cause, a.boots);
         a
     }
 
-    /// What to keep now (write it after a tick that changed it).
+    /// What to keep now (write it after a tick that changed it): the log's last entry, Heartbeat
+    /// polls left out (they do nothing, so running one again after a restart harms nothing,
+    /// and a write per poll would wear the flash out).
     pub const fn durable(&self) -> Durable {
-        let (last_seq, outcome) = self.log.last();
+        let (last_seq, outcome) = self.kept;
         Durable {
             last_seq,
             outcome,
