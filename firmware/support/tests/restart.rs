@@ -536,3 +536,24 @@ fn a_flash_that_takes_no_write_takes_no_command_and_the_board_still_ticks() {
     // Not taken, not answered: the ground sends it again.
     assert!(l.heartbeats.is_empty());
 }
+
+/// spec/watchdog.toml's value of `key` (its `[watchdog]` table: `key = value  # why`).
+fn spec_ms(key: &str) -> u32 {
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec/watchdog.toml");
+    let text = std::fs::read_to_string(p).expect("spec/watchdog.toml");
+    let line = text
+        .lines()
+        .find(|l| l.split('=').next().map(str::trim) == Some(key))
+        .unwrap_or_else(|| panic!("spec/watchdog.toml has no {key}"));
+    let value = line.split('=').nth(1).unwrap().split('#').next().unwrap();
+    value.trim().parse().expect("a number of ms")
+}
+
+#[test]
+fn the_timeouts_are_spec_watchdogs() {
+    assert_eq!(restart::CONTROL_TIMEOUT_MS, spec_ms("control_timeout_ms"));
+    assert_eq!(restart::RTC_TIMEOUT_MS, spec_ms("rtc_timeout_ms"));
+    // Each covers many control periods, and the backstop the control watchdog.
+    assert!(restart::CONTROL_TIMEOUT_MS >= 10 * mmic_fw_support::control::TICK_MS);
+    assert!(restart::RTC_TIMEOUT_MS > restart::CONTROL_TIMEOUT_MS);
+}
