@@ -17,6 +17,11 @@ pub const CONTROL_TIMEOUT_MS: u32 = 1000;
 /// so it covers the boot up to the first complete tick, fed through the same gate.
 pub const RTC_TIMEOUT_MS: u32 = 4000;
 
+// Each covers many control periods, and the backstop outlasts the control watchdog.
+const _: () = assert!(
+    CONTROL_TIMEOUT_MS >= 10 * crate::control::TICK_MS && RTC_TIMEOUT_MS > CONTROL_TIMEOUT_MS
+);
+
 /// What the gate feeds: the board's watchdogs.
 pub trait Feed {
     /// Restarts every watchdog's count.

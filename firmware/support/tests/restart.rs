@@ -553,7 +553,4 @@ fn spec_ms(key: &str) -> u32 {
 fn the_timeouts_are_spec_watchdogs() {
     assert_eq!(restart::CONTROL_TIMEOUT_MS, spec_ms("control_timeout_ms"));
     assert_eq!(restart::RTC_TIMEOUT_MS, spec_ms("rtc_timeout_ms"));
-    // Each covers many control periods, and the backstop the control watchdog.
-    assert!(restart::CONTROL_TIMEOUT_MS >= 10 * mmic_fw_support::control::TICK_MS);
-    assert!(restart::RTC_TIMEOUT_MS > restart::CONTROL_TIMEOUT_MS);
 }
