@@ -416,14 +416,6 @@ fn first_life(fill: bool) -> Ram {
         let mut s = FlashDurable::open(flash).unwrap();
         let d = s.load().expect("the first life's record");
         // The next life writes its boot count in the last slot; its ahead record compacts.
-        while s.log().free_slots() > 2 {
-            s.keep(&Durable {
-                boots: d.boots,
-                ..d
-            })
-            .unwrap();
-            s.keep(&d).unwrap();
-        }
         while s.log().free_slots() > 1 {
             s.keep(&d).unwrap();
         }
