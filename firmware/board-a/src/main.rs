@@ -3,6 +3,10 @@
 //! server board's TCP connection and does what the library's `WifiSession` says: command
 //! packets into the rx queue, the heartbeats of the tx queue back) and the 10 ms control task
 //! (sensors, `BoardA::tick`, servos, bolter, regulator, the serial line to board B).
+//!
+//! Board A keeps its exactly-once log and boot count in the flash partition `mmic_a`
+//! (board-a/partitions.csv) and starts from it as Table 7's power-on says; its watchdogs are
+//! fed only after a complete control tick (`support::restart`, `support::wdt`).
 #![no_std]
 #![no_main]
 
@@ -12,12 +16,14 @@ use embassy_net::tcp::TcpSocket;
 use embassy_net::Stack;
 use embassy_time::{with_timeout, Duration, Instant, Ticker, Timer};
 use esp_backtrace as _;
+use esp_bootloader_esp_idf::partitions::{self, FlashRegion, PARTITION_TABLE_MAX_LEN};
 use esp_hal::gpio::Input;
 use esp_hal::i2c::master::{Config as I2cConfig, I2c};
 use esp_hal::time::Rate;
 use esp_hal::uart::{Config as UartConfig, Uart};
 use esp_hal::Blocking;
 use esp_println::println;
+use esp_storage::FlashStorage;
 use mmic::node::robot::board_a;
 use mmic::node::robot::handoff::{Consumer, PacketQueue, Producer};
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
@@ -27,9 +33,12 @@ use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::HEARTBEAT_LEN;
 use static_cell::StaticCell;
 use support::control::{commands_in, ControlA, QUEUE, TICK_MS};
+use support::durable::FlashDurable;
 use support::hw::{self, Serial};
 use support::net;
+use support::restart::Gate;
 use support::sensors::Side;
+use support::wdt::{self, Dogs};
 
 esp_bootloader_esp_idf::esp_app_desc!();
 
@@ -40,16 +49,29 @@ const BOARD: &str = match option_env!("MMIC_BOARD") {
 };
 /// Status line period, ticks.
 const STATUS_TICKS: u32 = 500;
+/// The flash partition of board A's record (board-a/partitions.csv): two 4 KiB sectors.
+const DURABLE_PARTITION: &str = "mmic_a";
+
+type Flash = partitions::NorFlashRegion<'static, 'static, 'static>;
+type Control = ControlA<'static, FlashDurable<Flash>>;
 
 type Bus = RefCell<I2c<'static, Blocking>>;
 static BUS: StaticCell<Bus> = StaticCell::new();
 static RX: StaticCell<PacketQueue<COMMAND_LEN, QUEUE>> = StaticCell::new();
 static TX: StaticCell<PacketQueue<HEARTBEAT_LEN, QUEUE>> = StaticCell::new();
+static FLASH: StaticCell<FlashStorage<'static>> = StaticCell::new();
+static REGION: StaticCell<FlashRegion<'static, 'static>> = StaticCell::new();
 
 #[esp_rtos::main]
 async fn main(spawner: Spawner) -> ! {
     wifi::boot!(p);
-    println!("mmic board A{BOARD} on {}", support::chip::CHIP);
+    // The RTC watchdog from here: it covers the start-up up to the first complete tick.
+    let (cause, code) = wdt::reset_cause();
+    let dogs = Dogs::arm(p.RTC_TIMER, p.TIMG1);
+    println!(
+        "mmic board A{BOARD} on {}, reset reason {code:#04x}: {cause}",
+        support::chip::CHIP
+    );
 
     // Start-up: a peripheral that cannot be configured is a build or wiring error.
     let n: u8 = BOARD.parse().expect("MMIC_BOARD: 1..=255");
@@ -72,39 +94,63 @@ async fn main(spawner: Spawner) -> ! {
         board,
         ..Default::default()
     };
-    let ctl = ControlA::new(cfg, frontend::Config::default(), cmd_out, hb_in);
-    spawner.spawn(control(ctl, side, outs, serial).expect("control task"));
+    // Table 7's power-on, with the exactly-once log and boot count flash kept.
+    let store = FlashDurable::open(durable_flash(p.FLASH)).expect("board A's record in flash");
+    let front = frontend::Config::default();
+    let ctl = ControlA::new(cfg, front, cmd_out, hb_in, store, cause);
+    println!("boot {:?}, kept {:?}", ctl.a.boot(), ctl.a.durable());
+    spawner.spawn(control(ctl, side, outs, serial, dogs).expect("control task"));
 
     // WiFi: station on the lab's access point, board A at its fixed address.
     let stack = wifi::start(&spawner, p.WIFI, net::robot(n));
     wifi_task(stack, cmd_in, hb_out).await
 }
 
-/// The control task: one library tick every 10 ms.
+/// Board A's record's partition as NOR flash. Start-up only: an image flashed without
+/// board-a/partitions.csv has no such partition, and must not run without its log (a command
+/// could run twice across a restart).
+fn durable_flash(flash: esp_hal::peripherals::FLASH<'static>) -> Flash {
+    let flash = FLASH.init(FlashStorage::new(flash));
+    let mut table = [0u8; PARTITION_TABLE_MAX_LEN];
+    let pt = partitions::read_partition_table(flash, &mut table).expect("partition table");
+    let entry = pt
+        .iter()
+        .find(|e| e.label_as_str() == DURABLE_PARTITION)
+        .expect("no mmic_a partition: flash with --partition-table board-a/partitions.csv");
+    let region = REGION.init(entry.as_flash_region(flash));
+    region.as_nor_flash().expect("mmic_a is not encrypted")
+}
+
+/// The control task: one library tick every 10 ms, the watchdogs fed after each complete one.
 #[embassy_executor::task]
 async fn control(
-    mut ctl: ControlA<'static>,
+    mut ctl: Control,
     mut side: Side<'static, I2c<'static, Blocking>, Input<'static>>,
     mut outs: hw::Outputs,
     mut serial: Serial,
+    mut dogs: Dogs,
 ) {
     let mut ticker = Ticker::every(Duration::from_millis(TICK_MS.into()));
     let mut ticks = 0u32;
+    dogs.arm_control();
+    let mut gate = Gate::new(dogs);
     loop {
         let now = Instant::now().as_millis() as u32;
-        let o = ctl.tick(now, &mut side, &mut outs, &mut serial);
+        let o = gate.run(|| ctl.tick(now, &mut side, &mut outs, &mut serial));
         for e in &o.events {
             println!("t={now} {e:?}");
         }
         ticks = ticks.wrapping_add(1);
         if ticks.is_multiple_of(STATUS_TICKS) {
             println!(
-                "t={now} mode={:?} i2c={:?} rx_err={} b_discarded={} hb_dropped={}",
+                "t={now} mode={:?} i2c={:?} rx_err={} b_discarded={} hb_dropped={} {:?} free={}",
                 ctl.a.mode(),
                 side.errors,
                 serial.rx_errors,
                 ctl.from_b.discarded(),
-                ctl.heartbeats_dropped()
+                ctl.heartbeats_dropped(),
+                ctl.counters,
+                ctl.store().log().free_slots()
             );
         }
         ticker.next().await;

@@ -1,6 +1,7 @@
 //! Board B (Figure 7): side B's sensors and outputs, and the serial line to board A. One
 //! embassy task: every 10 ms, read, filter, `BoardB::tick`, drive, send its heartbeat when
-//! the library says one is due (every 50 ms).
+//! the library says one is due (every 50 ms). Its watchdogs are fed only after a complete
+//! tick (`support::restart`, `support::wdt`); it keeps nothing across a restart.
 #![no_std]
 #![no_main]
 
@@ -25,7 +26,9 @@ use static_cell::StaticCell;
 use support::control::{bolter_lines, Actuators, Counters, Sensors, TICK_MS};
 use support::hw::{self, Serial};
 use support::link::{ByteSink, ByteSource, Link};
+use support::restart::Gate;
 use support::sensors::Side;
+use support::wdt::{self, Dogs};
 
 esp_bootloader_esp_idf::esp_app_desc!();
 
@@ -39,7 +42,13 @@ async fn main(_spawner: Spawner) -> ! {
     let p = esp_hal::init(esp_hal::Config::default().with_cpu_clock(CpuClock::max()));
     let timg0 = TimerGroup::new(p.TIMG0);
     esp_rtos::start(timg0.timer0, p.FROM_CPU_INTR0);
-    println!("mmic board B on {}", support::chip::CHIP);
+    // The RTC watchdog from here: it covers the start-up up to the first complete tick.
+    let (cause, code) = wdt::reset_cause();
+    let mut dogs = Dogs::arm(p.RTC_TIMER, p.TIMG1);
+    println!(
+        "mmic board B on {}, reset reason {code:#04x}: {cause}",
+        support::chip::CHIP
+    );
 
     // Start-up: a peripheral that cannot be configured is a build or wiring error.
     let pins = support::take_pins!(p);
@@ -63,9 +72,11 @@ async fn main(_spawner: Spawner) -> ! {
 
     let mut ticker = Ticker::every(Duration::from_millis(TICK_MS.into()));
     let mut ticks = 0u32;
+    dogs.arm_control();
+    let mut gate = Gate::new(dogs);
     loop {
         let now = Instant::now().as_millis() as u32;
-        ctl.tick(now, &mut side, &mut outs, &mut serial);
+        gate.run(|| ctl.tick(now, &mut side, &mut outs, &mut serial));
         ticks = ticks.wrapping_add(1);
         if ticks.is_multiple_of(STATUS_TICKS) {
             println!(

@@ -4,7 +4,8 @@
 //! go to board A in visits (connect, send, the heartbeat by the visit's deadline, disconnect:
 //! the library's `Visit`, as before); the heartbeats go back into the gateway; the TM transfer
 //! frames it says are due go to the ground at [`net::GROUND`]:[`net::TM_PORT`]. The SDLS
-//! counters persist in the flash partition `mmic_ctr` (server/partitions.csv).
+//! counters persist in the flash partition `mmic_ctr` (server/partitions.csv). The watchdogs
+//! are fed only after a complete pass of the glue (`support::restart`, `support::wdt`).
 //!
 //! Every step is `support::server::ServerGlue::poll` (host-tested in support/tests/server.rs);
 //! this file is the sockets, the flash and the tasks.
@@ -31,7 +32,9 @@ use mmic::wire::heartbeat::HEARTBEAT_LEN;
 use static_cell::StaticCell;
 use support::counters::FlashCounters;
 use support::net;
+use support::restart::Gate;
 use support::server::{BoardLink, Clock, Datagrams, ServerGlue};
+use support::wdt::{self, Dogs};
 
 esp_bootloader_esp_idf::esp_app_desc!();
 
@@ -63,6 +66,10 @@ static GLUE: StaticCell<Glue> = StaticCell::new();
 #[esp_rtos::main]
 async fn main(spawner: Spawner) -> ! {
     wifi::boot!(p);
+    // The RTC watchdog from here: it covers the start-up up to the first complete pass.
+    let (cause, code) = wdt::reset_cause();
+    let dogs = Dogs::arm(p.RTC_TIMER, p.TIMG1);
+    esp_println::println!("mmic server board, reset reason {code:#04x}: {cause}");
     let store = FlashCounters::open(counters_flash(p.FLASH)).expect("SDLS counters in flash");
     let mut robots = [BoardNumber::ONE; R];
     for (r, n) in robots.iter_mut().zip(ROBOTS) {
@@ -76,7 +83,7 @@ async fn main(spawner: Spawner) -> ! {
     // Start-up: WiFi station on the lab's access point at the server's fixed address.
     let stack = wifi::start(&spawner, p.WIFI, net::SERVER);
     spawner.spawn(visits(stack, config.gateway.uplink.timeout_ms).expect("visit task"));
-    serve(stack, glue).await
+    serve(stack, glue, dogs).await
 }
 
 /// The counters' partition as NOR flash. Start-up only: an image flashed without
@@ -94,8 +101,8 @@ fn counters_flash(flash: esp_hal::peripherals::FLASH<'static>) -> Flash {
 }
 
 /// The loop: one pass of the glue, then sleep until a datagram, a heartbeat or the gateway's
-/// next deadline (1 ms to [`IDLE_MS`]).
-async fn serve(stack: Stack<'static>, glue: &'static mut Glue) -> ! {
+/// next deadline (1 ms to [`IDLE_MS`]). The watchdogs are fed after each complete pass.
+async fn serve(stack: Stack<'static>, glue: &'static mut Glue, mut dogs: Dogs) -> ! {
     let (mut rx_meta, mut tx_meta) = ([PacketMetadata::EMPTY; 8], [PacketMetadata::EMPTY; 8]);
     let (mut rx_buf, mut tx_buf) = ([0u8; 8 * 256], [0u8; 8 * FRAME_LEN]);
     let mut sock = UdpSocket::new(stack, &mut rx_meta, &mut rx_buf, &mut tx_meta, &mut tx_buf);
@@ -103,8 +110,10 @@ async fn serve(stack: Stack<'static>, glue: &'static mut Glue) -> ! {
     let to = IpEndpoint::new(Ipv4Address::from(net::GROUND).into(), net::TM_PORT);
     let mut ground = Ground { sock, to };
     let (mut clock, mut board) = (Uptime, Visits);
+    dogs.arm_control();
+    let mut gate = Gate::new(dogs);
     loop {
-        let next = glue.poll(&mut clock, &mut ground, &mut board);
+        let next = gate.run(|| glue.poll(&mut clock, &mut ground, &mut board));
         let wait = support::server::sleep_ms(next, wifi::now_ms(), IDLE_MS);
         select3(
             ground.sock.wait_recv_ready(),

@@ -2,11 +2,13 @@
 //! ([`Frontend::push`]), step the library's node, drive its outputs, move its packets. The
 //! order is the host simulator's (host/src/sim/nodes.rs).
 
+use crate::durable::Keep;
 use crate::link::{ByteSink, ByteSource, Link};
 use mmic::bolter::{Drive, MuxLines};
-use mmic::node::robot::board_a::{self, BoardA};
+use mmic::node::robot::board_a::{self, BoardA, Durable};
 use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::node::robot::wifi_session::WifiSession;
+use mmic::restart::ResetCause;
 use mmic::sensors::frontend::{self, Frontend, WINDOW};
 use mmic::units::PulseWidth;
 use mmic::wire::command::COMMAND_LEN;
@@ -59,15 +61,20 @@ pub trait Actuators {
     fn bolter(&mut self, lines: [bool; 3], mux: MuxLines);
 }
 
-/// What the glue counts: packets the serial line did not take (failed sensor reads: `Side`).
+/// What the glue counts: packets the serial line did not take (failed sensor reads: `Side`),
+/// and on board A the durable record's writes that failed (`store_failed`) and the commands
+/// not taken because their record could not be written first (`unkept`: the ground resends).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[allow(missing_docs)]
 pub struct Counters {
     pub tx_errors: u32,
+    pub store_failed: u32,
+    pub unkept: u32,
 }
 
-/// Board A's control task.
-pub struct ControlA<'q> {
+/// Board A's control task, with its durable record's store `K` (decision
+/// `restart-board-a-storage`).
+pub struct ControlA<'q, K: Keep> {
     /// The library's board A.
     pub a: BoardA,
     front: Frontend<WINDOW>,
@@ -77,23 +84,55 @@ pub struct ControlA<'q> {
     pub from_b: Link,
     /// Counts.
     pub counters: Counters,
+    keep: K,
+    /// The record the store holds (what a reset would find), as far as this task knows.
+    kept: Option<Durable>,
 }
 
-impl<'q> ControlA<'q> {
-    /// Board A with its ends of the two hand-off queues.
+impl<'q, K: Keep> ControlA<'q, K> {
+    /// Board A after a start for `cause`, from what `keep` kept (Table 7's power-on: Standby,
+    /// servos unpowered, nothing resumed; the exactly-once log as it was; the boot count one
+    /// more, written after the first tick), with its ends of the two hand-off queues.
     pub fn new(
         cfg: board_a::Config,
         front: frontend::Config,
         commands: Consumer<'q, COMMAND_LEN, QUEUE>,
         heartbeats: Producer<'q, HEARTBEAT_LEN, QUEUE>,
+        mut keep: K,
+        cause: ResetCause,
     ) -> Self {
+        let kept = keep.load();
         ControlA {
-            a: BoardA::new(cfg),
+            a: BoardA::restarted(cfg, kept, cause),
             front: Frontend::new(front),
             commands,
             heartbeats,
             from_b: Link::new(PacketKind::InternalHeartbeat),
             counters: Counters::default(),
+            keep,
+            kept,
+        }
+    }
+
+    /// The store.
+    pub const fn store(&self) -> &K {
+        &self.keep
+    }
+
+    /// Writes `d` unless the store holds it; false when the write failed (counted).
+    fn persist(&mut self, d: Durable) -> bool {
+        if self.kept == Some(d) {
+            return true;
+        }
+        match self.keep.keep(&d) {
+            Ok(()) => {
+                self.kept = Some(d);
+                true
+            }
+            Err(_) => {
+                self.counters.store_failed = self.counters.store_failed.saturating_add(1);
+                false
+            }
         }
     }
 
@@ -102,7 +141,9 @@ impl<'q> ControlA<'q> {
         self.heartbeats.dropped()
     }
 
-    /// One tick at `now` ms; returns the library's outputs (for logs).
+    /// One tick at `now` ms; returns the library's outputs (for logs). The command it takes
+    /// is written ahead (`BoardA::ahead`) before the library's tick, and not taken when that
+    /// write fails; what the tick changed (`BoardA::durable`) is written after it.
     pub fn tick(
         &mut self,
         now: u32,
@@ -112,7 +153,13 @@ impl<'q> ControlA<'q> {
     ) -> board_a::Outputs {
         let r = sensors.read();
         let f = self.front.push(&r.raw);
-        let (command, from_b) = (self.commands.pop(), self.from_b.next(uart));
+        let (mut command, from_b) = (self.commands.pop(), self.from_b.next(uart));
+        if let Some(ahead) = self.a.ahead(command.as_ref()) {
+            if !self.persist(ahead) {
+                self.counters.unkept = self.counters.unkept.saturating_add(1);
+                command = None;
+            }
+        }
         let inputs =
             board_a::Inputs::sensed(&f, r.arm_contracted, r.bolter_at_home, command, from_b);
         let o = self.a.tick(now, &inputs);
@@ -124,6 +171,9 @@ impl<'q> ControlA<'q> {
                 self.counters.tx_errors = self.counters.tx_errors.saturating_add(1);
             }
         }
+        // What the tick changed, after the outputs and before the heartbeat that reports it
+        // leaves; a failed write is tried again after the next tick.
+        self.persist(self.a.durable());
         if let Some(hb) = o.heartbeat {
             if let Err(full) = self.heartbeats.push(hb) {
                 self.heartbeats.give_up(full);

@@ -8,7 +8,9 @@
 pub mod control;
 pub mod counters;
 pub mod drivers;
+pub mod durable;
 pub mod link;
+pub mod restart;
 pub mod sensors;
 pub mod server;
 
@@ -16,6 +18,8 @@ pub mod server;
 pub mod chip;
 #[cfg(target_arch = "riscv32")]
 pub mod hw;
+#[cfg(target_arch = "riscv32")]
+pub mod wdt;
 
 /// The A–B serial line's rate, baud.
 pub const BAUD: u32 = 115_200;

@@ -14,14 +14,23 @@ use mmic::mode::Mode;
 use mmic::node::robot::board_a;
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{WifiConfig, WifiSession};
+use mmic::restart::ResetCause;
 use mmic::sensors::frontend;
 use mmic::units::{BoardNumber, PulseWidth};
 use mmic::wire::command::CommandRepr;
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 use mmic::wire::PacketKind;
 use mmic_fw_support::control::{commands_in, Actuators, ControlA, QUEUE};
+use mmic_fw_support::durable::FlashDurable;
 use mmic_fw_support::link::{ByteSink, ByteSource, Link};
 use mmic_fw_support::sensors::Side;
+
+mod common;
+use common::Ram;
+
+fn store() -> FlashDurable<Ram> {
+    FlashDurable::open(Ram::new(2)).unwrap()
+}
 
 /// A switch.
 struct Sw(bool);
@@ -121,6 +130,8 @@ fn board_a_command_to_heartbeat_through_the_glue() {
         frontend::Config::default(),
         control_in,
         control_out,
+        store(),
+        ResetCause::PowerOn,
     );
     let (mut outs, mut uart) = (Outs::default(), Line::default());
     uart.rx = b"\x00\xffMI noise".to_vec(); // garbage on board B's line
@@ -185,7 +196,14 @@ fn garbage_on_the_b_line_resyncs_and_the_link_holds() {
     let bus = RefCell::new(Mock::new(&traffic));
     let mut side = Side::new(&bus, [Sw(true), Sw(true)], true);
     let fcfg = frontend::Config::default();
-    let mut ctl = ControlA::new(board_a::Config::default(), fcfg, control_in, control_out);
+    let mut ctl = ControlA::new(
+        board_a::Config::default(),
+        fcfg,
+        control_in,
+        control_out,
+        store(),
+        ResetCause::PowerOn,
+    );
     let mut b = BoardB::new(board_b::Config::default());
     let mut to_b = Link::new(PacketKind::BCommand);
     let (mut outs, mut uart) = (Outs::default(), Line::default());
