@@ -1033,9 +1033,15 @@ fn inject_is_checked_and_summary_json_is_what_mmic_sim_returned() {
             "faults",
             "assembly-system",
             "refusals",
-            "exit"
+            "exit",
+            "executed_twice",
+            "restarts",
+            "board_a",
+            "board_b",
+            "server"
         ]
     );
+    assert_eq!(json["executed_twice"], 0);
     assert!(stdout.contains("injected: assembly-system@4.5"), "{stdout}");
 }
 

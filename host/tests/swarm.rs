@@ -35,10 +35,11 @@ fn every_drawn_plan_fits_the_robot_and_a_seed_always_draws_the_same_scenario() {
     }
     assert_eq!(protocols.len(), 2);
     assert_eq!(starts.len(), 15, "plans start in every state");
-    // Every injection the simulator has is drawn by some seed.
+    // Every injection the simulator has, restarts included, is drawn by some seed.
     assert_eq!(
         injected.len(),
-        mmic_host::sim::inject::Injection::ALL.len(),
+        mmic_host::sim::inject::Injection::ALL.len()
+            + mmic_host::sim::inject::Injection::REBOOTS.len(),
         "{injected:?}"
     );
 }

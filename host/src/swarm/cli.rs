@@ -21,11 +21,12 @@ a random state), the links' loss, duplication (resent commands), reordering, lat
 and cuts, board B's clock phase, and up to three faults (battery sag, obstacles on arm,
 gripper or bolter, a jammed fastener, a stuck switch, an encoder offset, silent sensors, a cut
 A-B line, a misstated reconfiguration, the System fault command) plus the operator's Stop and
-Reset. Each run lasts --sim-seconds of simulated time; the robot idles, still watched, after
+Reset, and restarts of board A, board B or the server board (0.4 of the runs, --restarts). Each run lasts --sim-seconds of simulated time; the robot idles, still watched, after
 its plan ends.
 
 Invariants, on every run: no command admitted twice by board A (each traced to the packet its
-sender wrote, whatever its sequence number); at least one gripper closed at every board A tick
+sender wrote, whatever its sequence number; a Heartbeat poll, which does nothing, may run again
+after a restart); at least one gripper closed at every board A tick
 of a motion; nothing driven by board A in Standby, nothing moving in the plant from 100 ms after
 entering it; every fault raised in Operational takes Table 8's mode in the same tick (low
 battery and assembly system at the motion's end), and no fault raises power; every command the
@@ -52,6 +53,7 @@ Examples:
   mmic swarm --runs 200 --json target/swarm.json
   mmic swarm --replay 85 --out target/swarm-85   one seed again, with its whole log
   mmic swarm --seconds 60 --plant-bug double-exec   the swarm's own test: a planted double execution
+  mmic swarm --seconds 60 --restarts on --plant-bug log-not-restored   board A boots without its log
   mmic swarm --seconds 60 --link frames      every PUS scenario over the space data link
   mmic swarm --seconds 60 --link packets     scenarios as they were before frames were drawn
   mmic swarm --seconds 60 --link frames --sdls on   every PUS run over frames secured, most attacked
