@@ -461,3 +461,24 @@ fn a_deferred_fault_lets_the_motion_complete() {
         [(Stage::Completion, None, 1)]
     );
 }
+
+/// The kept key of a source never moves back: telecommands 2 then 1 (reordered on the way)
+/// keep 2, so that after a restart a copy of 2 is answered RESTARTED, never run again (the
+/// counterexample of host/tests/protocol/restarts.rs).
+#[test]
+fn kept_key_never_moves_back_on_reordered_telecommands() {
+    let mut g = gateway();
+    g.tc(&tc(2, Request::Function(Command::Stop)));
+    g.tc(&tc(1, Request::Function(Command::Mode(Mode::Operational))));
+    let kept = g.kept(BoardNumber::ONE).unwrap_or_default();
+    assert_eq!(kept.iter().map(|k| k.1).collect::<Vec<_>>(), [2]);
+    let mut g = G::new(Config::default());
+    assert!(g.add_restarted(BoardNumber::ONE, kept));
+    let out = g.tc(&tc(2, Request::Function(Command::Stop)));
+    assert_eq!(out.reports[0].stage(), Some((Stage::Start, false)));
+    assert!(g
+        .tick(0)
+        .to_robots
+        .iter()
+        .all(|(_, c)| c.command != Command::Stop));
+}

@@ -1,5 +1,5 @@
-//! Model checks (stateright) of exactly-once commanding, of the paper's scheme, of COP-1 and of
-//! SDLS's counters across restarts.
+//! Model checks (stateright) of exactly-once commanding (also across restarts of every node), of
+//! the paper's scheme, of COP-1 and of SDLS's counters across restarts.
 //!
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
@@ -7,6 +7,7 @@ mod cop1;
 mod protocol_exactly_once;
 mod protocol_paper;
 mod protocol_pus;
+mod restarts;
 mod sdls;
 
 use mmic::node::robot::board_a::{self, BoardA, Event};

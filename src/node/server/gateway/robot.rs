@@ -135,11 +135,18 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
         let _ = self.log.push(Entry { key, request, last });
     }
 
-    /// `key` is the newest taken from its source: the kept marks move (the source moves to
-    /// the end; the least recently heard one is forgotten when they are full).
+    /// `key` was taken from its source: the kept mark moves to it unless it holds a newer one
+    /// (telecommands can arrive out of order: a mark that went back would let a copy of the
+    /// newer one run again after a restart; the stateright model in
+    /// host/tests/protocol/restarts.rs found it). The source moves to the end; the least
+    /// recently heard one is forgotten when they are full.
     fn mark(&mut self, (source, seq): (u16, u16)) {
+        let mut seq = seq;
         if let Some(i) = self.marks.iter().position(|(s, _)| *s == source) {
-            self.marks.remove(i);
+            let (_, old) = self.marks.remove(i);
+            if newer14(old, seq) {
+                seq = old;
+            }
         } else if self.marks.is_full() {
             self.marks.remove(0);
         }
