@@ -42,13 +42,14 @@ def test_ccsdspy_decodes_the_recorded_hk_stream(recording):
     assert list(d["met_fine"]) == [e["time"]["fine"] for e in expected]
     assert list(d["hk_sid"]) == [1] * n
     names = list(expected[0]["parameters"])
-    assert len(names) == 33
+    assert len(names) == 34
     for name in names:
         assert list(d[name]) == [e["parameters"][name] for e in expected], name
     assert list(d["crc"]) == [crc16_ccitt_false(p[:-2]) for p in packets]
     # The edge values are really there (not a stream of defaults).
     assert {e["parameters"]["last_seq"] for e in expected} >= {0, 65535}
     assert {e["parameters"]["v_bat_a"] for e in expected} >= {0, 65535}
+    assert {e["parameters"]["boot"] for e in expected} >= {0, 0x21, 255}
 
 
 def test_a_corrupted_packet_is_noticed(recording, tmp_path):

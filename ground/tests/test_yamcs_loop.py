@@ -6,7 +6,7 @@ Rust stand-in `mmic ground robot` (the real PUS gateway + a trivial board A; $GR
 another command line, see ground/README.md). Raw TM injected by the tests is made by `mmic encode
 pus-tm` or by the gateway (`mmic ground fixtures`), sent as robot 2 (APID 0x102) so as not to disturb
 robot 1's sequence counts.
-(a) TM(3,25) values (the edge values of all 33 parameters) come back equal through a parameter
+(a) TM(3,25) values (the edge values of all 34 parameters) come back equal through a parameter
     subscription; bad CRC and APIDs outside 0x101..=0x1FF are not taken; units; MET -> UTC.
 (b) TCs issued through yamcs-client reach the robot as the bytes YAMCS recorded; the gateway's ST[1]
     reports drive the XTCE verifiers: are-you-alive, mode operational then a reconfiguration complete;
