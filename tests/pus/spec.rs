@@ -315,6 +315,7 @@ struct PusTiming {
     tc_timeout_ms: u32,
     tc_query_ms: u32,
     tc_max_attempts: u8,
+    tc_max_attempts_under_cop1: u8,
     gateway_poll_ms: u32,
     gateway_visit_timeout_ms: u32,
 }
@@ -333,6 +334,31 @@ fn pus_timing_is_the_decision() {
         (w.poll_ms, w.uplink.timeout_ms),
         (t.gateway_poll_ms, t.gateway_visit_timeout_ms)
     );
+    // Over frames the ground outlasts FOP-1: it gives up no sooner than the frame is.
+    let fop = mmic::link::fop::FopConfig::MISSION;
+    let f = g.under_cop1(&fop);
+    assert_eq!(
+        (f.timeout_ms, f.query_ms, f.max_attempts),
+        (g.timeout_ms, g.query_ms, t.tc_max_attempts_under_cop1)
+    );
+    assert!(
+        u64::from(f.max_attempts) * u64::from(f.timeout_ms)
+            >= u64::from(fop.tx_limit) * u64::from(fop.t1_ms)
+    );
+    // Never fewer attempts than asked for, and no overflow on an extreme link.
+    let many = mmic::node::ground::pus::Config {
+        max_attempts: 200,
+        ..g
+    };
+    assert_eq!(many.under_cop1(&fop).max_attempts, 200);
+    let slow = mmic::link::fop::FopConfig {
+        t1_ms: u32::MAX,
+        tx_limit: 255,
+        ..fop
+    };
+    assert_eq!(g.under_cop1(&slow).max_attempts, u8::MAX);
+    let zero = mmic::node::ground::pus::Config { timeout_ms: 0, ..g };
+    assert_eq!(zero.under_cop1(&fop).max_attempts, u8::MAX);
     // A resend means a loss: the ground waits longer than one visit and one poll period.
     assert!(t.tc_timeout_ms > t.gateway_visit_timeout_ms + t.gateway_poll_ms);
 }

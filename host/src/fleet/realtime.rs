@@ -168,7 +168,7 @@ async fn fleet(cfg: SimConfig) -> std::io::Result<(Ends, crate::sim::shell::Grou
             let runners = (0..n)
                 .map(|i| {
                     PlanRunner::pus(
-                        cfg.pus,
+                        cfg.ground_pus(),
                         BoardNumber::new((i % 255) as u8 + 1).unwrap_or(BoardNumber::ONE),
                     )
                 })

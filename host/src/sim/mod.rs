@@ -511,6 +511,15 @@ impl SimConfig {
     /// the demo plan starts.
     pub const DEFAULT_START: State = State::A;
 
+    /// The ground's telecommand link as it runs: [`SimConfig::pus`], and over frames with
+    /// enough attempts to outlast FOP-1's (`pus::Config::under_cop1`).
+    pub fn ground_pus(&self) -> pus::Config {
+        match self.link {
+            LinkLayer::Packets => self.pus,
+            LinkLayer::Frames => self.pus.under_cop1(&mmic::link::fop::FopConfig::MISSION),
+        }
+    }
+
     /// The built-in demo plan at the default settings.
     pub fn demo() -> SimConfig {
         SimConfig::with_steps(demo_steps())

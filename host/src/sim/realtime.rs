@@ -490,7 +490,7 @@ fn ground_loop(
         Protocol::Pus => {
             let runners = links
                 .iter()
-                .map(|(_, _, b)| PlanRunner::pus(cfg.pus, *b))
+                .map(|(_, _, b)| PlanRunner::pus(cfg.ground_pus(), *b))
                 .collect();
             // With --link frames the ground's packets go through each robot's FOP-1.
             // With SDLS, each secured with its robot's keys.

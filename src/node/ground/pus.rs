@@ -47,6 +47,7 @@ use crate::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use crate::ccsds::EmitError;
 use crate::command::Command;
 use crate::faults::Faults;
+use crate::link::fop::FopConfig;
 use crate::mode::Mode;
 use crate::node::exactly_once::uplink::{Done, Efficiency, Outcome};
 use crate::pus::function::{self, FunctionError};
@@ -90,6 +91,34 @@ impl Default for Config {
             timeout_ms: 1000,
             query_ms: 5000,
             max_attempts: 10,
+        }
+    }
+}
+
+impl Config {
+    /// The same link with its telecommands carried in TC frames under COP-1 (`fop`): as many
+    /// attempts as it takes for the ground to give a telecommand up no sooner than FOP-1
+    /// gives its frame up (`tx_limit` transmissions, `t1_ms` apart), and never fewer than
+    /// before. A frame FARM-1 did not take holds every later one back, so the link's resends
+    /// cannot get past the gap: only FOP-1's retransmissions can (spec/decisions.toml,
+    /// `pus-ground-under-cop1`). The timeout stays, so a lost report is asked for as soon.
+    ///
+    /// ```
+    /// use mmic::link::fop::FopConfig;
+    /// use mmic::node::ground::pus::Config;
+    ///
+    /// let c = Config::default().under_cop1(&FopConfig::MISSION);
+    /// assert_eq!((c.timeout_ms, c.max_attempts), (1000, 30)); // 10 × 3 s
+    /// ```
+    pub fn under_cop1(self, fop: &FopConfig) -> Config {
+        let horizon = u64::from(fop.tx_limit) * u64::from(fop.t1_ms);
+        let needed = horizon.div_ceil(u64::from(self.timeout_ms.max(1)));
+        let max_attempts = u8::try_from(needed)
+            .unwrap_or(u8::MAX)
+            .max(self.max_attempts);
+        Config {
+            max_attempts,
+            ..self
         }
     }
 }

@@ -370,7 +370,7 @@ pub fn run_watched(cfg: &SimConfig, watched: bool) -> std::io::Result<(Summary, 
         }
         Protocol::Pus => {
             let runners = (0..n)
-                .map(|i| PlanRunner::pus(cfg.pus, board_number(i)))
+                .map(|i| PlanRunner::pus(cfg.ground_pus(), board_number(i)))
                 .collect();
             Engine::new(cfg, runners, watched).run()
         }

@@ -287,11 +287,10 @@ impl Watch {
                 cfg.ground.max_attempts as u32,
                 cfg.ground.timeout_ms,
             ),
-            super::Protocol::Pus => (
-                cfg.pus.timeout_ms,
-                cfg.pus.max_attempts as u32,
-                cfg.pus.timeout_ms,
-            ),
+            super::Protocol::Pus => {
+                let pus = cfg.ground_pus();
+                (pus.timeout_ms, pus.max_attempts as u32, pus.timeout_ms)
+            }
         };
         Watch {
             robots: (0..n).map(|_| RobotWatch::default()).collect(),
