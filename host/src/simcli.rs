@@ -49,7 +49,7 @@ Before anything is sent, the plan is checked against the robot's state, from its
 const SUMMARY_JSON_HELP: &str = r#"--summary-json FILE writes one JSON object when the run ends:
   {"completed": false, "mode": "safed", "faults": ["bolter-overcurrent"],
    "refusals": ["not_allowed_in_mode"], "exit": 1, "executed_twice": 0,
-   "restarts": {"board_a": 1, "board_b": 0, "server": 0}}
+   "restarts": {"board_a": 1, "board_b": 0, "ground": 0, "server": 0}}
 completed: every step of the plan done. mode: standby, safed or operational, as the robot
 last reported it (the last heartbeat the ground received). faults: the Table 8 faults board A
 raised, in the order raised, each once, by their --inject names (a module's idle-check and
@@ -58,7 +58,7 @@ board A refused, in order, by the names of spec/modes.toml [refusals]:
   REFUSALS.
 exit: the exit code this run of mmic sim returns. executed_twice: sequenced commands board A
 accepted more than once (0 unless exactly-once broke: a script checks it). restarts: the
-restarts injected with --inject reboot-a/-b/-server, all robots."#;
+restarts injected with --inject reboot-a/-b/-server/-ground, all robots (the ground's once per robot)."#;
 
 /// `mmic sim --help`'s part on `--summary-json`, with the refusal names of the library
 /// (spec/modes.toml `[refusals]`).

@@ -1,4 +1,4 @@
-//! Restarts of the robot's nodes in the virtual-time engine (`--inject reboot-a/-b/-server`):
+//! Restarts of the robot's nodes and the ground in the virtual-time engine (`--inject reboot-*`):
 //! what each keeps (spec/decisions.toml `restart-*`) holds exactly-once and the SDLS counters
 //! across them, and the swarm finds a planted restart defect and replays it.
 
@@ -47,7 +47,7 @@ fn board_a_keeps_its_log_across_restarts_and_nothing_runs_twice() {
             cfg.wifi_loss = 0.3;
             cfg.links.wifi.duplicate = 0.3;
             let s = engine::run(&cfg).unwrap();
-            assert_eq!(s.restarts, [4, 0, 0], "seed {seed} {protocol:?}");
+            assert_eq!(s.restarts, [4, 0, 0, 0], "seed {seed} {protocol:?}");
             assert_eq!(s.executed_twice, 0, "seed {seed} {protocol:?}");
             // Board A came up with its boot count in heartbeat byte 59 each time.
             let boots: Vec<u64> = s
@@ -81,7 +81,7 @@ fn server_restarts_keep_the_sdls_counters_and_refuse_old_frames() {
         attack: 0.3,
     });
     let s = engine::run(&cfg).unwrap();
-    assert_eq!(s.restarts, [0, 0, 2]);
+    assert_eq!(s.restarts, [0, 0, 2, 0]);
     assert_eq!(s.executed_twice, 0);
     let sdls = s.frames.and_then(|f| f.sdls).expect("SDLS figures");
     assert!(sdls.attack_frames > 0);
@@ -119,6 +119,88 @@ fn server_restarts_keep_the_sdls_counters_and_refuse_old_frames() {
     // The command in progress at the first restart ended reported (unacknowledged or a
     // refusal), never silently: the plan stopped with a reason, or went on.
     assert!(s.ends.iter().all(|e| e.is_some()), "{:?}", s.ends);
+}
+
+/// The ground's restarts (`--inject reboot-ground@S`), over both protocols and over frames
+/// with SDLS: in a wait, the plan goes on at the step it stood at and numbers past every
+/// number given out before; with a step open, the plan ends `Restarted` there and nothing is
+/// sent again. Either way nothing runs twice and every command sent ends.
+#[test]
+#[cfg_attr(miri, ignore = "whole simulated runs: minutes under Miri")]
+fn the_ground_restarts_from_its_kept_position_and_numbering() {
+    let plan = "mode operational\nwait 6s\nbolt 1\nmode standby\n";
+    let cases = [
+        (Protocol::Legacy, LinkLayer::Packets),
+        (Protocol::Pus, LinkLayer::Packets),
+        (Protocol::Pus, LinkLayer::Frames),
+    ];
+    for (protocol, link) in cases {
+        // In the wait (Operational is entered within 2 s): the plan completes.
+        let mut cfg = config(protocol, link, &["reboot-ground@4"]);
+        cfg.steps = mmic_host::sim::steps_of(&mmic_host::plan::parse(plan).unwrap());
+        cfg.run_to_end = false;
+        if link == LinkLayer::Frames {
+            cfg.sdls = Some(SdlsConfig {
+                keys: SdlsKeys::Random,
+                attack: 0.0,
+            });
+        }
+        let s = engine::run(&cfg).unwrap();
+        let what = format!("{protocol:?} {link:?}");
+        assert!(
+            s.completed(),
+            "{what}: {}",
+            mmic_host::sim::report::text(&s)
+        );
+        assert_eq!(s.restarts, [0, 0, 0, 1], "{what}");
+        assert_eq!(s.executed_twice, 0, "{what}");
+        // Numbers before and after the restart: the later all above the earlier.
+        let restart_at = s.events("restart").next().unwrap()["t_ms"]
+            .as_u64()
+            .unwrap();
+        let seqs = |before: bool| -> Vec<u64> {
+            s.events("done")
+                .filter(|r| (r["t_ms"].as_u64().unwrap() < restart_at) == before)
+                .map(|r| r["event"]["seq"].as_u64().unwrap())
+                .collect()
+        };
+        let (old, new) = (seqs(true), seqs(false));
+        assert!(
+            !old.is_empty() && !new.is_empty(),
+            "{what}: {old:?} {new:?}"
+        );
+        assert!(
+            new.iter().all(|n| old.iter().all(|o| n > o)),
+            "{what}: {old:?} then {new:?}"
+        );
+        if link == LinkLayer::Frames {
+            let f = s.frames.expect("frames figures");
+            let x = f.sdls.expect("SDLS figures");
+            // Only the ground's counter ahead of the server board's floor (COP-1 sent it again).
+            assert_eq!(
+                x.server.refused_total(),
+                x.server.refused[6],
+                "{what}: {x:?}"
+            );
+        }
+        // During bolt 1 (a motion of many seconds): the plan ends there, unknown.
+        let mut cfg = config(protocol, link, &["reboot-ground@9"]);
+        cfg.steps = mmic_host::sim::steps_of(&mmic_host::plan::parse(plan).unwrap());
+        let s = engine::run(&cfg).unwrap();
+        assert_eq!(
+            s.ends,
+            [Some(mmic::node::ground::plan_runner::PlanEnd::Restarted {
+                step: 2
+            })],
+            "{what}"
+        );
+        assert_eq!(s.executed_twice, 0, "{what}");
+        assert!(
+            s.events("done")
+                .all(|r| r["t_ms"].as_u64().unwrap() < 9_000),
+            "{what}"
+        );
+    }
 }
 
 /// The swarm draws restarts from their own stream, holds its invariants through them, and

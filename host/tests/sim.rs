@@ -954,7 +954,7 @@ fn stop_during_a_reconfiguration_then_reset_resumes_it_and_the_demo_completes() 
             link: None,
             frames: None,
             executed_twice: 0,
-            restarts: serde_json::json!({"board_a": 0, "board_b": 0, "server": 0}),
+            restarts: serde_json::json!({"board_a": 0, "board_b": 0, "ground": 0, "server": 0}),
         }
     );
 }
@@ -1038,6 +1038,7 @@ fn inject_is_checked_and_summary_json_is_what_mmic_sim_returned() {
             "restarts",
             "board_a",
             "board_b",
+            "ground",
             "server"
         ]
     );

@@ -1,6 +1,6 @@
 //! Fault injection: each of Table 8's ten faults, a sensor that stops answering (the ADC of
 //! either side, the hip encoder: the project's sensor loss), and the operator's Stop and
-//! Reset, and the restart of a node (board A, board B, the server board), at a simulated time
+//! Reset, and the restart of a node (board A, board B, the server board, the ground), at a simulated time
 //! (`mmic sim --inject NAME@SECONDS`).
 //!
 //! A fault acts physically where it can, so that the firmware has to detect it the way the
@@ -51,6 +51,14 @@ pub enum Node {
     /// The server board (keeps the gateway's newest TC key per source and the SDLS counters:
     /// decision `restart-server`).
     Server,
+    /// The ground (keeps the plan's position and its link's numbering, and with SDLS its
+    /// counters: decision `restart-ground`). One ground for every robot of a run.
+    Ground,
+}
+
+impl Node {
+    /// Every node, in the order of the per-node counts (`restarts`).
+    pub const ALL: [Node; 4] = [Node::A, Node::B, Node::Server, Node::Ground];
 }
 
 /// How long a restarting node is down before its first tick, ms: the ESP32's boot (ROM
@@ -103,15 +111,17 @@ impl Injection {
             Injection::Reboot(Node::A) => "reboot-a".to_string(),
             Injection::Reboot(Node::B) => "reboot-b".to_string(),
             Injection::Reboot(Node::Server) => "reboot-server".to_string(),
+            Injection::Reboot(Node::Ground) => "reboot-ground".to_string(),
         }
     }
 
     /// The restarts, one per node. Not in [`Injection::ALL`] (the faults the swarm's main
     /// stream draws from): the swarm draws restarts from a stream of their own.
-    pub const REBOOTS: [Injection; 3] = [
+    pub const REBOOTS: [Injection; 4] = [
         Injection::Reboot(Node::A),
         Injection::Reboot(Node::B),
         Injection::Reboot(Node::Server),
+        Injection::Reboot(Node::Ground),
     ];
 
     /// Every valid name, comma-separated (for error messages and `--help`).
@@ -168,6 +178,9 @@ impl Injection {
             Injection::Reboot(Node::B) => "board B restarts: down 300 ms, then as at power-on",
             Injection::Reboot(Node::Server) => {
                 "the server board restarts: down 300 ms, then its gateway with the kept TC keys and SDLS counters"
+            }
+            Injection::Reboot(Node::Ground) => {
+                "the ground restarts: down 300 ms, then the plan from where it stood, numbering past every number given out; a step open at the crash ends the plan"
             }
         }
     }

@@ -520,6 +520,23 @@ impl SimConfig {
         }
     }
 
+    /// The longest a command of the ground's may stay open, ms: every transmission its
+    /// link makes before giving it up, and the last one's answer.
+    pub fn command_life_ms(&self) -> u32 {
+        let (period, attempts, answer) = match self.protocol {
+            Protocol::Legacy => (
+                self.ground.period_ms,
+                u32::from(self.ground.max_attempts),
+                self.ground.timeout_ms,
+            ),
+            Protocol::Pus => {
+                let pus = self.ground_pus();
+                (pus.timeout_ms, u32::from(pus.max_attempts), pus.timeout_ms)
+            }
+        };
+        period.saturating_mul(attempts).saturating_add(answer)
+    }
+
     /// The built-in demo plan at the default settings.
     pub fn demo() -> SimConfig {
         SimConfig::with_steps(demo_steps())
@@ -619,8 +636,9 @@ pub struct Summary {
     /// exactly-once broke. Counted by the virtual-time engine; the realtime engine counts from
     /// its log ([`Summary::events`]).
     pub executed_twice: u64,
-    /// Restarts of board A, board B and the server board, all robots (`--inject reboot-*`).
-    pub restarts: [u32; 3],
+    /// Restarts of board A, board B, the server board and the ground, all robots (`--inject
+    /// reboot-*`; the ground's counted once per robot).
+    pub restarts: [u32; 4],
 }
 
 impl Summary {
@@ -660,7 +678,7 @@ impl Summary {
             last_heartbeat: stats.last_heartbeat,
             realtime: false,
             executed_twice: 0,
-            restarts: [0; 3],
+            restarts: [0; 4],
         }
     }
 

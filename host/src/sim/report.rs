@@ -103,6 +103,7 @@ pub fn summary_json(s: &Summary, exit: u8) -> SummaryJson {
         },
         restarts: serde_json::json!({
             "board_a": s.restarts[0], "board_b": s.restarts[1], "server": s.restarts[2],
+            "ground": s.restarts[3],
         }),
     }
 }
@@ -124,6 +125,7 @@ pub fn executed_twice(s: &Summary) -> Vec<u64> {
     let mut count = std::collections::BTreeMap::new();
     for e in s.events("executed") {
         let seq = e["event"]["seq"].as_u64().unwrap_or(0);
+        // `BoardA::may_run_again` on the logged event: the Heartbeat poll.
         if seq != 0 && e["event"]["command"] != "heartbeat" {
             *count.entry((e["node"].to_string(), seq)).or_insert(0u32) += 1;
         }
@@ -290,6 +292,10 @@ pub fn plan_line(s: &Summary) -> String {
         Some(PlanEnd::Unacknowledged { step }) => {
             format!("plan: stopped at {}: unacknowledged", step_ref(s, step))
         }
+        Some(PlanEnd::Restarted { step }) => format!(
+            "plan: stopped at {}: the ground restarted while it was open (it ran at most once)",
+            step_ref(s, step)
+        ),
         Some(PlanEnd::Interrupted { step, mode, faults }) => format!(
             "plan: stopped at {}: interrupted, robot in {mode} (faults: {})",
             step_ref(s, step),

@@ -271,6 +271,11 @@ pub trait Ground {
     /// An injection's ground part: an out-of-band command handed to the runner, or the next
     /// reconfiguration misstated; returns why the runner did not take it, if it did not.
     fn inject(&mut self, injection: inject::Injection) -> Option<String>;
+    /// The runner after the ground restarted: from what its disk kept (the plan's position,
+    /// the link's numbering: decision `restart-ground`), the rest lost.
+    fn restarted(&self) -> Self
+    where
+        Self: Sized;
 }
 
 /// The legacy ground: the plan runner over the uplink, and the last heartbeat.
@@ -313,6 +318,13 @@ impl Ground for LegacyGround {
 
     fn inject(&mut self, injection: inject::Injection) -> Option<String> {
         ground_injection(&mut self.run, injection)
+    }
+
+    fn restarted(&self) -> LegacyGround {
+        LegacyGround {
+            run: PlanRunner::restarted(self.run.uplink().restarted(), self.run.kept()),
+            last: None,
+        }
     }
 }
 
@@ -360,6 +372,10 @@ impl Ground for PlanRunner<TcLink> {
 
     fn inject(&mut self, injection: inject::Injection) -> Option<String> {
         ground_injection(self, injection)
+    }
+
+    fn restarted(&self) -> PlanRunner<TcLink> {
+        PlanRunner::restarted(self.uplink().restarted(), self.kept())
     }
 }
 
@@ -545,6 +561,24 @@ impl<G: Ground> GroundSide<G> {
             );
         }
         send
+    }
+
+    /// Robot `i`'s ground restarted at `now` (its runner from what the disk kept): every
+    /// command it had open ends, logged as lost with the RAM (`ended_unknown`: it ran at most
+    /// once); a plan whose step was open ends [`PlanEnd::Restarted`].
+    pub fn restart(&mut self, i: usize, now: u32) {
+        let Some(r) = self.runners.get(i) else { return };
+        let fresh = r.restarted();
+        self.runners[i] = fresh;
+        for (seq, since) in std::mem::take(&mut self.open[i]) {
+            self.event(
+                now,
+                json!({"type": "ended_unknown", "robot": i + 1, "seq": seq, "open_since_ms": since,
+                       "why": "the ground restarted"}),
+            );
+        }
+        // The plan's end, if the restart ended it, comes with the runner's next tick.
+        self.sent_at[i] = None;
     }
 
     /// Robot `i`'s commands sent and not done (number, first transmission's time, ms): at most

@@ -88,8 +88,8 @@ impl std::str::FromStr for RestartDraw {
 
 /// The restart stream's draws for `seed`, seeded apart from the others (so that every earlier
 /// draw of every seed stays what it was): whether the run has restarts (0.4 of them, unless
-/// [`Options::restarts`] says), then one to three, each of board A, board B or the server board
-/// (a third each) at a time in the run's fault window. All drawn whatever the choice, so the
+/// [`Options::restarts`] says), then one to three, each of board A, board B, the server board
+/// or the ground (a quarter each) at a time in the run's fault window. All drawn whatever the choice, so the
 /// stream stays aligned.
 fn draw_restarts(seed: u64, opts: &Options, cfg: &mut SimConfig, latest: u32) {
     let mut rng = fastrand::Rng::with_seed(seed ^ RESTART_STREAM);

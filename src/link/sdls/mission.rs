@@ -44,8 +44,12 @@ pub const TM_TX_BLOCK: u32 = 256;
 /// The ground's TM window: frames lost in a row up to this many are followed (YAMCS's
 /// `seqNumWindow` is the same).
 pub const TM_WINDOW: u32 = 100_000;
-/// The ground's TM floor is reserved 256 at a time.
-pub const TM_RX_BLOCK: u32 = 256;
+/// The ground's TM floor is reserved 16 at a time: a restarted ground refuses at most 24 of
+/// the server board's next TM frames (12 s at two a second, less than a telecommand's 30 s
+/// over frames), and a frame is refused as not reserved only after some 8 lost in a row.
+/// (256 left a restarted ground deaf for three minutes: nothing sends TM frames again; 4 had
+/// frames refused after ordinary bursts of loss.)
+pub const TM_RX_BLOCK: u32 = 16;
 
 fn tc_channel(board: BoardNumber) -> Channel {
     Channel {

@@ -229,6 +229,19 @@ impl Uplink {
         up
     }
 
+    /// The number the next submitted command gets: what a restarting ground keeps to start
+    /// after ([`Uplink::starting_at`]; decision `restart-ground`).
+    pub const fn next_seq(&self) -> u16 {
+        self.next_seq
+    }
+
+    /// The uplink of this one's ground after a restart that kept its numbering (the number it
+    /// would give out next, written before a number is first sent: decision
+    /// `restart-ground`): nothing outstanding, nothing measured, numbering where it stood.
+    pub const fn restarted(&self) -> Uplink {
+        Uplink::starting_at(self.cfg, self.board, self.next_seq)
+    }
+
     /// Still probing after a restart ([`Uplink::after_restart`]).
     pub const fn is_syncing(&self) -> bool {
         self.syncing

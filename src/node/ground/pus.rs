@@ -315,6 +315,33 @@ impl TcLink {
         }
     }
 
+    /// For robot `board`, numbering from sequence count `next` (its low 14 bits): a restarted ground's link,
+    /// from the count it kept ([`TcLink::next_count`]; decision `restart-ground`). A ground
+    /// that numbered from 0 again would have its new telecommands answered as copies of old
+    /// ones by a gateway that kept a newer key.
+    pub fn starting_at(cfg: Config, board: BoardNumber, next: u16) -> TcLink {
+        TcLink {
+            next: SeqCount::masked(next),
+            ..TcLink::new(cfg, board)
+        }
+    }
+
+    /// The sequence count the next submitted command gets.
+    pub const fn next_count(&self) -> u16 {
+        self.next.get()
+    }
+
+    /// This link after its ground restarted, keeping only the sequence count (decision
+    /// `restart-ground`): nothing outstanding or followed, no status, nothing measured.
+    pub fn restarted(&self) -> TcLink {
+        TcLink {
+            cfg: self.cfg,
+            apid: self.apid,
+            next: self.next,
+            ..TcLink::new(self.cfg, BoardNumber::ONE)
+        }
+    }
+
     /// The APID of its telecommands.
     pub const fn apid(&self) -> u16 {
         self.apid

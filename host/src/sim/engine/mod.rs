@@ -227,7 +227,7 @@ enum Board {
 /// One robot's nodes and links.
 struct Robot {
     number: BoardNumber,
-    names: [String; 3],
+    names: [String; 4],
     a: SideA,
     b: SideB,
     plant: Plant,
@@ -268,9 +268,12 @@ struct Robot {
     /// With SDLS: the robot's (TC, TM) keys, as provisioned in the server board's image.
     keys: Option<(Key256, Key256)>,
     /// Board A, board B, the server board: down (restarting) until their `Up` event.
-    down: [bool; 3],
+    down: [bool; 4],
     /// The restarts of each node so far.
-    restarts: [u32; 3],
+    restarts: [u32; 4],
+    /// The space data link's figures of the ends' earlier lives (a restarted end counts
+    /// from 0 again).
+    past_frames: FrameStats,
 }
 
 /// The attacker on a robot's uplink ([`super::SdlsConfig::attack`]): it captures the TC data
@@ -479,19 +482,11 @@ impl<'c, G: Ground> Engine<'c, G> {
             for i in 0..self.robots.len() {
                 w.finish(i, now, &self.ground.open_commands(i));
             }
-            // SDLS: the server board verified no more TC frames than the ground protected.
+            // SDLS: the server board verified no more TC frames than the ground protected
+            // (over every life of each end).
             for (i, r) in self.robots.iter().enumerate() {
-                let server = match &r.board {
-                    Board::Frames(g) => g.security(r.number).map(|c| c.accepted),
-                    _ => None,
-                };
-                let ground = r
-                    .ground_link
-                    .as_ref()
-                    .and_then(|gl| gl.security())
-                    .map(|c| c.protected);
-                if let (Some(s), Some(g)) = (server, ground) {
-                    w.sdls_checked(i, now, s, g);
+                if let Some(x) = r.frames().sdls {
+                    w.sdls_checked(i, now, x.server.verified, x.ground.protected);
                 }
             }
         }
@@ -508,7 +503,7 @@ impl<'c, G: Ground> Engine<'c, G> {
             let f = std::fs::File::create(p)?;
             log::write_lines(&records, &mut std::io::BufWriter::new(f))?;
         }
-        let mut restarts = [0u32; 3];
+        let mut restarts = [0u32; 4];
         for r in &self.robots {
             for (t, n) in restarts.iter_mut().zip(r.restarts) {
                 *t += n;
@@ -619,6 +614,15 @@ impl<'c, G: Ground> Engine<'c, G> {
                 if let Some(a) = &mut r.attacker {
                     a.waiting.clear();
                 }
+                if let Board::Frames(g) = &r.board {
+                    r.past_frames.add_server(g, r.number);
+                }
+            }
+            Node::Ground => {
+                r.ground_reader = Deframer::new();
+                if let Some(gl) = r.ground_link.take() {
+                    r.past_frames.add_ground(&gl);
+                }
             }
         }
         self.node_event(i, k, json!({"type": "restart", "down_ms": BOOT_MS}));
@@ -660,6 +664,30 @@ impl<'c, G: Ground> Engine<'c, G> {
                     r.keys.clone(),
                 );
                 self.wake_server(i, self.now);
+            }
+            Node::Ground => {
+                let now = self.now_ms();
+                self.ground.restart(i, now);
+                let r = &mut self.robots[i];
+                if cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames {
+                    // FOP-1 starts afresh (its AD service initiated again with a CLCW check);
+                    // SDLS continues from the stored counters (decision `sdls-counters`).
+                    let mut gl = Box::new(SimGroundLink::new(r.number));
+                    if let Some((tc, tm)) = r.keys.clone() {
+                        let stored = (
+                            r.store
+                                .get(&("ground", sdls::mission::tc_spi(r.number)))
+                                .copied(),
+                            r.store
+                                .get(&("ground", sdls::mission::tm_spi(r.number)))
+                                .copied(),
+                        );
+                        gl.secure(tc, tm, stored);
+                    }
+                    gl.start(now, &mut |_: &[u8]| {});
+                    r.ground_link = Some(gl);
+                    r.persist();
+                }
             }
         }
         let boot = match node {
@@ -713,6 +741,9 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
         self.ground_links_tick();
         for i in 0..self.robots.len() {
+            if self.robots[i].down[Node::Ground as usize] {
+                continue;
+            }
             for p in self.ground.tick(i, now) {
                 self.ground_sends(i, &p);
             }
@@ -795,7 +826,7 @@ impl<'c, G: Ground> Engine<'c, G> {
             Hop::GroundToServer | Hop::AToServer => Some(Node::Server),
             Hop::ServerToA | Hop::BToA => Some(Node::A),
             Hop::AToB => Some(Node::B),
-            Hop::ServerToGround => None,
+            Hop::ServerToGround => Some(Node::Ground),
         };
         if let Some(n) = to {
             if self.robots[i].down[n as usize] {
@@ -887,15 +918,14 @@ impl<'c, G: Ground> Engine<'c, G> {
         let out = r.a.tick(&mut r.plant, now, command, from_b);
         r.kept_a = Some(r.a.board.durable());
         for e in &out.events {
-            // A Heartbeat poll does nothing: running one again after a restart is allowed
-            // (decision `restart-board-a`), so it is not counted.
+            // Nothing but a Heartbeat poll may run twice (`BoardA::may_run_again`).
             if let board_a::Event::Executed {
                 seq,
                 refusal: None,
                 command,
             } = e
             {
-                if *seq != 0 && *command != Some(mmic::command::Command::Heartbeat) {
+                if *seq != 0 && !mmic::node::robot::board_a::BoardA::may_run_again(*command) {
                     *self.executions.entry((i, *seq)).or_default() += 1;
                 }
             }
@@ -1346,12 +1376,7 @@ impl<'c, G: Ground> Engine<'c, G> {
         }
         let mut s = FrameStats::default();
         for r in &self.robots {
-            if let Some(gl) = &r.ground_link {
-                s.add_ground(gl);
-            }
-            if let Board::Frames(g) = &r.board {
-                s.add_server(g, r.number);
-            }
+            s = s.merged(r.frames());
             if let (Some(a), Some(sdls)) = (&r.attacker, s.sdls.as_mut()) {
                 sdls.attack_frames += a.sent;
                 sdls.attacks_refused_sdls += a.refused_sdls;
@@ -1546,6 +1571,7 @@ impl Robot {
                 format!("board_a{}", i + 1),
                 format!("board_b{}", i + 1),
                 format!("server{}", i + 1),
+                "ground".to_string(),
             ],
             a: SideA::new(BoardA::in_state(
                 board_a::Config {
@@ -1578,8 +1604,9 @@ impl Robot {
             kept_a: None,
             kept_server: Kept::new(),
             keys,
-            down: [false; 3],
-            restarts: [0; 3],
+            down: [false; 4],
+            restarts: [0; 4],
+            past_frames: FrameStats::default(),
         }
         .persisted()
     }
@@ -1609,6 +1636,18 @@ impl Robot {
         }
     }
 
+    /// This robot's space data link figures, over every life of both ends.
+    fn frames(&self) -> FrameStats {
+        let mut s = self.past_frames;
+        if let Some(gl) = &self.ground_link {
+            s.add_ground(gl);
+        }
+        if let Board::Frames(g) = &self.board {
+            s.add_server(g, self.number);
+        }
+        s
+    }
+
     fn persisted(mut self) -> Robot {
         self.persist();
         self
@@ -1620,7 +1659,7 @@ impl Robot {
             Protocol::Legacy => "serial_ground",
             Protocol::Pus => "udp_ground",
         };
-        let [a, b, s] = &self.names;
+        let [a, b, s, _] = &self.names;
         match hop {
             Hop::GroundToServer => (ground_link, "ground", s),
             Hop::ServerToGround => (ground_link, s, "ground"),

@@ -281,20 +281,9 @@ pub struct Watch {
 impl Watch {
     /// Watching `n` robots of a run of `cfg`.
     pub fn new(cfg: &SimConfig, n: usize) -> Watch {
-        let (period, attempts, answer) = match cfg.protocol {
-            super::Protocol::Legacy => (
-                cfg.ground.period_ms,
-                cfg.ground.max_attempts as u32,
-                cfg.ground.timeout_ms,
-            ),
-            super::Protocol::Pus => {
-                let pus = cfg.ground_pus();
-                (pus.timeout_ms, pus.max_attempts as u32, pus.timeout_ms)
-            }
-        };
         Watch {
             robots: (0..n).map(|_| RobotWatch::default()).collect(),
-            command_life_ms: period.saturating_mul(attempts).saturating_add(answer),
+            command_life_ms: cfg.command_life_ms(),
             gripper_closed_us: Travel::GRIPPER.extended.micros() as f64,
             violations: Vec::new(),
             checked: Checked::default(),
@@ -332,7 +321,7 @@ impl Watch {
 
     /// With SDLS, at the end of a run: robot `i`'s server board verified `verified` TC frames,
     /// its ground protected `protected`; every verified frame must be one the ground sent.
-    pub fn sdls_checked(&mut self, i: usize, now: u32, verified: u32, protected: u32) {
+    pub fn sdls_checked(&mut self, i: usize, now: u32, verified: u64, protected: u64) {
         if verified > protected {
             self.violation(
                 now,
@@ -471,11 +460,10 @@ impl Watch {
             );
             return;
         };
-        // A Heartbeat poll does nothing: board A may run one again after a restart (its
-        // flash keeps no poll: decision `restart-board-a`).
-        let poll = mmic::wire::command::CommandRepr::parse(p)
-            .is_ok_and(|c| c.command == mmic::command::Command::Heartbeat);
-        if poll {
+        // Nothing but a Heartbeat poll may run twice (`BoardA::may_run_again`).
+        let exempt = mmic::wire::command::CommandRepr::parse(p)
+            .is_ok_and(|c| mmic::node::robot::board_a::BoardA::may_run_again(Some(c.command)));
+        if exempt {
             return;
         }
         if let Some(first) = r.admitted.insert(origin, now) {

@@ -115,6 +115,25 @@ pub enum InterjectError {
     },
 }
 
+/// What the ground's disk keeps of a plan runner across the ground's restart (decision
+/// `restart-ground`): where the plan stands, whether a Stop holds it, and the out-of-band
+/// commands still waiting for a slot. The link's numbering is kept beside it, by the link
+/// ([`Uplink::next_seq`], [`super::pus::TcLink::next_count`]). Written whenever it changes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct PlanKept {
+    /// The step being run (0-based).
+    pub step: usize,
+    /// Its command was outstanding, or its motion running: its outcome is lost with the RAM.
+    pub open: bool,
+    /// An accepted Stop held the plan.
+    pub held: bool,
+    /// The plan had ended.
+    pub end: Option<PlanEnd>,
+    /// Out-of-band commands not yet sent, oldest first.
+    pub pending: [Option<Command>; INTERJECTIONS],
+}
+
 /// The runner, over the legacy [`Uplink`] or another [`Link`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -168,6 +187,54 @@ impl<L: Link> PlanRunner<L> {
             held: false,
             misstate: false,
         }
+    }
+
+    /// What to keep across the ground's restart ([`PlanRunner::restarted`]).
+    pub const fn kept(&self) -> PlanKept {
+        PlanKept {
+            step: self.next,
+            open: matches!(self.phase, Phase::Sending | Phase::Settling { .. }),
+            held: self.held,
+            end: self.end(),
+            pending: self.pending,
+        }
+    }
+
+    /// The runner of a ground that restarted, over `link` (numbering after the last number
+    /// the ground gave out: decision `restart-ground`), from what its disk kept. A step whose
+    /// command or motion was open at the crash ends the plan as [`PlanEnd::Restarted`]: the
+    /// ground does not know whether it ran, and sending it again as a new command could run
+    /// it twice. Otherwise the plan goes on at the step it stood at (a wait starts again).
+    /// An out-of-band command that was outstanding is lost with the RAM; those still waiting
+    /// are sent.
+    ///
+    /// ```
+    /// use mmic::command::Command;
+    /// use mmic::mode::Mode;
+    /// use mmic::node::exactly_once::uplink::{Config, Uplink};
+    /// use mmic::node::ground::plan_runner::{PlanEnd, PlanRunner, PlanStep};
+    /// use mmic::units::BoardNumber;
+    ///
+    /// let steps = [PlanStep::Command(Command::Mode(Mode::Operational))];
+    /// let mut run = PlanRunner::new(Config::default(), BoardNumber::ONE);
+    /// let sent = run.tick(&steps, 0).send.unwrap(); // step 0 outstanding: the ground crashes
+    /// let up = Uplink::starting_at(Config::default(), BoardNumber::ONE, run.uplink().next_seq());
+    /// let mut again = PlanRunner::restarted(up, run.kept());
+    /// assert_eq!(again.end(), Some(PlanEnd::Restarted { step: 0 }));
+    /// assert_eq!(again.tick(&steps, 100).send, None); // nothing is sent again
+    /// assert!(again.uplink().next_seq() > sent.seq);
+    /// ```
+    pub const fn restarted(link: L, kept: PlanKept) -> PlanRunner<L> {
+        let mut run = PlanRunner::over(link);
+        run.next = kept.step;
+        run.held = kept.held;
+        run.pending = kept.pending;
+        run.phase = match (kept.end, kept.open) {
+            (Some(e), _) => Phase::Ended(e),
+            (None, true) => Phase::Ended(PlanEnd::Restarted { step: kept.step }),
+            (None, false) => Phase::Ready,
+        };
+        run
     }
 
     /// The link (efficiency, outstanding command).

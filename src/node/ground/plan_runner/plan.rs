@@ -56,6 +56,13 @@ pub enum PlanEnd {
         /// Its latched faults.
         faults: Faults,
     },
+    /// The ground restarted while step `step`'s command was outstanding or its motion ran
+    /// ([`super::PlanRunner::restarted`]): its outcome is not known to the ground (it ran at
+    /// most once). The operator looks at the robot before planning on.
+    Restarted {
+        /// The step.
+        step: usize,
+    },
     /// Step `step`'s telecommand (or an out-of-band one during it) was refused by the PUS
     /// gateway itself, not by board A (a failure code of spec/ccsds/services.toml that is no
     /// refusal: the request did not read, the queue was full, the key was reused).

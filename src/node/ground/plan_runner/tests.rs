@@ -214,3 +214,50 @@ fn a_misstated_reconfiguration_goes_out_once_with_a_wrong_initial_state(
     assert_eq!(reconfigurations[1], m_b, "only the next one");
     Ok(())
 }
+
+#[test]
+fn a_restarted_ground_goes_on_between_steps_and_ends_an_open_step_as_restarted() {
+    let steps = [
+        PlanStep::Command(Command::Mode(Mode::Operational)),
+        PlanStep::Wait { ms: 3000 },
+        PlanStep::Command(Command::Mode(Mode::Standby)),
+    ];
+    let cfg = uplink::Config::default();
+    let fresh = |run: &PlanRunner| {
+        let up = Uplink::starting_at(cfg, BoardNumber::ONE, run.uplink().next_seq());
+        PlanRunner::restarted(up, run.kept())
+    };
+    let mut run = PlanRunner::new(cfg, BoardNumber::ONE);
+    // Before anything was sent: the plan starts over at step 0, numbered as before.
+    assert_eq!(fresh(&run).end(), None);
+    assert_eq!(fresh(&run).step(), 0);
+    // Step 0 outstanding: unknown, the plan ends there and nothing goes out again.
+    let sent = run.tick(&steps, 0).send.unwrap();
+    let mut again = fresh(&run);
+    assert_eq!(again.end(), Some(PlanEnd::Restarted { step: 0 }));
+    assert_eq!(again.tick(&steps, 5000).send, None);
+    // Accepted, and the wait of step 1 running: the plan goes on at step 1, numbering past
+    // every number given out before; an interjection still waiting is kept and sent first.
+    run.heartbeat(&steps, 20, &answer(&sent, Mode::Operational));
+    // Settling (polls) is open too.
+    assert_eq!(fresh(&run).end(), Some(PlanEnd::Restarted { step: 0 }));
+    let mut now = 100;
+    while run.step() == 0 {
+        now = exchange(&mut run, &steps, now, Mode::Operational).0 + 100;
+    }
+    assert_eq!(run.step(), 1);
+    run.interject(Command::Stop).unwrap();
+    let mut again = fresh(&run);
+    assert_eq!((again.step(), again.end()), (1, None));
+    let first = again.tick(&steps, now).send.unwrap();
+    assert_eq!(first.command, Command::Stop);
+    assert!(first.seq > sent.seq);
+    // An ended plan stays ended.
+    let mut ended = PlanRunner::new(cfg, BoardNumber::ONE);
+    let (_, _, t) = exchange(&mut ended, &[steps[0]], 0, Mode::Operational);
+    assert!(t.end.is_none());
+    let _ = exchange(&mut ended, &[steps[0]], 200, Mode::Operational);
+    ended.tick(&[steps[0]], 400);
+    let end = ended.end();
+    assert_eq!(fresh(&ended).end(), end);
+}

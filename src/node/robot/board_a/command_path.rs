@@ -62,10 +62,7 @@ impl BoardA {
         out: &mut Outputs,
     ) {
         self.log.record(seq, refusal);
-        // What flash keeps: every sequenced command but the Heartbeat poll, which does
-        // nothing and which the gateway sends four times a second when idle (a flash write per
-        // poll would wear the sector out in months: decision `restart-board-a`).
-        if seq != 0 && command != Some(Command::Heartbeat) {
+        if seq != 0 && !BoardA::may_run_again(command) {
             self.kept = (seq, refusal);
         }
         self.refusal = refusal;

@@ -93,6 +93,23 @@ impl BoardA {
         a
     }
 
+    /// Whether `command` may run again after a restart: the Heartbeat poll, which does
+    /// nothing and which the gateway sends four times a second when idle, so board A's flash
+    /// leaves it out of [`BoardA::durable`] (a flash write per poll would wear the sector out
+    /// in months: decision `restart-board-a`). Every other sequenced command is remembered,
+    /// and the simulator's checks count a second run of it.
+    ///
+    /// ```
+    /// use mmic::command::Command;
+    /// use mmic::node::robot::board_a::BoardA;
+    ///
+    /// assert!(BoardA::may_run_again(Some(Command::Heartbeat)));
+    /// assert!(!BoardA::may_run_again(Some(Command::Stop)));
+    /// ```
+    pub fn may_run_again(command: Option<crate::command::Command>) -> bool {
+        command == Some(crate::command::Command::Heartbeat)
+    }
+
     /// What to keep now (write it after a tick that changed it): the log's last entry, Heartbeat
     /// polls left out (they do nothing, so running one again after a restart harms nothing,
     /// and a write per poll would wear the flash out).
