@@ -147,3 +147,54 @@ fn the_space_data_link_over_lossy_udp_completes_the_demo_and_counts_its_frames()
         assert!(seq == 0 || seen.insert(seq), "{seq} executed twice");
     }
 }
+
+/// Restarts on the wall clock (`--inject reboot-a/-b/-ground@S` with `--realtime`): the
+/// threads of board A (both tasks), board B and the ground go down for 300 ms and boot from
+/// what they kept, as in virtual time; nothing runs twice. The server board's threads do
+/// not restart yet: refused with a clear error.
+#[test]
+fn board_a_board_b_and_the_ground_restart_on_the_wall_clock() {
+    for (protocol, inject, node) in [
+        (Protocol::Legacy, "reboot-a@8", 0),
+        (Protocol::Pus, "reboot-b@8", 1),
+    ] {
+        let mut cfg = realtime_demo(protocol);
+        cfg.inject(inject.parse().unwrap()).unwrap();
+        let s = realtime::run(&cfg).unwrap();
+        let mut want = [0u32; 4];
+        want[node] = 1;
+        assert_eq!(s.restarts, want, "{inject}: {}", report::text(&s));
+        assert!(report::executed_twice(&s).is_empty(), "{inject}");
+        assert_eq!(events(&s, "boot").len(), 1, "{inject}");
+        // Board A came up in Standby (boot byte: power-on, once); board B announced its
+        // restart and board A went Safed: either way the plan stopped, with a reason.
+        assert!(!s.completed() && s.ends[0].is_some(), "{inject}");
+        if node == 0 {
+            assert_eq!(events(&s, "boot")[0]["boot"], 0x21);
+        }
+    }
+    // The ground in a wait, over frames with SDLS: the plan goes on and completes.
+    let mut cfg = realtime_demo(Protocol::Pus);
+    cfg.link = LinkLayer::Frames;
+    cfg.scale = 10.0;
+    cfg.steps = mmic_host::sim::steps_of(
+        &mmic_host::plan::parse("mode operational\nwait 6s\nbolt 1\nmode standby\n").unwrap(),
+    );
+    cfg.sdls = Some(mmic_host::sim::SdlsConfig {
+        keys: mmic_host::sim::SdlsKeys::Random,
+        attack: 0.0,
+    });
+    cfg.inject("reboot-ground@4".parse().unwrap()).unwrap();
+    let s = realtime::run(&cfg).unwrap();
+    assert!(s.completed(), "{}", report::text(&s));
+    assert_eq!(s.restarts, [0, 0, 0, 1]);
+    assert!(report::executed_twice(&s).is_empty());
+    // The server board's restart stays virtual-time only.
+    let mut cfg = realtime_demo(Protocol::Legacy);
+    cfg.inject("reboot-server@3".parse().unwrap()).unwrap();
+    let e = realtime::run(&cfg).unwrap_err().to_string();
+    assert!(
+        e.contains("reboot-server") && e.contains("virtual-time"),
+        "{e}"
+    );
+}

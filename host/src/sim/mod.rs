@@ -35,6 +35,7 @@
 
 pub mod bench;
 pub mod clock;
+pub mod downtime;
 pub mod engine;
 pub mod inject;
 pub mod lockstep;

@@ -7,8 +7,10 @@
 //! TM transfer frames out, one per datagram).
 
 use super::clock::{Clock, NodeClock};
+use super::downtime::{Downtime, Phase};
+use super::inject::BOOT_MS;
 use super::log::Log;
-use super::plant::Plant;
+use super::plant::{Drives, Plant};
 use super::shell::{SideA, SideB};
 use super::FrameStats;
 use mmic::link::farm::Verdict;
@@ -16,12 +18,15 @@ use mmic::link::sdls::Key256;
 use mmic::link::tc_frame::{self, SpacecraftId, TcFrame};
 use mmic::link::tm_frame::TM_FRAME_LEN;
 use mmic::link::ControlCommand;
+use mmic::node::robot::board_a::{BoardA, Durable};
+use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::node::server::frames::{FrameConfig, FrameGateway, Stored};
 use mmic::node::server::gateway::{self, Gateway, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
+use mmic::restart::ResetCause;
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::deframer::{Deframed, Deframer};
@@ -202,6 +207,9 @@ pub struct WifiTask<'q> {
     pub loss: f64,
     /// Seed of the loss draws.
     pub seed: u64,
+    /// Board A is restarting (set by its control task): the WiFi task takes no connection and
+    /// drops what it holds, and starts a new session once it is up again.
+    pub down: Arc<AtomicBool>,
 }
 
 impl WifiTask<'_> {
@@ -212,6 +220,14 @@ impl WifiTask<'_> {
         let _ = self.listener.set_nonblocking(true);
         while node.running() {
             let now = node.poll();
+            if self.down.load(Ordering::Relaxed) {
+                // Restarting: connections refused (accepted and dropped), RAM lost.
+                while self.heartbeats.pop().is_some() {}
+                let _ = self.listener.accept();
+                session = WifiSession::new(WifiConfig::default());
+                std::thread::sleep(Duration::from_micros(300));
+                continue;
+            }
             match self.listener.accept() {
                 Ok((sock, _)) => {
                     let queued = std::iter::from_fn(|| self.heartbeats.pop());
@@ -248,6 +264,9 @@ impl WifiTask<'_> {
         let mut buf = [0u8; 256];
         while node.running() {
             let now = node.poll();
+            if self.down.load(Ordering::Relaxed) {
+                return; // board A restarts: the connection drops
+            }
             match sock.read(&mut buf) {
                 Ok(0) => return,
                 Ok(n) => {
@@ -328,6 +347,13 @@ pub struct ControlTask<'q> {
     pub plant: Arc<Mutex<Plant>>,
     /// Board A's mode, faults and state for the run's summary.
     pub status: Arc<Mutex<Value>>,
+    /// Board A's restarts (`--inject reboot-a@S`), and the flag its WiFi task reads.
+    pub restarts: Downtime,
+    /// Set while board A is down.
+    pub down: Arc<AtomicBool>,
+    /// Board A's flash: its exactly-once log's last entry and boot count (decision
+    /// `restart-board-a`).
+    pub kept: Option<Durable>,
 }
 
 impl ControlTask<'_> {
@@ -336,13 +362,51 @@ impl ControlTask<'_> {
         node.every_tick(|now| self.tick(&node, now));
     }
 
+    /// A restart going on: true while board A is down (this tick does nothing).
+    fn restarting(&mut self, node: &Node<'_>, now: u32) -> bool {
+        match self.restarts.step(now) {
+            Phase::Running => return false,
+            Phase::WentDown => {
+                self.down.store(true, Ordering::Relaxed);
+                let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
+                p.advance(now);
+                p.drive_a(Drives::off(), None);
+                node.event(now, json!({"type": "restart", "down_ms": BOOT_MS}));
+            }
+            Phase::Down => {}
+            Phase::CameUp => {
+                let board =
+                    BoardA::restarted(self.a.board.config(), self.kept, ResetCause::PowerOn);
+                self.kept = Some(board.durable());
+                self.a = SideA::new(board);
+                self.down.store(false, Ordering::Relaxed);
+                let boot = self.a.board.boot().to_wire();
+                node.event(now, json!({"type": "boot", "boot": boot}));
+                return false;
+            }
+        }
+        // Down: what reaches it is lost.
+        while self.commands.pop().is_some() {}
+        while self.from_b.try_recv().is_ok() {}
+        true
+    }
+
     fn tick(&mut self, node: &Node<'_>, now: u32) {
+        if self.restarting(node, now) {
+            return;
+        }
         let command = self.commands.pop();
         let from_b = self.from_b.try_recv().ok().and_then(|v| v.try_into().ok());
+        // Board A's flash: the record written ahead of a tick that may run a new command,
+        // then after it.
+        if let Some(d) = self.a.board.ahead(command.as_ref()) {
+            self.kept = Some(d);
+        }
         let out = {
             let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
             self.a.tick(&mut p, now, command, from_b)
         };
+        self.kept = Some(self.a.board.durable());
         for e in &out.events {
             node.event(now, event_json(e));
         }
@@ -374,6 +438,9 @@ pub struct BoardBTask {
     pub to_a: Lossy<std::io::PipeWriter>,
     /// The robot's body.
     pub plant: Arc<Mutex<Plant>>,
+    /// Board B's restarts (`--inject reboot-b@S`): it keeps nothing (decision
+    /// `restart-board-b`).
+    pub restarts: Downtime,
 }
 
 impl BoardBTask {
@@ -381,6 +448,25 @@ impl BoardBTask {
     pub fn run(mut self, node: Node<'_>) {
         let mut was_lost = false;
         node.every_tick(|now| {
+            let phase = self.restarts.step(now);
+            match phase {
+                Phase::Running => {}
+                Phase::WentDown => {
+                    let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
+                    p.advance(now);
+                    p.drive_b(Drives::off());
+                    node.event(now, json!({"type": "restart", "down_ms": BOOT_MS}));
+                }
+                Phase::Down => {}
+                Phase::CameUp => {
+                    self.b = SideB::new(BoardB::restarted(board_b::Config::default()));
+                    node.event(now, json!({"type": "boot", "boot": null}));
+                }
+            }
+            if matches!(phase, Phase::WentDown | Phase::Down) {
+                while self.from_a.try_recv().is_ok() {}
+                return;
+            }
             let command = self.from_a.try_recv().ok().and_then(|v| v.try_into().ok());
             let out = {
                 let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());

@@ -9,11 +9,14 @@
 //! ([`super::engine`], the default) cannot.
 
 use super::clock::{self, Clock};
+use super::downtime::{Downtime, Phase};
+use super::inject::{Injection, Node, BOOT_MS};
 use super::log;
 use super::nodes::{self, Lossy};
 use super::plant::{self, PlantConfig};
 use super::shell::{Ground, GroundSide, GroundStats, LegacyGround, SideA, SideB};
 use super::{FrameStats, LinkLayer, Protocol, SimConfig, Summary, PACE_SLACK_MS};
+use mmic::link::sdls;
 use mmic::node::ground::frames::GroundLink as FopLink;
 use mmic::node::ground::plan_runner::{PlanEnd, PlanRunner};
 use mmic::node::robot::board_a::{self, BoardA};
@@ -42,6 +45,11 @@ struct Serial {
 }
 
 /// The ground's end of a robot's link: the writer, the packets read, the robot's number.
+/// The ground's durable SDLS counters, (robot, SPI) → value.
+type Store = std::collections::BTreeMap<(usize, u16), u128>;
+/// A robot's SDLS keys, TC and TM.
+type Keys = (mmic::link::sdls::Key256, mmic::link::sdls::Key256);
+
 type GroundLink = (
     Lossy<Box<dyn Write + Send>>,
     std::sync::mpsc::Receiver<Vec<u8>>,
@@ -138,12 +146,14 @@ fn spawn_robot<'scope, 'env>(
     let (cmd_queue, hb_queue) = (&mut queues.0, &mut queues.1);
     let (cmd_p, cmd_c) = cmd_queue.split();
     let (hb_p, hb_c) = hb_queue.split();
+    let a_down = Arc::new(AtomicBool::new(false));
     let wifi = nodes::WifiTask {
         listener: robot.listener,
         commands: cmd_p,
         heartbeats: hb_c,
         loss: cfg.wifi_loss,
         seed: seed ^ 0x5eed,
+        down: a_down.clone(),
     };
     let control = nodes::ControlTask {
         a: SideA::new(BoardA::in_state(
@@ -167,6 +177,9 @@ fn spawn_robot<'scope, 'env>(
         ),
         plant: plant.clone(),
         status,
+        restarts: Downtime::of(cfg, Node::A),
+        down: a_down,
+        kept: None,
     };
     let b = nodes::BoardBTask {
         b: SideB::new(BoardB::new(board_b::Config::default())),
@@ -181,6 +194,7 @@ fn spawn_robot<'scope, 'env>(
             2,
         ),
         plant,
+        restarts: Downtime::of(cfg, Node::B),
     };
     // The WiFi task logs its packets (the packet log) and the hand-off events with them.
     let nodes = (
@@ -342,11 +356,11 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     if let Some(r) = cfg
         .injections
         .iter()
-        .find(|s| matches!(s.injection, super::inject::Injection::Reboot(_)))
+        .find(|s| s.injection == Injection::Reboot(Node::Server))
     {
         return Err(std::io::Error::other(format!(
             "{} is injected in the virtual-time engine only (the default): the realtime \
-             engine's nodes are threads that cannot restart yet",
+             engine restarts board A, board B and the ground, not yet the server board's threads",
             r.injection
         )));
     }
@@ -420,7 +434,22 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         .join()
         .map_err(|_| std::io::Error::other("log writer panicked"))??;
     let status = statuses[0].lock().map(|s| s.clone()).unwrap_or(Value::Null);
+    // The restarts, from the nodes' events (the ground's counted once per robot, as the
+    // virtual-time engine counts them).
+    let mut restarts = [0u32; 4];
+    for r in records.iter().filter(|r| r["event"]["type"] == "restart") {
+        let node = r["node"].as_str().unwrap_or("");
+        match ["board_a", "board_b", "server", "ground"]
+            .iter()
+            .position(|p| node.starts_with(p))
+        {
+            Some(3) => restarts[3] += n as u32,
+            Some(k) => restarts[k] += 1,
+            None => {}
+        }
+    }
     Ok(Summary {
+        restarts,
         max_tick_lateness_ms: lateness.load(Ordering::Relaxed),
         held_ms: clock.held_ms(),
         pace_slack_ms: clock.slack_ms(),
@@ -472,7 +501,7 @@ type SimFopLink = FopLink<10, 64, 1024>;
 fn ground_loop(
     cfg: &SimConfig,
     links: Vec<GroundLink>,
-    keys: &[(mmic::link::sdls::Key256, mmic::link::sdls::Key256)],
+    keys: &[Keys],
     clock: clock::NodeClock<'_>,
     log: Option<log::Log>,
 ) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
@@ -485,7 +514,7 @@ fn ground_loop(
                     last: None,
                 })
                 .collect();
-            run_ground(cfg, links, runners, Vec::new(), clock, log)
+            run_ground(cfg, links, runners, (Vec::new(), keys), clock, log)
         }
         Protocol::Pus => {
             let runners = links
@@ -507,7 +536,7 @@ fn ground_loop(
                     })
                 })
                 .collect();
-            run_ground(cfg, links, runners, fops, clock, log)
+            run_ground(cfg, links, runners, (fops, keys), clock, log)
         }
     }
 }
@@ -515,12 +544,14 @@ fn ground_loop(
 /// The opsUI: one plan runner per robot, in one thread (one ground process). With a robot's
 /// FOP-1 link in `fops` (`--link frames`), its packets go out in TC frames and the TM frames
 /// that come back are taken apart by it (their CLCW to FOP-1, their packets to the runner);
-/// the link's figures are returned.
+/// the link's figures are returned. `--inject reboot-ground@S` restarts it (decision
+/// `restart-ground`): down for [`BOOT_MS`], what reaches it lost, then each runner from what
+/// the disk kept and each FOP-1 afresh, with SDLS from the stored counters.
 fn run_ground<G: Ground>(
     cfg: &SimConfig,
     mut links: Vec<GroundLink>,
     runners: Vec<G>,
-    mut fops: Vec<Option<Box<SimFopLink>>>,
+    (mut fops, keys): (Vec<Option<Box<SimFopLink>>>, &[Keys]),
     clock: clock::NodeClock<'_>,
     log: Option<log::Log>,
 ) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
@@ -534,16 +565,19 @@ fn run_ground<G: Ground>(
     );
     // The ground's durable SDLS counters, (robot, SPI) → value: kept for the run.
     let mut store = std::collections::BTreeMap::new();
-    let mut persist = |i: usize, gl: &mut SimFopLink| {
+    let persist = |store: &mut Store, i: usize, gl: &mut SimFopLink| {
         for (spi, v) in gl.due().collect::<Vec<_>>() {
             store.insert((i, spi), v);
             gl.persisted(spi, v);
         }
     };
+    let mut restarts = Downtime::of(cfg, Node::Ground);
+    // The link's figures of the ground's earlier lives.
+    let mut past = FrameStats::default();
     // FOP-1 initiates the AD service; it runs once a CLCW confirms it.
     for (i, ((writer, _, _), fop)) in links.iter_mut().zip(fops.iter_mut()).enumerate() {
         if let Some(gl) = fop {
-            persist(i, gl);
+            persist(&mut store, i, gl);
             gl.start(clock.now_ms(), &mut |f: &[u8]| {
                 writer.send(clock.now_ms(), f);
             });
@@ -555,6 +589,48 @@ fn run_ground<G: Ground>(
         clock.ready(now);
         if now > cfg.max_sim_ms || ground.all_done() {
             break;
+        }
+        let phase = restarts.step(now);
+        if phase == Phase::WentDown {
+            ground_event(&log, now, json!({"type": "restart", "down_ms": BOOT_MS}));
+            for f in fops.iter_mut() {
+                if let Some(gl) = f.take() {
+                    past.add_ground(&gl);
+                }
+            }
+        }
+        match phase {
+            Phase::Running => {}
+            Phase::WentDown | Phase::Down => {
+                // Down: what reaches it is lost.
+                for (_, rx, _) in links.iter_mut() {
+                    while rx.try_recv().is_ok() {}
+                }
+                std::thread::sleep(Duration::from_micros(500));
+                continue;
+            }
+            Phase::CameUp => {
+                for (i, (writer, _, b)) in links.iter_mut().enumerate() {
+                    ground.restart(i, now);
+                    if cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames {
+                        let mut gl = Box::new(SimFopLink::new(*b));
+                        if let Some((tc, tm)) = keys.get(i) {
+                            let stored = |spi| store.get(&(i, spi)).copied();
+                            let kept = (
+                                stored(sdls::mission::tc_spi(*b)),
+                                stored(sdls::mission::tm_spi(*b)),
+                            );
+                            gl.secure(tc.clone(), tm.clone(), kept);
+                        }
+                        persist(&mut store, i, &mut gl);
+                        gl.start(now, &mut |f: &[u8]| {
+                            writer.send(clock.now_ms(), f);
+                        });
+                        fops[i] = Some(gl);
+                    }
+                }
+                ground_event(&log, now, json!({"type": "boot", "boot": null}));
+            }
         }
         for (i, (writer, rx, _)) in links.iter_mut().enumerate() {
             let Some(gl) = fops.get_mut(i).and_then(|f| f.as_deref_mut()) else {
@@ -572,7 +648,7 @@ fn run_ground<G: Ground>(
             let mut emit = |f: &[u8]| {
                 writer.send(clock.now_ms(), f);
             };
-            persist(i, gl);
+            persist(&mut store, i, gl);
             gl.tick(now, &mut emit);
             for p in ground.tick(i, now) {
                 if gl.send(&p, now, &mut emit).is_err() {
@@ -593,7 +669,7 @@ fn run_ground<G: Ground>(
                                "sdls": log::sdls_header(&bytes)}),
                     );
                 }
-                persist(i, gl);
+                persist(&mut store, i, gl);
                 for p in packets {
                     for q in ground.receive(i, t, &p) {
                         if gl.send(&q, t, &mut emit).is_err() {
@@ -607,7 +683,7 @@ fn run_ground<G: Ground>(
         std::thread::sleep(Duration::from_micros(500));
     }
     let (ends, stats) = ground.finish(now);
-    let mut frames = FrameStats::default();
+    let mut frames = past;
     for gl in fops.iter().flatten() {
         frames.add_ground(gl);
     }

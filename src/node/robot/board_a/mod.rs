@@ -111,6 +111,11 @@ pub struct BoardA {
 }
 
 impl BoardA {
+    /// The settings it runs with (a shell restarting the board starts it with the same).
+    pub const fn config(&self) -> Config {
+        self.cfg
+    }
+
     /// Startup: Standby, no state known, servos at their home pulses.
     pub fn new(cfg: Config) -> BoardA {
         BoardA {
