@@ -10,7 +10,7 @@
 use crate::wire_enum::wire_enum;
 
 wire_enum! {
-    /// A refused command's reason. Wire value 1..=9; 0 means accepted. None of these is the
+    /// A refused command's reason. Wire value 1..=10; 0 means accepted. None of these is the
     /// paper's: it has no refusal codes (spec/decisions.toml, `heartbeat-byte-62`).
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
     #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -42,11 +42,17 @@ wire_enum! {
         /// holding arm's axis: the geometric model has it, the robot's joints do not (the hip's
         /// axis is perpendicular to both arms; spec/decisions.toml, `turn-to-turn-moves`).
         TurnWithoutHip = 9 => "turn_without_hip",
+        /// No refusal of the command itself: board A restarted while taking it, and its flash
+        /// holds only the record written ahead of that tick (spec/decisions.toml,
+        /// `restart-board-a`), so it ran at most once and whether it ran is not known. A copy
+        /// after the restart is answered with this; the uplink reports the command
+        /// unacknowledged (its outcome unknown), never accepted.
+        Restarted = 10 => "restarted",
     }
 
     /// All reasons, in wire order.
     const ALL;
-    /// Wire value 1..=9.
+    /// Wire value 1..=10.
     pub const fn to_wire(self) -> u8;
     /// Reason from its wire value; `None` for 0 (accepted) and unknown values.
     pub const fn from_wire(b: u8) -> Option<Self>;

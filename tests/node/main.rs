@@ -3,6 +3,7 @@
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
 mod board_a;
+mod board_a_restart;
 mod board_b;
 mod node_boards;
 mod node_fidelity;

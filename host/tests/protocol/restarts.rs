@@ -141,12 +141,18 @@ impl RobotA {
         &mut self,
         bytes: [u8; COMMAND_LEN],
         how: Take,
-        restore: bool,
+        (restore, ahead_accepted): (bool, bool),
         c: Counts<'_, N>,
     ) -> (Option<[u8; HEARTBEAT_LEN]>, bool) {
         let ahead = self.a.ahead(Some(&bytes));
         if let Some(ahead) = ahead {
-            self.store = ahead;
+            self.store = match ahead_accepted {
+                true => Durable {
+                    outcome: None,
+                    ..ahead
+                },
+                false => ahead,
+            };
         }
         if how == Take::CrashBeforeTick {
             self.restart(restore);
@@ -252,8 +258,6 @@ struct Legacy {
     /// acknowledged (a resend after the restart answered, not run).
     ran_before_a_restart: [bool; COMMANDS.len()],
     acked_after_a_restart: bool,
-    /// Board A crashed with the command's ahead record written and its after-tick record not.
-    interrupted: [bool; COMMANDS.len()],
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -282,9 +286,10 @@ struct LegacyModel {
     keeps: GroundKeeps,
     /// Board A restarts from its store (false: the planted fault).
     restore_a: bool,
-    /// An accepted command ran once even when board A crashed while taking it (the ahead
-    /// record's "accepted" is then a guess: see `spec/protocol/README.md`).
-    strict: bool,
+    /// Board A's ahead record says "accepted" (the planted fault: the record before the
+    /// design change, which a crash between the two writes turned into a false
+    /// acknowledgement) instead of "restarted while taking it" (`Refusal::Restarted`).
+    ahead_accepted: bool,
 }
 
 fn plan_index(c: &Command) -> Option<usize> {
@@ -361,7 +366,6 @@ impl Model for LegacyModel {
             mid_command: [false; NODES.len()],
             ran_before_a_restart: [false; COMMANDS.len()],
             acked_after_a_restart: false,
-            interrupted: [false; COMMANDS.len()],
         }]
     }
 
@@ -439,13 +443,9 @@ impl Model for LegacyModel {
                             judged: &mut n.judged,
                             ran: &mut n.ran,
                         };
-                        let (hb, ahead) = n.robot.take(bytes, how, self.restore_a, counts);
-                        if how != Take::Whole && ahead {
-                            let c = CommandRepr::parse(&bytes).ok()?;
-                            if let Some(i) = plan_index(&c.command) {
-                                n.interrupted[i] = true;
-                            }
-                        }
+                        let (hb, _) =
+                            n.robot
+                                .take(bytes, how, (self.restore_a, self.ahead_accepted), counts);
                         if how != Take::Whole {
                             for (k, r) in ran_before.iter().enumerate() {
                                 n.ran_before_a_restart[k] |= *r > 0 || n.ran[k] > 0;
@@ -520,14 +520,11 @@ impl Model for LegacyModel {
             }),
             Property::always(
                 "an accepted command ran once, a refused one not at all",
-                |m: &LegacyModel, s: &Legacy| {
-                    (0..COMMANDS.len()).all(|i| {
-                        let excused = !m.strict && s.interrupted[i];
-                        match s.ends[i] {
-                            Some(End::Done(Outcome::Accepted)) => s.ran[i] == 1 || excused,
-                            Some(End::Done(Outcome::Refused(_))) => s.ran[i] == 0,
-                            _ => true,
-                        }
+                |_, s: &Legacy| {
+                    (0..COMMANDS.len()).all(|i| match s.ends[i] {
+                        Some(End::Done(Outcome::Accepted)) => s.ran[i] == 1,
+                        Some(End::Done(Outcome::Refused(_))) => s.ran[i] == 0,
+                        _ => true,
                     })
                 },
             ),
@@ -678,7 +675,7 @@ fn legacy(keeps: GroundKeeps, restore_a: bool) -> LegacyModel {
         max_restarts_total: 1,
         keeps,
         restore_a,
-        strict: false,
+        ahead_accepted: false,
     }
 }
 
@@ -735,8 +732,6 @@ struct Pus {
     restarts: [u8; NODES.len()],
     mid_command: [bool; NODES.len()],
     restarted_answer: bool,
-    /// Board A crashed with the telecommand's ahead record written and its after-tick record not.
-    interrupted: [bool; TCS.len()],
 }
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -762,8 +757,8 @@ struct PusModel {
     /// The ground keeps its next sequence count (false: the planted fault, from 1 again).
     ground_keeps_count: bool,
     restore_a: bool,
-    /// As `LegacyModel::strict`.
-    strict: bool,
+    /// As `LegacyModel::ahead_accepted`.
+    ahead_accepted: bool,
 }
 
 impl PusModel {
@@ -898,7 +893,6 @@ impl Model for PusModel {
             restarts: [0; NODES.len()],
             mid_command: [false; NODES.len()],
             restarted_answer: false,
-            interrupted: [false; TCS.len()],
         }]
     }
 
@@ -1008,13 +1002,9 @@ impl Model for PusModel {
                             judged: &mut n.judged,
                             ran: &mut n.ran,
                         };
-                        let (hb, ahead) = n.robot.take(bytes, how, self.restore_a, counts);
-                        if how != Take::Whole && ahead {
-                            let c = CommandRepr::parse(&bytes).ok()?;
-                            if let Some(i) = TCS.iter().position(|t| *t == c.command) {
-                                n.interrupted[i] = true;
-                            }
-                        }
+                        let (hb, _) =
+                            n.robot
+                                .take(bytes, how, (self.restore_a, self.ahead_accepted), counts);
                         if let Some(hb) = hb {
                             if n.wifi.len() < self.max_in_flight {
                                 put(&mut n.wifi, Packet::Heartbeat(hb));
@@ -1069,11 +1059,9 @@ impl Model for PusModel {
             }),
             Property::always(
                 "a telecommand reported started or completed ran exactly once",
-                |m: &PusModel, s: &Pus| {
+                |_, s: &Pus| {
                     (0..TCS.len()).all(|i| {
-                        !(s.started[i] || s.made[i] == Some(Final::Completed))
-                            || s.ran[i] == 1
-                            || (!m.strict && s.interrupted[i])
+                        !(s.started[i] || s.made[i] == Some(Final::Completed)) || s.ran[i] == 1
                     })
                 },
             ),
@@ -1158,7 +1146,7 @@ fn pus() -> PusModel {
         restore_gateway: true,
         ground_keeps_count: true,
         restore_a: true,
-        strict: false,
+        ahead_accepted: false,
     }
 }
 
@@ -1197,9 +1185,9 @@ fn exactly_once_across_restarts() {
             &["an accepted command ran once, a refused one not at all"],
         ),
         (
-            "an accepted command ran once, with board A's crash between its two writes not excused",
+            "planted: board A's ahead record saying accepted, as before the design change",
             LegacyModel {
-                strict: true,
+                ahead_accepted: true,
                 ..legacy(GroundKeeps::LastNumber, true)
             },
             &["an accepted command ran once, a refused one not at all"],
@@ -1235,18 +1223,30 @@ fn exactly_once_across_restarts() {
     }
     let faults: [(&str, PusModel, &[&'static str]); 3] = [
         (
-            "a TC reported started or completed ran once, with board A's crash between its two writes not excused",
-            PusModel { strict: true, ..pus() },
+            "planted: board A's ahead record saying accepted, as before the design change",
+            PusModel {
+                ahead_accepted: true,
+                ..pus()
+            },
             &["a telecommand reported started or completed ran exactly once"],
         ),
         (
             "planted: the gateway restarted without its kept keys (Gateway::add)",
-            PusModel { restore_gateway: false, ..pus() },
-            &["no telecommand run twice", "board A judges no telecommand twice"],
+            PusModel {
+                restore_gateway: false,
+                ..pus()
+            },
+            &[
+                "no telecommand run twice",
+                "board A judges no telecommand twice",
+            ],
         ),
         (
             "planted: the ground restarted numbering its TCs from 1 again",
-            PusModel { ground_keeps_count: false, ..pus() },
+            PusModel {
+                ground_keeps_count: false,
+                ..pus()
+            },
             &["no telecommand refused for a reused key"],
         ),
     ];

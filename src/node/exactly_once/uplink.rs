@@ -68,7 +68,8 @@ pub enum Outcome {
     Accepted,
     /// Board A took and refused it, with the reason (it did not run).
     Refused(Refusal),
-    /// No acknowledgement after every attempt: it ran once or not at all.
+    /// No acknowledgement after every attempt, or board A answered that it restarted while
+    /// taking it ([`Refusal::Restarted`]): it ran once or not at all.
     Unacknowledged,
 }
 
@@ -384,6 +385,8 @@ impl Uplink {
             command: o.command,
             outcome: match hb.refusal {
                 None => Outcome::Accepted,
+                // Board A restarted while taking it: it ran at most once, not known whether.
+                Some(Refusal::Restarted) => Outcome::Unacknowledged,
                 Some(r) => Outcome::Refused(r),
             },
             attempts: o.attempts,

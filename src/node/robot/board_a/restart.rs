@@ -123,8 +123,10 @@ impl BoardA {
     }
 
     /// The record to write *before* the tick that takes `command`, when that tick may run it:
-    /// a new sequenced command for this robot, recorded as accepted (the tick's own outcome
-    /// replaces it in [`BoardA::durable`]). `None` when the tick runs nothing the log must
+    /// a new sequenced command for this robot, its outcome recorded as not known
+    /// ([`Refusal::Restarted`]: a restart before the tick's own outcome replaces it in
+    /// [`BoardA::durable`] leaves a command that ran at most once, and a copy is answered so,
+    /// never as accepted). `None` when the tick runs nothing the log must
     /// remember (no packet, another robot's, a copy, an unsequenced command).
     pub fn ahead(
         &self,
@@ -133,7 +135,7 @@ impl BoardA {
         let (seq, _) = self.unpack(command?).ok()?;
         (seq != 0 && self.log.admit(seq) == Admission::Execute).then_some(Durable {
             last_seq: seq,
-            outcome: None,
+            outcome: Some(Refusal::Restarted),
             boots: self.boots,
         })
     }

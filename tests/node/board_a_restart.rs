@@ -1,0 +1,86 @@
+//! Board A crashing while it takes a command (decision `restart-board-a`): whatever the instant,
+//! the copy a sender resends after the restart is never run again, and it is never
+//! acknowledged as accepted unless it ran: a crash between the record written ahead of the
+//! tick and the one written after it answers "restarted while taking it" (byte 62 = 10), which
+//! the uplink ends as unacknowledged.
+
+use mmic::command::Command;
+use mmic::mode::Mode;
+use mmic::node::exactly_once::uplink::{self, Outcome, Uplink};
+use mmic::node::robot::board_a::{BoardA, Config, Event, Inputs};
+use mmic::refusal::Refusal;
+use mmic::restart::ResetCause;
+use mmic::units::BoardNumber;
+use mmic::wire::heartbeat::HeartbeatRepr;
+
+/// Where the power is cut while board A takes `command`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Cut {
+    /// After the ahead write, before the tick.
+    BeforeTick,
+    /// After the tick, before the after-tick write.
+    BeforeWrite,
+    /// After both writes.
+    AfterWrites,
+}
+
+#[test]
+fn a_copy_after_a_crash_mid_command_is_never_run_again_nor_acknowledged_falsely() {
+    // Operational from Standby is accepted; Stop in Standby is refused (nothing to stop).
+    for command in [Command::Mode(Mode::Operational), Command::Stop] {
+        for cut in [Cut::BeforeTick, Cut::BeforeWrite, Cut::AfterWrites] {
+            let mut up = Uplink::new(uplink::Config::default(), BoardNumber::ONE);
+            let seq = up.submit(command).unwrap();
+            let packet = up.tick(0).send.unwrap().to_bytes();
+            let mut a = BoardA::new(Config::default());
+            let mut flash = a.ahead(Some(&packet)).expect("a new sequenced command");
+            assert_eq!(flash.outcome, Some(Refusal::Restarted), "the ahead record");
+            let mut ran = None;
+            if cut != Cut::BeforeTick {
+                let out = a.tick(
+                    0,
+                    &Inputs {
+                        command: Some(packet),
+                        ..Inputs::at_home()
+                    },
+                );
+                ran = out.events.iter().find_map(|e| match e {
+                    Event::Executed {
+                        seq: s, refusal, ..
+                    } if *s == seq => Some(*refusal),
+                    _ => None,
+                });
+                if cut == Cut::AfterWrites {
+                    flash = a.durable();
+                }
+            }
+            // Power cut; board A boots from flash and the uplink's resend (the same packet)
+            // arrives.
+            let mut a = BoardA::restarted(Config::default(), Some(flash), ResetCause::PowerOn);
+            let out = a.tick(
+                10,
+                &Inputs {
+                    command: Some(packet),
+                    ..Inputs::at_home()
+                },
+            );
+            let what = format!("{command:?} cut {cut:?}");
+            assert!(
+                !out.events
+                    .iter()
+                    .any(|e| matches!(e, Event::Executed { .. })),
+                "{what}: run again"
+            );
+            let hb = HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap();
+            assert_eq!(hb.last_seq, seq, "{what}");
+            let done = up.heartbeat(20, &hb).done.expect("the copy is answered");
+            let want = match (cut, ran) {
+                (Cut::AfterWrites, Some(None)) => Outcome::Accepted,
+                (Cut::AfterWrites, Some(Some(r))) => Outcome::Refused(r),
+                // Not known whether it ran: unknown, never "accepted".
+                _ => Outcome::Unacknowledged,
+            };
+            assert_eq!(done.outcome, want, "{what} (first run: {ran:?})");
+        }
+    }
+}
