@@ -140,11 +140,11 @@ fn link_draw(s: &str) -> Result<LinkDraw, String> {
 }
 
 fn sdls_draw(s: &str) -> Result<SdlsDraw, String> {
-    s.parse()
+    s.parse().map_err(|e| format!("--sdls: {e}"))
 }
 
 fn restart_draw(s: &str) -> Result<RestartDraw, String> {
-    s.parse()
+    s.parse().map_err(|e| format!("--restarts: {e}"))
 }
 
 /// Runs `mmic swarm`.

@@ -51,40 +51,45 @@ impl Default for Options {
     }
 }
 
-/// Whether a scenario's nodes restart (`--inject reboot-*`).
+/// Whether a scenario gets a feature drawn from its own stream: drawn (`any`), never (`off`:
+/// every seed's scenario as before the feature was drawn) or always (`on`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum RestartDraw {
-    /// Drawn from the seed's restart stream: 0.4 of the runs, one to three restarts.
+pub enum Draw {
+    /// Drawn from the seed's stream.
     #[default]
     Any,
-    /// Never: every seed's scenario as before restarts were drawn.
+    /// Never.
     Off,
-    /// In every run: one to three restarts.
+    /// In every run that can have it.
     On,
 }
 
-impl RestartDraw {
+impl Draw {
     /// Its name on the command line.
     pub const fn name(self) -> &'static str {
         match self {
-            RestartDraw::Any => "any",
-            RestartDraw::Off => "off",
-            RestartDraw::On => "on",
+            Draw::Any => "any",
+            Draw::Off => "off",
+            Draw::On => "on",
         }
     }
 }
 
-impl std::str::FromStr for RestartDraw {
+impl std::str::FromStr for Draw {
     type Err = String;
-    fn from_str(s: &str) -> Result<RestartDraw, String> {
+    fn from_str(s: &str) -> Result<Draw, String> {
         match s {
-            "any" => Ok(RestartDraw::Any),
-            "off" => Ok(RestartDraw::Off),
-            "on" => Ok(RestartDraw::On),
-            _ => Err(format!("{s:?} is no restart choice: any, off or on")),
+            "any" => Ok(Draw::Any),
+            "off" => Ok(Draw::Off),
+            "on" => Ok(Draw::On),
+            _ => Err(format!("{s:?} is no choice: any, off or on")),
         }
     }
 }
+
+/// Whether a scenario's nodes restart (`--inject reboot-*`): `any` draws it from the seed's
+/// restart stream (0.4 of the runs, one to three restarts).
+pub type RestartDraw = Draw;
 
 /// The restart stream's draws for `seed`, seeded apart from the others (so that every earlier
 /// draw of every seed stays what it was): whether the run has restarts (0.4 of them, unless
@@ -116,40 +121,9 @@ fn draw_restarts(seed: u64, opts: &Options, cfg: &mut SimConfig, latest: u32) {
 /// The restart stream's seed mask.
 const RESTART_STREAM: u64 = 0x5245_5354_0000_0000;
 
-/// Whether a frames scenario's link is secured with SDLS.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum SdlsDraw {
-    /// Drawn from the seed's link stream: half of the frames runs.
-    #[default]
-    Any,
-    /// Never: frames runs as they were before SDLS was drawn.
-    Off,
-    /// Every frames run.
-    On,
-}
-
-impl SdlsDraw {
-    /// Its name on the command line.
-    pub const fn name(self) -> &'static str {
-        match self {
-            SdlsDraw::Any => "any",
-            SdlsDraw::Off => "off",
-            SdlsDraw::On => "on",
-        }
-    }
-}
-
-impl std::str::FromStr for SdlsDraw {
-    type Err = String;
-    fn from_str(s: &str) -> Result<SdlsDraw, String> {
-        match s {
-            "any" => Ok(SdlsDraw::Any),
-            "off" => Ok(SdlsDraw::Off),
-            "on" => Ok(SdlsDraw::On),
-            _ => Err(format!("{s:?} is no SDLS choice: any, off or on")),
-        }
-    }
-}
+/// Whether a frames scenario's link is secured with SDLS: `any` draws it from the seed's link
+/// stream (half of the frames runs).
+pub type SdlsDraw = Draw;
 
 /// The link layer a PUS scenario gets (legacy scenarios have none to choose).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
