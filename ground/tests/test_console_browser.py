@@ -21,8 +21,11 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import socket
 import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -31,7 +34,11 @@ from rust_side import REPO, mmic_bin
 
 selenium = pytest.importorskip("selenium", reason="selenium is in ground/requirements.txt: run ground/setup")
 from selenium import webdriver  # noqa: E402
-from selenium.common.exceptions import StaleElementReferenceException, TimeoutException  # noqa: E402
+from selenium.common.exceptions import (  # noqa: E402
+    SessionNotCreatedException,
+    StaleElementReferenceException,
+    TimeoutException,
+)
 from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
@@ -83,16 +90,34 @@ def console():
 def browser(console):
     if not (Path(CHROMIUM).exists() and Path(CHROMEDRIVER).exists()):
         pytest.skip(f"no {CHROMIUM} / {CHROMEDRIVER}: ground/setup installs chromium and chromium-driver")
-    opts = webdriver.ChromeOptions()
-    opts.binary_location = CHROMIUM
-    for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu",
-              "--window-size=1400,2000", "--disable-extensions", "--no-first-run"):
-        opts.add_argument(a)
-    d = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
+    # Chromium sometimes exits at start-up on a loaded machine (CI saw "session not created:
+    # Chrome instance exited" once, 2026-11-26, and the same tests passed alone right after):
+    # each attempt gets a profile of its own, and a failed start is tried again twice, said
+    # on stderr, before the error is raised.
+    profiles = []
+    for attempt in range(1, 4):
+        profiles.append(tempfile.mkdtemp(prefix="mmic-chromium-"))
+        opts = webdriver.ChromeOptions()
+        opts.binary_location = CHROMIUM
+        for a in ("--headless=new", "--no-sandbox", "--disable-dev-shm-usage", "--disable-gpu",
+                  "--window-size=1400,2000", "--disable-extensions", "--no-first-run",
+                  f"--user-data-dir={profiles[-1]}"):
+            opts.add_argument(a)
+        try:
+            d = webdriver.Chrome(service=Service(CHROMEDRIVER), options=opts)
+            break
+        except SessionNotCreatedException as e:
+            if attempt == 3:
+                raise
+            first = (e.msg or "").splitlines()[0] if e.msg else repr(e)
+            print(f"chromium did not start (attempt {attempt} of 3): {first}", file=sys.stderr)
+            time.sleep(2)
     d.set_page_load_timeout(WAIT)
     SHOTS.mkdir(parents=True, exist_ok=True)
     yield d
     d.quit()
+    for p in profiles:
+        shutil.rmtree(p, ignore_errors=True)
 
 
 def text(d) -> str:
