@@ -303,9 +303,10 @@ class Relay:
         self.tm.bind(("127.0.0.1", 0))
         self.tm_port = self.tm.getsockname()[1]
         self.counts = {d: dict(received=0, dropped=0, duplicated=0, forwarded=0) for d in ("tc", "tm")}
-        self.tc_seen: set[int] = set()     # N(S) of every AD frame YAMCS sent
+        self.tc_seen: dict[int, bytes] = {}  # N(S) of every AD frame YAMCS sent: its first copy
         self.ad_frames = 0
         self.retransmissions = 0           # AD frames YAMCS sent with an N(S) it had sent before
+        self.altered = 0                   # ... of those, how many differed from the first copy
         self.bc_frames = 0
         self.stop = threading.Event()
         self.threads = [
@@ -344,7 +345,9 @@ class Relay:
             self.ad_frames += 1
             if f.seq in self.tc_seen:
                 self.retransmissions += 1
-            self.tc_seen.add(f.seq)
+                self.altered += self.tc_seen[f.seq] != data
+            else:
+                self.tc_seen[f.seq] = data
         elif f.kind == "BC":
             self.bc_frames += 1
 
@@ -457,7 +460,11 @@ class TestThroughALossyRelay:
         for d in ("tc", "tm"):
             c = relay.counts[d]
             assert c["dropped"] >= 0.2 * c["received"] and c["received"] > 0, relay.counts
-        assert relay.retransmissions >= 1 and watch.max_tx >= 2, "no COP-1 retransmission through 20 % loss"
+        # The wire is the witness of a retransmission: the relay saw YAMCS send an N(S) again, the
+        # same bytes. YAMCS's txCount is only sampled every 0.1 s and resets when the frame is
+        # acknowledged, so a sample can miss it (CI once saw 10 retransmissions, highest sample 1).
+        assert relay.retransmissions >= 1, "no COP-1 retransmission through 20 % loss"
+        assert relay.altered == 0, f"{relay.altered} retransmitted frames differ from their first copy"
         assert st.cop1_active and st.state == "ACTIVE" and st.v_s == st.nn_r == len(MODES), str(st)
         # The gateway's TM frames, all of them (the relay lost some on the way): both readers agree,
         # no gap in what it sent, and the last CLCW is YAMCS's view.
