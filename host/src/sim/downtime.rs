@@ -7,7 +7,9 @@
 //! use mmic_host::sim::downtime::{Downtime, Phase};
 //! let mut d = Downtime::new(vec![1_000, 1_100]); // the second falls while it is down
 //! assert_eq!(d.step(990), Phase::Running);
+//! assert!(d.due(1_005));
 //! assert_eq!(d.step(1_005), Phase::WentDown);
+//! assert!(!d.due(1_200));
 //! assert_eq!(d.step(1_200), Phase::Down);
 //! assert_eq!(d.step(1_305), Phase::CameUp);
 //! assert_eq!(d.step(5_000), Phase::Running); // 1_100 was that same boot
@@ -56,6 +58,13 @@ impl Downtime {
                 .map(|s| s.at_ms)
                 .collect(),
         )
+    }
+
+    /// Whether a restart falls due at `now` while the node is up: the next [`Downtime::step`]
+    /// would say [`Phase::WentDown`]. A node busy in a blocking wait (the server board's
+    /// visit of board A) asks this to break off, then steps.
+    pub fn due(&self, now: u32) -> bool {
+        self.until.is_none() && self.at.get(self.next).is_some_and(|&t| t <= now)
     }
 
     /// At a tick at `now`. A restart asked for while the node is down is the same boot, as

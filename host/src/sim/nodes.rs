@@ -14,6 +14,7 @@ use super::plant::{Drives, Plant};
 use super::shell::{SideA, SideB};
 use super::FrameStats;
 use mmic::link::farm::Verdict;
+use mmic::link::sdls;
 use mmic::link::sdls::Key256;
 use mmic::link::tc_frame::{self, SpacecraftId, TcFrame};
 use mmic::link::tm_frame::TM_FRAME_LEN;
@@ -23,7 +24,7 @@ use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
 use mmic::node::server::frames::{FrameConfig, FrameGateway, Stored};
-use mmic::node::server::gateway::{self, Gateway, Out};
+use mmic::node::server::gateway::{self, Gateway, Kept, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
 use mmic::restart::ResetCause;
@@ -448,19 +449,16 @@ impl BoardBTask {
     pub fn run(mut self, node: Node<'_>) {
         let mut was_lost = false;
         node.every_tick(|now| {
-            let phase = self.restarts.step(now);
+            let phase = restart_phase(&node, &mut self.restarts, now);
             match phase {
-                Phase::Running => {}
+                Phase::Running | Phase::Down => {}
                 Phase::WentDown => {
                     let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
                     p.advance(now);
                     p.drive_b(Drives::off());
-                    node.event(now, json!({"type": "restart", "down_ms": BOOT_MS}));
                 }
-                Phase::Down => {}
                 Phase::CameUp => {
                     self.b = SideB::new(BoardB::restarted(board_b::Config::default()));
-                    node.event(now, json!({"type": "boot", "boot": null}));
                 }
             }
             if matches!(phase, Phase::WentDown | Phase::Down) {
@@ -483,6 +481,28 @@ impl BoardBTask {
     }
 }
 
+/// A node's restart phase at `now` (board B, the server board), its `restart` and `boot`
+/// events logged as the virtual-time engine logs them.
+fn restart_phase(node: &Node<'_>, restarts: &mut Downtime, now: u32) -> Phase {
+    let phase = restarts.step(now);
+    match phase {
+        Phase::WentDown => node.event(now, json!({"type": "restart", "down_ms": BOOT_MS})),
+        Phase::CameUp => node.event(now, json!({"type": "boot", "boot": null})),
+        Phase::Running | Phase::Down => {}
+    }
+    phase
+}
+
+/// How long a server task waits when it has nothing to do (or is down).
+const SERVER_IDLE: Duration = Duration::from_micros(300);
+
+/// Everything waiting on a UDP socket, read and dropped: what reaches a node that is down is
+/// lost.
+fn lose_datagrams(sock: &UdpSocket) {
+    let mut buf = [0u8; 2048];
+    while sock.recv(&mut buf).is_ok() {}
+}
+
 /// The server board: takes commands from the ground's serial line, visits robots with a
 /// pending command (connect, send, wait for the heartbeat, forward it, disconnect).
 pub struct ServerTask {
@@ -494,6 +514,9 @@ pub struct ServerTask {
     pub robots: Vec<(BoardNumber, SocketAddr)>,
     /// How long to wait for a heartbeat, simulated ms.
     pub visit_ms: u32,
+    /// The server board's restarts (`--inject reboot-server@S`): the relay keeps nothing
+    /// (decision `restart-server`); a visit going on is broken off.
+    pub restarts: Downtime,
 }
 
 impl ServerTask {
@@ -501,11 +524,20 @@ impl ServerTask {
     pub fn run(mut self, node: Node<'_>) {
         let mut srv: Server<4> = Server::new();
         while node.running() {
-            node.poll();
+            let now = node.poll();
+            match restart_phase(&node, &mut self.restarts, now) {
+                Phase::WentDown | Phase::Down => {
+                    srv = Server::new();
+                    while self.from_ground.try_recv().is_ok() {}
+                    std::thread::sleep(SERVER_IDLE);
+                    continue;
+                }
+                Phase::CameUp | Phase::Running => {}
+            }
             self.take_from_ground(&node, &mut srv);
             let now = node.clock.now_ms();
             let Some(mut visit) = Visit::next(&mut srv, now, self.visit_ms) else {
-                std::thread::sleep(Duration::from_micros(300));
+                std::thread::sleep(SERVER_IDLE);
                 continue;
             };
             let Some(addr) = self
@@ -520,7 +552,9 @@ impl ServerTask {
                 continue;
             };
             visit.written(&mut srv);
-            if let Some(hb) = await_heartbeat(&node, sock, &mut visit) {
+            let restarts = &self.restarts;
+            let up = || !restarts.due(node.clock.now_ms());
+            if let Some(hb) = await_heartbeat_with(&node, sock, &mut visit, up) {
                 self.to_ground.send(node.clock.now_ms(), &hb);
             }
         }
@@ -558,26 +592,21 @@ fn connect(addr: &SocketAddr, packet: &[u8]) -> Option<TcpStream> {
 /// Waits on a visit's connection for board A's heartbeat until the visit's deadline (the
 /// library's [`Visit`] decides). Polled without blocking: a socket read timeout is rounded up
 /// to the kernel's tick (4–8 ms here), and a blocked server would hold the paced clock back.
-fn await_heartbeat(
-    node: &Node<'_>,
-    sock: TcpStream,
-    visit: &mut Visit,
-) -> Option<[u8; HEARTBEAT_LEN]> {
-    await_heartbeat_with(node, sock, visit, || {})
-}
-
-/// [`await_heartbeat`], calling `meanwhile` between polls of the socket (the frame gateway
-/// keeps its link going during a visit: TC frames in, a TM frame at least every idle period).
+/// Between polls of the socket it calls `meanwhile`, and breaks the visit off when that says
+/// false (the server board restarts); the frame gateway keeps its link going there too (TC
+/// frames in, a TM frame at least every idle period).
 fn await_heartbeat_with(
     node: &Node<'_>,
     mut sock: TcpStream,
     visit: &mut Visit,
-    mut meanwhile: impl FnMut(),
+    mut meanwhile: impl FnMut() -> bool,
 ) -> Option<[u8; HEARTBEAT_LEN]> {
     let _ = sock.set_nonblocking(true);
     let mut buf = [0u8; 256];
     while node.running() && visit.left_ms(node.poll()).is_some() {
-        meanwhile();
+        if !meanwhile() {
+            return None;
+        }
         match sock.read(&mut buf) {
             Ok(0) => return None,
             Ok(n) => {
@@ -650,6 +679,9 @@ pub struct GatewayTask {
     /// With an external ground (`mmic sim --ground-tm-to`): one JSON line per packet
     /// crossing the ground link.
     pub wire: Option<WireLog>,
+    /// The server board's restarts (`--inject reboot-server@S`): it keeps the newest
+    /// telecommand key per source (decision `restart-server`); a visit going on is broken off.
+    pub restarts: Downtime,
 }
 
 /// The packets between an external ground and the gateway, one JSON line each, as
@@ -677,11 +709,26 @@ type SimGateway = Gateway<1, 8, 64>;
 impl GatewayTask {
     /// Runs until the run stops.
     pub fn run(mut self, node: Node<'_>) {
+        let board = self.robot.0;
         let mut g = SimGateway::new(self.config);
-        g.add(self.robot.0);
+        g.add(board);
+        // Its flash: the telecommand keys it took, written before the tick may send one on.
+        let mut kept = Kept::new();
         let mut buf = [0u8; 2048];
         while node.running() {
             let now = node.poll();
+            match restart_phase(&node, &mut self.restarts, now) {
+                Phase::WentDown | Phase::Down => {
+                    lose_datagrams(&self.from_ground);
+                    std::thread::sleep(SERVER_IDLE);
+                    continue;
+                }
+                Phase::CameUp => {
+                    g = SimGateway::new(self.config);
+                    g.add_restarted(board, kept.clone());
+                }
+                Phase::Running => {}
+            }
             let mut busy = false;
             // Until board A's first heartbeat the gateway holds telecommands back itself.
             while let Ok(n) = self.from_ground.recv(&mut buf) {
@@ -701,6 +748,9 @@ impl GatewayTask {
                     ),
                 }
             }
+            if let Some(k) = g.kept(board) {
+                kept = k;
+            }
             let out = g.tick(node.clock.now_ms());
             let visits = out.to_robots.clone();
             self.reports(&node, &mut g, out);
@@ -711,7 +761,7 @@ impl GatewayTask {
                 }
             }
             if !busy {
-                std::thread::sleep(Duration::from_micros(300));
+                std::thread::sleep(SERVER_IDLE);
             }
         }
     }
@@ -748,7 +798,9 @@ impl GatewayTask {
         let Some(sock) = connect(&self.robot.1, visit.packet()) else {
             return;
         };
-        let hb = await_heartbeat(node, sock, &mut visit)
+        let restarts = &self.restarts;
+        let up = || !restarts.due(node.clock.now_ms());
+        let hb = await_heartbeat_with(node, sock, &mut visit, up)
             .and_then(|b| mmic::wire::heartbeat::HeartbeatRepr::parse(&b).ok());
         if let Some(hb) = hb {
             let out = g.heartbeat(node.clock.now_ms(), &hb);
@@ -780,6 +832,10 @@ pub struct FrameGatewayTask {
     /// SDLS on the link: the robot's TC and TM keys. Its durable counters are kept in memory
     /// for the run.
     pub sdls: Option<(Key256, Key256)>,
+    /// The server board's restarts (`--inject reboot-server@S`): it keeps the newest
+    /// telecommand key per source and its SDLS counters (decisions `restart-server`,
+    /// `sdls-counters`); FARM-1 starts again at V(R) = 0; a visit going on is broken off.
+    pub restarts: Downtime,
 }
 
 /// One robot, eight waiting telecommands, 64 remembered keys, 4 KiB of TM packets waiting for
@@ -811,23 +867,42 @@ pub fn verdict_name(v: &Verdict) -> String {
 impl FrameGatewayTask {
     /// Runs until the run stops; then adds the server board's figures to [`Self::stats`].
     pub fn run(mut self, node: Node<'_>) {
-        let mut g = Box::new(SimFrameGateway::new(FrameConfig {
-            gateway: self.config,
-            ..FrameConfig::default()
-        }));
-        g.add(self.robot.0);
-        if let Some((tc, tm)) = self.sdls.clone() {
-            g.secure(self.robot.0, tc, tm, Stored::default());
-        }
+        let board = self.robot.0;
+        // Its flash: the SDLS counters by SPI, the telecommand keys it took.
         let mut store = std::collections::BTreeMap::new();
+        let mut kept = Kept::new();
+        let mut g = self.boot(None, &store);
+        // Whether this life's figures are in `stats` already (it went down).
+        let mut counted = false;
         while node.running() {
-            node.poll();
+            let now = node.poll();
+            match restart_phase(&node, &mut self.restarts, now) {
+                Phase::WentDown | Phase::Down => {
+                    if !counted {
+                        if let Ok(mut s) = self.stats.lock() {
+                            s.add_server(&g, board);
+                        }
+                        counted = true;
+                    }
+                    lose_datagrams(&self.from_ground);
+                    std::thread::sleep(SERVER_IDLE);
+                    continue;
+                }
+                Phase::CameUp => {
+                    g = self.boot(Some(kept.clone()), &store);
+                    counted = false;
+                }
+                Phase::Running => {}
+            }
             // The durable counters: written (here, kept for the run) and confirmed.
             for (spi, v) in g.due().collect::<Vec<_>>() {
                 store.insert(spi, v);
                 g.persisted(spi, v);
             }
             let mut busy = self.link(&node, &mut g);
+            if let Some(k) = g.kept(board) {
+                kept = k;
+            }
             let visits = g.tick(node.clock.now_ms());
             for (board, command) in visits {
                 busy = true;
@@ -837,12 +912,40 @@ impl FrameGatewayTask {
             }
             self.tm_frames(&node, &mut g);
             if !busy {
-                std::thread::sleep(Duration::from_micros(300));
+                std::thread::sleep(SERVER_IDLE);
             }
         }
-        if let Ok(mut s) = self.stats.lock() {
-            s.add_server(&g, self.robot.0);
+        if !counted {
+            if let Ok(mut s) = self.stats.lock() {
+                s.add_server(&g, board);
+            }
         }
+    }
+
+    /// The gateway as it starts: afresh, or after a restart from the keys it `kept`; with SDLS,
+    /// from the counters in `store`.
+    fn boot(
+        &self,
+        kept: Option<Kept>,
+        store: &std::collections::BTreeMap<u16, u128>,
+    ) -> Box<SimFrameGateway> {
+        let board = self.robot.0;
+        let mut g = Box::new(SimFrameGateway::new(FrameConfig {
+            gateway: self.config,
+            ..FrameConfig::default()
+        }));
+        match kept {
+            Some(k) => g.add_restarted(board, k),
+            None => g.add(board),
+        };
+        if let Some((tc, tm)) = self.sdls.clone() {
+            let stored = Stored {
+                tc: store.get(&sdls::mission::tc_spi(board)).copied(),
+                tm: store.get(&sdls::mission::tm_spi(board)).copied(),
+            };
+            g.secure(board, tc, tm, stored);
+        }
+        g
     }
 
     /// The link's own work: every TC frame waiting taken, the TM frames due sent. Whether a TC
@@ -917,6 +1020,7 @@ impl FrameGatewayTask {
         };
         let hb = await_heartbeat_with(node, sock, &mut visit, || {
             self.link(node, g);
+            !self.restarts.due(node.clock.now_ms())
         })
         .and_then(|b| mmic::wire::heartbeat::HeartbeatRepr::parse(&b).ok());
         if let Some(hb) = hb {

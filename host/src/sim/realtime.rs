@@ -10,7 +10,7 @@
 
 use super::clock::{self, Clock};
 use super::downtime::{Downtime, Phase};
-use super::inject::{Injection, Node, BOOT_MS};
+use super::inject::{Node, BOOT_MS};
 use super::log;
 use super::nodes::{self, Lossy};
 use super::plant::{self, PlantConfig};
@@ -275,6 +275,7 @@ impl ServerEnds<'_> {
             robot: (self.board, self.addr),
             config: env.cfg.gateway,
             wire: env.cfg.external.as_ref().map(|x| x.wire.clone()),
+            restarts: Downtime::of(env.cfg, Node::Server),
         };
         Ok((gw, udp))
     }
@@ -298,6 +299,7 @@ impl ServerEnds<'_> {
                 (None, Some(_)) => env.keys.get(self.board.get() as usize - 1).cloned(),
                 (None, None) => None,
             },
+            restarts: Downtime::of(env.cfg, Node::Server),
         };
         Ok((gw, udp))
     }
@@ -327,6 +329,7 @@ fn spawn_server<'scope, 'env>(
                 to_ground: s.lossy(env, server_to_ground.write, "serial_ground", 3),
                 robots: vec![(s.board, s.addr)],
                 visit_ms: cfg.visit_ms,
+                restarts: Downtime::of(cfg, Node::Server),
             };
             scope.spawn(move || server.run(node));
             let to_server = s.lossy(env, ground_to_server.write, "serial_ground", 4);
@@ -353,17 +356,6 @@ fn spawn_server<'scope, 'env>(
 
 /// Runs the simulation on the wall clock to the end of every robot's plan (or the time limit).
 pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
-    if let Some(r) = cfg
-        .injections
-        .iter()
-        .find(|s| s.injection == Injection::Reboot(Node::Server))
-    {
-        return Err(std::io::Error::other(format!(
-            "{} is injected in the virtual-time engine only (the default): the realtime \
-             engine restarts board A, board B and the ground, not yet the server board's threads",
-            r.injection
-        )));
-    }
     let n = cfg.robots.max(1) as usize;
     let (logger, log_rx) = log::Log::new();
     let secured = cfg.link == LinkLayer::Frames
