@@ -715,3 +715,30 @@ impl Summary {
             .filter(move |r| r["kind"] == "event" && r["event"]["type"] == ty)
     }
 }
+
+/// The server board's PUS gateway behind the space data link as it starts, in both engines:
+/// afresh (`kept` none) or after a restart from the telecommand keys it kept (decision
+/// `restart-server`); with SDLS keys, from its stored counters (decision `sdls-counters`). The
+/// replay's own type, so that a recorded trace replays with the same sizes.
+pub fn boot_frame_gateway(
+    config: gateway::Config,
+    board: mmic::units::BoardNumber,
+    kept: Option<gateway::Kept>,
+    keys: Option<(Key256, Key256)>,
+    stored: mmic::node::server::frames::Stored,
+) -> Box<mmic_replay::ReplayFrameGateway> {
+    let mut g = Box::new(mmic_replay::ReplayFrameGateway::new(
+        mmic::node::server::frames::FrameConfig {
+            gateway: config,
+            ..Default::default()
+        },
+    ));
+    match kept {
+        Some(k) => g.add_restarted(board, k),
+        None => g.add(board),
+    };
+    if let Some((tc, tm)) = keys {
+        g.secure(board, tc, tm, stored);
+    }
+    g
+}

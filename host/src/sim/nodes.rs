@@ -23,7 +23,7 @@ use mmic::node::robot::board_a::{BoardA, Durable};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::server::frames::{FrameConfig, FrameGateway, Stored};
+use mmic::node::server::frames::Stored;
 use mmic::node::server::gateway::{self, Gateway, Kept, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -839,8 +839,8 @@ pub struct FrameGatewayTask {
 }
 
 /// One robot, eight waiting telecommands, 64 remembered keys, 4 KiB of TM packets waiting for
-/// frames (as the virtual-time engine's).
-type SimFrameGateway = FrameGateway<1, 8, 64, 4096>;
+/// frames (the virtual-time engine's type).
+type SimFrameGateway = mmic_replay::ReplayFrameGateway;
 
 /// FARM-1's verdict on a frame, for the wire log: `accept`, `discard:<reason>` (the reason's
 /// name), `unlock`, `set-vr:<V(R)>` (with ` (not executed)` when Lockout kept it from acting),
@@ -930,22 +930,11 @@ impl FrameGatewayTask {
         store: &std::collections::BTreeMap<u16, u128>,
     ) -> Box<SimFrameGateway> {
         let board = self.robot.0;
-        let mut g = Box::new(SimFrameGateway::new(FrameConfig {
-            gateway: self.config,
-            ..FrameConfig::default()
-        }));
-        match kept {
-            Some(k) => g.add_restarted(board, k),
-            None => g.add(board),
+        let stored = Stored {
+            tc: store.get(&sdls::mission::tc_spi(board)).copied(),
+            tm: store.get(&sdls::mission::tm_spi(board)).copied(),
         };
-        if let Some((tc, tm)) = self.sdls.clone() {
-            let stored = Stored {
-                tc: store.get(&sdls::mission::tc_spi(board)).copied(),
-                tm: store.get(&sdls::mission::tm_spi(board)).copied(),
-            };
-            g.secure(board, tc, tm, stored);
-        }
-        g
+        super::boot_frame_gateway(self.config, board, kept, self.sdls.clone(), stored)
     }
 
     /// The link's own work: every TC frame waiting taken, the TM frames due sent. Whether a TC

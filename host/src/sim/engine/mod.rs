@@ -55,7 +55,7 @@ use mmic::node::robot::board_a::{self, BoardA, Durable};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::server::frames::{FrameConfig, Stored};
+use mmic::node::server::frames::Stored;
 use mmic::node::server::gateway::{Gateway, Kept, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -1461,26 +1461,21 @@ fn server_board(
     match cfg.protocol {
         Protocol::Legacy => Board::Relay(Server::new()),
         Protocol::Pus if cfg.link == LinkLayer::Frames => {
-            let mut g = Box::new(SimFrameGateway::new(FrameConfig {
-                gateway: cfg.gateway,
-                ..FrameConfig::default()
-            }));
-            match kept {
-                Some(k) => g.add_restarted(number, k),
-                None => g.add(number),
+            let stored = Stored {
+                tc: store
+                    .get(&("server", sdls::mission::tc_spi(number)))
+                    .copied(),
+                tm: store
+                    .get(&("server", sdls::mission::tm_spi(number)))
+                    .copied(),
             };
-            if let Some((tc, tm)) = keys {
-                let stored = Stored {
-                    tc: store
-                        .get(&("server", sdls::mission::tc_spi(number)))
-                        .copied(),
-                    tm: store
-                        .get(&("server", sdls::mission::tm_spi(number)))
-                        .copied(),
-                };
-                g.secure(number, tc, tm, stored);
-            }
-            Board::Frames(g)
+            Board::Frames(super::boot_frame_gateway(
+                cfg.gateway,
+                number,
+                kept,
+                keys,
+                stored,
+            ))
         }
         Protocol::Pus => {
             let mut g = Box::new(SimGateway::new(cfg.gateway));
