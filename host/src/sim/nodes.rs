@@ -811,10 +811,13 @@ impl GatewayTask {
 
 /// The server board as the PUS gateway behind the space data link (`--protocol pus --link
 /// frames`): one TC transfer frame per datagram from the ground into
-/// [`FrameGateway::tc_frame`](mmic::node::server::frames::FrameGateway::tc_frame) (FARM-1, then the packets into the gateway), the visits of board
-/// A as [`GatewayTask`]'s, and every TM transfer frame [`FrameGateway::frame`](mmic::node::server::frames::FrameGateway::frame) says is due —
+/// [`FrameGateway::tc_frame`] (FARM-1, then the packets into the gateway), the visits of board
+/// A as [`GatewayTask`]'s, and every TM transfer frame [`FrameGateway::frame`] says is due —
 /// a gathered report, a changed CLCW, and at least one every idle period — to the ground, one
 /// per datagram. The link keeps going during a visit.
+///
+/// [`FrameGateway::tc_frame`]: mmic::node::server::frames::FrameGateway::tc_frame
+/// [`FrameGateway::frame`]: mmic::node::server::frames::FrameGateway::frame
 pub struct FrameGatewayTask {
     /// Where the ground's TC frames arrive (non-blocking).
     pub from_ground: UdpSocket,
