@@ -218,6 +218,10 @@ pub enum Cmd {
         #[arg(long)]
         json: bool,
     },
+    /// SDLS's durable stores: provision the simulator's state file, or the server image's
+    /// keys and counters partitions, for a set of keys (the explicit step a first start needs).
+    #[command(subcommand)]
+    Sdls(crate::sdlscli::SdlsCmd),
     /// Run the host simulator: opsUI, server board, boards A and B and a plant model, in
     /// virtual time (deterministic) or with --realtime on real transports, driving a plan (the
     /// built-in demo without --plan).
@@ -505,6 +509,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
             }
             .map_err(CliError::Output)?;
         }
+        Cmd::Sdls(cmd) => crate::sdlscli::run(cmd, out)?,
         Cmd::Sim(args) => crate::simcli::sim(*args, out)?,
         Cmd::Swarm(args) => crate::swarm::cli::run(*args, out)?,
         Cmd::Fleet(args) => crate::fleet::cli::run(*args, out)?,

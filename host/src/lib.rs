@@ -15,6 +15,7 @@ pub mod plan;
 pub mod plot;
 pub mod pus;
 pub mod replay;
+pub mod sdlscli;
 pub mod sim;
 pub mod simcli;
 pub mod spec;

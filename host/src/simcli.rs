@@ -196,6 +196,13 @@ pub struct SimArgs {
     /// source tree, the logs and the output.
     #[arg(long, value_name = "DIR")]
     pub sdls_keys: Option<PathBuf>,
+    /// The durable state of the --sdls-keys's counters (required with them; not inside the
+    /// key directory): key fingerprints (not keys), SDLS counters, FARM-1's progress and the
+    /// kept telecommand keys, written (temporary file, fsync, rename) before anything that
+    /// depends on it leaves. Made once per set of keys by `mmic sdls provision --keys DIR
+    /// --state FILE`; a run never makes it, and refuses to start without it.
+    #[arg(long, value_name = "FILE")]
+    pub sdls_state: Option<PathBuf>,
     /// SDLS (CCSDS 355.0, AES-256-GCM) on the space data link of the simulator's own ground
     /// (--protocol pus --link frames): the ground protects its TC data frames and verifies the
     /// TM frames, the server board verifies the TC frames before FARM-1 and protects its TM
@@ -363,56 +370,31 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     cfg.log_path = Some(a.out.join("sim.jsonl"));
     cfg.record = a.record.clone();
     cfg.progress = !a.quiet;
-    if let (Some(tm_to), Some(tc_port)) = (a.ground_tm_to, a.ground_tc_port) {
-        let one = mmic::units::BoardNumber::ONE;
-        let sdls = a
-            .sdls_keys
-            .as_deref()
-            .map(|d| read_keys(d, one))
-            .transpose()?;
-        return external(cfg, tm_to, tc_port, sdls, out);
+    let ground = a.ground_tm_to.zip(a.ground_tc_port);
+    let sdls = sdls_options(&a, &cfg, ground.is_some())?;
+    if let Some((tm_to, tc_port)) = ground {
+        let (keys, store) =
+            match sdls {
+                Some(Sdls {
+                    keys: sim::SdlsKeys::Given(mut v),
+                    state: Some(store),
+                }) if !v.is_empty() => (Some(v.swap_remove(0)), store),
+                // Refused by sdls_options: an external ground's link is secured only with
+                // given keys and their state.
+                Some(_) => return Err(CliError::Usage(
+                    "--sdls with an external ground needs --sdls-keys DIR and --sdls-state FILE"
+                        .into(),
+                )),
+                None => (None, sim::durable::Durable::memory()),
+            };
+        return external(cfg, tm_to, tc_port, keys, store, out);
     }
-    if a.sdls || a.sdls_keys.is_some() {
-        if cfg.link != sim::LinkLayer::Frames {
-            return Err(CliError::Usage(
-                "--sdls needs --protocol pus --link frames".into(),
-            ));
-        }
-        if !(0.0..=1.0).contains(&a.sdls_attack) {
-            return Err(CliError::Usage(format!(
-                "--sdls-attack {}: a chance, 0..1",
-                a.sdls_attack
-            )));
-        }
-        if a.sdls_attack > 0.0 && cfg.realtime {
-            return Err(CliError::Usage(
-                "--sdls-attack runs in virtual time (not with --realtime)".into(),
-            ));
-        }
-        if cfg.record.is_some() {
-            return Err(CliError::Usage(
-                "--record runs without --sdls (a replay trace has no keys)".into(),
-            ));
-        }
-        let keys = match &a.sdls_keys {
-            Some(dir) => sim::SdlsKeys::Given(
-                (0..cfg.robots.max(1))
-                    .map(|i| {
-                        let n = mmic::units::BoardNumber::new((i % 255) as u8 + 1)
-                            .unwrap_or(mmic::units::BoardNumber::ONE);
-                        read_keys(dir, n)
-                    })
-                    .collect::<Result<_, _>>()?,
-            ),
-            None if cfg.realtime => sim::SdlsKeys::Random,
-            None => sim::SdlsKeys::Seeded,
-        };
+    if let Some(Sdls { keys, state }) = sdls {
         cfg.sdls = Some(sim::SdlsConfig {
             keys,
+            state: state.and_then(|d| d.path()),
             attack: a.sdls_attack,
         });
-    } else if a.sdls_attack > 0.0 {
-        return Err(CliError::Usage("--sdls-attack needs --sdls".into()));
     }
     let summary = sim::run(&cfg).map_err(CliError::Sim)?;
     let plots = report::plots(&summary, &a.out).map_err(|source| CliError::Write {
@@ -437,6 +419,101 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     verdict
 }
 
+/// The SDLS a run was asked for: its keys and, for given keys, their durable store.
+struct Sdls {
+    keys: sim::SdlsKeys,
+    state: Option<sim::durable::Durable>,
+}
+
+/// The SDLS options, checked as a whole: nothing runs weaker than asked. Any SDLS option asks
+/// for SDLS; every set that cannot give it is refused here, naming what is missing (exit 2),
+/// before anything is sent: SDLS needs the space data link; given keys need their state file
+/// (else a second run reuses IVs and accepts the first run's frames); an external ground
+/// needs given keys (it holds the same); a state file must be provisioned for those keys.
+fn sdls_options(a: &SimArgs, cfg: &SimConfig, external: bool) -> Result<Option<Sdls>, CliError> {
+    let asked = a.sdls || a.sdls_keys.is_some() || a.sdls_state.is_some() || a.sdls_attack != 0.0;
+    if !asked {
+        return Ok(None);
+    }
+    let usage = |m: &str| Err(CliError::Usage(m.to_string()));
+    if cfg.protocol != sim::Protocol::Pus || cfg.link != sim::LinkLayer::Frames {
+        return usage("SDLS (--sdls, --sdls-keys, --sdls-state, --sdls-attack) protects the space data link: it needs --protocol pus --link frames; refusing to run without the protection asked for");
+    }
+    if a.sdls_attack != 0.0 && !a.sdls && a.sdls_keys.is_none() {
+        return usage("--sdls-attack attacks a secured link: it needs --sdls");
+    }
+    if !(0.0..=1.0).contains(&a.sdls_attack) {
+        return Err(CliError::Usage(format!(
+            "--sdls-attack {}: a chance, 0..1",
+            a.sdls_attack
+        )));
+    }
+    if a.sdls_attack > 0.0 && (cfg.realtime || external) {
+        return usage("--sdls-attack runs in virtual time with the simulator's own ground (not with --realtime or an external ground)");
+    }
+    if cfg.record.is_some() {
+        return usage("--record runs without SDLS (a replay trace has no keys)");
+    }
+    let (dir, state) = match (&a.sdls_keys, &a.sdls_state) {
+        (None, Some(_)) => return usage("--sdls-state keeps the counters of given keys: it needs --sdls-keys DIR"),
+        (Some(_), None) => return usage("--sdls-keys DIR needs --sdls-state FILE: the durable counters of those keys, kept between runs (made once by `mmic sdls provision --keys DIR --state FILE`); without them a second run would reuse IVs and accept the first run's frames again"),
+        (None, None) if external => return usage("--sdls with an external ground (--ground-tm-to) needs --sdls-keys DIR (the ground's keys) and --sdls-state FILE: refusing to run the link in clear"),
+        (None, None) => {
+            let keys = if cfg.realtime { sim::SdlsKeys::Random } else { sim::SdlsKeys::Seeded };
+            return Ok(Some(Sdls { keys, state: None }));
+        }
+        (Some(d), Some(s)) => (d, s),
+    };
+    crate::sdlscli::outside_keys(dir, state, "--sdls-state")?;
+    let robots = if external { 1 } else { cfg.robots.max(1) };
+    let keys = (0..robots)
+        .map(|i| {
+            let n = mmic::units::BoardNumber::new((i % 255) as u8 + 1)
+                .unwrap_or(mmic::units::BoardNumber::ONE);
+            crate::sdlscli::read_keys(dir, n)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let store = sim::durable::Durable::open(state).map_err(|e| CliError::Usage(e.to_string()))?;
+    // Every robot's link must boot from it, at both ends the run has: refused now (exit 2)
+    // rather than a link stopped later.
+    for (i, (tc, tm)) in keys.iter().enumerate() {
+        let n = mmic::units::BoardNumber::new((i % 255) as u8 + 1)
+            .unwrap_or(mmic::units::BoardNumber::ONE);
+        let ends: &[_] = if external {
+            &[(
+                mmic::node::server::store::End::Server,
+                sim::durable::Section::Server,
+            )]
+        } else {
+            &[
+                (
+                    mmic::node::server::store::End::Server,
+                    sim::durable::Section::Server,
+                ),
+                (
+                    mmic::node::server::store::End::Ground,
+                    sim::durable::Section::Ground,
+                ),
+            ]
+        };
+        for (end, section) in ends {
+            mmic::node::server::store::boot(*end, n, tc, tm, |k| store.lookup(*section, k))
+                .map_err(|e| {
+                    CliError::Usage(format!(
+                        "--sdls-state {}: robot {}, the {} end: {e}",
+                        state.display(),
+                        n.get(),
+                        section.name()
+                    ))
+                })?;
+        }
+    }
+    Ok(Some(Sdls {
+        keys: sim::SdlsKeys::Given(keys),
+        state: Some(store),
+    }))
+}
+
 /// `mmic sim --ground-tm-to`: the robot and its server board, commanded by an external ground
 /// over UDP for --max-seconds of wall time; the packet lines go to `out`.
 fn external(
@@ -444,15 +521,13 @@ fn external(
     tm_to: std::net::SocketAddr,
     tc_port: u16,
     sdls: Option<(Key256, Key256)>,
+    store: sim::durable::Durable,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
     if cfg.protocol != sim::Protocol::Pus {
         return Err(CliError::Usage(
             "--ground-tm-to and --ground-tc-port need --protocol pus".into(),
         ));
-    }
-    if sdls.is_some() && cfg.link != sim::LinkLayer::Frames {
-        return Err(CliError::Usage("--sdls-keys needs --link frames".into()));
     }
     cfg.realtime = true;
     cfg.scale = 1.0;
@@ -468,6 +543,7 @@ fn external(
             tx,
         ))))),
         sdls,
+        store,
     });
     let summary = std::thread::scope(|s| -> Result<sim::Summary, CliError> {
         let run = s.spawn(move || sim::run(&cfg));
@@ -540,24 +616,4 @@ pub fn bench(max: u8, seconds: u32, out: &mut dyn Write) -> Result<(), CliError>
     .map_err(CliError::Sim)?;
     writeln!(out, "{result}").map_err(CliError::Output)?;
     Ok(())
-}
-
-/// Robot `one`'s SDLS keys from `dir` (`spi-<TC SPI>.key`, `spi-<TM SPI>.key`: 32 octets
-/// each; robot 1's are `spi-257.key` and `spi-513.key`). The error names the file and the
-/// length found, never the octets.
-fn read_keys(
-    dir: &std::path::Path,
-    one: mmic::units::BoardNumber,
-) -> Result<(Key256, Key256), CliError> {
-    let read = |spi: u16| -> Result<Key256, CliError> {
-        let path = dir.join(format!("spi-{spi}.key"));
-        let bytes = std::fs::read(&path)
-            .map_err(|e| CliError::Usage(format!("--sdls-keys: {}: {e}", path.display())))?;
-        Key256::from_slice(&bytes)
-            .map_err(|e| CliError::Usage(format!("--sdls-keys: {}: {e}", path.display())))
-    };
-    Ok((
-        read(mmic::link::sdls::mission::tc_spi(one))?,
-        read(mmic::link::sdls::mission::tm_spi(one))?,
-    ))
 }

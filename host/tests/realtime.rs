@@ -182,6 +182,7 @@ fn board_a_board_b_and_the_ground_restart_on_the_wall_clock() {
     );
     cfg.sdls = Some(mmic_host::sim::SdlsConfig {
         keys: mmic_host::sim::SdlsKeys::Random,
+        state: None,
         attack: 0.0,
     });
     cfg.inject("reboot-ground@4".parse().unwrap()).unwrap();
@@ -206,6 +207,7 @@ fn board_a_board_b_and_the_ground_restart_on_the_wall_clock() {
         if link == LinkLayer::Frames {
             cfg.sdls = Some(mmic_host::sim::SdlsConfig {
                 keys: mmic_host::sim::SdlsKeys::Random,
+                state: None,
                 attack: 0.0,
             });
         }

@@ -78,6 +78,7 @@ fn server_restarts_keep_the_sdls_counters_and_refuse_old_frames() {
     cfg.log_packets = true;
     cfg.sdls = Some(SdlsConfig {
         keys: SdlsKeys::Seeded,
+        state: None,
         attack: 0.3,
     });
     let s = engine::run(&cfg).unwrap();
@@ -142,6 +143,7 @@ fn the_ground_restarts_from_its_kept_position_and_numbering() {
         if link == LinkLayer::Frames {
             cfg.sdls = Some(SdlsConfig {
                 keys: SdlsKeys::Random,
+                state: None,
                 attack: 0.0,
             });
         }

@@ -23,6 +23,7 @@ fn secured(seed: u64, attack: f64, loss: f64) -> SimConfig {
     cfg.progress = false;
     cfg.sdls = Some(SdlsConfig {
         keys: SdlsKeys::Seeded,
+        state: None,
         attack,
     });
     cfg
@@ -359,6 +360,7 @@ fn the_realtime_engine_secures_its_own_ground_with_keys_made_at_run_time() {
     cfg.scale = 10.0;
     cfg.sdls = Some(SdlsConfig {
         keys: SdlsKeys::Random,
+        state: None,
         attack: 0.0,
     });
     let s = mmic_host::sim::run(&cfg).expect("the run");

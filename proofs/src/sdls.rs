@@ -536,7 +536,9 @@ pub fn check_tx_ops(start: u128, near_end: bool, block: u8, ops: &[u8]) -> usize
 pub fn secured_gateway() -> Gateway {
     let mut g = Gateway::new(FrameConfig::default());
     assert!(g.add(BOARD));
-    assert!(g.secure(BOARD, test_key(0), test_key(1), Stored::default()));
+    assert!(g
+        .secure(BOARD, test_key(0), test_key(1), Stored::default())
+        .is_ok());
     let mut due = [(0u16, 0u128); 4];
     let mut n = 0;
     for d in g.due() {
@@ -635,6 +637,9 @@ pub fn check_secured_tc_frame(bytes: &[u8]) -> bool {
             assert_eq!(sec.accepted, sec_before.accepted);
             assert_eq!(link, link_before, "an SDLS refusal reached FARM-1");
             assert_eq!((r.accepted, r.refused), (0, 0));
+        }
+        Err(FrameRefusal::Origin) => {
+            panic!("a frame from the ground's address refused for its origin")
         }
         Ok(_) => {
             let control = TcPrimaryHeader::read(bytes).is_some_and(|h| h.control);

@@ -32,6 +32,13 @@
 use crate::bolter::BolterPair;
 use crate::faults::{Fault, Faults};
 use crate::link::sdls::SdlsRefusal;
+
+/// The place of `not-reserved` among [`SdlsRefusal::NAMES`].
+const NOT_RESERVED: usize = 6;
+const _: () = assert!(matches!(
+    SdlsRefusal::NAMES[NOT_RESERVED].as_bytes(),
+    b"not-reserved"
+));
 use crate::mode::Mode;
 use crate::restart::Boot;
 use crate::safety::policy::fault_action;
@@ -180,8 +187,13 @@ impl Event {
                 AttemptResult::GaveUp => 3,
             },
             Event::ModeChanged { .. } | Event::Cleared(_) => 1,
-            // Medium: refused frames are an attack or a fault of the link or the ground's
-            // keys, and nothing of them executed. A restart stopped what the robot was doing.
+            // Informative: a frame refused as not reserved verified (its MAC is good), so it is
+            // the ground's own, beyond the durable floor after a restart or a long loss (the
+            // next reservation lets its retransmission in): never an attack.
+            Event::Security { reason, .. } if *reason as usize == NOT_RESERVED => 1,
+            // Medium: other refused frames are an attack or a fault of the link or the
+            // ground's keys, and nothing of them executed. A restart stopped what the robot
+            // was doing.
             Event::Security { .. } | Event::Restarted(_) => 3,
         }
     }

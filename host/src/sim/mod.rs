@@ -36,6 +36,7 @@
 pub mod bench;
 pub mod clock;
 pub mod downtime;
+pub mod durable;
 pub mod engine;
 pub mod inject;
 pub mod lockstep;
@@ -421,6 +422,9 @@ pub struct External {
     pub wire: nodes::WireLog,
     /// SDLS on the space data link (`--sdls-keys`): robot 1's TC and TM keys.
     pub sdls: Option<(mmic::link::sdls::Key256, mmic::link::sdls::Key256)>,
+    /// The server board's durable store (`--sdls-state FILE` with SDLS; without, memory for
+    /// the run): SDLS counters, FARM-1's progress, the kept telecommand keys.
+    pub store: durable::Durable,
 }
 
 impl std::fmt::Debug for External {
@@ -451,6 +455,9 @@ pub enum SdlsKeys {
 pub struct SdlsConfig {
     /// The keys.
     pub keys: SdlsKeys,
+    /// The durable store of given keys' counters (`--sdls-state FILE`, made by `mmic sdls
+    /// provision`): required with [`SdlsKeys::Given`], unused with keys made for the run.
+    pub state: Option<PathBuf>,
     /// Virtual time: the attacker on each robot's uplink. For each TC frame the uplink
     /// delivers, the chance that the attacker also sends one frame: a captured TC data frame
     /// again (a replay) or a copy with one bit flipped and its FECF made good again (so that
@@ -500,6 +507,53 @@ impl SdlsConfig {
                 Ok((read()?, read()?))
             }
         }
+    }
+}
+
+impl SdlsConfig {
+    /// The state file of given keys' counters, opened (`None`: no given keys).
+    pub fn open_state(&self) -> std::io::Result<Option<durable::Durable>> {
+        match (&self.keys, &self.state) {
+            (SdlsKeys::Given(_), Some(path)) => durable::Durable::open(path)
+                .map(Some)
+                .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string())),
+            (SdlsKeys::Given(_), None) => Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "given SDLS keys need their durable state file (--sdls-state FILE): without it \
+                 every run would start the counters afresh under the same keys (IV reuse)",
+            )),
+            _ => Ok(None),
+        }
+    }
+
+    /// Robot `i`'s keys and the durable store of both ends of its link: for given keys the
+    /// state file (`state`, from [`SdlsConfig::open_state`]), which must be provisioned for
+    /// them; for keys made for the run a store in memory, provisioned here (both die with the
+    /// run). Fails closed: keys that cannot be made stop the run.
+    pub fn robot(
+        &self,
+        seed: u64,
+        i: usize,
+        state: Option<&durable::Durable>,
+    ) -> std::io::Result<((Key256, Key256), durable::Durable)> {
+        let keys = self.keys(seed, i)?;
+        let board = mmic::units::BoardNumber::new((i % 255) as u8 + 1)
+            .unwrap_or(mmic::units::BoardNumber::ONE);
+        let store = match (&self.keys, state) {
+            (SdlsKeys::Given(v), Some(d)) if i < v.len() => d.clone(),
+            (SdlsKeys::Given(v), None) if i < v.len() => {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidInput,
+                    "given SDLS keys need their durable state file (--sdls-state FILE)",
+                ))
+            }
+            _ => {
+                let d = durable::Durable::memory();
+                durable::provision_memory(&d, board, &keys)?;
+                d
+            }
+        };
+        Ok((keys, store))
     }
 }
 
@@ -714,31 +768,4 @@ impl Summary {
             .iter()
             .filter(move |r| r["kind"] == "event" && r["event"]["type"] == ty)
     }
-}
-
-/// The server board's PUS gateway behind the space data link as it starts, in both engines:
-/// afresh (`kept` none) or after a restart from the telecommand keys it kept (decision
-/// `restart-server`); with SDLS keys, from its stored counters (decision `sdls-counters`). The
-/// replay's own type, so that a recorded trace replays with the same sizes.
-pub fn boot_frame_gateway(
-    config: gateway::Config,
-    board: mmic::units::BoardNumber,
-    kept: Option<gateway::Kept>,
-    keys: Option<(Key256, Key256)>,
-    stored: mmic::node::server::frames::Stored,
-) -> Box<mmic_replay::ReplayFrameGateway> {
-    let mut g = Box::new(mmic_replay::ReplayFrameGateway::new(
-        mmic::node::server::frames::FrameConfig {
-            gateway: config,
-            ..Default::default()
-        },
-    ));
-    match kept {
-        Some(k) => g.add_restarted(board, k),
-        None => g.add(board),
-    };
-    if let Some((tc, tm)) = keys {
-        g.secure(board, tc, tm, stored);
-    }
-    g
 }

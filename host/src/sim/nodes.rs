@@ -14,7 +14,6 @@ use super::plant::{Drives, Plant};
 use super::shell::{SideA, SideB};
 use super::FrameStats;
 use mmic::link::farm::Verdict;
-use mmic::link::sdls;
 use mmic::link::sdls::Key256;
 use mmic::link::tc_frame::{self, SpacecraftId, TcFrame};
 use mmic::link::tm_frame::TM_FRAME_LEN;
@@ -23,7 +22,7 @@ use mmic::node::robot::board_a::{BoardA, Durable};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::{Consumer, Producer};
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::server::frames::Stored;
+use mmic::node::server::frames::Origin;
 use mmic::node::server::gateway::{self, Gateway, Kept, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -832,18 +831,22 @@ pub struct FrameGatewayTask {
     pub wire: Option<WireLog>,
     /// Where the server board's figures of the link (FARM-1, TM frames) go when the run ends.
     pub stats: Arc<Mutex<FrameStats>>,
-    /// SDLS on the link: the robot's TC and TM keys. Its durable counters are kept in memory
-    /// for the run.
+    /// SDLS on the link: the robot's TC and TM keys.
     pub sdls: Option<(Key256, Key256)>,
-    /// The server board's restarts (`--inject reboot-server@S`): it keeps the newest
-    /// telecommand key per source and its SDLS counters (decisions `restart-server`,
-    /// `sdls-counters`); FARM-1 starts again at V(R) = 0; a visit going on is broken off.
+    /// Its flash ([`super::durable`]): the SDLS counters, FARM-1's progress and the kept
+    /// telecommand keys (memory for the run, or the state file of given keys).
+    pub store: super::durable::Durable,
+    /// The ground's address: FARM-1 obeys BC frames only from it (decision `sdls-bc-origin`;
+    /// on loopback every local process shares it).
+    pub ground: std::net::IpAddr,
+    /// The server board's restarts (`--inject reboot-server@S`): it boots from its store
+    /// (decisions `restart-server`, `sdls-counters`); a visit going on is broken off.
     pub restarts: Downtime,
 }
 
 /// One robot, eight waiting telecommands, 64 remembered keys, 4 KiB of TM packets waiting for
 /// frames (the virtual-time engine's type).
-type SimFrameGateway = mmic_replay::ReplayFrameGateway;
+type SimFrameGateway = super::durable::FrameGateway;
 
 /// FARM-1's verdict on a frame, for the wire log: `accept`, `discard:<reason>` (the reason's
 /// name), `unlock`, `set-vr:<V(R)>` (with ` (not executed)` when Lockout kept it from acting),
@@ -868,76 +871,76 @@ pub fn verdict_name(v: &Verdict) -> String {
 }
 
 impl FrameGatewayTask {
-    /// Runs until the run stops; then adds the server board's figures to [`Self::stats`].
+    /// Runs until the run stops; then adds the server board's figures to [`Self::stats`]. A
+    /// store that does not boot (not provisioned for the keys) stops the link: nothing is
+    /// taken or sent, and the log says why.
     pub fn run(mut self, node: Node<'_>) {
         let board = self.robot.0;
-        // Its flash: the SDLS counters by SPI, the telecommand keys it took.
-        let mut store = std::collections::BTreeMap::new();
-        let mut kept = Kept::new();
-        let mut g = self.boot(None, &store);
+        let mut g = self.boot(&node);
         // Whether this life's figures are in `stats` already (it went down).
         let mut counted = false;
         while node.running() {
             let now = node.poll();
             match restart_phase(&node, &mut self.restarts, now) {
                 Phase::WentDown | Phase::Down => {
-                    if !counted {
+                    if let (false, Some(g)) = (counted, &g) {
                         if let Ok(mut s) = self.stats.lock() {
-                            s.add_server(&g, board);
+                            s.add_server(g, board);
                         }
-                        counted = true;
                     }
+                    counted = true;
                     lose_datagrams(&self.from_ground);
                     std::thread::sleep(SERVER_IDLE);
                     continue;
                 }
                 Phase::CameUp => {
-                    g = self.boot(Some(kept.clone()), &store);
+                    g = self.boot(&node);
                     counted = false;
                 }
                 Phase::Running => {}
             }
-            // The durable counters: written (here, kept for the run) and confirmed.
-            for (spi, v) in g.due().collect::<Vec<_>>() {
-                store.insert(spi, v);
-                g.persisted(spi, v);
-            }
-            let mut busy = self.link(&node, &mut g);
-            if let Some(k) = g.kept(board) {
-                kept = k;
-            }
-            let visits = g.tick(node.clock.now_ms());
+            let Some(gw) = g.as_deref_mut() else {
+                // The link stopped: what arrives is not taken.
+                lose_datagrams(&self.from_ground);
+                std::thread::sleep(SERVER_IDLE);
+                continue;
+            };
+            super::durable::persist_gateway(gw, &self.store);
+            let mut busy = self.link(&node, gw);
+            super::durable::persist_gateway(gw, &self.store);
+            let visits = gw.tick(node.clock.now_ms());
             for (board, command) in visits {
                 busy = true;
                 if board == self.robot.0 {
-                    self.visit(&node, &mut g, command.to_bytes());
+                    self.visit(&node, gw, command.to_bytes());
                 }
             }
-            self.tm_frames(&node, &mut g);
+            self.tm_frames(&node, gw);
             if !busy {
                 std::thread::sleep(SERVER_IDLE);
             }
         }
-        if !counted {
+        if let (false, Some(g)) = (counted, &g) {
             if let Ok(mut s) = self.stats.lock() {
-                s.add_server(&g, board);
+                s.add_server(g, board);
             }
         }
     }
 
-    /// The gateway as it starts: afresh, or after a restart from the keys it `kept`; with SDLS,
-    /// from the counters in `store`.
-    fn boot(
-        &self,
-        kept: Option<Kept>,
-        store: &std::collections::BTreeMap<u16, u128>,
-    ) -> Box<SimFrameGateway> {
+    /// The gateway as it starts, from its store ([`super::durable::boot_gateway`]); `None`
+    /// (logged) when the store refuses it.
+    fn boot(&self, node: &Node<'_>) -> Option<Box<SimFrameGateway>> {
         let board = self.robot.0;
-        let stored = Stored {
-            tc: store.get(&sdls::mission::tc_spi(board)).copied(),
-            tm: store.get(&sdls::mission::tm_spi(board)).copied(),
-        };
-        super::boot_frame_gateway(self.config, board, kept, self.sdls.clone(), stored)
+        match super::durable::boot_gateway(self.config, board, &self.store, self.sdls.clone()) {
+            Ok(g) => Some(g),
+            Err(e) => {
+                node.event(
+                    node.clock.now_ms(),
+                    json!({"type": "link_stopped", "why": e.to_string()}),
+                );
+                None
+            }
+        }
     }
 
     /// The link's own work: every TC frame waiting taken, the TM frames due sent. Whether a TC
@@ -945,11 +948,18 @@ impl FrameGatewayTask {
     fn link(&mut self, node: &Node<'_>, g: &mut SimFrameGateway) -> bool {
         let mut buf = [0u8; 2048];
         let mut busy = false;
-        while let Ok(n) = self.from_ground.recv(&mut buf) {
+        while let Ok((n, from)) = self.from_ground.recv_from(&mut buf) {
             busy = true;
             let now = node.clock.now_ms();
             let bytes = buf.get(..n).unwrap_or(&[]);
-            let got = g.tc_frame(now, bytes);
+            let origin = if from.ip() == self.ground {
+                Origin::Ground
+            } else {
+                Origin::Elsewhere
+            };
+            let got = g.tc_frame_from(now, bytes, origin);
+            // What a restart resumes from, before anything of the frame leaves the board.
+            super::durable::persist_gateway(g, &self.store);
             // With SDLS a data frame's packets are ciphertext: its security header instead.
             let secured = self.sdls.is_some();
             let sec = if secured {

@@ -16,7 +16,6 @@ use super::nodes::{self, Lossy};
 use super::plant::{self, PlantConfig};
 use super::shell::{Ground, GroundSide, GroundStats, LegacyGround, SideA, SideB};
 use super::{FrameStats, LinkLayer, Protocol, SimConfig, Summary, PACE_SLACK_MS};
-use mmic::link::sdls;
 use mmic::node::ground::frames::GroundLink as FopLink;
 use mmic::node::ground::plan_runner::{PlanEnd, PlanRunner};
 use mmic::node::robot::board_a::{self, BoardA};
@@ -44,12 +43,13 @@ struct Serial {
     read: std::sync::mpsc::Receiver<Vec<u8>>,
 }
 
-/// The ground's end of a robot's link: the writer, the packets read, the robot's number.
-/// The ground's durable SDLS counters, (robot, SPI) → value.
-type Store = std::collections::BTreeMap<(usize, u16), u128>;
-/// A robot's SDLS keys, TC and TM.
-type Keys = (mmic::link::sdls::Key256, mmic::link::sdls::Key256);
+/// A robot's SDLS keys, TC and TM, and the durable store of both ends of its link.
+type Keys = (
+    (mmic::link::sdls::Key256, mmic::link::sdls::Key256),
+    super::durable::Durable,
+);
 
+/// The ground's end of a robot's link: the writer, the packets read, the robot's number.
 type GroundLink = (
     Lossy<Box<dyn Write + Send>>,
     std::sync::mpsc::Receiver<Vec<u8>>,
@@ -67,8 +67,8 @@ struct RunEnv<'a> {
     packet_log: Option<log::Log>,
     /// The server boards' figures of the space data link, added when their tasks end.
     frames: Arc<Mutex<FrameStats>>,
-    /// With SDLS in the run's own ground: every robot's (TC, TM) keys, by index.
-    keys: &'a [(mmic::link::sdls::Key256, mmic::link::sdls::Key256)],
+    /// With SDLS in the run's own ground: every robot's (TC, TM) keys and store, by index.
+    keys: &'a [Keys],
 }
 
 impl<'a> RunEnv<'a> {
@@ -296,9 +296,24 @@ impl ServerEnds<'_> {
             stats: env.frames.clone(),
             sdls: match (&env.cfg.external, &env.cfg.sdls) {
                 (Some(x), _) => x.sdls.clone(),
-                (None, Some(_)) => env.keys.get(self.board.get() as usize - 1).cloned(),
+                (None, Some(_)) => env
+                    .keys
+                    .get(self.board.get() as usize - 1)
+                    .map(|k| k.0.clone()),
                 (None, None) => None,
             },
+            store: match &env.cfg.external {
+                Some(x) => x.store.clone(),
+                None => env
+                    .keys
+                    .get(self.board.get() as usize - 1)
+                    .map_or_else(super::durable::Durable::memory, |k| k.1.clone()),
+            },
+            ground: env
+                .cfg
+                .external
+                .as_ref()
+                .map_or(std::net::Ipv4Addr::LOCALHOST.into(), |x| x.tm_to.ip()),
             restarts: Downtime::of(env.cfg, Node::Server),
         };
         Ok((gw, udp))
@@ -361,11 +376,14 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
     let secured = cfg.link == LinkLayer::Frames
         && (cfg.sdls.is_some() || cfg.external.as_ref().is_some_and(|x| x.sdls.is_some()));
     let logger = logger.secured(secured);
-    // With SDLS in the run's own ground, each robot's keys, for both ends.
+    // With SDLS in the run's own ground, each robot's keys and store, for both ends.
     let keys = match (&cfg.sdls, &cfg.external) {
-        (Some(c), None) if cfg.link == LinkLayer::Frames => (0..n)
-            .map(|i| c.keys(cfg.seed, i))
-            .collect::<std::io::Result<Vec<_>>>()?,
+        (Some(c), None) if cfg.link == LinkLayer::Frames => {
+            let state = c.open_state()?;
+            (0..n)
+                .map(|i| c.robot(cfg.seed, i, state.as_ref()))
+                .collect::<std::io::Result<Vec<_>>>()?
+        }
         _ => Vec::new(),
     };
     let robots = (0..n)
@@ -519,15 +537,28 @@ fn ground_loop(
                 .iter()
                 .enumerate()
                 .map(|(i, (_, _, b))| {
-                    (cfg.link == LinkLayer::Frames).then(|| {
-                        let mut gl = Box::new(SimFopLink::new(*b));
-                        if let Some((tc, tm)) = keys.get(i) {
-                            gl.secure(tc.clone(), tm.clone(), (None, None));
-                        }
-                        gl
-                    })
+                    (cfg.link == LinkLayer::Frames)
+                        .then(|| {
+                            let mut gl = Box::new(SimFopLink::new(*b));
+                            if let Some((k, d)) = keys.get(i) {
+                                super::durable::boot_ground(&mut gl, *b, d, k.clone())?;
+                            }
+                            Ok(gl)
+                        })
+                        .transpose()
                 })
-                .collect();
+                .collect::<Result<Vec<_>, super::durable::BootError>>();
+            let fops = match fops {
+                Ok(f) => f,
+                Err(e) => {
+                    ground_event(
+                        &log,
+                        0,
+                        json!({"type": "link_stopped", "why": e.to_string()}),
+                    );
+                    links.iter().map(|_| None).collect()
+                }
+            };
             run_ground(cfg, links, runners, (fops, keys), clock, log)
         }
     }
@@ -555,12 +586,11 @@ fn run_ground<G: Ground>(
         cfg.progress,
         log.clone(),
     );
-    // The ground's durable SDLS counters, (robot, SPI) → value: kept for the run.
-    let mut store = std::collections::BTreeMap::new();
-    let persist = |store: &mut Store, i: usize, gl: &mut SimFopLink| {
-        for (spi, v) in gl.due().collect::<Vec<_>>() {
-            store.insert((i, spi), v);
-            gl.persisted(spi, v);
+    // The ground's durable SDLS counters: each robot's store (memory for the run, or the
+    // state file of given keys).
+    let persist = |i: usize, gl: &mut SimFopLink| {
+        if let Some((_, d)) = keys.get(i) {
+            super::durable::persist_ground(gl, d);
         }
     };
     let mut restarts = Downtime::of(cfg, Node::Ground);
@@ -569,7 +599,7 @@ fn run_ground<G: Ground>(
     // FOP-1 initiates the AD service; it runs once a CLCW confirms it.
     for (i, ((writer, _, _), fop)) in links.iter_mut().zip(fops.iter_mut()).enumerate() {
         if let Some(gl) = fop {
-            persist(&mut store, i, gl);
+            persist(i, gl);
             gl.start(clock.now_ms(), &mut |f: &[u8]| {
                 writer.send(clock.now_ms(), f);
             });
@@ -606,15 +636,17 @@ fn run_ground<G: Ground>(
                     ground.restart(i, now);
                     if cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames {
                         let mut gl = Box::new(SimFopLink::new(*b));
-                        if let Some((tc, tm)) = keys.get(i) {
-                            let stored = |spi| store.get(&(i, spi)).copied();
-                            let kept = (
-                                stored(sdls::mission::tc_spi(*b)),
-                                stored(sdls::mission::tm_spi(*b)),
-                            );
-                            gl.secure(tc.clone(), tm.clone(), kept);
+                        if let Some((k, d)) = keys.get(i) {
+                            if let Err(e) = super::durable::boot_ground(&mut gl, *b, d, k.clone()) {
+                                ground_event(
+                                    &log,
+                                    now,
+                                    json!({"type": "link_stopped", "why": e.to_string()}),
+                                );
+                                continue;
+                            }
                         }
-                        persist(&mut store, i, &mut gl);
+                        persist(i, &mut gl);
                         gl.start(now, &mut |f: &[u8]| {
                             writer.send(clock.now_ms(), f);
                         });
@@ -640,7 +672,7 @@ fn run_ground<G: Ground>(
             let mut emit = |f: &[u8]| {
                 writer.send(clock.now_ms(), f);
             };
-            persist(&mut store, i, gl);
+            persist(i, gl);
             gl.tick(now, &mut emit);
             for p in ground.tick(i, now) {
                 if gl.send(&p, now, &mut emit).is_err() {
@@ -661,7 +693,7 @@ fn run_ground<G: Ground>(
                                "sdls": log::sdls_header(&bytes)}),
                     );
                 }
-                persist(&mut store, i, gl);
+                persist(i, gl);
                 for p in packets {
                     for q in ground.receive(i, t, &p) {
                         if gl.send(&q, t, &mut emit).is_err() {

@@ -287,6 +287,7 @@ fn draw_link(seed: u64, protocol: Protocol, opts: &Options, cfg: &mut SimConfig)
         };
         cfg.sdls = secured.then_some(SdlsConfig {
             keys: SdlsKeys::Seeded,
+            state: None,
             attack,
         });
     }

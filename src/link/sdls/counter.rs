@@ -211,6 +211,21 @@ impl ReplayWindow {
         Ok(())
     }
 
+    /// Right after [`ReplayWindow::boot`], moves `last` back from the stored floor to `iv`,
+    /// the last IV accepted before the restart as the shell kept it exactly (it wrote it
+    /// before anything of that frame left the board): the IVs between it and the floor were
+    /// never accepted, and the sender's next frames are taken at once instead of refused as
+    /// replays. Only at or below the durable floor; false (nothing changes) otherwise.
+    pub fn resume(&mut self, iv: Iv) -> bool {
+        let back = self.floor().ahead_of(iv);
+        if back >= HALF {
+            return false;
+        }
+        self.last = iv;
+        self.ahead = back;
+        true
+    }
+
     /// The floor to write now: when half a block or less is left above `last`, or an
     /// authenticated frame was beyond the floor.
     pub fn due(&self) -> Option<u128> {

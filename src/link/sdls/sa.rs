@@ -145,6 +145,15 @@ impl SecurityAssociation {
         }
     }
 
+    /// A receiving association resumes after a restart from the last IV it accepted
+    /// ([`ReplayWindow::resume`]); false for a sending one, or an IV beyond the floor.
+    pub fn resume(&mut self, last: Iv) -> bool {
+        match &mut self.role {
+            Role::Receive(w) => w.resume(last),
+            Role::Send(_) => false,
+        }
+    }
+
     /// The shell wrote `value` durably.
     pub fn persisted(&mut self, value: u128) -> bool {
         match &mut self.role {

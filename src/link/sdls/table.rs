@@ -108,6 +108,15 @@ impl<const N: usize> SaTable<N> {
         self.get_mut(spi).is_some_and(|sa| sa.persisted(value))
     }
 
+    /// `spi`'s receiving association resumes from the last IV it accepted before a restart
+    /// (`last`, below 2^96); false if there is none or the IV is beyond its floor.
+    pub fn resume(&mut self, spi: u16, last: u128) -> bool {
+        let Some(iv) = Iv::new(last) else {
+            return false;
+        };
+        self.get_mut(spi).is_some_and(|sa| sa.resume(iv))
+    }
+
     /// Whether `spi`'s association can protect a frame now (a sending one whose next IV is
     /// reserved).
     pub fn ready(&self, spi: u16) -> bool {

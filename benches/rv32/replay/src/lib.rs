@@ -571,6 +571,7 @@ fn frames_loop(g: &mut ReplayFrameGateway, io: &mut ServerIo<'_>, m: &mut impl M
     while let Some(f) = io.inbox.pop_front() {
         m.call(Call::TcFrame, true);
         let got = g.tc_frame(now, &f);
+        keep(g);
         m.call(Call::TcFrame, false);
         m.enter(Phase::Record);
         io.w.debug(Field::TcFrame, &got);
@@ -593,6 +594,14 @@ fn frames_loop(g: &mut ReplayFrameGateway, io: &mut ServerIo<'_>, m: &mut impl M
         let d = g.next_deadline(now);
         m.enter(Phase::Record);
         io.w.u32(Field::Deadline, d.unwrap_or(u32::MAX));
+    }
+}
+
+/// What the gateway asks to keep, confirmed at once (the engine's store in memory, written
+/// before anything that depends on it leaves: `sim::durable::persist_gateway`).
+fn keep(g: &mut ReplayFrameGateway) {
+    for e in g.durable_due::<16>() {
+        g.durable_written(&e);
     }
 }
 

@@ -48,14 +48,13 @@ use super::plant::{Drives, Plant};
 use super::shell::{frames, Ground, GroundSide, LegacyGround, SideA, SideB};
 use super::{FrameStats, LinkLayer, Protocol, SimConfig, Summary};
 use link::{Fate, Link, LinkModel};
-use mmic::link::sdls::{self, Key256};
+use mmic::link::sdls::Key256;
 use mmic::node::ground::frames::GroundLink;
 use mmic::node::ground::plan_runner::PlanRunner;
 use mmic::node::robot::board_a::{self, BoardA, Durable};
 use mmic::node::robot::board_b::{self, BoardB};
 use mmic::node::robot::handoff::PacketQueue;
 use mmic::node::robot::wifi_session::{Outgoing, WifiConfig, WifiSession};
-use mmic::node::server::frames::Stored;
 use mmic::node::server::gateway::{Gateway, Kept, Out};
 use mmic::node::server::relay::{Accepted, Server};
 use mmic::node::server::visit::Visit;
@@ -256,14 +255,16 @@ struct Robot {
     /// The ground's end of the space data link (`--link frames`).
     ground_link: Option<Box<SimGroundLink>>,
     links: [Link; 6],
-    /// With SDLS: the durable store of both ends' counters, (end, SPI) → value. It is the
-    /// run's (memory): a server board or ground that started again would boot from it.
-    store: std::collections::BTreeMap<(&'static str, u16), u128>,
+    /// The durable store of both ends (`sim::durable`): SDLS counters, FARM-1's progress, the
+    /// kept telecommand keys behind frames. Memory for the run, or with given keys the state
+    /// file: a server board or ground that starts again boots from it.
+    store: super::durable::Durable,
     /// With SDLS and an attacker: the attacker on the uplink.
     attacker: Option<Attacker>,
     /// Board A's flash: its exactly-once log and boot count (decision `restart-board-a`).
     kept_a: Option<Durable>,
-    /// The server board's flash: its gateway's newest TC key per source (`restart-server`).
+    /// The server board's flash without frames: its PUS gateway's newest TC key per source
+    /// (`restart-server`; behind frames they are in `store`).
     kept_server: Kept,
     /// With SDLS: the robot's (TC, TM) keys, as provisioned in the server board's image.
     keys: Option<(Key256, Key256)>,
@@ -369,13 +370,13 @@ pub fn run_watched(cfg: &SimConfig, watched: bool) -> std::io::Result<(Summary, 
                     last: None,
                 })
                 .collect();
-            Engine::new(cfg, runners, watched).run()
+            Engine::new(cfg, runners, watched)?.run()
         }
         Protocol::Pus => {
             let runners = (0..n)
                 .map(|i| PlanRunner::pus(cfg.ground_pus(), board_number(i)))
                 .collect();
-            Engine::new(cfg, runners, watched).run()
+            Engine::new(cfg, runners, watched)?.run()
         }
     }
 }
@@ -388,7 +389,7 @@ fn board_number(i: usize) -> BoardNumber {
 }
 
 impl<'c, G: Ground> Engine<'c, G> {
-    fn new(cfg: &'c SimConfig, runners: Vec<G>, watched: bool) -> Engine<'c, G> {
+    fn new(cfg: &'c SimConfig, runners: Vec<G>, watched: bool) -> std::io::Result<Engine<'c, G>> {
         let n = runners.len();
         let secured = cfg.sdls.is_some() && cfg.link == LinkLayer::Frames;
         let log = (cfg.log_events || cfg.log_packets || cfg.log_path.is_some())
@@ -401,7 +402,13 @@ impl<'c, G: Ground> Engine<'c, G> {
             cfg.progress,
             log.clone(),
         );
-        let robots = (0..n).map(|i| Robot::new(cfg, i)).collect();
+        let state = match &cfg.sdls {
+            Some(s) if cfg.link == LinkLayer::Frames => s.open_state()?,
+            _ => None,
+        };
+        let robots = (0..n)
+            .map(|i| Robot::new(cfg, i, state.as_ref()))
+            .collect::<std::io::Result<_>>()?;
         let mut e = Engine {
             cfg,
             now: 0,
@@ -439,7 +446,7 @@ impl<'c, G: Ground> Engine<'c, G> {
                 e.at(u64::from(s.at_ms) * 1000, Ev::Reboot(node));
             }
         }
-        e
+        Ok(e)
     }
 
     fn at(&mut self, at: u64, ev: Ev) {
@@ -656,13 +663,22 @@ impl<'c, G: Ground> Engine<'c, G> {
             }
             Node::B => r.b = SideB::new(BoardB::restarted(board_b::Config::default())),
             Node::Server => {
-                r.board = server_board(
+                // A store the run provisioned itself boots: a refusal here would be the
+                // simulator's fault, and the server board then stays down (its link stopped).
+                match server_board(
                     cfg,
                     r.number,
                     Some(r.kept_server.clone()),
                     &r.store,
                     r.keys.clone(),
-                );
+                ) {
+                    Ok(b) => r.board = b,
+                    Err(e) => {
+                        let why = e.to_string();
+                        self.node_event(i, 2, json!({"type": "link_stopped", "why": why}));
+                        return;
+                    }
+                }
                 self.wake_server(i, self.now);
             }
             Node::Ground => {
@@ -673,16 +689,14 @@ impl<'c, G: Ground> Engine<'c, G> {
                     // FOP-1 starts afresh (its AD service initiated again with a CLCW check);
                     // SDLS continues from the stored counters (decision `sdls-counters`).
                     let mut gl = Box::new(SimGroundLink::new(r.number));
-                    if let Some((tc, tm)) = r.keys.clone() {
-                        let stored = (
-                            r.store
-                                .get(&("ground", sdls::mission::tc_spi(r.number)))
-                                .copied(),
-                            r.store
-                                .get(&("ground", sdls::mission::tm_spi(r.number)))
-                                .copied(),
-                        );
-                        gl.secure(tc, tm, stored);
+                    if let Some(keys) = r.keys.clone() {
+                        if let Err(e) =
+                            super::durable::boot_ground(&mut gl, r.number, &r.store, keys)
+                        {
+                            let why = e.to_string();
+                            self.node_event(i, 3, json!({"type": "link_stopped", "why": why}));
+                            return;
+                        }
                     }
                     gl.start(now, &mut |_: &[u8]| {});
                     r.ground_link = Some(gl);
@@ -1449,34 +1463,21 @@ fn reading(s: &super::plant::Senses) -> trace::Reading {
     }
 }
 
-/// Robot `i`'s server board as it starts: at power-on (`kept` none), or after a restart from
-/// what its flash kept (the gateway's TC keys, the SDLS counters in `store`).
+/// Robot `i`'s server board as it starts: at power-on, or after a restart from what its flash
+/// kept (behind frames `store`: the kept telecommand keys, FARM-1's progress, the SDLS
+/// counters; the PUS gateway over packets its `kept` keys).
 fn server_board(
     cfg: &SimConfig,
     number: BoardNumber,
     kept: Option<Kept>,
-    store: &std::collections::BTreeMap<(&'static str, u16), u128>,
+    store: &super::durable::Durable,
     keys: Option<(Key256, Key256)>,
-) -> Board {
-    match cfg.protocol {
+) -> Result<Board, super::durable::BootError> {
+    Ok(match cfg.protocol {
         Protocol::Legacy => Board::Relay(Server::new()),
-        Protocol::Pus if cfg.link == LinkLayer::Frames => {
-            let stored = Stored {
-                tc: store
-                    .get(&("server", sdls::mission::tc_spi(number)))
-                    .copied(),
-                tm: store
-                    .get(&("server", sdls::mission::tm_spi(number)))
-                    .copied(),
-            };
-            Board::Frames(super::boot_frame_gateway(
-                cfg.gateway,
-                number,
-                kept,
-                keys,
-                stored,
-            ))
-        }
+        Protocol::Pus if cfg.link == LinkLayer::Frames => Board::Frames(
+            super::durable::boot_gateway(cfg.gateway, number, store, keys)?,
+        ),
         Protocol::Pus => {
             let mut g = Box::new(SimGateway::new(cfg.gateway));
             match kept {
@@ -1485,7 +1486,7 @@ fn server_board(
             };
             Board::Gateway(g)
         }
-    }
+    })
 }
 
 /// Marks the copy of a duplicated packet in its delivery's connection number (connection
@@ -1493,7 +1494,11 @@ fn server_board(
 const DUPLICATE: u64 = 1 << 63;
 
 impl Robot {
-    fn new(cfg: &SimConfig, i: usize) -> Robot {
+    fn new(
+        cfg: &SimConfig,
+        i: usize,
+        state: Option<&super::durable::Durable>,
+    ) -> std::io::Result<Robot> {
         let number = board_number(i);
         let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
         let plant = Plant::new(
@@ -1539,15 +1544,20 @@ impl Robot {
         let frames = cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames;
         let mut ground_link = frames.then(|| Box::new(SimGroundLink::new(number)));
         let sdls = cfg.sdls.as_ref().filter(|_| frames);
-        // Keys the configuration cannot give (an unreadable random source) leave the link in
-        // clear: the run's SDLS figures then stay absent. Made once: both ends (and the
-        // server board after a restart, as from its flash) share them.
-        let keys = sdls.and_then(|s| s.keys(cfg.seed, i).ok());
-        let board = server_board(cfg, number, None, &Default::default(), keys.clone());
+        // Made once: both ends (and the server board after a restart, as from its flash)
+        // share them. Keys that cannot be made stop the run (never a link in clear).
+        let (keys, store) = match sdls {
+            Some(s) => {
+                let (k, d) = s.robot(cfg.seed, i, state)?;
+                (Some(k), d)
+            }
+            None => (None, super::durable::Durable::memory()),
+        };
+        let board = server_board(cfg, number, None, &store, keys.clone())?;
         let mut attacker = None;
         if let (Some(sdls), Some(gl)) = (sdls, &mut ground_link) {
-            if let Some((tc, tm)) = keys.clone() {
-                gl.secure(tc, tm, (None, None));
+            if let Some(k) = keys.clone() {
+                super::durable::boot_ground(gl, number, &store, k)?;
             }
             attacker = (sdls.attack > 0.0).then(|| Attacker {
                 rate: sdls.attack,
@@ -1560,7 +1570,7 @@ impl Robot {
                 passed: 0,
             });
         }
-        Robot {
+        Ok(Robot {
             number,
             names: [
                 format!("board_a{}", i + 1),
@@ -1594,7 +1604,7 @@ impl Robot {
             ground_reader: Deframer::new(),
             ground_link,
             links,
-            store: std::collections::BTreeMap::new(),
+            store,
             attacker,
             kept_a: None,
             kept_server: Kept::new(),
@@ -1603,11 +1613,11 @@ impl Robot {
             restarts: [0; 4],
             past_frames: FrameStats::default(),
         }
-        .persisted()
+        .persisted())
     }
 
-    /// Writes both ends' due SDLS counters to the store and confirms them (the store is
-    /// memory: written at once).
+    /// Writes what both ends ask to keep to the store and confirms it (memory: at once; a
+    /// state file: flushed to the disk first).
     fn persist(&mut self) {
         let kept = match &self.board {
             Board::Gateway(g) => g.kept(self.number),
@@ -1618,16 +1628,10 @@ impl Robot {
             self.kept_server = k;
         }
         if let Board::Frames(g) = &mut self.board {
-            for (spi, v) in g.due().collect::<Vec<_>>() {
-                self.store.insert(("server", spi), v);
-                g.persisted(spi, v);
-            }
+            super::durable::persist_gateway(g, &self.store);
         }
         if let Some(gl) = &mut self.ground_link {
-            for (spi, v) in gl.due().collect::<Vec<_>>() {
-                self.store.insert(("ground", spi), v);
-                gl.persisted(spi, v);
-            }
+            super::durable::persist_ground(gl, &self.store);
         }
     }
 

@@ -38,8 +38,15 @@
 //! let n = frame.emit(&mut buf).unwrap();
 //! let verdict = g.tc_frame(0, &buf[..n]);
 //! assert_eq!(verdict.accepted, 1);
-//! // The TM frame due now carries the acceptance report and the CLCW: V(R) = 1.
+//! // What a restart must resume from (FARM-1's V(R) = 1) is written durably by the shell
+//! // first: until it confirms, no TM frame leaves.
 //! let mut tm = [0u8; TM_FRAME_LEN];
+//! assert!(g.frame(0, &mut tm).is_none());
+//! for e in g.durable_due::<8>() {
+//!     // ... the shell writes `e` to flash here ...
+//!     assert!(g.durable_written(&e));
+//! }
+//! // The TM frame due now carries the acceptance report and the CLCW: V(R) = 1.
 //! let (board, len) = g.frame(0, &mut tm).unwrap();
 //! assert_eq!(board, BoardNumber::ONE);
 //! let params = TmFrameParams::mission(0x101).unwrap();
@@ -47,7 +54,10 @@
 //! assert_eq!(Clcw::parse(&f.ocf.unwrap()).unwrap().report_value, 1);
 //! ```
 
-use super::gateway::{Config as GatewayConfig, Gateway, Kept, Out, TmOut, MAX_TM_DATA};
+use super::gateway::{
+    Config as GatewayConfig, Gateway, Kept, Out, TmOut, KEPT_SOURCES, MAX_TM_DATA,
+};
+use super::store::{Entry, Progress};
 use crate::ccsds::primary::PrimaryHeader;
 use crate::ccsds::tm::TM_MIN_LEN;
 use crate::link::clcw::ClcwVcid;
@@ -64,6 +74,9 @@ use crate::units::BoardNumber;
 use crate::wire::command::CommandRepr;
 use crate::wire::heartbeat::HeartbeatRepr;
 use heapless::Vec;
+
+mod durable;
+pub use durable::DUE_PER_ROBOT;
 
 /// The largest telemetry packet the gateway writes.
 const MAX_TM_LEN: usize = TM_MIN_LEN + MAX_TM_DATA;
@@ -157,6 +170,8 @@ pub struct LinkCounters {
     /// TM frames SDLS could not protect (none expected: a frame waits until its association's
     /// counter is reserved).
     pub tm_unprotected: u32,
+    /// BC frames refused because they came from elsewhere than the ground's address.
+    pub bc_origin: u32,
 }
 
 /// Why a TC frame went no further than the link.
@@ -168,34 +183,71 @@ pub enum FrameRefusal {
     /// SDLS ([`SdlsRefusal`]): nothing of the frame reached FARM-1.
     #[error(transparent)]
     Security(#[from] SdlsRefusal),
+    /// A BC frame not from the ground's address ([`Origin`]): FARM-1 never saw it.
+    #[error("a BC frame from elsewhere than the ground's address: not obeyed")]
+    Origin,
 }
 
 impl FrameRefusal {
-    /// The check's name ([`TcFrameError::NAMES`] or [`SdlsRefusal::NAMES`]).
+    /// The check's name ([`TcFrameError::NAMES`], [`SdlsRefusal::NAMES`], or `bc-origin`).
     pub const fn name(&self) -> &'static str {
         match self {
             FrameRefusal::Frame(e) => e.name(),
             FrameRefusal::Security(e) => e.name(),
+            FrameRefusal::Origin => "bc-origin",
         }
     }
 
-    /// `frame` or `sdls`.
+    /// `frame`, `sdls` or `cop`.
     pub const fn layer(&self) -> &'static str {
         match self {
             FrameRefusal::Frame(_) => "frame",
             FrameRefusal::Security(_) => "sdls",
+            FrameRefusal::Origin => "cop",
         }
     }
 }
 
-/// Counters kept in durable storage by the shell, per robot: where the TC window's floor and
-/// the TM counter's reservation stood (`None`: a new association).
+/// What the shell kept in durable storage, per robot ([`super::store`]): where the TC
+/// window's floor and the TM counter's reservation stood (`None`: a new association), and
+/// where FARM-1 and the TC window stood after the last accepted frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Stored {
     /// The TC floor.
     pub tc: Option<u128>,
     /// The TM reservation.
     pub tm: Option<u128>,
+    /// FARM-1's V(R) and the last TC IV accepted (`None`: FARM-1 starts at V(R) = 0).
+    pub progress: Option<Progress>,
+}
+
+/// Where a TC frame came from, as the shell's transport tells it: FARM-1 obeys a BC frame
+/// (Unlock, Set V(R), which go in clear) only from the ground's configured address (decision
+/// `sdls-bc-origin`); data frames are judged by SDLS wherever they come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Origin {
+    /// The configured ground address.
+    Ground,
+    /// Anywhere else.
+    Elsewhere,
+}
+
+/// Why [`FrameGateway::secure`] could not secure a robot's link: the shell must not run it
+/// in clear instead.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+pub enum SecureError {
+    /// The robot is not served ([`FrameGateway::add`] first).
+    #[error("robot {board} is not served: add it before securing its link")]
+    NotServed {
+        /// The robot.
+        board: u8,
+    },
+    /// The TM frame has no room for the security header and MAC.
+    #[error("robot {board}'s TM frames have no room for SDLS's header and MAC")]
+    Layout {
+        /// The robot.
+        board: u8,
+    },
 }
 
 /// What became of one TC frame.
@@ -227,6 +279,12 @@ struct RobotLink<const N: usize> {
     sdls: Option<SaTable<2>>,
     /// SDLS refusals waiting for their ST\[5\] report, by reason.
     alarms: [Alarm; SdlsRefusal::NAMES.len()],
+    /// Where FARM-1 and the TC window stand now, and what the shell last confirmed durable
+    /// (no TM frame and no visit leaves while they differ: `durable`).
+    progress: Progress,
+    progress_kept: Progress,
+    /// The kept-key entries the shell last confirmed, by slot.
+    kept_written: [Option<Entry>; KEPT_SOURCES],
 }
 
 impl<const N: usize> RobotLink<N> {
@@ -281,10 +339,10 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     }
 
     /// Serves robot `board` after the server board restarted, with what its gateway kept
-    /// ([`Gateway::add_restarted`]). FARM-1 starts again as at power-on (V(R) = 0, no flags):
-    /// the ground's FOP-1 finds N(R) unexpected, re-initiates with Set V(R) and sends the
-    /// packets of its unconfirmed frames again, which the kept keys answer without running
-    /// them twice. Then [`FrameGateway::secure`] with the stored SDLS counters.
+    /// ([`Gateway::add_restarted`]): a telecommand it may have taken before is answered, never
+    /// run twice. Then [`FrameGateway::secure`] with the stored SDLS counters and progress (or,
+    /// without SDLS, [`FrameGateway::resume`]): FARM-1 resumes at the V(R) it had, so the
+    /// ground's FOP-1 finds the N(R) it expects and retransmits what is unconfirmed.
     pub fn add_restarted(&mut self, board: BoardNumber, kept: Kept) -> bool {
         self.add_link(board, Some(kept))
     }
@@ -295,6 +353,15 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     }
 
     fn add_link(&mut self, board: BoardNumber, kept: Option<Kept>) -> bool {
+        let restarted = kept.is_some();
+        let added = self.push_link(board, kept);
+        if added && restarted {
+            self.kept_restored(board);
+        }
+        added
+    }
+
+    fn push_link(&mut self, board: BoardNumber, kept: Option<Kept>) -> bool {
         let scid = SpacecraftId::of_board(board).get();
         let Some(params) = TmFrameParams::mission(scid) else {
             return false;
@@ -316,41 +383,75 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 counters: LinkCounters::default(),
                 sdls: None,
                 alarms: [Alarm::default(); SdlsRefusal::NAMES.len()],
+                progress: Progress::default(),
+                progress_kept: Progress::default(),
+                kept_written: [None; KEPT_SOURCES],
             })
             .is_ok()
     }
 
     /// Secures robot `board`'s link with SDLS (`crate::link::sdls::mission`): its TC frames
     /// are verified under `tc_key` (and refused unless they verify, BC frames excepted), its
-    /// TM frames protected under `tm_key`; `stored`, the counters the shell kept. Call it
-    /// right after [`FrameGateway::add`], before any frame: the TM framer starts again with
-    /// room for the security header and MAC. False when the robot is not served.
+    /// TM frames protected under `tm_key`; `stored`, what the shell kept (the counters, and
+    /// FARM-1's progress, [`FrameGateway::resume`]). Call it right after
+    /// [`FrameGateway::add`], before any frame: the TM framer starts again with room for the
+    /// security header and MAC. An error leaves the link as it was: the shell must not run it
+    /// in clear instead.
     pub fn secure(
         &mut self,
         board: BoardNumber,
         tc_key: Key256,
         tm_key: Key256,
         stored: Stored,
-    ) -> bool {
+    ) -> Result<(), SecureError> {
         let idle = self.cfg.idle_period_ms;
-        let Some(link) = self.links.iter_mut().find(|l| l.board == board) else {
-            return false;
-        };
-        let Some(params) = link
+        let n = board.get();
+        let link = self
+            .links
+            .iter_mut()
+            .find(|l| l.board == board)
+            .ok_or(SecureError::NotServed { board: n })?;
+        let params = link
             .framer
             .params()
             .with_security(sdls::HEADER_LEN as u8, sdls::MAC_LEN as u8)
-        else {
-            return false;
-        };
+            .ok_or(SecureError::Layout { board: n })?;
         let mut table = SaTable::new();
         let tc = sdls::mission::tc_receiver(board, tc_key, stored.tc);
         let tm = sdls::mission::tm_sender(board, tm_key, stored.tm);
+        // Unreachable: an empty table of two places takes two SPIs that differ.
         if table.add(tc).is_err() || table.add(tm).is_err() {
-            return false;
+            return Err(SecureError::NotServed { board: n });
         }
         link.framer = TmFramer::new(params, idle);
         link.sdls = Some(table);
+        if let Some(p) = stored.progress {
+            self.resume(board, p);
+        }
+        Ok(())
+    }
+
+    /// Robot `board`'s FARM-1 resumes at the kept V(R) (Open, no flag), and, on a secured link,
+    /// its TC window at the last IV accepted (when the durable floor covers it). False when
+    /// the robot is not served.
+    pub fn resume(&mut self, board: BoardNumber, p: Progress) -> bool {
+        let window = self.cfg.farm_window;
+        let Some(link) = self.links.iter_mut().find(|l| l.board == board) else {
+            return false;
+        };
+        let status = crate::link::farm::FarmStatus {
+            vr: p.vr,
+            ..Farm::new(window).status()
+        };
+        if let Some(farm) = Farm::restore(window, status) {
+            link.farm = farm;
+        }
+        let spi = sdls::mission::tc_spi(board);
+        if let (Some(table), Some(iv)) = (link.sdls.as_mut(), p.tc_iv) {
+            table.resume(spi, iv);
+        }
+        link.progress = p;
+        link.progress_kept = p;
         true
     }
 
@@ -407,8 +508,13 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         &self.refused
     }
 
-    /// A TC frame from the ground, at `now`.
+    /// A TC frame from the ground's address, at `now` ([`FrameGateway::tc_frame_from`]).
     pub fn tc_frame(&mut self, now: u32, bytes: &[u8]) -> FrameIn {
+        self.tc_frame_from(now, bytes, Origin::Ground)
+    }
+
+    /// A TC frame from `origin`, at `now`.
+    pub fn tc_frame_from(&mut self, now: u32, bytes: &[u8], origin: Origin) -> FrameIn {
         // The robot by the header's spacecraft ID (before any check: it only picks the
         // configuration; the checks then say whether the frame is sound and whether it is
         // really for that robot).
@@ -461,9 +567,18 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         } else {
             frame.data()
         };
+        if frame.kind() == FrameKind::Bc && origin != Origin::Ground {
+            link.counters.bc_origin = link.counters.bc_origin.wrapping_add(1);
+            result.verdict = Err(FrameRefusal::Origin);
+            return result;
+        }
+        let mut iv = None;
         if let (Some(table), true) = (link.sdls.as_mut(), frame.kind() != FrameKind::Bc) {
             match secured::verify_tc(table, &frame, &mut plain) {
-                Ok((_, range)) => data = plain.get(range).unwrap_or(&[]),
+                Ok((v, range)) => {
+                    iv = Some(v.iv.get());
+                    data = plain.get(range).unwrap_or(&[]);
+                }
                 Err(e) => {
                     result.verdict = Err(e.into());
                     if let Some(a) = link.alarms.get_mut(e.position()) {
@@ -489,6 +604,12 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         result.verdict = Ok(verdict);
         if let Verdict::Discard(_) = verdict {
             link.counters.tc_discarded = link.counters.tc_discarded.wrapping_add(1);
+        }
+        // What a restart must resume from: V(R) (a BC frame may have moved it) and the IV of
+        // a frame SDLS verified (the window moved to it whatever FARM-1 did with the frame).
+        link.progress.vr = link.farm.vr();
+        if iv.is_some() {
+            link.progress.tc_iv = iv;
         }
         if verdict != Verdict::Accept || frame.kind() == FrameKind::Bc {
             return result;
@@ -525,7 +646,15 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     /// Time passes: the gateway's resends, polls and housekeeping (their reports go into the
     /// TM framers); the legacy commands due now, at most one per robot. A robot whose queue
     /// has room again releases FARM-1's buffer.
+    ///
+    /// Nothing is done while the shell has not confirmed a durable entry that gates
+    /// ([`FrameGateway::durable_due`]): a telecommand must not reach board A before what a
+    /// restart needs to answer it again is kept.
     pub fn tick(&mut self, now: u32) -> Vec<(BoardNumber, CommandRepr), R> {
+        if self.gated() {
+            self.security_reports(now);
+            return Vec::new();
+        }
         let out = self.gateway.tick(now);
         let mut to_robots = Vec::new();
         for c in &out.to_robots {
@@ -574,6 +703,8 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         let gather = self.cfg.gather_ms;
         let link = self.links.iter_mut().find(|l| {
             l.due(now, gather)
+                // The CLCW would report a V(R) a restart could not resume from.
+                && l.progress == l.progress_kept
                 && l.sdls
                     .as_ref()
                     .is_none_or(|t| t.ready(sdls::mission::tm_spi(l.board)))

@@ -1,0 +1,242 @@
+//! The keys partition (`mmic_keys`, firmware/server/partitions.csv): the server board's SDLS
+//! keys, flashed apart from the image (the image carries no key), read at start-up.
+//!
+//! | octets | what |
+//! |---|---|
+//! | 0..8 | magic `MMICKEYS` |
+//! | 8 | version, 1 |
+//! | 9 | n, the keys that follow (1..=[`MAX_KEYS`]) |
+//! | 10..12 | `0x0000` |
+//! | 12 + 36 i .. | key i: SPI (big-endian, 2), `0x0000`, the 32 key octets |
+//! | 12 + 36 n .. +4 | CRC-32/ISO-HDLC of everything before, big-endian |
+//!
+//! The rest of the partition is erased (`0xFF`). Each refusal is named ([`KeysError`]), and a
+//! key is checked ([`Key256::check`]) when read: an all-zero or published test key is refused
+//! here as at provisioning.
+//!
+//! ```
+//! use mmic::link::sdls::Key256;
+//! use mmic::node::server::store::keys;
+//!
+//! let k = |s: u8| Key256::from_bytes(core::array::from_fn(|i| (i as u8).wrapping_mul(77) ^ s));
+//! let mut part = [0xFF; 4096];
+//! let n = keys::emit(&[(257, &k(1)), (513, &k(2))], &mut part).unwrap();
+//! assert_eq!(n, 12 + 2 * 36 + 4);
+//! let set = keys::parse(&part).unwrap();
+//! assert_eq!(set.spis().collect::<Vec<_>>(), [257, 513]);
+//! assert!(set.get(257).is_some());
+//! assert_eq!(keys::parse(&[0xFF; 64]).unwrap_err(), keys::KeysError::Blank);
+//! part[20] ^= 1; // a flipped key bit
+//! assert!(matches!(keys::parse(&part), Err(keys::KeysError::Crc { .. })));
+//! ```
+
+use crate::link::sdls::key::{WeakKey, KEY_LEN};
+use crate::link::sdls::Key256;
+use crc::{Crc, NoTable, CRC_32_ISO_HDLC};
+use heapless::Vec;
+
+/// The magic at the partition's start.
+pub const MAGIC: [u8; 8] = *b"MMICKEYS";
+/// The layout's version.
+pub const VERSION: u8 = 1;
+/// Keys a partition holds at most: the TC and TM keys of 8 robots.
+pub const MAX_KEYS: usize = 16;
+/// The header's octets.
+pub const HEADER_LEN: usize = 12;
+/// One key's octets.
+pub const ENTRY_LEN: usize = 4 + KEY_LEN;
+
+const CRC32: Crc<u32, NoTable> = Crc::<u32, NoTable>::new(&CRC_32_ISO_HDLC);
+
+/// Why a keys partition was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum KeysError {
+    /// Erased: nothing was ever written (the keys were not provisioned).
+    #[error("the keys partition is erased: no keys were provisioned")]
+    Blank,
+    /// Not this layout.
+    #[error("the keys partition does not start with MMICKEYS")]
+    Magic,
+    /// Another version.
+    #[error("the keys partition has layout version {found}, this image reads {expected}")]
+    Version {
+        /// [`VERSION`].
+        expected: u8,
+        /// What it holds.
+        found: u8,
+    },
+    /// No key, or more than [`MAX_KEYS`].
+    #[error("the keys partition says {found} keys, 1..={max} expected")]
+    Count {
+        /// [`MAX_KEYS`].
+        max: usize,
+        /// What it says.
+        found: usize,
+    },
+    /// Shorter than its keys and CRC.
+    #[error("the keys partition needs {needed} octets, has {found}")]
+    Truncated {
+        /// Octets needed.
+        needed: usize,
+        /// Octets there.
+        found: usize,
+    },
+    /// The CRC does not match: a torn or altered write.
+    #[error("the keys partition's CRC is {found:#010x}, its contents give {expected:#010x}")]
+    Crc {
+        /// Computed.
+        expected: u32,
+        /// Stored.
+        found: u32,
+    },
+    /// A reserved field is not zero.
+    #[error("the keys partition's reserved octets at {at} are not zero")]
+    Reserved {
+        /// Their offset.
+        at: usize,
+    },
+    /// An SPI twice.
+    #[error("SPI {spi} appears twice in the keys partition")]
+    Duplicate {
+        /// The SPI.
+        spi: u16,
+    },
+    /// A key nobody should use.
+    #[error("SPI {spi}: {reason}")]
+    Weak {
+        /// The SPI.
+        spi: u16,
+        /// Why.
+        reason: WeakKey,
+    },
+    /// The output is too small ([`emit`]).
+    #[error("{needed} octets needed to write the keys, {found} given")]
+    Room {
+        /// Octets needed.
+        needed: usize,
+        /// Octets given.
+        found: usize,
+    },
+}
+
+/// The keys read from a partition, by SPI (zeroized when dropped).
+#[derive(Debug, Default)]
+pub struct KeySet {
+    keys: Vec<(u16, Key256), MAX_KEYS>,
+}
+
+impl KeySet {
+    /// The key of `spi`.
+    pub fn get(&self, spi: u16) -> Option<&Key256> {
+        self.keys.iter().find(|(s, _)| *s == spi).map(|(_, k)| k)
+    }
+
+    /// Every SPI, in the partition's order.
+    pub fn spis(&self) -> impl Iterator<Item = u16> + '_ {
+        self.keys.iter().map(|(s, _)| *s)
+    }
+}
+
+/// Reads a keys partition (its first octets at least; the rest is ignored).
+pub fn parse(part: &[u8]) -> Result<KeySet, KeysError> {
+    let head = part.get(..HEADER_LEN).ok_or(KeysError::Truncated {
+        needed: HEADER_LEN,
+        found: part.len(),
+    })?;
+    if head.iter().all(|&b| b == 0xFF) {
+        return Err(KeysError::Blank);
+    }
+    if head[..8] != MAGIC {
+        return Err(KeysError::Magic);
+    }
+    if head[8] != VERSION {
+        return Err(KeysError::Version {
+            expected: VERSION,
+            found: head[8],
+        });
+    }
+    let n = usize::from(head[9]);
+    if n == 0 || n > MAX_KEYS {
+        return Err(KeysError::Count {
+            max: MAX_KEYS,
+            found: n,
+        });
+    }
+    if head[10..12] != [0, 0] {
+        return Err(KeysError::Reserved { at: 10 });
+    }
+    let body = HEADER_LEN + n * ENTRY_LEN;
+    let all = part.get(..body + 4).ok_or(KeysError::Truncated {
+        needed: body + 4,
+        found: part.len(),
+    })?;
+    let (signed, crc) = all.split_at(body);
+    let found = u32::from_be_bytes([crc[0], crc[1], crc[2], crc[3]]);
+    let expected = CRC32.checksum(signed);
+    if found != expected {
+        return Err(KeysError::Crc { expected, found });
+    }
+    let mut set = KeySet::default();
+    for (i, e) in signed[HEADER_LEN..].chunks_exact(ENTRY_LEN).enumerate() {
+        let spi = u16::from_be_bytes([e[0], e[1]]);
+        if e[2..4] != [0, 0] {
+            return Err(KeysError::Reserved {
+                at: HEADER_LEN + i * ENTRY_LEN + 2,
+            });
+        }
+        if set.get(spi).is_some() {
+            return Err(KeysError::Duplicate { spi });
+        }
+        let key = Key256::from_slice(&e[4..]).map_err(|_| KeysError::Truncated {
+            needed: body + 4,
+            found: part.len(),
+        })?;
+        key.check()
+            .map_err(|reason| KeysError::Weak { spi, reason })?;
+        // Unreachable past MAX_KEYS (n is checked above).
+        let _ = set.keys.push((spi, key));
+    }
+    Ok(set)
+}
+
+/// Writes `keys` in the partition's layout at the start of `out` (the caller erases the rest
+/// and clears `out` once it is written out: it holds the keys). Weak keys and repeated SPIs
+/// are refused. Returns the octets written.
+pub fn emit(keys: &[(u16, &Key256)], out: &mut [u8]) -> Result<usize, KeysError> {
+    if keys.is_empty() || keys.len() > MAX_KEYS {
+        return Err(KeysError::Count {
+            max: MAX_KEYS,
+            found: keys.len(),
+        });
+    }
+    let body = HEADER_LEN + keys.len() * ENTRY_LEN;
+    if out.len() < body + 4 {
+        return Err(KeysError::Room {
+            needed: body + 4,
+            found: out.len(),
+        });
+    }
+    for (i, (spi, key)) in keys.iter().enumerate() {
+        key.check()
+            .map_err(|reason| KeysError::Weak { spi: *spi, reason })?;
+        if keys[..i].iter().any(|(s, _)| s == spi) {
+            return Err(KeysError::Duplicate { spi: *spi });
+        }
+    }
+    let (head, rest) = out.split_at_mut(HEADER_LEN);
+    head[..8].copy_from_slice(&MAGIC);
+    head[8] = VERSION;
+    head[9] = keys.len() as u8;
+    head[10..12].fill(0);
+    for ((spi, key), e) in keys.iter().zip(rest.chunks_exact_mut(ENTRY_LEN)) {
+        e[..2].copy_from_slice(&spi.to_be_bytes());
+        e[2..4].fill(0);
+        e[4..].copy_from_slice(key.octets());
+    }
+    let crc = CRC32.checksum(out.get(..body).unwrap_or(&[]));
+    if let Some(c) = out.get_mut(body..body + 4) {
+        c.copy_from_slice(&crc.to_be_bytes());
+    }
+    Ok(body + 4)
+}
