@@ -19,9 +19,15 @@
 //! failure the ground reports ([`TcLink`] giving it up as unacknowledged, an ST\[1\]
 //! failure), within [`bound_ms`] of its submission; one the gateway never took is given up
 //! within `max_attempts × timeout_ms` ([`untaken_bound_ms`]); board A runs none twice, and
-//! every one reported completed ran exactly once. And the attack bites: FOP-1 confirms AD
-//! frames FARM-1 never accepted (their packets never reached the gateway), so the tests
-//! cannot pass vacuously.
+//! every one reported completed ran exactly once (one given up may have run once: the ground
+//! reports its outcome unknown). And the attack bites: FOP-1 confirms AD frames FARM-1 never
+//! accepted (their packets never reached the gateway), so the tests cannot pass vacuously.
+//! Once the attacker stops, the link recovers by itself: the next telecommand completes (the
+//! ground's re-initiation unlocks a FARM-1 the attack left in Lockout).
+//!
+//! The attacker relays the ground's own frames, so it is not stopped by FARM-1 taking BC
+//! frames only from the source of the last authenticated frame (decision `sdls-bc-source`);
+//! it has no key, so it makes nothing run and forges no report.
 
 use mmic::ccsds::tm::TmRepr;
 use mmic::command::{Command, ServoTarget};
@@ -483,8 +489,10 @@ struct Run {
     ad_frames: u32,
     /// FOP-1's alerts.
     alerts: u32,
-    /// TM frames the ground refused but as replays (the attacker's copies): a rewritten CLCW
-    /// with its FECF made good passes every check.
+    /// TM frames the ground refused by a frame check or for their MAC: none, a rewritten CLCW
+    /// with its FECF made good passes both. (SDLS refuses the attacker's copies as replays,
+    /// and, rarely, an authentic frame whose IV ran past the ground's durable floor before this
+    /// loop wrote it, as not-reserved: neither is the attack's doing.)
     tm_refused: u32,
     /// When the run stopped, ms.
     end_ms: u32,
@@ -724,7 +732,7 @@ fn run(n: u16, seed: u64, tactics: Tactics, script: Option<Scripted>, limit_ms: 
         alerts: c.alerts.iter().sum(),
         tm_refused: {
             let sec = ground.security().unwrap();
-            c.tm_refused + sec.refused_total() - sec.refused_for("replay")
+            c.tm_refused + sec.refused_for("bad-mac")
         },
         end_ms,
     }
@@ -802,16 +810,16 @@ fn every_frame_skipped_cop1_says_delivered_and_the_ground_gives_each_up() {
 /// before every uplink frame of a short run (three telecommands: the clean run's three AD
 /// frames): 771 runs. Set V(R) = N(S) + 1 skips the frame (FOP-1 confirms it) and the ground's
 /// link sends the telecommand again after its timeout. A Set V(R) that puts the next frame in
-/// FARM-1's lockout area (236 of the 256 values) locks FARM-1 out, and the ground's
-/// re-initiation with Set V(R) cannot leave Lockout (232.1-B-2 obeys Set V(R) in Open and
-/// Wait only): every later telecommand is given up, reported, none lost silently.
+/// FARM-1's lockout area (236 of the 256 values) locks FARM-1 out; the ground's
+/// re-initiation unlocks it (an Unlock before its Set V(R), which Lockout ignores) and every
+/// telecommand completes: one forged frame costs seconds, never a telecommand.
 #[test]
 fn every_forged_bc_frame_before_every_frame_of_a_short_run() {
     let clean = run(3, 1, Tactics::default(), None, 60_000);
     assert_eq!(clean.completed(), 3);
     let mut commands: Vec<ControlCommand> = (0..=255u8).map(ControlCommand::SetVr).collect();
     commands.push(ControlCommand::Unlock);
-    let (mut runs, mut bitten, mut worst, mut given_up, mut stuck) = (0, 0, 0, 0, 0);
+    let (mut runs, mut bitten, mut worst, mut given_up) = (0, 0, 0, 0);
     for i in 0..clean.up_frames {
         for &cmd in &commands {
             let what = format!("{cmd:?} before uplink frame {i}");
@@ -826,7 +834,7 @@ fn every_forged_bc_frame_before_every_frame_of_a_short_run() {
             runs += 1;
             bitten += u32::from(r.bites > 0);
             given_up += 3 - r.completed();
-            stuck += u32::from(r.cmds.last().unwrap().end.unwrap().1 != End::Completed);
+            assert_eq!(r.completed(), 3, "{what}: {:?}", r.cmds);
             if cmd == ControlCommand::SetVr(i as u8 + 1) {
                 // The attack itself: the frame skipped, acknowledged, and sent again by the
                 // ground's link after its timeout, under the same key.
@@ -836,7 +844,7 @@ fn every_forged_bc_frame_before_every_frame_of_a_short_run() {
         }
     }
     println!(
-        "{runs} runs: the attack bit in {bitten}; {given_up} telecommands given up, the last one of {stuck} runs; longest time to an outcome {worst} ms (bound {} ms)",
+        "{runs} runs: the attack bit in {bitten}; {given_up} telecommands given up; longest time to an outcome {worst} ms (bound {} ms)",
         bound_ms()
     );
 }
@@ -864,6 +872,7 @@ fn every_clcw_rewrite_in_every_tm_frame_of_a_short_run() {
         runs += 1;
         bitten += u32::from(r.bites > 0);
         given_up += 3 - r.completed();
+        assert_eq!(r.completed(), 3, "{what}: {:?}", r.cmds);
     }
     assert!(bitten > 0);
     println!(
@@ -872,9 +881,11 @@ fn every_clcw_rewrite_in_every_tm_frame_of_a_short_run() {
     );
 }
 
-/// A seeded attacker doing everything at random, on top of its own drops and copies, over
-/// many seeds: ten telecommands each; in half of them the attack stops after 60 s, and the
-/// last telecommand is submitted 30 s later.
+/// A seeded attacker doing everything at random (forged Set V(R) = N(S) + 1 and to any value,
+/// Unlock, CLCWs rewritten, drops, copies) over 90 seeds (`COP1_SEEDS` for more): ten
+/// telecommands each; in half of the runs the attack stops after 60 s and the last
+/// telecommand is submitted 30 s later (FOP-1's longest recovery, tx_limit × T1): it
+/// completes.
 #[test]
 fn a_random_on_path_attacker_loses_nothing_silently_and_runs_nothing_twice() {
     let (mut runs, mut bitten, mut bites, mut worst) = (0, 0, 0, 0);
@@ -883,17 +894,27 @@ fn a_random_on_path_attacker_loses_nothing_silently_and_runs_nothing_twice() {
     // The last telecommands of the runs whose attacker stopped (submitted after FOP-1's
     // longest recovery), and those of them completed.
     let (mut after, mut after_done) = (0, 0);
-    for seed in 1..=60u64 {
+    let seeds: u64 = std::env::var("COP1_SEEDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(90);
+    for seed in 1..=seeds {
         let mut rng = Rng::new(seed);
-        let mut p = |max: f64| (rng.below(1001) as f64 / 1000.0) * max;
+        // Every third run an aggressive attacker (up to a forged frame before every AD frame,
+        // every CLCW rewritten, half the frames dropped); the others a moderate one.
+        let scale = if seed % 3 == 0 { 1.0 } else { 0.0 };
+        let mut p = |moderate: f64, aggressive: f64| {
+            let max = moderate + scale * (aggressive - moderate);
+            (rng.below(1001) as f64 / 1000.0) * max
+        };
         let tactics = Tactics {
-            skip: p(0.5),
-            drop_and_ack: p(0.2),
-            set_vr: p(0.05),
-            unlock: p(0.05),
-            rewrite: p(0.3),
-            drop: p(0.2),
-            dup: p(0.1),
+            skip: p(0.5, 1.0),
+            drop_and_ack: p(0.2, 0.6),
+            set_vr: p(0.05, 0.4),
+            unlock: p(0.05, 0.4),
+            rewrite: p(0.3, 1.0),
+            drop: p(0.2, 0.5),
+            dup: p(0.1, 0.4),
             until: if seed % 2 == 0 { 60_000 } else { u32::MAX },
             ack_all: false,
         };
@@ -919,6 +940,8 @@ fn a_random_on_path_attacker_loses_nothing_silently_and_runs_nothing_twice() {
             assert!(last.at >= t, "{what}");
             after += 1;
             after_done += usize::from(matches!(last.end, Some((_, End::Completed))));
+            // The link recovers once the attacker stops: the next telecommand completes.
+            assert_eq!(last.end.map(|e| e.1), Some(End::Completed), "{what}");
         }
         forged += r.forged;
         rewritten += r.rewritten;
