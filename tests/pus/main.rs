@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod cop1_attack;
 mod event;
 mod frames;
 mod function;

@@ -5,7 +5,9 @@
 //!
 //! The link initiates the AD service with a CLCW check when it starts (FOP-1 waits for the
 //! first CLCW; the server board sends one at least every idle period), and again, with Set
-//! V(R) to its own V(S), after every alert (the transmission limit reached, a lockout). The
+//! V(R) to its own V(S), after every alert (the transmission limit reached, a lockout),
+//! preceded by an Unlock when the last CLCW showed FARM-1 in Lockout (which Set V(R) does not
+//! leave). The
 //! packets of the frames FOP-1 purged then go to the front of the outbox and are sent again:
 //! FARM-1 may have passed some of them already, and the gateway's request keys make such a
 //! copy harmless (it is answered, never run twice).
@@ -47,7 +49,7 @@ use crate::link::fop::{AlertCode, Directive, Fop, FopConfig, FopOutput, FopState
 use crate::link::sdls::{self, frames as secured, Key256, SaTable, SdlsCounters, SdlsRefusal};
 use crate::link::tc_frame::{self, MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
 use crate::link::tm_frame::{TmFrameError, TmFrameParams, TmFrameRepr};
-use crate::link::FrameKind;
+use crate::link::{ControlCommand, FrameKind};
 use crate::node::ground::pus::MAX_TC_LEN;
 use crate::units::BoardNumber;
 use heapless::{Deque, Vec};
@@ -138,6 +140,8 @@ pub struct GroundLink<const K: usize, const Q: usize, const N: usize> {
     counters: GroundCounters,
     /// SDLS, when the link is secured: the TC (sending) and TM (receiving) associations.
     sdls: Option<SaTable<2>>,
+    /// The last CLCW showed FARM-1 in Lockout: the next re-initiation unlocks it first.
+    locked_out: bool,
 }
 
 impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
@@ -158,6 +162,7 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
             tm: TmFrameParams::mission(spacecraft_id.get()),
             counters: GroundCounters::default(),
             sdls: None,
+            locked_out: false,
         }
     }
 
@@ -276,6 +281,7 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
             if clcw.lockout {
                 self.counters.lockouts = self.counters.lockouts.wrapping_add(1);
             }
+            self.locked_out = clcw.lockout;
             let mut outs: Vec<FopOutput<Packet>, 24> = Vec::new();
             self.fop.clcw(&clcw, now, &mut |o| {
                 let _ = outs.push(o);
@@ -421,6 +427,13 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
             .wrapping_sub(self.counters.packets.min(self.counters.ad_frames));
         if alerted {
             self.counters.initiations = self.counters.initiations.wrapping_add(1);
+            if self.locked_out {
+                // FARM-1 obeys Set V(R) in Open and Wait only (232.1-B-2 Table 6-1, E8): out
+                // of Lockout it takes an Unlock, sent first. Without it a link locked out
+                // (a forged Set V(R) into the lockout area, a restarted FARM-1 at V(R) = 0)
+                // stayed locked for good, every re-initiation ignored.
+                self.emit_bc(ControlCommand::Unlock, 0, emit);
+            }
             let vs = self.fop.vs();
             let mut again: Vec<FopOutput<Packet>, 4> = Vec::new();
             self.fop
@@ -431,20 +444,25 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
             for o in again {
                 if let FopOutput::Transmit(f) = o {
                     if let FrameData::Control(cmd) = f.data {
-                        self.counters.bc_frames = self.counters.bc_frames.wrapping_add(1);
-                        let repr = TcFrameRepr {
-                            spacecraft_id: self.spacecraft_id,
-                            vcid: Vcid::new(tc_frame::MISSION_VCID).unwrap_or_default(),
-                            seq: f.ns,
-                            content: TcContent::Bc(cmd),
-                        };
-                        let mut buf = [0u8; 8];
-                        if let Ok(n) = repr.emit(&mut buf) {
-                            emit(buf.get(..n).unwrap_or(&[]));
-                        }
+                        self.emit_bc(cmd, f.ns, emit);
                     }
                 }
             }
+        }
+    }
+
+    /// A BC frame (in clear: SDLS protects data frames only), counted.
+    fn emit_bc(&mut self, cmd: ControlCommand, ns: u8, emit: &mut impl FnMut(&[u8])) {
+        self.counters.bc_frames = self.counters.bc_frames.wrapping_add(1);
+        let repr = TcFrameRepr {
+            spacecraft_id: self.spacecraft_id,
+            vcid: Vcid::new(tc_frame::MISSION_VCID).unwrap_or_default(),
+            seq: ns,
+            content: TcContent::Bc(cmd),
+        };
+        let mut buf = [0u8; 8];
+        if let Ok(n) = repr.emit(&mut buf) {
+            emit(buf.get(..n).unwrap_or(&[]));
         }
     }
 }
