@@ -130,8 +130,7 @@ class Console:
         self.out = Path(out) if out else REPO / "target" / "console"
         self.start_timeout = start_timeout
         self.yamcs = Yamcs(mdb, http_port=http_port, tm_port=tm_port, tc_port=tc_port, link=link,
-                           max_lifetime=seconds + 60, start_timeout=start_timeout,
-                           **({"sdls_reprotect": True} if link == "frames-sdls" else {}))
+                           max_lifetime=seconds + 60, start_timeout=start_timeout)
         self.robot: Robot | None = None
 
     @property

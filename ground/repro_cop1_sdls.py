@@ -63,7 +63,7 @@ def run(reprotect: bool, mdb=DEFAULT_MDB, t1: float = 1.0, extra_seconds: float 
     """`commands` are issued back to back (AD frames N(S) 0 .. commands-1): the first transmission of N(S) 0 is
     dropped, the others arrive ahead of V(R) and FARM-1 discards them, so T1 makes YAMCS send them all again
     (go-back-N)."""
-    y = Yamcs(mdb, link="frames-sdls", cop1_t1=t1, sdls_reprotect=reprotect, max_lifetime=120)
+    y = Yamcs(mdb, link="frames-sdls", cop1_t1=t1, sdls_plugin=reprotect, max_lifetime=120)
     y.start()
     try:
         with StandIn(y.tm_port, y.tc_port, str(y.sdls_key_dir), drop=first_ad_dropper()) as robot:

@@ -8,7 +8,9 @@ ground/run-tests sets after building it) and what it makes.
 - `RobotProcess` is the robot the YAMCS loop talks to over UDP. By default the stand-in
   `mmic ground robot` (the real gateway + a trivial board A); $GROUND_ROBOT replaces the command
   line (a format string with {mmic}, {tm_port}, {tc_port}, {seconds}), e.g. for
-  `mmic sim --protocol pus` (ground/README.md, "Plugging in the simulator").
+  `mmic sim --protocol pus` (ground/README.md, "Plugging in the simulator");
+- `sdls_sim_command(out, keys, state)` is RobotProcess's command for the simulator behind SDLS, as every
+  SDLS test with the Rust robot starts it; $GROUND_SDLS_ROBOT replaces its template.
 """
 from __future__ import annotations
 
@@ -87,6 +89,24 @@ def fixtures(out: Path) -> Path:
 
 def jsonl(path: Path) -> list[dict]:
     return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+
+
+# The simulated robot behind the space data link with SDLS (`Yamcs(link="frames-sdls")`), as the tests start it.
+# $GROUND_SDLS_ROBOT replaces this template: RobotProcess's placeholders ({mmic}, {tm_port}, {tc_port},
+# {seconds}) and {out} (the run's --out directory), {keys} (the harness's key directory), {state} (a file for the
+# robot's own durable SDLS counters, in the test's temporary directory, kept across YAMCS's restarts), e.g. once
+# the simulator takes them: GROUND_SDLS_ROBOT="$(default) --sdls-state {state}".
+SDLS_SIM = ("{mmic} sim --protocol pus --link frames --ground-tm-to 127.0.0.1:{tm_port} "
+            "--ground-tc-port {tc_port} --max-seconds {seconds} --quiet --out {out} --sdls-keys {keys}")
+
+
+def sdls_sim_command(out, keys, state=None) -> str:
+    """RobotProcess's `command` for `mmic sim` behind SDLS ($GROUND_SDLS_ROBOT or SDLS_SIM)."""
+    template = os.environ.get("GROUND_SDLS_ROBOT", SDLS_SIM)
+    state = state if state is not None else Path(out) / "robot-sdls.state"
+    for k, v in (("{out}", out), ("{keys}", keys), ("{state}", state)):
+        template = template.replace(k, str(v).replace("{", "{{").replace("}", "}}"))
+    return template
 
 
 class RobotProcess:

@@ -39,8 +39,10 @@ INSTANCE = "mmic"
 LINKS = ("packets", "frames", "frames-sdls")
 # The plug-in (ground/yamcs-plugin/, built by ground/setup) is on every run's classpath: every link's TC
 # postprocessor is its DurablePusCommandPostprocessor (sequence counts kept across restarts), and with SDLS
-# (link "frames-sdls") YAMCS's own SA factory or the plug-in's, which re-protects a COP-1 retransmission from
-# its plaintext instead of encrypting the ciphertext again.
+# (link "frames-sdls") both directions' SAs are the plug-in's (sdls_plugin=True, the default): YAMCS's SA with
+# its counter in a durable state file per SA (provisioned by this harness for every fresh run, sdls_state.py),
+# which also re-protects a COP-1 retransmission from its plaintext instead of encrypting the ciphertext again.
+# sdls_plugin=False puts YAMCS's own SA factory on both directions (to show what it does).
 SDLS_FACTORY = "org.yamcs.security.sdls.SecurityAssociationAes256Gcm128Factory"
 REPROTECT_FACTORY = "org.mmic.yamcs.ReprotectingAes256Gcm128Factory"
 PLUGIN_JAR = REPO / "target" / "ground-plugin" / "mmic-yamcs.jar"
@@ -95,13 +97,18 @@ class Yamcs:
                  run_dir: str | os.PathLike | None = None, start_timeout: float = 60.0,
                  max_lifetime: int = 600, java: str | None = None, xmx: str = "512m",
                  link: str = "packets", spacecraft_id: int = 0x101, cop1_t1: float = 3,
-                 sdls_reprotect: bool = False, durable_seqcount: bool = True):
+                 sdls_plugin: bool = True, sdls_reprotect: bool | None = None,
+                 sdls_provision: bool = True, durable_seqcount: bool = True):
         if link not in LINKS:
             raise ValueError(f"link {link!r}: one of {LINKS} (ground/yamcs/links/)")
         self.link = link
         self.cop1_t1 = cop1_t1
-        # frames-sdls: YAMCS's TC SA factory, or the plug-in's re-protecting one (needs PLUGIN_JAR)
-        self.sdls_reprotect = sdls_reprotect
+        # frames-sdls: the plug-in's SA factory on both directions (durable counters, re-protected COP-1
+        # retransmissions), or YAMCS's own (False). `sdls_reprotect` is the former name of the same choice.
+        self.sdls_plugin = sdls_plugin if sdls_reprotect is None else sdls_reprotect
+        # frames-sdls with the plug-in: write the SAs' first counter states (sdls_state.py provision) at render;
+        # False leaves them missing (the SAs then refuse to start: the fail-closed test)
+        self.sdls_provision = sdls_provision
         # Every link's TC postprocessor is the plug-in's (sequence counts kept across restarts).
         if not PLUGIN_JAR.is_file():
             raise FileNotFoundError(f"{PLUGIN_JAR}: run ground/setup (it compiles ground/yamcs-plugin/)")
@@ -124,6 +131,9 @@ class Yamcs:
         self.log_path = self.run_dir / "yamcs.log"
         # frames-sdls: the directory of the run's random keys (spi-<SPI>.key, 0600), for the robot to read
         self.sdls_key_dir = self.run_dir / "etc" / "sdls-keys" if link == "frames-sdls" else None
+        # frames-sdls: the plug-in's counter state files (spi-<SPI>.state), outside the key directory and outside
+        # YAMCS's data directory; they outlive the keys' deletion at stop (they hold no secret)
+        self.sdls_state_dir = self.run_dir / "sdls-state" if link == "frames-sdls" else None
         self.start_seconds: float | None = None
         self.stop_seconds: float | None = None
         self.client = None
@@ -156,8 +166,15 @@ class Yamcs:
             os.chmod(etc, 0o700)
             sdls.write_random_keys(self.sdls_key_dir, SDLS_SPIS)
             values["@KEY_DIR@"] = str(self.sdls_key_dir)
-            values["@SDLS_TC_FACTORY@"] = REPROTECT_FACTORY if self.sdls_reprotect else SDLS_FACTORY
+            values["@STATE_DIR@"] = str(self.sdls_state_dir)
+            self.sdls_state_dir.mkdir(mode=0o700)
+            if self.sdls_plugin and self.sdls_provision:
+                self.provision_sdls_state()
         links = (GROUND / "yamcs" / "links" / f"{self.link}.yaml").read_text()
+        if self.sdls_key_dir is not None and not self.sdls_plugin:
+            # YAMCS's own factory ignores the plug-in's options (stateFile, reserveBlock): its `args` are not
+            # checked against a spec
+            links = links.replace(REPROTECT_FACTORY, SDLS_FACTORY)
         if not self.durable_seqcount:
             links = links.replace("org.mmic.yamcs.DurablePusCommandPostprocessor",
                                   "org.yamcs.pus.PusCommandPostprocessor")
@@ -171,6 +188,19 @@ class Yamcs:
             if "@" in "".join(l.split("#")[0] for l in text.splitlines() if "@" in l):
                 raise ValueError(f"unreplaced placeholder in {tpl}")
             (etc / tpl.name).write_text(text)
+
+    def sdls_state_file(self, spi: int) -> Path:
+        return self.sdls_state_dir / f"spi-{spi}.state"
+
+    def provision_sdls_state(self) -> None:
+        """The explicit provisioning step, once per fresh run (fresh keys): the TC SA's sender starts at IV 0,
+        the TM SA's receiver with nothing accepted (ground/sdls_state.py; ground/README.md)."""
+        import sdls
+        import sdls_state
+
+        tc, tm = SDLS_SPIS
+        sdls_state.provision(self.sdls_state_file(tc), tc, "tx", sdls.key_path(self.sdls_key_dir, tc))
+        sdls_state.provision(self.sdls_state_file(tm), tm, "rx", sdls.key_path(self.sdls_key_dir, tm))
 
     def classpath(self) -> str:
         cp = yamcs_classpath()
@@ -187,7 +217,7 @@ class Yamcs:
                self.java, f"-Xmx{self.xmx}", "-cp", self.classpath(), "org.yamcs.YamcsServer",
                "--etc-dir", "etc", "--data-dir", "data"]
         t0 = time.monotonic()
-        with open(self.log_path, "wb") as log:
+        with open(self.log_path, "wb" if render else "ab") as log:  # a restart appends
             # cwd = run dir: YAMCS writes ./cache there. Own session: one PID stops the whole group.
             self.proc = subprocess.Popen(cmd, cwd=self.run_dir, stdout=log, stderr=subprocess.STDOUT,
                                          stdin=subprocess.DEVNULL, start_new_session=True)
@@ -198,8 +228,11 @@ class Yamcs:
                 if time.monotonic() - t0 > self.start_timeout:
                     raise YamcsStartError(f"YAMCS not ready after {self.start_timeout:.0f} s")
                 try:
-                    if self._get_json(f"/api/instances/{INSTANCE}").get("state") == "RUNNING":
+                    state = self._get_json(f"/api/instances/{INSTANCE}").get("state")
+                    if state == "RUNNING":
                         break
+                    if state == "FAILED":
+                        raise YamcsStartError(f"instance {INSTANCE} FAILED (see {self.log_path})")
                 except (urllib.error.URLError, ConnectionError, TimeoutError, ValueError):
                     pass
                 time.sleep(0.2)
@@ -213,17 +246,25 @@ class Yamcs:
             raise
         return self
 
-    def restart(self) -> "Yamcs":
-        """Stops YAMCS and starts it again on the same ports, configuration and data directory (what
-        it keeps on disk, e.g. the telecommand sequence counts, it finds again). Not with SDLS: the
-        run's keys are deleted when it stops."""
-        if self.sdls_key_dir is not None:
-            raise ValueError("restart: the frames-sdls link's keys are deleted when YAMCS stops")
-        self.stop()
+    def restart(self, *, kill: bool = False, wipe_database: bool = False) -> "Yamcs":
+        """Stops YAMCS and starts it again on the same ports, configuration, keys and data directory (what
+        it keeps on disk, e.g. the telecommand sequence counts and the SDLS counter states, it finds again).
+        kill: SIGKILL at once instead of SIGTERM (a crash at whatever instant it is). wipe_database: YAMCS's
+        data directory is emptied before the start (its archive and memento database, where YAMCS's own SA
+        keeps its counters), all but the plug-in's telecommand sequence counts (a file of its own there)."""
+        self.stop(keep_keys=True, kill=kill)
+        if wipe_database:
+            data = self.run_dir / "data"
+            counts = data / INSTANCE / "mmic-tc-seqcount.txt"
+            kept = counts.read_bytes() if counts.is_file() else None
+            shutil.rmtree(data)
+            (data / INSTANCE).mkdir(parents=True)
+            if kept is not None:
+                counts.write_bytes(kept)
         return self.start(render=False)
 
     # -- tear-down ------------------------------------------------------------------------------
-    def stop(self, grace: float = 15.0) -> None:
+    def stop(self, grace: float = 15.0, *, keep_keys: bool = False, kill: bool = False) -> None:
         if self.client is not None:
             try:
                 self.client.close()
@@ -232,20 +273,21 @@ class Yamcs:
             self.client = None
         p, self.proc = self.proc, None
         if p is None or p.poll() is not None:
-            if self.sdls_key_dir is not None:
+            if self.sdls_key_dir is not None and not keep_keys:
                 shutil.rmtree(self.sdls_key_dir, ignore_errors=True)
             return
         t0 = time.monotonic()
         try:
-            self._kill(p, grace)
+            self._kill(p, grace, kill)
         finally:
             self.stop_seconds = time.monotonic() - t0
-            if self.sdls_key_dir is not None:
+            if self.sdls_key_dir is not None and not keep_keys:
                 shutil.rmtree(self.sdls_key_dir, ignore_errors=True)  # throwaway keys: gone with the run
 
     @staticmethod
-    def _kill(p: subprocess.Popen, grace: float) -> None:
-        for sig, wait in ((signal.SIGTERM, grace), (signal.SIGKILL, 5.0)):
+    def _kill(p: subprocess.Popen, grace: float, kill: bool = False) -> None:
+        steps = ((signal.SIGKILL, 5.0),) if kill else ((signal.SIGTERM, grace), (signal.SIGKILL, 5.0))
+        for sig, wait in steps:
             try:
                 os.killpg(p.pid, sig)  # the group led by our `timeout` process (start_new_session)
             except ProcessLookupError:
@@ -292,6 +334,7 @@ def main(argv=None) -> int:
         print(json.dumps({"http": y.url, "instance": INSTANCE, "tm_udp_in": f"127.0.0.1:{y.tm_port}",
                           "tc_udp_out": f"127.0.0.1:{y.tc_port}", "run_dir": str(y.run_dir),
                           "sdls_key_dir": str(y.sdls_key_dir) if y.sdls_key_dir else None,
+                          "sdls_state_dir": str(y.sdls_state_dir) if y.sdls_state_dir else None,
                           "start_seconds": round(y.start_seconds, 2), "rss_mib": (y.rss_kib() or 0) // 1024}),
               flush=True)
         try:

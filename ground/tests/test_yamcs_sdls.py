@@ -12,7 +12,8 @@ minimal FARM-1, protected TM frames with the CLCW). No Rust: these are the facts
     go again): with YAMCS's own SA the MACs of the retransmissions verify but their plaintexts are the
     first transmissions' ciphertexts; with the plug-in's SA (ground/yamcs-plugin/) they are the packets
     again, under fresh IVs (repro_cop1_sdls.py).
-(d) the first TM frame after YAMCS starts is not window-checked.
+(d) with YAMCS's own SA (`sdls_plugin=False`), the first TM frame after YAMCS starts is not window-checked (the
+    plug-in's SA, on both directions otherwise, checks it: test_sdls_state.py, test_yamcs_sdls_restart.py).
 """
 from __future__ import annotations
 
@@ -188,7 +189,7 @@ def test_tm_first_frame_after_start_is_not_window_checked():
     window for the first frame and adopts its IV (SecurityAssociationAes256Gcm128's constructor sets
     skipVerifyingNextSeqNum). So an old recorded frame that arrives first is taken, and the genuine frames,
     far ahead of it, are then refused until an operator sets the counter (PUT /api/sdls/.../513/seq)."""
-    y = Yamcs(XTCE, link="frames-sdls", max_lifetime=120)
+    y = Yamcs(XTCE, link="frames-sdls", max_lifetime=120, sdls_plugin=False)   # YAMCS's own SA
     y.start()
     try:
         with StandIn(y.tm_port, y.tc_port, str(y.sdls_key_dir), period=3600) as robot:  # frames when asked

@@ -25,12 +25,10 @@ from pathlib import Path
 import pytest
 import sdls
 import sdls_attack
-from rust_side import XTCE, RobotProcess
+from rust_side import XTCE, RobotProcess, sdls_sim_command
 from yamcs_harness import INSTANCE, Yamcs
 
 STEP = 10.0
-SIM = ("{{mmic}} sim --protocol pus --link frames --ground-tm-to 127.0.0.1:{{tm_port}} "
-       "--ground-tc-port {{tc_port}} --max-seconds {{seconds}} --quiet --out {out} --sdls-keys {keys}")
 SCID = 257
 TC_WINDOW = 1 << 20   # spec/ccsds/sdls.toml tc_window
 
@@ -111,11 +109,11 @@ def rust_expect(frame: bytes, i: int, bit: int, last_iv: int) -> str:
 @pytest.fixture(scope="module")
 def loop(tmp_path_factory):
     out = tmp_path_factory.mktemp("sdls-attack")
-    y = Yamcs(XTCE, link="frames-sdls", max_lifetime=240, sdls_reprotect=True)
+    y = Yamcs(XTCE, link="frames-sdls", max_lifetime=240)
     y.start()
     try:
         r = RobotProcess(tm_port=y.tm_port, tc_port=y.tc_port,
-                         command=SIM.format(out=out, keys=y.sdls_key_dir))
+                         command=sdls_sim_command(out, y.sdls_key_dir))
         assert r.ready.wait(STEP), "the robot did not start"
         try:
             yield y, r, out, tmp_path_factory.mktemp("sdls-wrong-keys")

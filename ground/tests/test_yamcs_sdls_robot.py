@@ -15,13 +15,11 @@ import time
 from pathlib import Path
 
 import pytest
-from rust_side import XTCE, RobotProcess, wait
+from rust_side import XTCE, RobotProcess, sdls_sim_command, wait
 from yamcs_harness import INSTANCE, Yamcs
 
 STEP = 10.0
 MOTION = 90.0
-SIM = ("{{mmic}} sim --protocol pus --link frames --ground-tm-to 127.0.0.1:{{tm_port}} "
-       "--ground-tc-port {{tc_port}} --max-seconds {{seconds}} --quiet --out {out} --sdls-keys {keys}")
 
 
 
@@ -29,11 +27,11 @@ SIM = ("{{mmic}} sim --protocol pus --link frames --ground-tm-to 127.0.0.1:{{tm_
 @pytest.fixture(scope="module")
 def loop(tmp_path_factory):
     out = tmp_path_factory.mktemp("sdls-robot")
-    y = Yamcs(XTCE, link="frames-sdls", max_lifetime=240, sdls_reprotect=True)
+    y = Yamcs(XTCE, link="frames-sdls", max_lifetime=240)
     y.start()
     try:
         r = RobotProcess(tm_port=y.tm_port, tc_port=y.tc_port,
-                         command=SIM.format(out=out, keys=y.sdls_key_dir))
+                         command=sdls_sim_command(out, y.sdls_key_dir))
         assert r.ready.wait(STEP), "the robot did not start"
         try:
             yield y, r, out

@@ -98,7 +98,8 @@ fn every_section_names_a_decision() {
     assert_eq!(t.len(), 6);
 }
 
-/// YAMCS's SDLS links: the same SPIs, masks and TM window; TM verified; the keys from files.
+/// YAMCS's SDLS links: the same SPIs, masks and TM window; TM verified; the keys from files; the
+/// counters in durable state files, reserved in the mission's blocks.
 #[test]
 fn yamcs_is_configured_with_the_same_choices() {
     let y = repo("ground/yamcs/links/frames-sdls.yaml");
@@ -122,4 +123,12 @@ fn yamcs_is_configured_with_the_same_choices() {
     assert!(tc_part.contains(&mask_tc), "{tc_part}");
     assert!(tc_part.contains(&format!("encryptionSpi: {}", mission::tc_spi(one))));
     assert!(tc_part.contains(&format!("spi-{}.key", mission::tc_spi(one))));
+    // Both SAs are the plug-in's, its counters in durable state files reserved with the mission's
+    // blocks: the ground's TC reservation and its TM floor (ground/yamcs-plugin/).
+    let plugin = "class: org.mmic.yamcs.ReprotectingAes256Gcm128Factory";
+    assert!(tm_part.contains(plugin) && tc_part.contains(plugin));
+    assert!(tm_part.contains("stateFile: ") && tc_part.contains("stateFile: "));
+    assert!(tm_part.contains(&format!("reserveBlock: {}", mission::TM_RX_BLOCK)));
+    assert!(tc_part.contains(&format!("reserveBlock: {}", mission::TC_TX_BLOCK)));
+    assert!(!y.contains("initialSeqNum:"), "the state file is the counter");
 }

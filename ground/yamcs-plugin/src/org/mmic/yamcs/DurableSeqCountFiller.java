@@ -2,13 +2,9 @@ package org.mmic.yamcs;
 
 import java.io.IOException;
 import java.io.UncheckedIOException;
-import java.nio.ByteBuffer;
-import java.nio.channels.FileChannel;
 import java.nio.charset.StandardCharsets;
 import java.nio.file.Files;
 import java.nio.file.Path;
-import java.nio.file.StandardCopyOption;
-import java.nio.file.StandardOpenOption;
 import java.util.Map;
 import java.util.TreeMap;
 
@@ -26,9 +22,9 @@ import org.yamcs.tctm.CcsdsSeqCountFiller;
  * (spec/decisions.toml {@code yamcs-sequence-count}); a count that cannot be written fails its command.
  *
  * <p>
- * The file has one line per APID, {@code <apid> <last count>}, replaced atomically (a temporary file, forced, then
- * renamed over it). An unreadable file stops the link at start: numbering from 1 again is what this class is for
- * not doing.
+ * The file has one line per APID, {@code <apid> <last count>}, replaced atomically ({@link DurableFile}: a temporary
+ * file, forced, renamed over it, the directory forced). An unreadable file stops the link at start: numbering from 1
+ * again is what this class is for not doing.
  */
 public class DurableSeqCountFiller extends CcsdsSeqCountFiller {
     private final Path file;
@@ -76,18 +72,8 @@ public class DurableSeqCountFiller extends CcsdsSeqCountFiller {
     private void save() {
         StringBuilder text = new StringBuilder();
         last.forEach((apid, count) -> text.append(apid).append(' ').append(count).append('\n'));
-        Path tmp = file.resolveSibling(file.getFileName() + ".tmp");
         try {
-            Path dir = file.toAbsolutePath().getParent();
-            if (dir != null) {
-                Files.createDirectories(dir);
-            }
-            try (FileChannel ch = FileChannel.open(tmp, StandardOpenOption.CREATE, StandardOpenOption.WRITE,
-                    StandardOpenOption.TRUNCATE_EXISTING)) {
-                ch.write(ByteBuffer.wrap(text.toString().getBytes(StandardCharsets.US_ASCII)));
-                ch.force(true);
-            }
-            Files.move(tmp, file, StandardCopyOption.ATOMIC_MOVE, StandardCopyOption.REPLACE_EXISTING);
+            DurableFile.replace(file, text.toString().getBytes(StandardCharsets.US_ASCII));
         } catch (IOException e) {
             throw new UncheckedIOException("the telecommand sequence count could not be saved to " + file, e);
         }

@@ -10,7 +10,7 @@ import javax.crypto.spec.SecretKeySpec;
 import org.yamcs.security.sdls.SdlsSecurityAssociation;
 
 /**
- * YAMCS 5.12.8's AES-256-GCM security association with one change: a frame that is protected already is first
+ * An AES-256-GCM security association (YAMCS 5.12.8's, with the plug-in's durable counter) with one change: a frame that is protected already is first
  * restored to its plaintext, then protected again under a fresh IV.
  * <p>
  * Why: on a COP-1 retransmission, {@code Cop1TcPacketHandler.getFrame()} calls {@code TcFrameFactory.encodeFrame} again
@@ -23,7 +23,8 @@ import org.yamcs.security.sdls.SdlsSecurityAssociation;
  * old IV is read from the header and the frame is verified and decrypted with the key (the current one, else the one
  * before the last key change), the AAD computed with the same mask as when it was protected (encodeFrame rewrites
  * the same header first). A frame that does not verify is refused (GeneralSecurityException): no garbage goes out.
- * The old IV is never used again: the built-in SA's counter (persisted, also for the HTTP API) moves on.
+ * The old IV is never used again: the inner SA's counter moves on (the factory's inner SA is
+ * {@link DurableAes256Gcm128}: YAMCS's SA with its counter under a durable reservation).
  */
 public class ReprotectingAes256Gcm128 implements SdlsSecurityAssociation {
     private static final int IV_LEN = 12;
@@ -89,9 +90,9 @@ public class ReprotectingAes256Gcm128 implements SdlsSecurityAssociation {
 
     @Override
     public void setSecretKey(byte[] secretKey) {
+        inner.setSecretKey(secretKey); // first: it may refuse (the durable state not tied to the new key)
         previousKey = key;
         key = new SecretKeySpec(secretKey, "AES");
-        inner.setSecretKey(secretKey);
     }
 
     @Override
