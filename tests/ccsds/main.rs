@@ -15,6 +15,7 @@ mod interop_spacepackets;
 mod link_spec;
 mod sdls;
 mod sdls_spec;
+mod store;
 mod tc_frame;
 mod tm_frame;
 mod tm_link;

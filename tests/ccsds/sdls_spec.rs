@@ -130,5 +130,8 @@ fn yamcs_is_configured_with_the_same_choices() {
     assert!(tm_part.contains("stateFile: ") && tc_part.contains("stateFile: "));
     assert!(tm_part.contains(&format!("reserveBlock: {}", mission::TM_RX_BLOCK)));
     assert!(tc_part.contains(&format!("reserveBlock: {}", mission::TC_TX_BLOCK)));
-    assert!(!y.contains("initialSeqNum:"), "the state file is the counter");
+    assert!(
+        !y.contains("initialSeqNum:"),
+        "the state file is the counter"
+    );
 }

@@ -559,7 +559,9 @@ fn run(n: u16, seed: u64, tactics: Tactics, script: Option<Scripted>, limit_ms: 
         let bytes: Vec<u8> = (0..32).map(|_| r.next() as u8).collect();
         Key256::from_slice(&bytes).unwrap()
     };
-    assert!(server.secure(board, key(1), key(2), Stored::default()));
+    assert!(server
+        .secure(board, key(1), key(2), Stored::default())
+        .is_ok());
     ground.secure(key(1), key(2), (None, None));
     let mut tc = TcLink::new(tc_config(), board);
     let mut up = Wire::new(seed);
@@ -578,8 +580,10 @@ fn run(n: u16, seed: u64, tactics: Tactics, script: Option<Scripted>, limit_ms: 
     ground.start(0, &mut |f: &[u8]| emitted.push(f.to_vec()));
     let mut end_ms = limit_ms;
     for now in 0..limit_ms {
-        for (spi, v) in server.due().collect::<Vec<_>>() {
-            server.persisted(spi, v);
+        // The server board keeps what it must (SDLS counters, FARM-1's progress, kept keys)
+        // before anything that depends on it leaves, as its shells do.
+        for e in server.durable_due::<16>() {
+            server.durable_written(&e);
         }
         for (spi, v) in ground.due().collect::<Vec<_>>() {
             ground.persisted(spi, v);
@@ -587,7 +591,11 @@ fn run(n: u16, seed: u64, tactics: Tactics, script: Option<Scripted>, limit_ms: 
         // The uplink, through the attacker.
         for f in up.due(now) {
             for g in attacker.up(now, f) {
+                // On the path: its frames come from the ground's address.
                 let got = server.tc_frame(now, &g);
+                for e in server.durable_due::<16>() {
+                    server.durable_written(&e);
+                }
                 let (bypass, control, ns) = tc_kind(&g);
                 if !bypass && !control && got.verdict == Ok(Verdict::Accept) {
                     accepted_at[ns as usize] = Some(now);

@@ -7,6 +7,7 @@
 mod common;
 
 mod cop1_attack;
+mod durable;
 mod event;
 mod frames;
 mod function;

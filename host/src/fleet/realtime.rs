@@ -240,9 +240,14 @@ async fn wifi_task(
     let mut session = WifiSession::new(WifiConfig::default());
     while !shared.stop.load(Ordering::Relaxed) {
         let accepted = tokio::time::timeout(Duration::from_millis(200), listener.accept()).await;
-        let Ok(Ok((mut sock, _))) = accepted else {
+        let Ok(Ok((mut sock, peer))) = accepted else {
             continue;
         };
+        // Only the server board's address holds the slot (loopback here).
+        if !crate::sim::nodes::from_server(&peer, std::net::Ipv4Addr::LOCALHOST.into()) {
+            drop(sock);
+            continue;
+        }
         let _ = sock.set_nodelay(true);
         // Heartbeats made while nobody was connected are not sent to the next connection.
         session.open(

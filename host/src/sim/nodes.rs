@@ -210,6 +210,15 @@ pub struct WifiTask<'q> {
     /// Board A is restarting (set by its control task): the WiFi task takes no connection and
     /// drops what it holds, and starts a new session once it is up again.
     pub down: Arc<AtomicBool>,
+    /// The server board's address: a connection from anywhere else is closed at once, never
+    /// holds the slot, and is logged (decision `sdls-scope`; on loopback every local process
+    /// shares 127.0.0.1, so here it keeps out only other hosts).
+    pub server: std::net::IpAddr,
+}
+
+/// Whether board A takes a connection from `peer`: only from its server board's address.
+pub fn from_server(peer: &SocketAddr, server: std::net::IpAddr) -> bool {
+    peer.ip() == server
 }
 
 impl WifiTask<'_> {
@@ -229,6 +238,13 @@ impl WifiTask<'_> {
                 continue;
             }
             match self.listener.accept() {
+                Ok((sock, peer)) if !from_server(&peer, self.server) => {
+                    let _ = sock.shutdown(std::net::Shutdown::Both);
+                    node.event(
+                        now,
+                        json!({"type": "wifi_refused", "peer": peer.to_string()}),
+                    );
+                }
                 Ok((sock, _)) => {
                     let queued = std::iter::from_fn(|| self.heartbeats.pop());
                     session.open(now, queued, |hb| unconnected(&node, &hb));

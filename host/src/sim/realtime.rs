@@ -154,6 +154,7 @@ fn spawn_robot<'scope, 'env>(
         loss: cfg.wifi_loss,
         seed: seed ^ 0x5eed,
         down: a_down.clone(),
+        server: std::net::Ipv4Addr::LOCALHOST.into(),
     };
     let control = nodes::ControlTask {
         a: SideA::new(BoardA::in_state(

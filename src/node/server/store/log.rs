@@ -187,12 +187,14 @@ mod tests {
             &r[..16],
             &[0xC7, 0, 2, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0]
         );
+        assert_eq!(&r[16..], &0x4622_8447u32.to_be_bytes());
         assert_eq!(decode(&r), Record::Entry(e));
         let h = encode_header(7);
         assert_eq!(
             &h[..16],
             &[0x5E, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 7]
         );
+        assert_eq!(&h[16..], &0x9a04_e039u32.to_be_bytes());
         assert_eq!(decode(&h), Record::Header(7));
         let big = Entry {
             key: 0x2001,

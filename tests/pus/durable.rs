@@ -1,0 +1,320 @@
+//! What the server board keeps across a restart (issue 38, decision `restart-server`): FARM-1's
+//! V(R) and the TC window's last IV, written before anything of an accepted frame leaves the
+//! board, so that after a restart the ground's next transmission is taken at once and its
+//! FOP-1 sees the N(R) it expects; BC frames obeyed only from the ground's address.
+
+use mmic::ccsds::primary::{Apid, SeqCount};
+use mmic::ccsds::tc::TcRepr;
+use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
+use mmic::link::sdls::Key256;
+use mmic::link::tc_frame::{SpacecraftId, TcContent, TcFrameRepr, Vcid};
+use mmic::link::ControlCommand;
+use mmic::mode::Mode;
+use mmic::node::ground::frames::GroundLink;
+use mmic::node::server::frames::{FrameConfig, FrameGateway, FrameRefusal, Origin};
+use mmic::node::server::store::{self, End, Resume};
+use mmic::units::BoardNumber;
+use mmic::wire::heartbeat::HeartbeatRepr;
+use std::collections::BTreeMap;
+
+type Server = FrameGateway<1, 4, 64, 4096>;
+type Ground = GroundLink<10, 64, 1024>;
+type Flash = BTreeMap<u16, (u8, u128)>;
+
+const ONE: BoardNumber = BoardNumber::ONE;
+
+fn key(s: u8) -> Key256 {
+    Key256::from_bytes(core::array::from_fn(|i| {
+        (i as u8).wrapping_mul(101) ^ s ^ 0x3c
+    }))
+}
+
+fn stop(seq: u16) -> Vec<u8> {
+    let mut b = [0u8; 14];
+    TcRepr {
+        apid: Apid::new(0x101).unwrap(),
+        seq_count: SeqCount::new(seq).unwrap(),
+        header: TcSecondaryHeader {
+            ack: AckFlags::ALL,
+            service: 8,
+            subservice: 1,
+            source_id: 9,
+        },
+        app_data: &[6],
+    }
+    .emit(&mut b)
+    .unwrap();
+    b.to_vec()
+}
+
+/// The server board as it boots from its flash (both ends provisioned for keys 1 and 2).
+fn boot_server(flash: &Flash) -> Server {
+    let b = store::boot(End::Server, ONE, &key(1), &key(2), |k| {
+        flash.get(&k).copied()
+    })
+    .unwrap();
+    let mut s = Server::new(FrameConfig::default());
+    assert!(match b.kept {
+        Some(k) => s.add_restarted(ONE, k),
+        None => s.add(ONE),
+    });
+    s.secure(ONE, key(1), key(2), b.stored).unwrap();
+    s
+}
+
+/// Both ends over a clean link, 1 ms steps; board A answers every command at once.
+struct Link {
+    ground: Ground,
+    server: Server,
+    flash: Flash,
+    ground_flash: Flash,
+    up: Vec<Vec<u8>>,
+    /// Board A's executions of Stop, in order (a key each: the count never repeats).
+    ran: BTreeMap<u32, u32>,
+    run_count: u32,
+    /// Board A's exactly-once log: the last sequence number it took.
+    board_a_last: u16,
+    /// TC frames the server refused, by reason.
+    refused: Vec<&'static str>,
+}
+
+impl Link {
+    fn new() -> Link {
+        let (mut flash, mut ground_flash) = (Flash::new(), Flash::new());
+        for (end, f) in [(End::Server, &mut flash), (End::Ground, &mut ground_flash)] {
+            for e in store::provision(end, ONE, &key(1), &key(2), Resume::FRESH).unwrap() {
+                f.insert(e.key, (e.aux, e.value));
+            }
+        }
+        let g = store::boot(End::Ground, ONE, &key(1), &key(2), |k| {
+            ground_flash.get(&k).copied()
+        })
+        .unwrap();
+        let mut ground = Ground::new(ONE);
+        ground.secure(key(1), key(2), (g.stored.tc, g.stored.tm));
+        let server = boot_server(&flash);
+        let mut l = Link {
+            ground,
+            server,
+            flash,
+            ground_flash,
+            up: Vec::new(),
+            ran: BTreeMap::new(),
+            run_count: 0,
+            board_a_last: 0,
+            refused: Vec::new(),
+        };
+        l.keep();
+        let mut up = Vec::new();
+        l.ground.start(0, &mut |f: &[u8]| up.push(f.to_vec()));
+        l.up = up;
+        l
+    }
+
+    /// Both ends write what they must keep, as their shells do.
+    fn keep(&mut self) {
+        for e in self.server.durable_due::<16>() {
+            self.flash.insert(e.key, (e.aux, e.value));
+            assert!(self.server.durable_written(&e));
+        }
+        for (spi, v) in self.ground.due().collect::<Vec<_>>() {
+            self.ground_flash.insert(spi, (0, v));
+            self.ground.persisted(spi, v);
+        }
+    }
+
+    fn step(&mut self, now: u32) {
+        self.keep();
+        for f in std::mem::take(&mut self.up) {
+            if let Err(e) = self.server.tc_frame(now, &f).verdict {
+                self.refused.push(e.name());
+            }
+            self.keep();
+        }
+        for (_, c) in self.server.tick(now) {
+            // Board A (not restarted) runs a sequenced command once: a copy of its last one
+            // is answered, not run.
+            if c.seq != 0 && c.seq != self.board_a_last {
+                self.board_a_last = c.seq;
+                if c.command == mmic::command::Command::Stop {
+                    *self.ran.entry(self.run_count).or_default() += 1;
+                    self.run_count += 1;
+                }
+            }
+            let hb = HeartbeatRepr {
+                last_seq: self.board_a_last,
+                mode: Mode::Operational,
+                ..HeartbeatRepr::default()
+            };
+            self.server.heartbeat(now, &hb);
+            self.keep();
+        }
+        let mut buf = [0u8; 256];
+        let mut up = Vec::new();
+        while let Some((_, n)) = self.server.frame(now, &mut buf) {
+            let _ = self.ground.tm_frame(
+                now,
+                &buf[..n],
+                &mut |f: &[u8]| up.push(f.to_vec()),
+                &mut |_p: &[u8]| {},
+            );
+        }
+        self.ground.tick(now, &mut |f: &[u8]| up.push(f.to_vec()));
+        self.up.extend(up);
+    }
+
+    fn send(&mut self, seq: u16, now: u32) {
+        let mut up = Vec::new();
+        self.ground
+            .send(&stop(seq), now, &mut |f: &[u8]| up.push(f.to_vec()))
+            .unwrap();
+        self.up.extend(up);
+    }
+
+    fn alerts(&self) -> u32 {
+        self.ground.counters().alerts.iter().sum()
+    }
+}
+
+/// The server board restarts (its RAM lost, its flash kept) after three telecommands: with
+/// FARM-1's progress kept, the next two go through at once — no frame refused, no alert of the
+/// ground's FOP-1, nothing run twice. Without it (the store of main at ca6056d: counters
+/// only), the ground's next frames are refused as replays and FOP-1 alerts.
+#[test]
+fn a_restarted_server_board_resumes_farm_and_the_window_exactly() {
+    for keep_progress in [true, false] {
+        let mut l = Link::new();
+        for s in 1..=3 {
+            l.send(s, 1);
+        }
+        for now in 1..2_000 {
+            l.step(now);
+        }
+        assert_eq!(l.ran.len(), 3, "{:?}", l.ran);
+        let vr = l.server.farm(ONE).unwrap().vr();
+        if !keep_progress {
+            l.flash.remove(&store::progress_key(ONE));
+        }
+        l.server = boot_server(&l.flash);
+        let alerts = l.alerts();
+        for s in 4..=5 {
+            l.send(s, 2_000);
+        }
+        for now in 2_000..40_000 {
+            l.step(now);
+        }
+        if keep_progress {
+            assert_eq!(l.server.farm(ONE).unwrap().vr(), vr + 2);
+            assert!(
+                l.refused.is_empty(),
+                "refused after the restart: {:?}",
+                l.refused
+            );
+            assert_eq!(l.alerts(), alerts, "FOP-1 alerted after the restart");
+        } else {
+            assert!(
+                !l.refused.is_empty() || l.alerts() > alerts,
+                "without the progress the restart went unnoticed"
+            );
+        }
+        // Five telecommands, five runs of Stop by board A: none lost, none twice.
+        assert_eq!(l.run_count, 5, "keep {keep_progress}: {:?}", l.ran);
+    }
+}
+
+/// Until the shell confirms the progress of an accepted frame, nothing of it leaves: no TM
+/// frame (its CLCW would acknowledge it) and no visit of board A.
+#[test]
+fn nothing_of_an_accepted_frame_leaves_before_its_progress_is_kept() {
+    let mut l = Link::new();
+    l.send(1, 0);
+    // The first CLCW initiates FOP-1; the frame goes up.
+    for now in 0..50 {
+        l.step(now);
+        if !l.up.is_empty() {
+            break;
+        }
+    }
+    let frames = std::mem::take(&mut l.up);
+    assert!(!frames.is_empty());
+    for f in &frames {
+        l.server.tc_frame(100, f);
+    }
+    let due = l.server.durable_due::<16>();
+    assert!(
+        due.iter().any(|e| e.key == store::progress_key(ONE)),
+        "{due:?}"
+    );
+    let mut buf = [0u8; 256];
+    assert!(l.server.frame(200, &mut buf).is_none());
+    assert!(l.server.tick(200).is_empty());
+    for e in &due {
+        l.server.durable_written(e);
+    }
+    assert!(l.server.frame(200, &mut buf).is_some());
+    for now in 200..2_000 {
+        l.step(now);
+    }
+    assert_eq!(l.ran.len(), 1, "{:?}", l.ran);
+}
+
+/// A BC frame from elsewhere than the ground's address changes nothing but a counter; the
+/// same from the ground is obeyed (and its V(R) kept like an accepted frame's).
+#[test]
+fn bc_frames_from_elsewhere_change_nothing_but_a_counter() {
+    let mut l = Link::new();
+    let set_vr = |v: u8| {
+        let mut b = [0u8; 16];
+        let n = TcFrameRepr {
+            spacecraft_id: SpacecraftId::of_board(ONE),
+            vcid: Vcid::new(0).unwrap(),
+            seq: 0,
+            content: TcContent::Bc(ControlCommand::SetVr(v)),
+        }
+        .emit(&mut b)
+        .unwrap();
+        b[..n].to_vec()
+    };
+    let before = (
+        l.server.farm(ONE).unwrap().clone(),
+        *l.server.security(ONE).unwrap(),
+    );
+    for f in [set_vr(7), set_vr(200)] {
+        let got = l.server.tc_frame_from(5, &f, Origin::Elsewhere);
+        assert_eq!(got.verdict, Err(FrameRefusal::Origin));
+        assert_eq!(got.verdict.unwrap_err().name(), "bc-origin");
+    }
+    assert_eq!(l.server.farm(ONE).unwrap().vr(), before.0.vr());
+    assert_eq!(l.server.farm(ONE).unwrap().counters(), before.0.counters());
+    assert_eq!(*l.server.security(ONE).unwrap(), before.1);
+    assert_eq!(l.server.counters(ONE).unwrap().bc_origin, 2);
+    assert!(l.server.durable_due::<16>().is_empty());
+    assert!(l
+        .server
+        .tc_frame_from(6, &set_vr(7), Origin::Ground)
+        .verdict
+        .is_ok());
+    assert_eq!(l.server.farm(ONE).unwrap().vr(), 7);
+    assert!(l
+        .server
+        .durable_due::<16>()
+        .iter()
+        .any(|e| e.key == store::clear_progress_key(ONE) || e.key == store::progress_key(ONE)));
+}
+
+/// `not-reserved` refusals are of authentic frames (their MAC verified): reported as
+/// informative (severity 1); every other SDLS refusal at 3.
+#[test]
+fn an_authentic_frame_refused_after_a_restart_is_not_reported_as_an_attack() {
+    use mmic::link::sdls::SdlsRefusal;
+    use mmic::pus::event::Event;
+    for (i, name) in SdlsRefusal::NAMES.iter().enumerate() {
+        let e = Event::Security {
+            reason: i as u8,
+            refused: 1,
+            spi: 257,
+        };
+        let want = if *name == "not-reserved" { 1 } else { 3 };
+        assert_eq!(e.severity(), want, "{name}");
+    }
+}
