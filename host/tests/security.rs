@@ -373,3 +373,57 @@ fn the_external_ground_simulator_keeps_its_counters_across_processes() {
         (min2, ivs2.iter().max().unwrap())
     );
 }
+
+/// The key schedule and the GHASH key are zeroized on drop only with the `zeroize` features of
+/// `aes`, `ghash` and `polyval` (aes-gcm's own feature clears one temporary block): the
+/// workspace's feature resolution must keep all three (`src/link/sdls/key.rs` also asserts it
+/// at compile time, for the RISC-V targets the firmware builds).
+#[test]
+fn the_crates_holding_key_material_are_built_with_zeroize() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    // This host's target (the other platforms' crates need not be downloaded).
+    let rustc = Command::new("rustc")
+        .arg("-vV")
+        .output()
+        .expect("rustc -vV");
+    let host = String::from_utf8_lossy(&rustc.stdout)
+        .lines()
+        .find_map(|l| l.strip_prefix("host: ").map(str::to_string))
+        .expect("rustc's host");
+    let o = Command::new(cargo)
+        .args([
+            "metadata",
+            "--format-version",
+            "1",
+            "--offline",
+            "--filter-platform",
+        ])
+        .arg(&host)
+        .arg("--manifest-path")
+        .arg(root.join("Cargo.toml"))
+        .output()
+        .expect("cargo metadata");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let m: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let nodes = m["resolve"]["nodes"].as_array().unwrap();
+    for name in ["aes", "ghash", "polyval", "aes-gcm"] {
+        let node = nodes
+            .iter()
+            .find(|n| {
+                let id = n["id"].as_str().unwrap_or("");
+                id.contains(&format!("#{name}@"))
+            })
+            .unwrap_or_else(|| panic!("{name} is not in the build"));
+        let features: Vec<&str> = node["features"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(Value::as_str)
+            .collect();
+        assert!(
+            features.contains(&"zeroize"),
+            "{name} without zeroize: {features:?}"
+        );
+    }
+}

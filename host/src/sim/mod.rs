@@ -493,16 +493,21 @@ impl SdlsConfig {
             );
             let mut b = [0u8; mmic::link::sdls::KEY_LEN];
             rng.fill(&mut b);
-            Key256::from_bytes(b)
+            let k = Key256::from_bytes(b);
+            zeroize::Zeroize::zeroize(&mut b);
+            k
         };
         match &self.keys {
             SdlsKeys::Given(v) if i < v.len() => Ok(v[i].clone()),
             SdlsKeys::Given(_) | SdlsKeys::Seeded => Ok((seeded(1), seeded(2))),
             SdlsKeys::Random => {
                 let read = || -> std::io::Result<Key256> {
-                    let mut b = [0u8; mmic::link::sdls::KEY_LEN];
-                    std::io::Read::read_exact(&mut std::fs::File::open("/dev/urandom")?, &mut b)?;
-                    Ok(Key256::from_bytes(b))
+                    let mut b = zeroize::Zeroizing::new([0u8; mmic::link::sdls::KEY_LEN]);
+                    std::io::Read::read_exact(
+                        &mut std::fs::File::open("/dev/urandom")?,
+                        b.as_mut_slice(),
+                    )?;
+                    Ok(Key256::from_bytes(*b))
                 };
                 Ok((read()?, read()?))
             }
