@@ -87,6 +87,31 @@ fn the_choices_are_the_codes() {
     };
     assert_eq!((e.id(), e.severity()), (0x0205, 3));
     assert_eq!(sdls::SdlsRefusal::NAMES[5], "bad-mac");
+    let not_reserved = Event::Security {
+        reason: 6,
+        refused: 1,
+        spi: 257,
+    };
+    assert_eq!(sdls::SdlsRefusal::NAMES[6], "not-reserved");
+    assert_eq!(
+        i64::from(not_reserved.severity()),
+        int(&t, "events", "not_reserved_severity")
+    );
+    // The store's keys as spec/ writes them.
+    use mmic::node::server::store;
+    let b = BoardNumber::new(7).unwrap();
+    assert_eq!(text(&t, "store", "fingerprint_key"), "0x1000 | SPI");
+    assert_eq!(store::fingerprint_key(mission::tm_spi(b)), 0x1000 | 0x207);
+    assert_eq!(text(&t, "store", "progress_key"), "0x2000 + n");
+    assert_eq!(store::progress_key(b), 0x2007);
+    assert_eq!(text(&t, "store", "kept_key"), "0x3000 + 4n + slot");
+    assert_eq!(store::kept_key(b, 3), 0x3000 + 4 * 7 + 3);
+    assert_eq!(text(&t, "sa", "keys_partition"), "mmic_keys");
+    assert!(repo("firmware/server/partitions.csv").contains("mmic_keys,"));
+    assert_eq!(
+        mmic::node::server::frames::FrameRefusal::Origin.name(),
+        "bc-origin"
+    );
 }
 
 #[test]
@@ -95,7 +120,7 @@ fn every_section_names_a_decision() {
     let t = spec();
     crate::assert_sections_name_decisions("spec/ccsds/sdls.toml", &t);
     assert!(crate::repo("spec/decisions.toml").contains("id = \"sdls-scope\""));
-    assert_eq!(t.len(), 6);
+    assert_eq!(t.len(), 8);
 }
 
 /// YAMCS's SDLS links: the same SPIs, masks and TM window; TM verified; the keys from files; the
