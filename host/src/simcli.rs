@@ -215,9 +215,10 @@ pub struct SimArgs {
     #[arg(long)]
     pub sdls: bool,
     /// With --sdls, virtual time: an attacker on each robot's uplink. For each TC frame the
-    /// uplink delivers, the chance (0..1) that the attacker also sends a captured TC data frame
-    /// again or a copy with one bit flipped (its FECF made good), half each. Every such frame
-    /// must be refused before FARM-1; the summary counts them.
+    /// uplink delivers, the chance (0..1) that the attacker also sends, from its own address, a
+    /// captured TC data frame again, a copy with one bit flipped (its FECF made good), or a BC
+    /// frame (Unlock, or Set V(R) to any value), a third each. Every such frame must be refused
+    /// before FARM-1; the summary counts them.
     #[arg(long, value_name = "P", default_value_t = 0.0)]
     pub sdls_attack: f64,
     /// Run on the wall clock instead of in virtual time: real threads, OS pipes, TCP and UDP

@@ -459,9 +459,10 @@ pub struct SdlsConfig {
     /// provision`): required with [`SdlsKeys::Given`], unused with keys made for the run.
     pub state: Option<PathBuf>,
     /// Virtual time: the attacker on each robot's uplink. For each TC frame the uplink
-    /// delivers, the chance that the attacker also sends one frame: a captured TC data frame
-    /// again (a replay) or a copy with one bit flipped and its FECF made good again (so that
-    /// it gets past the FECF check to SDLS), half each. 0: no attacker.
+    /// delivers, the chance that the attacker also sends one frame, from its own address: a
+    /// captured TC data frame again (a replay), a copy with one bit flipped and its FECF made
+    /// good again (so that it gets past the FECF check to SDLS), or a BC frame (Unlock, Set
+    /// V(R) to any value: refused as not from the ground), a third each. 0: no attacker.
     pub attack: f64,
 }
 

@@ -636,8 +636,9 @@ pub fn sdls_text(x: &crate::sim::SdlsStats) -> String {
     );
     if x.attack_frames > 0 {
         t.push_str(&format!(
-            "; attacker sent {} frames (replays, bit flips): {} refused by SDLS, {} by a frame \
-             check, {} passed to FARM-1",
+            "; attacker sent {} frames (replays, bit flips, BC frames from its own address): {} \
+             refused by SDLS, {} by a frame check or as BC frames not from the ground, {} passed to \
+             FARM-1",
             x.attack_frames, x.attacks_refused_sdls, x.attacks_refused_frame, x.attacks_passed
         ));
     }

@@ -311,12 +311,41 @@ impl Attacker {
         }
         let pick = self.rng.usize(..self.captured.len());
         let mut f = self.captured[pick].clone();
-        if self.rng.bool() {
-            let n = f.len();
-            let bit = self.rng.usize(..(n - 2) * 8);
-            f[bit / 8] ^= 0x80 >> (bit % 8);
-            let crc = mmic::ccsds::pec(&f[..n - 2]);
-            f[n - 2..].copy_from_slice(&crc.to_be_bytes());
+        match self.rng.u8(..3) {
+            0 => {}
+            1 => {
+                let n = f.len();
+                let bit = self.rng.usize(..(n - 2) * 8);
+                f[bit / 8] ^= 0x80 >> (bit % 8);
+                let crc = mmic::ccsds::pec(&f[..n - 2]);
+                f[n - 2..].copy_from_slice(&crc.to_be_bytes());
+            }
+            _ => {
+                // A BC frame (in clear by decision sdls-clear-bc) for the same spacecraft:
+                // Set V(R) to any value, or Unlock, from the attacker's own address.
+                use mmic::link::tc_frame::{
+                    SpacecraftId, TcContent, TcFrameRepr, TcPrimaryHeader, Vcid,
+                };
+                let Some(h) = TcPrimaryHeader::read(&f) else {
+                    return;
+                };
+                let command = if self.rng.bool() {
+                    mmic::link::ControlCommand::Unlock
+                } else {
+                    mmic::link::ControlCommand::SetVr(self.rng.u8(..))
+                };
+                let repr = TcFrameRepr {
+                    spacecraft_id: SpacecraftId::new(h.spacecraft_id).unwrap_or_default(),
+                    vcid: Vcid::new(h.vcid).unwrap_or_default(),
+                    seq: 0,
+                    content: TcContent::Bc(command),
+                };
+                let mut b = [0u8; 16];
+                let Ok(n) = repr.emit(&mut b) else {
+                    return;
+                };
+                f = b[..n].to_vec();
+            }
         }
         self.sent += 1;
         self.waiting.push_back(f);
@@ -1281,7 +1310,13 @@ impl<'c, G: Ground> Engine<'c, G> {
             let Board::Frames(g) = &mut self.robots[i].board else {
                 return;
             };
-            let got = g.tc_frame(now, &f);
+            // The attacker sends from its own address (decision sdls-bc-origin).
+            let origin = if attack {
+                mmic::node::server::frames::Origin::Elsewhere
+            } else {
+                mmic::node::server::frames::Origin::Ground
+            };
+            let got = g.tc_frame_from(now, &f, origin);
             // The security header as sent (never the key; the data stays ciphertext).
             let sec = if secured {
                 log::sdls_header(&f)
