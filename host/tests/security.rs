@@ -36,7 +36,7 @@ fn scratch(name: &str) -> PathBuf {
 /// Random keys for robot 1 (spi-257.key, spi-513.key), mode 0600, in `dir`.
 fn keys(dir: &Path) -> (Vec<u8>, Vec<u8>) {
     std::fs::create_dir_all(dir).unwrap();
-    let mut random = || {
+    let random = || {
         let mut b = vec![0u8; 32];
         std::fs::File::open("/dev/urandom")
             .unwrap()
