@@ -28,7 +28,7 @@ pub const COUNTER_SECTOR: usize = 0x1000;
 pub enum SdlsCmd {
     /// Provision the simulator's durable state file for the keys of DIR (once per set of keys).
     Provision {
-        /// The key directory: spi-<SPI>.key, 32 raw octets each.
+        /// The key directory: `spi-<SPI>.key`, 32 raw octets each.
         #[arg(long, value_name = "DIR")]
         keys: PathBuf,
         /// The state file to make (refused if it exists, or inside DIR).
@@ -42,7 +42,7 @@ pub enum SdlsCmd {
     },
     /// Make the server image's keys and counters partitions for the keys of DIR.
     Image {
-        /// The key directory: spi-<SPI>.key, 32 raw octets each.
+        /// The key directory: `spi-<SPI>.key`, 32 raw octets each.
         #[arg(long, value_name = "DIR")]
         keys: PathBuf,
         /// The robots the server board serves (comma-separated board numbers).
