@@ -703,6 +703,8 @@ impl<'c, G: Ground> Engine<'c, G> {
                 ) {
                     Ok(b) => r.board = b,
                     Err(e) => {
+                        // Nothing reaches a stopped link: it stays down.
+                        r.down[Node::Server as usize] = true;
                         let why = e.to_string();
                         self.node_event(i, 2, json!({"type": "link_stopped", "why": why}));
                         return;
@@ -722,6 +724,8 @@ impl<'c, G: Ground> Engine<'c, G> {
                         if let Err(e) =
                             super::durable::boot_ground(&mut gl, r.number, &r.store, keys)
                         {
+                            // The link stopped: the ground's end of it is gone with its RAM.
+                            r.ground_link = None;
                             let why = e.to_string();
                             self.node_event(i, 3, json!({"type": "link_stopped", "why": why}));
                             return;
