@@ -1,6 +1,7 @@
 //! Board A (Figures 5 and 6): the robot's primary board. Two embassy tasks stand for the
 //! paper's two cores, joined by the library's hand-off queues: the WiFi task (accepts the
-//! server board's TCP connection and does what the library's `WifiSession` says: command
+//! server board's TCP connection — from the server board's address only, `net::command_peer`:
+//! any other peer is aborted at once — and does what the library's `WifiSession` says: command
 //! packets into the rx queue, the heartbeats of the tx queue back) and the 10 ms control task
 //! (sensors, `BoardA::tick`, servos, bolter, regulator, the serial line to board B).
 //!
@@ -13,7 +14,7 @@
 use core::cell::RefCell;
 use embassy_executor::Spawner;
 use embassy_net::tcp::TcpSocket;
-use embassy_net::Stack;
+use embassy_net::{IpAddress, Stack};
 use embassy_time::{with_timeout, Duration, Instant, Ticker, Timer};
 use esp_backtrace as _;
 use esp_bootloader_esp_idf::partitions::{self, FlashRegion, PARTITION_TABLE_MAX_LEN};
@@ -158,7 +159,9 @@ async fn control(
 }
 
 /// The WiFi task: one server connection at a time; a dropped connection is accepted again.
-/// What to do with each connection's bytes and each heartbeat is the library's session's.
+/// A connection from any peer but the server board (`net::command_peer`) is aborted as soon
+/// as it is accepted, before a byte of it is read: it never holds the one slot. What to do
+/// with each connection's bytes and each heartbeat is the library's session's.
 async fn wifi_task(
     stack: Stack<'static>,
     mut commands: Producer<'static, COMMAND_LEN, QUEUE>,
@@ -166,11 +169,26 @@ async fn wifi_task(
 ) -> ! {
     let (mut rx_buf, mut tx_buf) = ([0u8; 256], [0u8; 256]);
     let mut session = WifiSession::new(WifiConfig::default());
+    let mut refused = 0u32;
     loop {
         let mut sock = TcpSocket::new(stack, &mut rx_buf, &mut tx_buf);
         sock.set_timeout(Some(Duration::from_secs(5)));
         if sock.accept(net::PORT).await.is_err() {
             Timer::after_millis(10).await;
+            continue;
+        }
+        let peer = sock.remote_endpoint().map(|e| {
+            let IpAddress::Ipv4(a) = e.addr;
+            (a.octets(), e.port)
+        });
+        if !net::command_peer(peer) {
+            // Reset at once (the RST flushed out within 10 ms), then listen again.
+            sock.abort();
+            let _ = with_timeout(Duration::from_millis(10), sock.flush()).await;
+            refused = refused.wrapping_add(1);
+            if refused.is_power_of_two() {
+                println!("refused a command connection from {peer:?} ({refused} so far)");
+            }
             continue;
         }
         // Heartbeats made while no server was connected are dropped (counted by the session).

@@ -3,11 +3,20 @@
 //! per robot, the PUS gateway); the legacy commands it makes
 //! go to board A in visits (connect, send, the heartbeat by the visit's deadline, disconnect:
 //! the library's `Visit`, as before); the heartbeats go back into the gateway; the TM transfer
-//! frames it says are due go to the ground at [`net::GROUND`]:[`net::TM_PORT`]. The SDLS
-//! counters persist in the flash partition `mmic_ctr` (server/partitions.csv). The watchdogs
+//! frames it says are due go to the ground at [`net::GROUND`]:[`net::TM_PORT`]. The watchdogs
 //! are fed only after a complete pass of the glue (`support::restart`, `support::wdt`).
 //!
-//! Every step is `support::server::ServerGlue::poll` (host-tested in support/tests/server.rs);
+//! The image carries no key. At start-up it reads the SDLS keys from the flash partition
+//! `mmic_keys` and clears the buffer they were read into; the durable store (SDLS counters, key
+//! fingerprints, FARM-1's progress, the gateway's kept telecommand keys) is the log in
+//! `mmic_ctr` (server/partitions.csv; both written apart from the image, firmware/README.md
+//! "Keys"). Whatever the flash holds — no partition table, a partition missing, a keys
+//! partition blank, corrupt or with a weak key, a store blank, of another key or of other
+//! robots — nothing here panics: the robots that cannot start have their links stopped, the
+//! reason logged at start-up and every [`STATUS_MS`], and the board runs on (WiFi up,
+//! watchdogs fed) for the others.
+//!
+//! Every step is `support::server` (host-tested in support/tests/server.rs and security.rs);
 //! this file is the sockets, the flash and the tasks.
 #![no_std]
 #![no_main]
@@ -17,42 +26,70 @@ use embassy_executor::Spawner;
 use embassy_futures::select::select3;
 use embassy_net::tcp::TcpSocket;
 use embassy_net::udp::{PacketMetadata, RecvError, UdpSocket};
-use embassy_net::{IpEndpoint, Ipv4Address, Stack};
+use embassy_net::{IpAddress, IpEndpoint, Ipv4Address, Stack};
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
 use embassy_sync::channel::Channel;
 use embassy_time::{with_timeout, Duration, Timer};
 use esp_backtrace as _;
-use esp_bootloader_esp_idf::partitions::{self, FlashRegion, PARTITION_TABLE_MAX_LEN};
+use esp_bootloader_esp_idf::partitions::{
+    self, FlashRegion, PartitionEntry, PARTITION_TABLE_MAX_LEN,
+};
 use esp_storage::FlashStorage;
 use mmic::node::server::frames::{FrameConfig, FRAME_LEN};
+use mmic::node::server::store::keys::KeySet;
 use mmic::node::server::visit::{Heartbeat, Visit};
 use mmic::units::BoardNumber;
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::HEARTBEAT_LEN;
 use static_cell::StaticCell;
-use support::counters::FlashCounters;
+use support::counters::{FlashLog, LogState};
 use support::net;
 use support::restart::Gate;
-use support::server::{BoardLink, Clock, Datagrams, ServerGlue};
+use support::server::{
+    keys_from, open_store, BoardLink, Clock, Datagrams, LinkStop, PartitionFault, ServerGlue,
+    ENTRIES_PER_ROBOT, FOREIGN, KEYS_READ,
+};
 use support::wdt::{self, Dogs};
+use zeroize::Zeroize;
 
 esp_bootloader_esp_idf::esp_app_desc!();
 
-// `ROBOTS` and `KEYS`, from `MMIC_ROBOTS` and `MMIC_SDLS_KEY_DIR` (build.rs).
-include!(concat!(env!("OUT_DIR"), "/keys.rs"));
+// `ROBOTS`, from `MMIC_ROBOTS` (build.rs).
+include!(concat!(env!("OUT_DIR"), "/robots.rs"));
 
-/// The flash partition of the SDLS counters (server/partitions.csv): two 4 KiB sectors.
+/// The flash partition of the SDLS keys (server/partitions.csv): written apart from the image.
+const KEYS_PARTITION: &str = "mmic_keys";
+/// The flash partition of the durable store (server/partitions.csv): two 4 KiB sectors.
 const COUNTERS_PARTITION: &str = "mmic_ctr";
 /// Robots served.
 const R: usize = ROBOTS.len();
-/// SPIs the counter store holds: two per robot.
-const SPIS: usize = 2 * R;
+/// The robots served, as board numbers (checked when the image is built).
+const BOARDS: [BoardNumber; R] = {
+    let mut out = [BoardNumber::ONE; R];
+    let mut i = 0;
+    while i < R {
+        out[i] = match BoardNumber::new(ROBOTS[i]) {
+            Ok(b) => b,
+            Err(_) => panic!("MMIC_ROBOTS: board numbers 1..=255"),
+        };
+        i += 1;
+    }
+    out
+};
+/// Keys the store holds: every key a served robot can have (never full).
+const ENTRIES: usize = ENTRIES_PER_ROBOT * R;
 /// The longest the main loop sleeps while nothing is due (a heartbeat a visit brought back
 /// waits at most this long), ms.
 const IDLE_MS: u32 = 10;
+/// How often the status line (and the reasons of stopped links) is logged, ms.
+const STATUS_MS: u32 = 30_000;
+/// The partitions' raw type and subtype (server/partitions.csv: data, undefined).
+const DATA: u8 = 0x01;
+const UNDEFINED: u8 = 0x06;
 
 type Flash = partitions::NorFlashRegion<'static, 'static, 'static>;
-type Glue = ServerGlue<FlashCounters<Flash, SPIS>, R>;
+type Log = FlashLog<Flash, ENTRIES, FOREIGN>;
+type Glue = ServerGlue<Log, R>;
 
 /// Board A visits asked for by the gateway, and the heartbeats they brought back.
 static VISITS: Channel<CriticalSectionRawMutex, (BoardNumber, [u8; COMMAND_LEN]), R> =
@@ -70,15 +107,21 @@ async fn main(spawner: Spawner) -> ! {
     let (cause, code) = wdt::reset_cause();
     let dogs = Dogs::arm(p.RTC_TIMER, p.TIMG1);
     esp_println::println!("mmic server board, reset reason {code:#04x}: {cause}");
-    let store = FlashCounters::open(counters_flash(p.FLASH)).expect("SDLS counters in flash");
-    let mut robots = [BoardNumber::ONE; R];
-    for (r, n) in robots.iter_mut().zip(ROBOTS) {
-        *r = BoardNumber::new(n).expect("MMIC_ROBOTS");
+    let (keys, store) = partitions(FLASH.init(FlashStorage::new(p.FLASH)));
+    if let Ok(log) = &store {
+        report_store(log);
     }
     let config = FrameConfig::default();
-    // Each robot's link secured with SDLS under the keys built into the image, its counters
-    // restored from flash.
-    let glue = GLUE.init(ServerGlue::new(config, &robots, &KEYS, store).expect("robots and keys"));
+    // Each robot's link from what the store kept, secured under its keys; the keys dropped
+    // (zeroized) once the gateway holds them.
+    let glue = GLUE.init(ServerGlue::new(
+        config,
+        &BOARDS,
+        keys.as_ref().map_err(|e| *e),
+        store,
+    ));
+    drop(keys);
+    report(glue);
 
     // Start-up: WiFi station on the lab's access point at the server's fixed address.
     let stack = wifi::start(&spawner, p.WIFI, net::SERVER);
@@ -86,18 +129,118 @@ async fn main(spawner: Spawner) -> ! {
     serve(stack, glue, dogs).await
 }
 
-/// The counters' partition as NOR flash. Start-up only: an image flashed without
-/// server/partitions.csv has no such partition, and must not run without durable counters.
-fn counters_flash(flash: esp_hal::peripherals::FLASH<'static>) -> Flash {
-    let flash = FLASH.init(FlashStorage::new(flash));
-    let mut table = [0u8; PARTITION_TABLE_MAX_LEN];
-    let pt = partitions::read_partition_table(flash, &mut table).expect("partition table");
-    let entry = pt
+/// The keys and the durable store, or why not. Nothing the flash holds makes this panic: a
+/// partition table that does not read, a partition missing or of another kind, a keys
+/// partition refused, a log that does not open, each becomes the reason the links stop.
+fn partitions(
+    flash: &'static mut FlashStorage<'static>,
+) -> (Result<KeySet, LinkStop>, Result<Log, LinkStop>) {
+    let (keys_entry, ctr_entry) = {
+        let mut table = [0u8; PARTITION_TABLE_MAX_LEN];
+        match partitions::read_partition_table(flash, &mut table) {
+            Ok(pt) => (
+                pt.iter().find(|e| labelled(e, KEYS_PARTITION)),
+                pt.iter().find(|e| labelled(e, COUNTERS_PARTITION)),
+            ),
+            Err(_) => {
+                return (
+                    Err(LinkStop::KeysPartition(PartitionFault::Table)),
+                    Err(LinkStop::StorePartition(PartitionFault::Table)),
+                )
+            }
+        }
+    };
+    let keys = usable(keys_entry)
+        .map_err(LinkStop::KeysPartition)
+        .and_then(|e| read_keys(e, flash));
+    let store = usable(ctr_entry)
+        .map_err(LinkStop::StorePartition)
+        .and_then(|e| {
+            let region = REGION.init(e.as_flash_region(flash));
+            region
+                .as_nor_flash()
+                .map_err(|_| LinkStop::StorePartition(PartitionFault::Kind))
+        })
+        .and_then(|nor| open_store(nor, &BOARDS));
+    (keys, store)
+}
+
+/// Whether the partition's label is `name`, compared as octets (the label is flash content:
+/// `label_as_str` would take any octets for UTF-8).
+fn labelled(e: &PartitionEntry, name: &str) -> bool {
+    let label = e.label();
+    let len = label
         .iter()
-        .find(|e| e.label_as_str() == COUNTERS_PARTITION)
-        .expect("no mmic_ctr partition: flash with --partition-table server/partitions.csv");
-    let region = REGION.init(entry.as_flash_region(flash));
-    region.as_nor_flash().expect("mmic_ctr is not encrypted")
+        .position(|&b| b == 0 || b == 0xFF)
+        .unwrap_or(label.len());
+    label.get(..len) == Some(name.as_bytes())
+}
+
+/// The partition, if it is there and data/undefined as server/partitions.csv has it (its
+/// type is checked before esp-bootloader-esp-idf reads it as one it knows).
+fn usable(entry: Option<PartitionEntry>) -> Result<PartitionEntry, PartitionFault> {
+    let e = entry.ok_or(PartitionFault::Absent)?;
+    if e.raw_type() != DATA || e.raw_subtype() != UNDEFINED {
+        return Err(PartitionFault::Kind);
+    }
+    Ok(e)
+}
+
+/// The keys partition's first [`KEYS_READ`] octets, parsed (through the flash's decryption
+/// when the partition is flagged encrypted and flash encryption is on); the buffer is
+/// cleared either way.
+fn read_keys(e: PartitionEntry, flash: &mut FlashStorage<'static>) -> Result<KeySet, LinkStop> {
+    #[repr(align(4))]
+    struct Buf([u8; KEYS_READ]);
+    let mut region = e.as_flash_region(flash);
+    let n = KEYS_READ.min(region.partition_size());
+    let mut buf = Buf([0; KEYS_READ]);
+    let part = buf.0.get_mut(..n).unwrap_or(&mut []);
+    match region.read(0, part) {
+        Ok(()) => keys_from(part),
+        Err(_) => {
+            part.zeroize();
+            Err(LinkStop::KeysPartition(PartitionFault::Read))
+        }
+    }
+}
+
+/// The store as it opened: what it held, and the entries of robots not served.
+fn report_store(log: &Log) {
+    let state = match log.state() {
+        LogState::Blank => "erased: not provisioned",
+        LogState::NoHeader => "no valid sector header: corrupt or not provisioned",
+        LogState::Active { .. } => "open",
+    };
+    esp_println::println!(
+        "durable store mmic_ctr: {state}, generation {}, {} entries, {} free slots",
+        log.generation(),
+        log.entries().len(),
+        log.free_slots()
+    );
+    if !log.foreign().is_empty() || log.dropped() > 0 {
+        esp_println::println!(
+            "durable store mmic_ctr: {} entries of robots this image does not serve set apart \
+             (not used), {} more left out",
+            log.foreign().len(),
+            log.dropped()
+        );
+        for e in log.foreign() {
+            esp_println::println!("  not served: key {:#06x}", e.key);
+        }
+    }
+}
+
+/// Each robot's link: served, or stopped and why.
+fn report(glue: &Glue) {
+    for b in BOARDS {
+        if glue.serves(b) {
+            esp_println::println!("robot {}: link served (SDLS)", b.get());
+        }
+    }
+    for (b, why) in glue.stopped() {
+        esp_println::println!("robot {}: link STOPPED ({}): {why}", b.get(), why.name());
+    }
 }
 
 /// The loop: one pass of the glue, then sleep until a datagram, a heartbeat or the gateway's
@@ -112,8 +255,13 @@ async fn serve(stack: Stack<'static>, glue: &'static mut Glue, mut dogs: Dogs) -
     let (mut clock, mut board) = (Uptime, Visits);
     dogs.arm_control();
     let mut gate = Gate::new(dogs);
+    let mut status_at = wifi::now_ms().wrapping_add(STATUS_MS);
     loop {
         let next = gate.run(|| glue.poll(&mut clock, &mut ground, &mut board));
+        if (wifi::now_ms().wrapping_sub(status_at) as i32) >= 0 {
+            status_at = status_at.wrapping_add(STATUS_MS);
+            status(glue);
+        }
         let wait = support::server::sleep_ms(next, wifi::now_ms(), IDLE_MS);
         select3(
             ground.sock.wait_recv_ready(),
@@ -124,6 +272,29 @@ async fn serve(stack: Stack<'static>, glue: &'static mut Glue, mut dogs: Dogs) -
     }
 }
 
+/// The periodic status line: the glue's counts, a failing store, and every stopped link again.
+fn status(glue: &mut Glue) {
+    let c = *glue.counts();
+    esp_println::println!(
+        "t={} tc={} tc_elsewhere={} tm={} tm_unsent={} commands={} busy={} heartbeats={} \
+         store_writes={} store_failed={} backoff_ms={:?}",
+        wifi::now_ms(),
+        c.tc_datagrams,
+        c.tc_elsewhere,
+        c.tm_frames,
+        c.tm_unsent,
+        c.commands,
+        c.commands_busy,
+        c.heartbeats,
+        c.store_writes,
+        c.store_failed,
+        glue.backoff_ms()
+    );
+    for (b, why) in glue.stopped() {
+        esp_println::println!("robot {}: link STOPPED ({}): {why}", b.get(), why.name());
+    }
+}
+
 /// The ground's UDP socket, polled without blocking.
 struct Ground<'a> {
     sock: UdpSocket<'a>,
@@ -131,12 +302,13 @@ struct Ground<'a> {
 }
 
 impl Datagrams for Ground<'_> {
-    fn recv(&mut self, buf: &mut [u8]) -> Option<usize> {
+    fn recv(&mut self, buf: &mut [u8]) -> Option<(usize, Option<[u8; 4]>)> {
         let mut cx = Context::from_waker(Waker::noop());
         match self.sock.poll_recv_from(buf, &mut cx) {
-            Poll::Ready(Ok((n, _))) => Some(n),
-            // Longer than any TC frame: an empty datagram, which the frame checks refuse.
-            Poll::Ready(Err(RecvError::Truncated)) => Some(0),
+            Poll::Ready(Ok((n, meta))) => Some((n, Some(v4(meta.endpoint).0))),
+            // Longer than any TC frame: an empty datagram, which the frame checks refuse (its
+            // source unknown).
+            Poll::Ready(Err(RecvError::Truncated)) => Some((0, None)),
             Poll::Pending => None,
         }
     }
@@ -148,6 +320,12 @@ impl Datagrams for Ground<'_> {
             Poll::Ready(Ok(()))
         )
     }
+}
+
+/// An endpoint as the glue's checks take it (the stack runs IPv4 only).
+fn v4(e: IpEndpoint) -> net::Endpoint {
+    let IpAddress::Ipv4(a) = e.addr;
+    (a.octets(), e.port)
 }
 
 /// The clock of the library's state machines.
@@ -174,7 +352,8 @@ impl BoardLink for Visits {
 
 /// Figure 4's visits, one at a time: connect to board A of the robot, send the command, take
 /// the first heartbeat by the visit's deadline (`wait_ms`, the gateway's uplink timeout),
-/// disconnect.
+/// disconnect. A connection whose peer is not the visited board A (`net::visit_peer`) is
+/// aborted before a byte is sent or taken.
 #[embassy_executor::task]
 async fn visits(stack: Stack<'static>, wait_ms: u32) {
     let (mut rx_buf, mut tx_buf) = ([0u8; 256], [0u8; 256]);
@@ -186,7 +365,8 @@ async fn visits(stack: Stack<'static>, wait_ms: u32) {
         let to = (Ipv4Address::from(net::robot(board.get())), net::PORT);
         let left = visit.left_ms(wifi::now_ms()).unwrap_or(0);
         if let Ok(Ok(())) = with_timeout(wifi::ms(left), sock.connect(to)).await {
-            if wifi::write_all(&mut sock, visit.packet()).await {
+            let peer = sock.remote_endpoint().map(v4);
+            if net::visit_peer(board, peer) && wifi::write_all(&mut sock, visit.packet()).await {
                 if let Some(hb) = heartbeat(&mut sock, &mut visit).await {
                     // Full only if the main loop stopped taking them: dropped, and the
                     // gateway's uplink asks again.

@@ -1,9 +1,9 @@
 //! Board A's durable record (`mmic::node::robot::board_a::Durable`: the exactly-once log's
 //! last entry and the boot count) in NOR flash, across resets and power loss.
 //!
-//! The store is the SDLS counters' log ([`crate::counters`]): two sectors, one CRC per record,
-//! a torn record skipped, a full sector compacted into the other with its header written last.
-//! Board A keeps one "counter" in it, [`KEY`], whose 96-bit value holds the record's
+//! The store is the server board's durable log ([`crate::counters`]): two sectors, one CRC per
+//! record, a torn record skipped, a full sector compacted into the other with its header
+//! written last. Board A keeps one entry in it, [`KEY`], whose 96-bit value holds the record's
 //! [`Durable::LEN`] octets (the low 40 bits, little-endian; the rest zero). Why not a sibling
 //! log: the same torn-write argument would be written and tested twice, for a 5-octet payload
 //! that fits the 12-octet value.
@@ -13,11 +13,13 @@
 //! sequenced command (a command whose record could not be written is not taken: the ground
 //! sends it again), the `durable` record after every tick that changed it.
 
-use crate::counters::{CounterError, CounterStore, FlashCounters};
+use crate::counters::{EntryStore, FlashLog, LogError};
 use embedded_storage::nor_flash::NorFlash;
 use mmic::node::robot::board_a::Durable;
+use mmic::node::server::store::Entry;
 
-/// The record's key in the counter log (no SPI: the log holds board A's record alone).
+/// The record's key in the log (outside the server's key namespace: the log holds board A's
+/// record alone).
 pub const KEY: u16 = 0xB0A1;
 
 /// What board A's control task keeps (`Durable`), and where.
@@ -26,10 +28,10 @@ pub trait Keep {
     /// as one: the board then starts as from a fresh flash).
     fn load(&mut self) -> Option<Durable>;
     /// Makes `d` the record a reset finds. Once this returns `Ok`, it is durable.
-    fn keep(&mut self, d: &Durable) -> Result<(), CounterError>;
+    fn keep(&mut self, d: &Durable) -> Result<(), LogError>;
 }
 
-/// The record as the counter log's value.
+/// The record as the log's value.
 pub fn to_value(d: &Durable) -> u128 {
     let mut v = [0u8; 16];
     v[..Durable::LEN].copy_from_slice(&d.to_bytes());
@@ -51,19 +53,20 @@ pub fn from_value(value: u128) -> Option<Durable> {
 /// Board A's record in a flash region of two erase units (the `mmic_a` partition:
 /// board-a/partitions.csv).
 pub struct FlashDurable<F: NorFlash> {
-    log: FlashCounters<F, 1>,
+    log: FlashLog<F, 1>,
 }
 
 impl<F: NorFlash> FlashDurable<F> {
-    /// Opens the log on `flash` (formats a region that holds none).
-    pub fn open(flash: F) -> Result<Self, CounterError> {
+    /// Opens the log on `flash` (a region that holds none is formatted by the first write:
+    /// board A then starts as from a fresh flash).
+    pub fn open(flash: F) -> Result<Self, LogError> {
         Ok(FlashDurable {
-            log: FlashCounters::open(flash)?,
+            log: FlashLog::open(flash)?,
         })
     }
 
     /// The log (its free slots and generation, for logs).
-    pub const fn log(&self) -> &FlashCounters<F, 1> {
+    pub const fn log(&self) -> &FlashLog<F, 1> {
         &self.log
     }
 
@@ -75,10 +78,14 @@ impl<F: NorFlash> FlashDurable<F> {
 
 impl<F: NorFlash> Keep for FlashDurable<F> {
     fn load(&mut self) -> Option<Durable> {
-        from_value(self.log.load(KEY)?)
+        from_value(self.log.lookup(KEY)?.1)
     }
 
-    fn keep(&mut self, d: &Durable) -> Result<(), CounterError> {
-        self.log.store(KEY, to_value(d))
+    fn keep(&mut self, d: &Durable) -> Result<(), LogError> {
+        self.log.write(&Entry {
+            key: KEY,
+            aux: 0,
+            value: to_value(d),
+        })
     }
 }

@@ -1,28 +1,157 @@
-//! The SDLS counter store on a RAM NOR flash with the ESP32's geometry (4-octet read and write
+//! The durable log on a RAM NOR flash with the ESP32's geometry (4-octet read and write
 //! units, 4 KiB erase sectors): values survive a reset, a record torn by a power cut is
-//! ignored, compaction keeps the newest value of every SPI even when power is cut at any octet
-//! of it, and the store never programs an octet twice without an erase.
+//! ignored, compaction keeps the newest value of every key even when power is cut at any octet
+//! of it, and the store never programs an octet twice without an erase. Opening only reads;
+//! the provisioning tool's image opens as it is; entries of robots not served are set apart
+//! and carried, never a panic or a refusal.
 
 use crc::{Crc, CRC_32_ISO_HDLC};
-use mmic_fw_support::counters::{CounterError, CounterStore, FlashCounters, RECORD_LEN};
+use mmic::link::sdls::Key256;
+use mmic::node::server::store::{self, log, End, Entry, Resume};
+use mmic::units::BoardNumber;
+use mmic_fw_support::counters::{EntryStore, FlashLog, LogError, LogState, RECORD_LEN};
+use mmic_fw_support::server::{ENTRIES_PER_ROBOT, FOREIGN};
 
 mod common;
 use common::{Ram, SECTOR};
 
-type Store = FlashCounters<Ram, 64>;
+type Store = FlashLog<Ram, 64>;
+
+/// The old counter store's calls, over entries with aux 0.
+trait Counters {
+    fn load(&mut self, key: u16) -> Option<u128>;
+    fn store(&mut self, key: u16, value: u128) -> Result<(), LogError>;
+}
+
+impl<const S: usize, const X: usize> Counters for FlashLog<Ram, S, X> {
+    fn load(&mut self, key: u16) -> Option<u128> {
+        self.lookup(key).map(|(_, v)| v)
+    }
+    fn store(&mut self, key: u16, value: u128) -> Result<(), LogError> {
+        self.write(&Entry { key, aux: 0, value })
+    }
+}
 
 fn reopen(s: Store) -> Store {
-    FlashCounters::open(s.release().reset()).unwrap()
+    FlashLog::open(s.release().reset()).unwrap()
 }
 
 #[test]
-fn a_new_region_is_formatted_and_holds_nothing() {
-    let mut s = Store::open(Ram::new(2)).unwrap();
-    assert_eq!(s.load(257), None);
-    assert_eq!(s.generation(), 1);
-    assert_eq!(s.free_slots() as usize, SECTOR / RECORD_LEN - 1);
+fn opening_a_new_region_writes_nothing_and_the_first_write_formats_it() {
+    // Not erased (a new chip's content), and erased: nothing found, nothing written.
+    for (ram, state) in [
+        (Ram::new(2), LogState::NoHeader),
+        (Ram::erased(2), LogState::Blank),
+    ] {
+        let before = ram.mem.clone();
+        let mut s = Store::open(ram).unwrap();
+        assert_eq!(s.state(), state);
+        assert_eq!(s.load(257), None);
+        assert_eq!(s.generation(), 0);
+        let ram = s.release();
+        assert_eq!((ram.mem == before, ram.erases), (true, 0));
+        let mut s = Store::open(ram).unwrap();
+        s.store(257, 5).unwrap();
+        assert_eq!(s.state(), LogState::Active { generation: 1 });
+        assert_eq!(s.free_slots() as usize, SECTOR / RECORD_LEN - 2);
+        let mut s = reopen(s);
+        assert_eq!((s.load(257), s.generation()), (Some(5), 1));
+    }
+}
+
+/// Random keys that pass the library's weak-key check.
+fn key(seed: u64) -> Key256 {
+    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let bytes: [u8; 32] = core::array::from_fn(|_| {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        x as u8
+    });
+    let k = Key256::from_bytes(bytes);
+    assert!(k.check().is_ok());
+    k
+}
+
+/// The `mmic_ctr` image `mmic sdls image` writes (the library's `log::image` of the provisioned
+/// entries) opens as it is: the boot check finds its fingerprints and counters, and the log
+/// goes on after them.
+#[test]
+fn the_provisioning_tools_image_opens_and_boots() {
+    let one = BoardNumber::ONE;
+    let (tc, tm) = (key(1), key(2));
+    let entries = store::provision(End::Server, one, &tc, &tm, Resume::FRESH).unwrap();
+    let mut image = vec![0u8; 2 * SECTOR];
+    log::image(&entries, SECTOR, &mut image).unwrap();
+    let mut s = Store::open(Ram::from_image(&image)).unwrap();
+    assert_eq!(s.state(), LogState::Active { generation: 1 });
+    assert_eq!(s.entries().len(), 4);
+    let boot = store::boot(End::Server, one, &tc, &tm, |k| s.lookup(k)).unwrap();
+    assert_eq!(boot.stored.tm, Some(0));
+    assert_eq!(boot.stored.tc, Some(store::NOTHING_ACCEPTED));
+    assert_eq!((boot.stored.progress, boot.kept), (None, None));
+    s.store(0x0201, 256).unwrap();
     let mut s = reopen(s);
-    assert_eq!(s.load(257), None);
+    assert_eq!(s.load(0x0201), Some(256));
+    assert_eq!(s.entries().len(), 4);
+}
+
+/// A store holding other robots' entries and keys of no robot (another image's store, or one
+/// written by hand): opened for robot 1 alone, they are set apart (never looked up), the
+/// image's own keys always have room, and compactions carry what was set apart while room is
+/// left: no panic, no `Full`.
+#[test]
+fn entries_of_robots_not_served_are_set_apart_and_never_fill_the_log() {
+    type Server = FlashLog<Ram, { ENTRIES_PER_ROBOT }, { FOREIGN }>;
+    let served = [BoardNumber::ONE];
+    let mut entries = Vec::new();
+    // Robots 2..=9 provisioned, and 100 keys of no robot at all.
+    for n in 2..=9u8 {
+        let b = BoardNumber::new(n).unwrap();
+        entries.extend(
+            store::provision(End::Server, b, &key(n.into()), &key(99), Resume::FRESH).unwrap(),
+        );
+    }
+    for k in 0..100u16 {
+        entries.push(Entry {
+            key: 0x7000 + k,
+            aux: 1,
+            value: u128::from(k),
+        });
+    }
+    let foreign_keys = entries.len();
+    // Robot 1's own, provisioned last.
+    let (tc, tm) = (key(1), key(2));
+    entries.extend(store::provision(End::Server, served[0], &tc, &tm, Resume::FRESH).unwrap());
+    let mut image = vec![0u8; 2 * SECTOR];
+    log::image(&entries, SECTOR, &mut image).unwrap();
+    let open = |ram: Ram| Server::open_with(ram, |k| store::foreign(&served, k)).unwrap();
+    let mut s = open(Ram::from_image(&image));
+    assert_eq!(s.entries().len(), 4);
+    assert_eq!(s.foreign().len(), FOREIGN);
+    assert_eq!(s.dropped() as usize, foreign_keys - FOREIGN);
+    assert!(s.foreign().iter().all(|e| store::foreign(&served, e.key)));
+    assert!(store::boot(End::Server, served[0], &tc, &tm, |k| s.lookup(k)).is_ok());
+    // Robot 2's entries are not this image's to look up.
+    assert_eq!(s.lookup(0x0202), None);
+    // Every key robot 1 can have, written over several sectors' worth of records.
+    let own: Vec<u16> = (0..0x4000u16)
+        .filter(|&k| !store::foreign(&served, k))
+        .collect();
+    assert_eq!(own.len(), ENTRIES_PER_ROBOT);
+    for i in 0..3 * SECTOR / RECORD_LEN {
+        let k = own[i % own.len()];
+        s.store(k, i as u128).unwrap();
+    }
+    assert!(s.generation() >= 3, "{}", s.generation());
+    let mut s = open(s.release().reset());
+    assert_eq!(s.entries().len(), ENTRIES_PER_ROBOT);
+    // Carried over: what was set apart is still there.
+    assert_eq!(s.foreign().len(), FOREIGN);
+    assert_eq!(s.dropped(), 0);
+    let last = 3 * SECTOR / RECORD_LEN - 1;
+    assert_eq!(s.load(own[last % own.len()]), Some(last as u128));
+    assert_eq!(s.release().overwrites, 0);
 }
 
 #[test]
@@ -70,7 +199,7 @@ fn the_record_layout_is_the_documented_one() {
 fn only_values_below_2_to_the_96_are_stored() {
     let mut s = Store::open(Ram::new(2)).unwrap();
     let max = (1u128 << 96) - 1;
-    assert_eq!(s.store(257, 1 << 96), Err(CounterError::TooLarge(1 << 96)));
+    assert_eq!(s.store(257, 1 << 96), Err(LogError::TooLarge(1 << 96)));
     s.store(257, max).unwrap();
     let mut s = reopen(s);
     assert_eq!(s.load(257), Some(max));
@@ -181,7 +310,7 @@ fn many_spis_are_kept_and_one_more_than_built_for_is_refused() {
                 .unwrap();
         }
     }
-    assert_eq!(s.store(0x1000, 1), Err(CounterError::Full(64)));
+    assert_eq!(s.store(0x1000, 1), Err(LogError::Full(64)));
     let mut s = reopen(s);
     for spi in 0..64u16 {
         assert_eq!(s.load(0x100 + spi), Some(7000 + u128::from(spi)));
@@ -195,7 +324,7 @@ fn a_region_of_one_sector_is_refused() {
     let e = Store::open(Ram::new(1)).err().unwrap();
     assert!(matches!(
         e,
-        CounterError::Geometry {
+        LogError::Geometry {
             capacity: 4096,
             erase: 4096,
             ..

@@ -20,7 +20,7 @@ use mmic::units::{BoardNumber, PulseWidth};
 use mmic::wire::command::{CommandRepr, COMMAND_LEN};
 use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
 use mmic_fw_support::control::{Actuators, ControlA, Counters, Reading, Sensors, QUEUE};
-use mmic_fw_support::counters::{CounterError, RECORD_LEN};
+use mmic_fw_support::counters::{LogError, RECORD_LEN};
 use mmic_fw_support::durable::{self, FlashDurable, Keep};
 use mmic_fw_support::link::{ByteSink, ByteSource};
 use mmic_fw_support::restart::{self, reset_cause, Feed, Gate, PANIC_MARK};
@@ -276,7 +276,7 @@ impl Keep for Cut {
     fn load(&mut self) -> Option<Durable> {
         self.inner.load()
     }
-    fn keep(&mut self, d: &Durable) -> Result<(), CounterError> {
+    fn keep(&mut self, d: &Durable) -> Result<(), LogError> {
         self.inner.keep(d)?;
         if self.after_write.get() {
             panic!("power cut after a write");

@@ -1,270 +1,18 @@
 //! The server board's glue towards the ground on the host: the library's ground end
-//! (`GroundLink`: FOP-1, the packet extractor) sends PUS telecommands in TC transfer frames over
-//! a mocked UDP socket; the glue runs them through FARM-1 and the gateway, its legacy commands
-//! reach a mocked board A (which answers each with a heartbeat at the next pass, as a visit
-//! does), and the TM transfer frames that come back carry the ground's reports and the CLCW.
+//! (`GroundLink`: FOP-1, SDLS, the packet extractor) sends PUS telecommands in TC transfer
+//! frames over a mocked UDP socket; the glue runs them through SDLS, FARM-1 and the gateway,
+//! its legacy commands reach a mocked board A (which answers each with a heartbeat at the next
+//! pass, as a visit does), and the TM transfer frames that come back carry the ground's
+//! reports and the CLCW. The store is the durable log on a RAM flash as the provisioning tool
+//! makes it, the keys as the image reads them from the keys partition (`tests/bench`).
 
-use std::collections::{BTreeMap, VecDeque};
-
+mod bench;
 mod common;
-use common::Ram;
 
-use mmic::ccsds::primary::{Apid, SeqCount};
-use mmic::ccsds::tc::TcRepr;
-use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
-use mmic::ccsds::tm::TmRepr;
+use bench::{clear, tc, Bench};
 use mmic::command::Command;
-use mmic::link::sdls::Key256;
-use mmic::mode::Mode;
-use mmic::node::ground::frames::GroundLink;
-use mmic::node::server::frames::FrameConfig;
-use mmic::node::server::gateway::Config;
-use mmic::pus::verification::{Report, Stage};
 use mmic::units::BoardNumber;
-use mmic::wire::command::{CommandRepr, COMMAND_LEN};
-use mmic::wire::heartbeat::{HeartbeatRepr, HEARTBEAT_LEN};
-use mmic_fw_support::counters::{CounterError, CounterStore, FlashCounters};
-use mmic_fw_support::server::{
-    sleep_ms, BoardLink, Clock, Datagrams, GlueError, SdlsKey, ServerGlue,
-};
-
-/// The mocked UDP socket: datagrams from the ground waiting, datagrams sent to it.
-#[derive(Default)]
-struct Udp {
-    inbox: VecDeque<Vec<u8>>,
-    sent: Vec<Vec<u8>>,
-}
-impl Datagrams for Udp {
-    fn recv(&mut self, buf: &mut [u8]) -> Option<usize> {
-        let d = self.inbox.pop_front()?;
-        let n = d.len().min(buf.len());
-        buf[..n].copy_from_slice(&d[..n]);
-        Some(n)
-    }
-    fn send(&mut self, datagram: &[u8]) -> bool {
-        self.sent.push(datagram.to_vec());
-        true
-    }
-}
-
-/// Board A behind the visits: answers every command with a heartbeat naming its number, at the
-/// next pass; refuses commands while `busy`.
-#[derive(Default)]
-struct BoardA {
-    commands: Vec<CommandRepr>,
-    answers: VecDeque<[u8; HEARTBEAT_LEN]>,
-    busy: bool,
-}
-impl BoardLink for BoardA {
-    fn command(&mut self, board: BoardNumber, packet: [u8; COMMAND_LEN]) -> bool {
-        if self.busy {
-            return false;
-        }
-        let c = CommandRepr::parse(&packet).unwrap();
-        assert_eq!(c.board, board);
-        self.commands.push(c);
-        let hb = HeartbeatRepr {
-            board,
-            last_seq: c.seq,
-            mode: Mode::Operational,
-            ..HeartbeatRepr::default()
-        };
-        self.answers.push_back(hb.to_bytes());
-        true
-    }
-    fn heartbeat(&mut self) -> Option<[u8; HEARTBEAT_LEN]> {
-        self.answers.pop_front()
-    }
-}
-
-struct Ms(u32);
-impl Clock for Ms {
-    fn now_ms(&mut self) -> u32 {
-        self.0
-    }
-}
-
-/// A counter store in RAM.
-#[derive(Default)]
-struct Map(BTreeMap<u16, u128>);
-impl CounterStore for Map {
-    fn load(&mut self, spi: u16) -> Option<u128> {
-        self.0.get(&spi).copied()
-    }
-    fn store(&mut self, spi: u16, value: u128) -> Result<(), CounterError> {
-        self.0.insert(spi, value);
-        Ok(())
-    }
-}
-
-/// Random keys for robot 1's two SAs (made at run time; the glue only checks they are there).
-fn keys() -> Vec<SdlsKey> {
-    let mut seed = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .as_nanos() as u64
-        | 1;
-    [257u16, 513]
-        .iter()
-        .map(|&spi| {
-            let mut key = [0u8; 32];
-            for b in &mut key {
-                seed ^= seed << 13;
-                seed ^= seed >> 7;
-                seed ^= seed << 17;
-                *b = seed as u8;
-            }
-            SdlsKey { spi, key }
-        })
-        .collect()
-}
-
-fn config() -> FrameConfig {
-    FrameConfig {
-        gateway: Config {
-            hk_enabled: false,
-            ..Config::default()
-        },
-        ..FrameConfig::default()
-    }
-}
-
-/// TC(`service`,`sub`) for robot 1 numbered `seq`.
-fn tc(service: u8, sub: u8, seq: u16, data: &[u8]) -> Vec<u8> {
-    let mut b = vec![0u8; 13 + data.len()];
-    TcRepr {
-        apid: Apid::new(0x101).unwrap(),
-        seq_count: SeqCount::new(seq).unwrap(),
-        header: TcSecondaryHeader {
-            ack: AckFlags::ALL,
-            service,
-            subservice: sub,
-            source_id: 9,
-        },
-        app_data: data,
-    }
-    .emit(&mut b)
-    .unwrap();
-    b
-}
-
-/// What the ground heard.
-#[derive(Default, Debug)]
-struct Heard {
-    /// (service, subservice) of every TM packet.
-    packets: Vec<(u8, u8)>,
-    accepted: Vec<u16>,
-    completed: Vec<u16>,
-}
-
-struct Bench {
-    ground: GroundLink<10, 64, 1024>,
-    glue: ServerGlue<Map, 1>,
-    udp: Udp,
-    board: BoardA,
-    clock: Ms,
-    heard: Heard,
-    /// A datagram wrapper between the ground and the UDP socket (an attacker's stand-in).
-    wrap: fn(&[u8]) -> Vec<u8>,
-    /// The TC datagrams the ground sent.
-    uplink: Vec<Vec<u8>>,
-}
-
-impl Bench {
-    fn new(wrap: fn(&[u8]) -> Vec<u8>) -> Self {
-        let keys = keys();
-        let glue = ServerGlue::new(config(), &[BoardNumber::ONE], &keys, Map::default()).unwrap();
-        // The ground holds the same keys; its counters live with it for the test.
-        let mut ground = GroundLink::new(BoardNumber::ONE);
-        ground.secure(
-            Key256::from_bytes(keys[0].key),
-            Key256::from_bytes(keys[1].key),
-            (None, None),
-        );
-        persist_ground(&mut ground);
-        let mut b = Bench {
-            ground,
-            glue,
-            uplink: Vec::new(),
-            udp: Udp::default(),
-            board: BoardA::default(),
-            clock: Ms(0),
-            heard: Heard::default(),
-            wrap,
-        };
-        let mut up = Vec::new();
-        b.ground.start(0, &mut |f: &[u8]| up.push(wrap(f)));
-        b.uplink.extend(up.iter().cloned());
-        b.udp.inbox.extend(up);
-        b
-    }
-
-    fn send(&mut self, packet: &[u8]) {
-        let (now, wrap) = (self.clock.0, self.wrap);
-        let mut up = Vec::new();
-        self.ground
-            .send(packet, now, &mut |f: &[u8]| up.push(wrap(f)))
-            .unwrap();
-        persist_ground(&mut self.ground);
-        self.uplink.extend(up.iter().cloned());
-        self.udp.inbox.extend(up);
-    }
-
-    /// Runs `ms` milliseconds in 1 ms passes.
-    fn run(&mut self, ms: u32) {
-        for _ in 0..ms {
-            self.clock.0 += 1;
-            let now = self.clock.0;
-            self.glue
-                .poll(&mut self.clock, &mut self.udp, &mut self.board);
-            let wrap = self.wrap;
-            let mut up = Vec::new();
-            for f in std::mem::take(&mut self.udp.sent) {
-                let mut tms = Vec::new();
-                self.ground
-                    .tm_frame(
-                        now,
-                        &f,
-                        &mut |t: &[u8]| up.push(wrap(t)),
-                        &mut |p: &[u8]| tms.push(p.to_vec()),
-                    )
-                    .unwrap();
-                for p in tms {
-                    let tm = TmRepr::parse(&p, &[0x101]).unwrap();
-                    let (s, sub) = (tm.header.service, tm.header.subservice);
-                    self.heard.packets.push((s, sub));
-                    if s == 1 {
-                        let r = Report::parse(sub, tm.source_data).unwrap();
-                        match (r.stage, r.failure) {
-                            (Stage::Acceptance, None) => {
-                                self.heard.accepted.push(r.request.seq_count)
-                            }
-                            (Stage::Completion, None) => {
-                                self.heard.completed.push(r.request.seq_count)
-                            }
-                            _ => {}
-                        }
-                    }
-                }
-            }
-            self.ground.tick(now, &mut |f: &[u8]| up.push(wrap(f)));
-            persist_ground(&mut self.ground);
-            self.uplink.extend(up.iter().cloned());
-            self.udp.inbox.extend(up);
-        }
-    }
-}
-
-fn clear(f: &[u8]) -> Vec<u8> {
-    f.to_vec()
-}
-
-/// The ground's durable counters, written and confirmed at once.
-fn persist_ground(g: &mut GroundLink<10, 64, 1024>) {
-    for (spi, v) in g.due().collect::<Vec<_>>() {
-        g.persisted(spi, v);
-    }
-}
+use mmic_fw_support::server::{sleep_ms, LinkStop};
 
 #[test]
 fn an_are_you_alive_crosses_the_link_and_board_a_answers_it() {
@@ -335,8 +83,8 @@ fn a_garbage_datagram_is_refused_by_the_frame_checks_and_reaches_no_robot() {
     let before = b.board.commands.len();
     let refused_before: u32 = b.glue.gateway().refused().iter().sum();
     let datagrams_before = b.glue.counts().tc_datagrams;
-    b.udp.inbox.push_back(vec![0x55; 40]);
-    b.udp.inbox.push_back(vec![0x20; 300]); // longer than any TC frame: cut, then refused
+    b.udp.from_ground(vec![0x55; 40]);
+    b.udp.from_ground(vec![0x20; 300]); // longer than any TC frame: cut, then refused
     b.run(1);
     let refused: u32 = b.glue.gateway().refused().iter().sum();
     assert_eq!(refused - refused_before, 2);
@@ -345,20 +93,30 @@ fn a_garbage_datagram_is_refused_by_the_frame_checks_and_reaches_no_robot() {
     assert_eq!(b.glue.counts().tc_datagrams - datagrams_before, 2);
 }
 
+/// A keys partition without one of the robot's keys: its link is stopped (named), nothing is
+/// sent, its frames reach nothing, and the board runs on.
 #[test]
 fn a_robot_without_both_keys_is_not_served() {
-    let only_tc: Vec<SdlsKey> = keys().into_iter().filter(|k| k.spi == 257).collect();
-    let e = ServerGlue::<_, 1>::new(config(), &[BoardNumber::ONE], &only_tc, Map::default())
-        .err()
-        .unwrap();
-    assert_eq!(e, GlueError::NoKey { board: 1, spi: 513 });
-    // And the key never shows in Debug.
-    let k = SdlsKey {
-        spi: 257,
-        key: [0xA7; 32],
-    };
-    let shown = format!("{k:?}");
-    assert!(shown.contains("257") && !shown.contains("167") && !shown.contains("a7"));
+    use mmic::node::server::store::keys;
+    let (tc_key, _) = bench::keys_of(1);
+    let mut part = vec![0xFF; 4096];
+    keys::emit(&[(257, &tc_key)], &mut part).unwrap();
+    let glue = bench::glue([1], &part, bench::provisioned(&[1]));
+    assert_eq!(
+        glue.stopped(),
+        [(BoardNumber::ONE, LinkStop::NoKey { spi: 513 })]
+    );
+    let mut b = Bench::with(glue, clear);
+    b.send(&tc(8, 1, 0, &[6]));
+    // The ground's FOP-1 waits for a CLCW that never comes: a frame as anyone could send it.
+    b.udp.from_ground(bench::bd(1, &tc(8, 1, 1, &[6])));
+    b.run(2000);
+    assert!(b.board.commands.is_empty());
+    assert!(b.heard.packets.is_empty() && b.tm_ivs.is_empty());
+    assert!(b.glue.gateway().refused().iter().sum::<u32>() > 0);
+    // Nothing names a key.
+    let shown = format!("{:?} {}", b.glue, b.glue.stopped()[0].1);
+    assert!(shown.contains("513"), "{shown}");
 }
 
 /// An attacker on the ground's UDP port: every TC frame the ground sent, sent again (replays),
@@ -371,7 +129,7 @@ fn sdls_refuses_replays_and_forgeries_before_farm() {
     b.send(&tc(8, 1, 0, &[6]));
     b.run(2000);
     assert_eq!(b.heard.completed, [0]);
-    let stops = |b: &Bench| {
+    let stops = |b: &Bench<1>| {
         b.board
             .commands
             .iter()
@@ -395,7 +153,7 @@ fn sdls_refuses_replays_and_forgeries_before_farm() {
         .accepted_ad;
     let mut attacks = 0;
     for f in &data {
-        b.udp.inbox.push_back(f.clone());
+        b.udp.from_ground(f.clone());
         attacks += 1;
         for at in [6, 8, 20, f.len() - 3] {
             let mut g = f.clone();
@@ -403,7 +161,7 @@ fn sdls_refuses_replays_and_forgeries_before_farm() {
             let n = g.len();
             let crc = mmic::ccsds::pec(&g[..n - 2]);
             g[n - 2..].copy_from_slice(&crc.to_be_bytes());
-            b.udp.inbox.push_back(g);
+            b.udp.from_ground(g);
             attacks += 1;
         }
     }
@@ -455,77 +213,41 @@ fn a_pass_reports_the_gateways_next_deadline() {
 /// IVs continue above every IV used before it.
 #[test]
 fn the_counters_survive_a_reset_of_the_server_board_in_flash() {
-    type Flash = FlashCounters<Ram, 2>;
-    let keys = keys();
-    let mut ground = GroundLink::<10, 64, 1024>::new(BoardNumber::ONE);
-    ground.secure(
-        Key256::from_bytes(keys[0].key),
-        Key256::from_bytes(keys[1].key),
-        (None, None),
-    );
-    persist_ground(&mut ground);
-    let store = Flash::open(Ram::new(2)).unwrap();
-    let mut glue: ServerGlue<Flash, 1> =
-        ServerGlue::new(config(), &[BoardNumber::ONE], &keys, store).unwrap();
-    let (mut udp, mut board, mut clock) = (Udp::default(), BoardA::default(), Ms(0));
-    let mut uplink: Vec<Vec<u8>> = Vec::new();
-    let mut tm_ivs: Vec<u128> = Vec::new();
-    let iv =
-        |f: &[u8]| u128::from_be_bytes([&[0u8; 4][..], &f[8..20]].concat().try_into().unwrap());
-    ground.start(0, &mut |f: &[u8]| uplink.push(f.to_vec()));
-    udp.inbox.extend(uplink.iter().cloned());
-    let mut sent_stop = false;
-    for _ in 0..5000 {
-        clock.0 += 1;
-        let now = clock.0;
-        glue.poll(&mut clock, &mut udp, &mut board);
-        let mut up = Vec::new();
-        for f in std::mem::take(&mut udp.sent) {
-            tm_ivs.push(iv(&f));
-            ground
-                .tm_frame(now, &f, &mut |t: &[u8]| up.push(t.to_vec()), &mut |_| {})
-                .unwrap();
-        }
-        if !sent_stop && now == 100 {
-            ground
-                .send(&tc(8, 1, 0, &[6]), now, &mut |f: &[u8]| up.push(f.to_vec()))
-                .unwrap();
-            sent_stop = true;
-        }
-        ground.tick(now, &mut |f: &[u8]| up.push(f.to_vec()));
-        persist_ground(&mut ground);
-        uplink.extend(up.iter().cloned());
-        udp.inbox.extend(up);
-    }
-    assert!(board.commands.iter().any(|c| c.command == Command::Stop));
-    assert!(tm_ivs.len() >= 10, "{} TM frames", tm_ivs.len());
+    let mut b = Bench::new(clear);
+    b.run(100);
+    b.send(&tc(8, 1, 0, &[6]));
+    b.run(5000);
+    assert!(b.board.commands.iter().any(|c| c.command == Command::Stop));
+    assert!(b.tm_ivs.len() >= 10, "{} TM frames", b.tm_ivs.len());
     // Reset: a new glue on the same flash.
-    let ram = std::mem::replace(glue.store(), Flash::open(Ram::new(2)).unwrap()).release();
-    let store = Flash::open(ram.reset()).unwrap();
-    let mut glue: ServerGlue<Flash, 1> =
-        ServerGlue::new(config(), &[BoardNumber::ONE], &keys, store).unwrap();
-    let data: Vec<Vec<u8>> = uplink
+    let ram = bench::flash_of(&mut b.glue);
+    let mut glue = bench::glue([1], &bench::partition(&[1]), ram.reset());
+    assert!(glue.stopped().is_empty(), "{:?}", glue.stopped());
+    let data: Vec<Vec<u8>> = b
+        .uplink
         .iter()
         .filter(|f| f[0] & 0x10 == 0)
         .cloned()
         .collect();
     assert!(!data.is_empty());
-    udp.inbox.extend(data.iter().cloned());
-    udp.sent.clear();
+    for d in &data {
+        b.udp.from_ground(d.clone());
+    }
+    b.udp.sent.clear();
     for _ in 0..600 {
-        clock.0 += 1;
-        glue.poll(&mut clock, &mut udp, &mut board);
+        b.clock.0 += 1;
+        glue.poll(&mut b.clock, &mut b.udp, &mut b.board);
     }
     let sec = glue.gateway().security(BoardNumber::ONE).unwrap();
     assert_eq!(sec.refused_for("replay") as usize, data.len(), "{sec:?}");
     assert_eq!(sec.accepted, 0);
-    let before = tm_ivs.iter().max().copied().unwrap();
-    assert!(!udp.sent.is_empty());
-    for f in &udp.sent {
+    let before = b.tm_ivs.iter().max().copied().unwrap();
+    assert!(!b.udp.sent.is_empty());
+    for f in &b.udp.sent {
+        let iv = bench::iv(f);
         assert!(
-            iv(f) > before,
-            "a TM IV {} at or below {before} after the reset",
-            iv(f)
+            iv > before,
+            "a TM IV {iv} at or below {before} after the reset"
         );
     }
 }

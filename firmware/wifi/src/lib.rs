@@ -17,6 +17,14 @@ use support::net;
 
 static NET: StaticCell<StackResources<3>> = StaticCell::new();
 
+/// The lab access point's WPA2 passphrase, at build time (`MMIC_PASSWORD`). There is no
+/// default: without one, or with one WPA2 refuses or the old public default, the build stops
+/// here with the reason (`support::net::password`, host-tested).
+pub const PASSWORD: &str = match support::net::password(option_env!("MMIC_PASSWORD")) {
+    Ok(p) => p,
+    Err(why) => panic!("{}", why),
+};
+
 /// The radio boards' start-up, as the first statements of `main`: binds `$p` to the chip's
 /// peripherals at full clock, gives esp-radio its heap (64 KiB of reclaimed RAM plus 36 KiB,
 /// enough for WiFi and TCP) and starts esp-rtos on timer group 0. Expands in the calling
@@ -39,8 +47,7 @@ macro_rules! boot {
 /// the network stack, and returns the stack. Start-up only: a radio that cannot be configured
 /// is a build or wiring error, so it panics with the reason.
 pub fn start(spawner: &Spawner, radio: WIFI<'static>, address: [u8; 4]) -> Stack<'static> {
-    let auth =
-        AuthenticationMethodConfig::Wpa2Personal(net::PASSWORD.try_into().expect("password"));
+    let auth = AuthenticationMethodConfig::Wpa2Personal(PASSWORD.try_into().expect("password"));
     let sta = StationConfig::default()
         .with_ssid(net::SSID.try_into().expect("SSID"))
         .with_authentication(auth);

@@ -1,4 +1,4 @@
-//! A NOR flash in RAM with the ESP32's geometry, for the counter store's tests.
+//! A NOR flash in RAM with the ESP32's geometry, for the durable log's tests.
 #![allow(dead_code)]
 
 use embedded_storage::nor_flash::{
@@ -31,6 +31,21 @@ impl Ram {
             overwrites: 0,
             erases: 0,
             dead: false,
+        }
+    }
+    /// Erased (all `0xFF`): a partition `espflash erase-region` cleared.
+    pub fn erased(sectors: usize) -> Ram {
+        Ram {
+            mem: vec![0xFF; sectors * SECTOR],
+            ..Ram::new(sectors)
+        }
+    }
+    /// Holding `image` (a partition image `espflash write-bin` wrote).
+    pub fn from_image(image: &[u8]) -> Ram {
+        assert_eq!(image.len() % SECTOR, 0);
+        Ram {
+            mem: image.to_vec(),
+            ..Ram::new(image.len() / SECTOR)
         }
     }
     pub fn reset(mut self) -> Ram {
