@@ -505,6 +505,8 @@ fn event_json(subservice: u8, data: &[u8]) -> Result<Value, PusCodecError> {
         Event::Cleared(f) => json!({"faults": f.iter().map(|x| x.name()).collect::<Vec<_>>()}),
         Event::Fault { fault, mode } => json!({"fault": fault.name(), "mode": mode.name()}),
         Event::Restarted(b) => json!({"cause": b.cause.name(), "count": b.count}),
+        Event::LinkStopped { board, reason } => json!({"board": board,
+            "reason": mmic::pus::event::LINK_STOPPED_REASONS.get(usize::from(reason))}),
         Event::Security {
             reason,
             refused,

@@ -138,6 +138,16 @@ pub enum Event {
     /// decision `heartbeat-boot`): it is in Standby, its motion lost. ID 0x0004; the new boot
     /// byte (reset cause and boot count modulo 32).
     Restarted(Boot),
+    /// The server board could not start another robot's link (its store or keys were not
+    /// provisioned for it: decision `sdls-store`), reported at start on the links that run.
+    /// ID 0x0005; the robot's board number and the reason's place in
+    /// [`LINK_STOPPED_REASONS`].
+    LinkStopped {
+        /// The robot whose link is stopped.
+        board: u8,
+        /// The reason's place in [`LINK_STOPPED_REASONS`].
+        reason: u8,
+    },
     /// The server board's SDLS refused TC frames of the robot's link. ID 0x0200 + the
     /// reason's place in [`SdlsRefusal::NAMES`]; the auxiliary data are how many frames were
     /// refused for it since the last such report (at least one; reports are rate-limited,
@@ -156,6 +166,18 @@ pub enum Event {
 /// Source data of an event report, bytes.
 pub const EVENT_LEN: usize = 6;
 
+/// Why a robot's link did not start ([`Event::LinkStopped`]): the store's boot check
+/// (`node::server::store::Stopped`, the first four, in its order), then the shell's own.
+pub const LINK_STOPPED_REASONS: [&str; 7] = [
+    "unprovisioned",
+    "other-key",
+    "no-counter",
+    "weak-key",
+    "no-keys",
+    "no-store",
+    "not-served",
+];
+
 impl Event {
     /// The event definition ID.
     pub const fn id(&self) -> u16 {
@@ -165,6 +187,7 @@ impl Event {
             Event::Attempt { .. } => 2,
             Event::Cleared(_) => 3,
             Event::Restarted(_) => 4,
+            Event::LinkStopped { .. } => 5,
             Event::Security { reason, .. } => 0x0200 + *reason as u16,
         }
     }
@@ -195,6 +218,8 @@ impl Event {
             // ground's keys, and nothing of them executed. A restart stopped what the robot
             // was doing.
             Event::Security { .. } | Event::Restarted(_) => 3,
+            // High: a robot cannot be commanded at all until its store is provisioned.
+            Event::LinkStopped { .. } => 4,
         }
     }
 
@@ -210,6 +235,7 @@ impl Event {
             } => [pair.number(), *attempt, *result as u8, 0],
             Event::Cleared(f) => f.bits().to_be_bytes(),
             Event::Restarted(b) => [b.to_wire(), 0, 0, 0],
+            Event::LinkStopped { board, reason } => [*board, *reason, 0, 0],
             Event::Security { refused, spi, .. } => {
                 let [r0, r1] = refused.to_be_bytes();
                 let [s0, s1] = spi.to_be_bytes();
@@ -274,6 +300,18 @@ impl Event {
                 }
             }
             4 => Event::Restarted(Boot::from_wire(b[2])),
+            5 => {
+                if b[2] == 0 {
+                    return Err(field("board", 0));
+                }
+                if usize::from(b[3]) >= LINK_STOPPED_REASONS.len() {
+                    return Err(field("reason", u32::from(b[3])));
+                }
+                Event::LinkStopped {
+                    board: b[2],
+                    reason: b[3],
+                }
+            }
             0x0100..=0x01FF => Event::Fault {
                 fault: Fault::ALL
                     .into_iter()

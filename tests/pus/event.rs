@@ -31,6 +31,11 @@ fn events() -> Vec<Event> {
             v.push(Event::ModeChanged { from, to });
         }
     }
+    for board in [1u8, 2, 255] {
+        for reason in 0..mmic::pus::event::LINK_STOPPED_REASONS.len() as u8 {
+            v.push(Event::LinkStopped { board, reason });
+        }
+    }
     for pair in BolterPair::ALL {
         for attempt in 1..=3 {
             for result in RESULTS {
@@ -64,7 +69,7 @@ fn every_event_round_trips_in_its_severity_only() {
         }
         n += 1;
     }
-    assert_eq!(n, 15 * 3 + 9 + 4 * 3 * 4 + 32_767);
+    assert_eq!(n, 15 * 3 + 9 + 3 * 7 + 4 * 3 * 4 + 32_767);
 }
 
 #[test]
@@ -130,6 +135,22 @@ fn refusals_name_the_check() {
     assert_eq!(
         Event::parse(1, &[0, 1, b[2], b[3], 0, 1]),
         Err(EventError::Padding { id: 1 })
+    );
+    assert_eq!(
+        Event::parse(4, &[0, 5, 0, 1, 0, 0]),
+        Err(EventError::Field {
+            id: 5,
+            field: "board",
+            found: 0
+        })
+    );
+    assert_eq!(
+        Event::parse(4, &[0, 5, 1, 7, 0, 0]),
+        Err(EventError::Field {
+            id: 5,
+            field: "reason",
+            found: 7
+        })
     );
     assert_eq!(
         Event::parse(1, &[0, 2, 1, 4, 0, 0]),

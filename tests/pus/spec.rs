@@ -241,6 +241,7 @@ fn services_toml_is_what_the_gateway_serves() {
             ("0x0002", "bolting_attempt"),
             ("0x0003", "faults_cleared"),
             ("0x0004", "board_a_restarted"),
+            ("0x0005", "link_stopped"),
             ("0x0200 + n", "sdls_refused"),
             ("0x0100 + n", "fault")
         ]

@@ -164,6 +164,16 @@ impl LinkStop {
             LinkStop::NotServed => "not-served",
         }
     }
+
+    /// The reason's code in ST\[5\] `link_stopped` (`mmic::pus::event::LINK_STOPPED_REASONS`).
+    pub const fn code(&self) -> u8 {
+        match self {
+            LinkStop::Boot(s) => s.code(),
+            LinkStop::KeysPartition(_) | LinkStop::Keys(_) | LinkStop::NoKey { .. } => 4,
+            LinkStop::StorePartition(_) | LinkStop::Store(_) => 5,
+            LinkStop::Secure(_) | LinkStop::NotServed => 6,
+        }
+    }
 }
 
 /// What the glue counts (each wraps at `u32::MAX`); FARM-1's and the gateway's own counts are
@@ -268,6 +278,12 @@ impl<St: EntryStore, const R: usize> ServerGlue<St, R> {
                 }
             }
         };
+        // Said over the link at the first chance: ST[5] link_stopped in the telemetry of every
+        // robot whose link runs (a stopped link itself has no trusted way to send anything).
+        let mut gateway = gateway;
+        for (board, why) in &stopped {
+            gateway.link_stopped(0, *board, why.code());
+        }
         ServerGlue {
             gateway,
             store: store.ok(),

@@ -78,6 +78,14 @@ fn a_blank_store_stops_that_robots_link_and_the_board_serves_the_others() {
     assert!(bench.board.commands.iter().all(|c| c.board == b(1)));
     assert_eq!(stops(&bench), 1);
     assert_eq!(bench.heard.completed, [0]);
+    // Robot 1's telemetry says why robot 2's link is stopped: ST[5] link_stopped (0x0005),
+    // board 2, reason 0 (unprovisioned), at severity 4.
+    assert!(
+        bench.heard.events.contains(&vec![0, 5, 2, 0, 0, 0]),
+        "{:?}",
+        bench.heard.events
+    );
+    assert!(bench.heard.packets.contains(&(5, 4)));
 }
 
 /// An erased counters partition (`espflash erase-region`): every link stopped, nothing sent,

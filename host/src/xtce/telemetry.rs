@@ -70,7 +70,7 @@ const REQUEST_ID: [(&str, &str, &str); 6] = [
 ];
 
 /// The ST\[1\] failure report's and the ST\[5\] event reports' parameters after their headers.
-const REPORT_DATA: [(&str, &str, &str); 16] = [
+const REPORT_DATA: [(&str, &str, &str); 18] = [
     ("failure_code", "failure_code_type", "ST[1] failure code"),
     (
         "failure_data",
@@ -101,6 +101,16 @@ const REPORT_DATA: [(&str, &str, &str); 16] = [
         "event_boot",
         "uint8",
         "board_a_restarted: the new boot byte (reset cause in bits 7..5, boot count modulo 32)",
+    ),
+    (
+        "event_link_board",
+        "uint8",
+        "link_stopped: the robot whose link did not start",
+    ),
+    (
+        "event_link_reason",
+        "uint8",
+        "link_stopped: 0 unprovisioned, 1 other-key, 2 no-counter, 3 weak-key, 4 no-keys, 5 no-store, 6 not-served",
     ),
     (
         "event_sdls_refused",
@@ -489,7 +499,7 @@ fn containers() -> Vec<Container> {
 }
 
 /// The ST\[5\] event report and one container per event's auxiliary data.
-fn event_containers() -> [Container; 7] {
+fn event_containers() -> [Container; 8] {
     let severities = tm_subservices(|t| t.service == 5);
     let fault = vec![
         Comparison::new("event_id", Op::Ge, 0x100),
@@ -534,6 +544,12 @@ fn event_containers() -> [Container; 7] {
             "event 0x0004 board_a_restarted",
             &["event_boot", "event_spare24"],
             when("event-report", event_is(4)),
+        ),
+        container(
+            "event-link-stopped",
+            "event 0x0005 link_stopped",
+            &["event_link_board", "event_link_reason", "event_spare16"],
+            when("event-report", event_is(5)),
         ),
         container(
             "event-fault",

@@ -273,6 +273,8 @@ pub struct Heard {
     pub completed: Vec<u16>,
     /// Every verification report: (sequence count, stage, success).
     pub reports: Vec<(u16, Stage, bool)>,
+    /// The source data of every ST[5] event report.
+    pub events: Vec<Vec<u8>>,
 }
 
 pub type Ground = GroundLink<10, 64, 1024>;
@@ -393,6 +395,9 @@ impl<const R: usize, St: EntryStore> Bench<R, St> {
                 let tm = TmRepr::parse(&p, &[0x101]).unwrap();
                 let (s, sub) = (tm.header.service, tm.header.subservice);
                 self.heard.packets.push((s, sub));
+                if s == 5 {
+                    self.heard.events.push(tm.source_data.to_vec());
+                }
                 if s == 1 {
                     let r = Report::parse(sub, tm.source_data).unwrap();
                     let seq = r.request.seq_count;

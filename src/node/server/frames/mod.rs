@@ -690,6 +690,22 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         }
     }
 
+    /// Robot `stopped`'s link could not start (`reason`: its place in
+    /// [`crate::pus::event::LINK_STOPPED_REASONS`]): reported as ST\[5\] `link_stopped` in
+    /// every served robot's telemetry, the first chance an operator has to learn it over the
+    /// link (a stopped link has no trusted way to send anything). False when no link runs.
+    pub fn link_stopped(&mut self, now: u32, stopped: BoardNumber, reason: u8) -> bool {
+        let e = Event::LinkStopped {
+            board: stopped.get(),
+            reason,
+        };
+        let apids: Vec<u16, R> = self.links.iter().map(|l| robot_apid(l.board)).collect();
+        for apid in &apids {
+            self.report(now, &TmOut::new(*apid, 5, e.severity(), 0, &e.to_bytes()));
+        }
+        !apids.is_empty()
+    }
+
     /// A heartbeat from board A of `hb.board`; the reports go into the TM framer.
     pub fn heartbeat(&mut self, now: u32, hb: &HeartbeatRepr) {
         let out = self.gateway.heartbeat(now, hb);

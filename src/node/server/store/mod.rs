@@ -214,6 +214,11 @@ impl Stopped {
         Self::NAMES[self.position()]
     }
 
+    /// The code of ST\[5\]'s `link_stopped` ([`crate::pus::event::LINK_STOPPED_REASONS`]).
+    pub const fn code(&self) -> u8 {
+        self.position() as u8
+    }
+
     /// The reason's place in [`Stopped::NAMES`].
     pub const fn position(&self) -> usize {
         match self {
@@ -234,6 +239,24 @@ impl Stopped {
         }
     }
 }
+
+// The boot check's reasons are the first of ST[5]'s link_stopped reasons, in order.
+const _: () = {
+    let mut i = 0;
+    while i < Stopped::NAMES.len() {
+        let (a, b) = (
+            Stopped::NAMES[i].as_bytes(),
+            crate::pus::event::LINK_STOPPED_REASONS[i].as_bytes(),
+        );
+        assert!(a.len() == b.len());
+        let mut j = 0;
+        while j < a.len() {
+            assert!(a[j] == b[j]);
+            j += 1;
+        }
+        i += 1;
+    }
+};
 
 /// What a link starts from.
 #[derive(Debug, Clone, PartialEq, Eq)]
