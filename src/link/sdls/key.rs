@@ -104,9 +104,9 @@ pub fn test_keys() -> [(&'static str, [u8; KEY_LEN]); 3] {
     ]
 }
 
-/// What a durable store records of a key: the first 8 octets of HMAC-SHA-256(key,
-/// [`FINGERPRINT_LABEL`]). Not a secret, but kept out of logs all the same (`Debug` prints
-/// `Fingerprint(..)`).
+/// What a durable store records of a key: the first 8 octets of AES-256 under the key of
+/// [`FINGERPRINT_BLOCK`] (see the module's documentation). Not a secret, but kept out of logs
+/// all the same (`Debug` prints `Fingerprint(..)`).
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Fingerprint([u8; FINGERPRINT_LEN]);
 
