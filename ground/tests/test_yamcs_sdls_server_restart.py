@@ -50,7 +50,7 @@ DOWN = 0.3                    # host/src/sim/inject.rs BOOT_MS
 # YAMCS's verifiers (~0.1 s): 1.5 s margin for the rest, on a loaded 2-core machine.
 BOUND = T1 + 1.5
 # (S, offset of X from S, probe P right after the server is back)
-ROUNDS = [(8, -0.15, True), (15, +0.1, False), (22, +0.05, True), (29, +0.2, False), (36, -0.05, True)]
+ROUNDS = [(6, -0.15, True), (13, +0.1, False), (20, +0.05, True), (27, +0.2, False), (34, 0.0, True)]
 TC_LINK = "tc-frames.vc0"
 MODES = {1: "standby", 2: "operational"}
 
