@@ -13,7 +13,9 @@ What it starts: YAMCS through ground/yamcs_harness.py (`Yamcs(link=...)`, the ge
 spec/ccsds/mmic.xtce.xml, UDP TM in and TC out, its HttpServer with yamcs-web at `/`), then the robot:
 `mmic sim --protocol pus [--link frames] --ground-tm-to 127.0.0.1:<tm> --ground-tc-port <tc>
 --max-seconds N` (the server board's PUS gateway, board A's two tasks, board B and the plant at scale
-1; with `--link frames` the gateway behind FARM-1 and the TM framer, YAMCS's TC link under COP-1). The
+1; with `--link frames` the gateway behind FARM-1 and the TM framer, YAMCS's TC link under COP-1; with
+`frames-sdls` also `--sdls-keys` (the keys the harness made for YAMCS) and `--sdls-state` (the robot's durable
+state, provisioned by `mmic sdls provision` in YAMCS's run directory for those keys)). The
 robot's MET is mapped to UTC (the time correlation service `tco0` gets the robot's start as its
 power-on), so YAMCS shows the housekeeping at the time it was made. Both run until Ctrl-C, --seconds,
 or the robot's end; both are stopped by their process group (YAMCS by the harness, the robot here).
@@ -36,7 +38,7 @@ from urllib.parse import urlencode
 GROUND = Path(__file__).resolve().parent
 sys.path.insert(0, str(GROUND))
 
-from rust_side import REPO, XTCE, mmic_bin  # noqa: E402
+from rust_side import REPO, XTCE, mmic_bin, provision_robot_state  # noqa: E402
 from yamcs_harness import INSTANCE, Yamcs  # noqa: E402
 
 PROCESSOR = "realtime"
@@ -55,7 +57,7 @@ class Robot:
     `last` keeps the last lines for a failure's message."""
 
     def __init__(self, tm_port: int, tc_port: int, *, link: str, seconds: int, out: Path,
-                 sdls_keys: Path | None = None):
+                 sdls_keys: Path | None = None, sdls_state: Path | None = None):
         self.cmd = [mmic_bin(), "sim", "--protocol", "pus", "--ground-tm-to", f"127.0.0.1:{tm_port}",
                     "--ground-tc-port", str(tc_port), "--max-seconds", str(seconds), "--quiet",
                     "--out", str(out)]
@@ -63,7 +65,9 @@ class Robot:
             # frames-sdls: the robot's frames with SDLS, under the keys YAMCS was given.
             self.cmd[4:4] = ["--link", "frames"]
         if sdls_keys is not None:
-            self.cmd += ["--sdls-keys", str(sdls_keys)]
+            # and its durable SDLS state (counters, the keys' fingerprints, FARM-1's progress), provisioned for
+            # these keys (Console.start: in YAMCS's run directory, outside the key directory)
+            self.cmd += ["--sdls-keys", str(sdls_keys), "--sdls-state", str(sdls_state)]
         out.mkdir(parents=True, exist_ok=True)
         self.stderr_path = out / "console-robot.stderr"
         self._stderr = open(self.stderr_path, "w")
@@ -145,9 +149,13 @@ class Console:
     def start(self) -> "Console":
         self.yamcs.start()
         try:
-            keys = self.yamcs.sdls_key_dir if self.link == "frames-sdls" else None
+            keys = state = None
+            if self.link == "frames-sdls":
+                # the keys YAMCS was given, fresh for this run: the robot's state is provisioned for them
+                keys = self.yamcs.sdls_key_dir
+                state = provision_robot_state(keys, self.yamcs.run_dir / "robot-sdls.state")
             self.robot = Robot(self.yamcs.tm_port, self.yamcs.tc_port, link=self.link,
-                               seconds=self.seconds, out=self.out / "sim", sdls_keys=keys)
+                               seconds=self.seconds, out=self.out / "sim", sdls_keys=keys, sdls_state=state)
             self.robot.wait_ready(self.start_timeout)
             # MET -> UTC: the robot's gateway powered on when the process started (to ~0.1 s).
             tco = self.yamcs.client.get_tco_client(INSTANCE, "tco0")

@@ -10,7 +10,9 @@ ground/run-tests sets after building it) and what it makes.
   line (a format string with {mmic}, {tm_port}, {tc_port}, {seconds}), e.g. for
   `mmic sim --protocol pus` (ground/README.md, "Plugging in the simulator");
 - `sdls_sim_command(out, keys, state)` is RobotProcess's command for the simulator behind SDLS, as every
-  SDLS test with the Rust robot starts it; $GROUND_SDLS_ROBOT replaces its template.
+  SDLS test with the Rust robot starts it; $GROUND_SDLS_ROBOT replaces its template. The robot's durable
+  SDLS state (`--sdls-state`) is provisioned by it (`provision_robot_state`) the first time, and kept for
+  every later start of the same test (a restart of the robot process continues its counters).
 """
 from __future__ import annotations
 
@@ -93,17 +95,36 @@ def jsonl(path: Path) -> list[dict]:
 
 # The simulated robot behind the space data link with SDLS (`Yamcs(link="frames-sdls")`), as the tests start it.
 # $GROUND_SDLS_ROBOT replaces this template: RobotProcess's placeholders ({mmic}, {tm_port}, {tc_port},
-# {seconds}) and {out} (the run's --out directory), {keys} (the harness's key directory), {state} (a file for the
-# robot's own durable SDLS counters, in the test's temporary directory, kept across YAMCS's restarts), e.g. once
-# the simulator takes them: GROUND_SDLS_ROBOT="$(default) --sdls-state {state}".
+# {seconds}) and {out} (the run's --out directory), {keys} (the harness's key directory), {state} (the robot's
+# durable SDLS state file: counters, key fingerprints, FARM-1's progress; provisioned by sdls_sim_command, in the
+# test's temporary directory, never in the key directory, kept across YAMCS's and the robot's restarts).
 SDLS_SIM = ("{mmic} sim --protocol pus --link frames --ground-tm-to 127.0.0.1:{tm_port} "
-            "--ground-tc-port {tc_port} --max-seconds {seconds} --quiet --out {out} --sdls-keys {keys}")
+            "--ground-tc-port {tc_port} --max-seconds {seconds} --quiet --out {out} --sdls-keys {keys} "
+            "--sdls-state {state}")
+
+
+def provision_robot_state(keys, state) -> Path:
+    """The explicit provisioning step of the robot's durable SDLS state (`mmic sdls provision --keys DIR --state
+    FILE`: the keys' fingerprints and first counters, no key) for the keys of `keys`, once per set of keys: `state`
+    must not exist yet (mmic refuses to provision over a state file) and must lie outside the key directory."""
+    state = Path(state)
+    state.parent.mkdir(parents=True, exist_ok=True)
+    p = mmic("sdls", "provision", "--keys", str(keys), "--state", str(state), check=False)
+    if p.returncode != 0:
+        raise RuntimeError(f"mmic sdls provision --state {state}: exit {p.returncode}: {p.stderr.strip()}")
+    return state
 
 
 def sdls_sim_command(out, keys, state=None) -> str:
-    """RobotProcess's `command` for `mmic sim` behind SDLS ($GROUND_SDLS_ROBOT or SDLS_SIM)."""
+    """RobotProcess's `command` for `mmic sim` behind SDLS ($GROUND_SDLS_ROBOT or SDLS_SIM). The robot's state file
+    (`state`, default `out/robot-sdls.state`) is provisioned if it does not exist yet (the first start under
+    these keys) and otherwise used as it is (a restarted robot continues from it, as a server board from its
+    flash)."""
     template = os.environ.get("GROUND_SDLS_ROBOT", SDLS_SIM)
-    state = state if state is not None else Path(out) / "robot-sdls.state"
+    out = Path(out)
+    state = Path(state) if state is not None else out / "robot-sdls.state"
+    if not state.exists():
+        provision_robot_state(keys, state)
     for k, v in (("{out}", out), ("{keys}", keys), ("{state}", state)):
         template = template.replace(k, str(v).replace("{", "{{").replace("}", "}}"))
     return template

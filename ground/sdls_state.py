@@ -15,23 +15,25 @@ A new sender starts at IV 0, a new receiver with "nothing accepted yet" (last IV
 before (its state file lost) must not start there: `--resume-above N`, N at or above every IV used under it (the
 sender then starts at N + 1; the receiver refuses every IV up to N). An existing file is never overwritten.
 
-File (ASCII, five lines): `mmic-yamcs-sdls-state 1`, `spi <n>`, `role tx|rx`, `fingerprint <16 hex>` (the first
-8 octets of HMAC-SHA256(key, "mmic-yamcs-sdls-state"): which key the counter belongs to, revealing nothing of it),
-`value <decimal>`. Neither the key nor the fingerprint is ever printed.
+File (ASCII, five lines): `mmic-yamcs-sdls-state 2`, `spi <n>`, `role tx|rx`, `fingerprint <16 hex>` (which key
+the counter belongs to, revealing nothing of it: the library's key check value, `Key256::fingerprint` in
+src/link/sdls/key.rs, one scheme in every shell: the first 8 octets of AES-256 under the key of the block
+b"mmic-kcv-v1\x01\0\0\0\0"), `value <decimal>`. Version 1 recorded an HMAC as the fingerprint; the plug-in
+refuses such a file. Neither the key nor the fingerprint is ever printed.
 """
 from __future__ import annotations
 
 import argparse
-import hashlib
-import hmac
 import os
 import sys
 from pathlib import Path
 
-MAGIC = "mmic-yamcs-sdls-state 1"
+MAGIC = "mmic-yamcs-sdls-state 2"
 IV_SPACE = 1 << 96
 NOTHING_ACCEPTED = IV_SPACE - 1
-LABEL = b"mmic-yamcs-sdls-state"
+# The block the fingerprint enciphers (src/link/sdls/key.rs FINGERPRINT_BLOCK): a 12-octet label, a zero counter.
+FINGERPRINT_BLOCK = b"mmic-kcv-v1\x01\0\0\0\0"
+FINGERPRINT_LEN = 8
 KEY_LEN = 32
 
 
@@ -40,7 +42,13 @@ class StateError(ValueError):
 
 
 def fingerprint(key: bytes) -> str:
-    return hmac.new(key, LABEL, hashlib.sha256).digest()[:8].hex()
+    """The library's key fingerprint (Key256::fingerprint), hex: AES-256-ECB of FINGERPRINT_BLOCK, first 8 octets."""
+    from cryptography.hazmat.primitives.ciphers import Cipher, algorithms, modes
+
+    if len(key) != KEY_LEN:
+        raise StateError(f"an AES-256 key is {KEY_LEN} octets, not {len(key)}")
+    enc = Cipher(algorithms.AES(key), modes.ECB()).encryptor()
+    return (enc.update(FINGERPRINT_BLOCK) + enc.finalize())[:FINGERPRINT_LEN].hex()
 
 
 def read_key(key_file: str | os.PathLike) -> bytes:

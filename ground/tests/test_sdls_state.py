@@ -3,6 +3,8 @@
 frame checked with the independent ground/sdls.py.
 
 - provisioning (ground/sdls_state.py): the first states, never an overwrite, never in the key directory;
+- one key fingerprint in every shell: the library's (`mmic sdls provision` writes it into the robot's state file),
+  sdls_state.py's and the plug-in's agree (the plug-in opens a state sdls_state.py provisioned) for the same keys;
 - fail closed: a missing, malformed, other SPI's, other key's state, a state in the key directory, a receiver
   without `verifySeqNum`, a sender's state on a receiver: the SA does not start, and says which file and how to
   provision it;
@@ -84,6 +86,37 @@ def test_provisioning_writes_the_first_states_once_and_apart_from_the_keys(sa, t
     assert out.returncode == 0 and "fingerprint" not in out.stdout, out
 
 
+def test_one_key_fingerprint_in_every_shell(tmp_path):
+    """The library's key check value (Key256::fingerprint: AES-256 of FINGERPRINT_BLOCK, first 8 octets), as
+    `mmic sdls provision` records it (entries 0x1000 | SPI of both ends), equals sdls_state.py's; the plug-in takes a
+    state sdls_state.py provisioned for the key and refuses it for another key (so its fingerprint is the same
+    function). Random keys, never printed; the fingerprints compared, not shown."""
+    import json
+
+    from rust_side import mmic
+
+    for run in range(3):
+        keys = tmp_path / f"keys{run}"
+        sdls.write_random_keys(keys, (TC, TM))
+        robot_state = tmp_path / f"robot{run}.state"
+        mmic("sdls", "provision", "--keys", str(keys), "--state", str(robot_state))
+        doc = json.loads(robot_state.read_text())
+        for spi in (TC, TM):
+            key = sdls.key_path(keys, spi).read_bytes()
+            ours = sdls_state.fingerprint(key)
+            for end in ("server", "ground"):
+                lib = [e for e in doc[end] if int(e["key"], 16) == 0x1000 | spi]
+                assert len(lib) == 1 and int(lib[0]["value"], 16) == int(ours, 16), (end, spi)
+            role = "tx" if spi == TC else "rx"
+            f = tmp_path / f"yamcs{run}" / f"spi-{spi}.state"
+            sdls_state.provision(f, spi, role, sdls.key_path(keys, spi))
+            assert open_sa(keys, f, spi, rx=spi == TM) == "ok"
+            other = tmp_path / f"other{run}"
+            sdls.write_random_keys(other, (spi,))
+            msg = open_sa(other, f, spi, rx=spi == TM)
+            assert msg.startswith("refused: ") and "another key" in msg, msg
+
+
 def test_the_sa_does_not_start_without_a_usable_state(sa, tmp_path):
     keys, state = sa
     tc_state = state / f"spi-{TC}.state"
@@ -93,11 +126,13 @@ def test_the_sa_does_not_start_without_a_usable_state(sa, tmp_path):
     cases = {
         "missing": (state / "none.state", "does not exist"),
         "other SPI": (state / f"spi-{TM}.state", "it is the state of SPI 513"),
-        "garbage": (tmp_path / "garbage.state", "not an mmic-yamcs-sdls-state 1 file"),
+        "garbage": (tmp_path / "garbage.state", "not an mmic-yamcs-sdls-state 2 file"),
+        "version 1 (HMAC fingerprint)": (tmp_path / "v1.state", "a version-1 file"),
         "value out of range": (tmp_path / "big.state", "out of the 96-bit counter's range"),
         "in the key directory": (keys / "spi-257.state", "is in the key directory"),
     }
     (tmp_path / "garbage.state").write_text("0\n")
+    (tmp_path / "v1.state").write_text(good.replace("mmic-yamcs-sdls-state 2", "mmic-yamcs-sdls-state 1"))
     (tmp_path / "big.state").write_text(good.replace("value 0", f"value {2**97}"))
     (keys / "spi-257.state").write_text(good)
     seen = {}

@@ -11,7 +11,7 @@ import java.security.MessageDigest;
 import java.util.HexFormat;
 import java.util.List;
 
-import javax.crypto.Mac;
+import javax.crypto.Cipher;
 import javax.crypto.spec.SecretKeySpec;
 
 import org.yamcs.ConfigurationException;
@@ -27,21 +27,31 @@ import org.yamcs.ConfigurationException;
  * lines):
  *
  * <pre>
- * mmic-yamcs-sdls-state 1
+ * mmic-yamcs-sdls-state 2
  * spi 257
  * role tx                       (tx: the sender's reservation; rx: the receiver's floor)
- * fingerprint 0123456789abcdef  (HMAC-SHA256(key, "mmic-yamcs-sdls-state"), first 8 octets: which key; reveals nothing of it)
+ * fingerprint 0123456789abcdef  (the key's fingerprint, {@link #fingerprint}: which key; reveals nothing of it)
  * value 64                      (decimal; tx: 0..=2^96, rx: 0..2^96, 2^96-1 = nothing accepted yet)
  * </pre>
+ *
+ * The fingerprint is the library's ({@code Key256::fingerprint}, {@code src/link/sdls/key.rs}), one scheme in every
+ * shell: the first 8 octets of AES-256 under the key of the block {@code FINGERPRINT_BLOCK} =
+ * {@code "mmic-kcv-v1" 0x01 0x00 0x00 0x00 0x00} (a key check value; GCM with 96-bit IVs never enciphers that block).
+ * Version 1 of this file recorded HMAC-SHA256(key, "mmic-yamcs-sdls-state") instead: such a file is refused (its
+ * fingerprint cannot be checked against this scheme), naming the provisioning step.
  *
  * Anything else (a missing file, another SPI, another key, a malformed line) stops the SA at start with a
  * {@link ConfigurationException} naming the file and the provisioning step: starting from 0 is what this is for not
  * doing.
  */
 public final class SdlsCounterState {
-    public static final String MAGIC = "mmic-yamcs-sdls-state 1";
+    public static final String MAGIC = "mmic-yamcs-sdls-state 2";
+    /** The first version, whose fingerprint was an HMAC: refused with its own message. */
+    static final String MAGIC_V1 = "mmic-yamcs-sdls-state 1";
     public static final BigInteger IV_SPACE = BigInteger.ONE.shiftLeft(96);
-    private static final byte[] FINGERPRINT_LABEL = "mmic-yamcs-sdls-state".getBytes(StandardCharsets.US_ASCII);
+    /** The block the fingerprint enciphers (src/link/sdls/key.rs FINGERPRINT_BLOCK): 12-octet label, zero counter. */
+    static final byte[] FINGERPRINT_BLOCK = { 'm', 'm', 'i', 'c', '-', 'k', 'c', 'v', '-', 'v', '1', 0x01, 0, 0, 0, 0 };
+    static final int FINGERPRINT_LEN = 8;
 
     public enum Role {
         TX, RX
@@ -82,6 +92,11 @@ public final class SdlsCounterState {
             throw new ConfigurationException(where + " cannot be read (" + e + "): " + provisioning(file, spi));
         }
         try {
+            if (!lines.isEmpty() && lines.get(0).equals(MAGIC_V1)) {
+                throw new IllegalArgumentException("a version-1 file (its fingerprint is an HMAC, not the library's"
+                        + " key check value): its counter cannot be tied to the key; for this key provision a new"
+                        + " state with --resume-above the value it holds, or better a new key");
+            }
             if (lines.size() != 5 || !lines.get(0).equals(MAGIC)) {
                 throw new IllegalArgumentException("not an " + MAGIC + " file of five lines");
             }
@@ -119,13 +134,19 @@ public final class SdlsCounterState {
         return f[1];
     }
 
-    /** The key's fingerprint: HMAC-SHA256(key, label), first 8 octets, hex (reveals nothing of the key). */
+    /**
+     * The key's fingerprint, hex: the first 8 octets of AES-256 (ECB, one block, no padding) under the key of
+     * {@link #FINGERPRINT_BLOCK}, as the library's {@code Key256::fingerprint} (reveals nothing of the key). A key
+     * that is not 32 octets has none: refused.
+     */
     public static String fingerprint(byte[] key) {
+        if (key == null || key.length != 32) {
+            throw new IllegalArgumentException("an AES-256 key is 32 octets, not " + (key == null ? 0 : key.length));
+        }
         try {
-            Mac mac = Mac.getInstance("HmacSHA256");
-            mac.init(new SecretKeySpec(key, "HmacSHA256"));
-            byte[] h = mac.doFinal(FINGERPRINT_LABEL);
-            return HexFormat.of().formatHex(h, 0, 8);
+            Cipher aes = Cipher.getInstance("AES/ECB/NoPadding");
+            aes.init(Cipher.ENCRYPT_MODE, new SecretKeySpec(key, "AES"));
+            return HexFormat.of().formatHex(aes.doFinal(FINGERPRINT_BLOCK), 0, FINGERPRINT_LEN);
         } catch (GeneralSecurityException e) {
             throw new IllegalStateException(e);
         }
