@@ -59,7 +59,35 @@ fn boot_server(flash: &Flash) -> Server {
         None => s.add(ONE),
     });
     s.secure(ONE, key(1), key(2), b.stored).unwrap();
+    assert!(s.restore_queue(ONE, &b.queue));
     s
+}
+
+/// TC(8,1) `k`: move arm A to 900 + k µs (each telecommand its own command, so that board A's
+/// executions are counted per telecommand).
+fn arm(seq: u16, k: u16) -> Vec<u8> {
+    use mmic::command::{Command, ServoTarget};
+    let c = Command::Arm {
+        side: mmic::units::Side::A,
+        target: ServoTarget::Position(mmic::units::PulseWidth::new(900 + k).unwrap()),
+    };
+    let mut data = [0u8; 16];
+    let n = mmic::pus::function::encode(&c, &mut data).unwrap();
+    let mut b = [0u8; 64];
+    let len = TcRepr {
+        apid: Apid::new(0x101).unwrap(),
+        seq_count: SeqCount::new(seq).unwrap(),
+        header: TcSecondaryHeader {
+            ack: AckFlags::ALL,
+            service: 8,
+            subservice: 1,
+            source_id: 9,
+        },
+        app_data: &data[..n],
+    }
+    .emit(&mut b)
+    .unwrap();
+    b[..len].to_vec()
 }
 
 /// Both ends over a clean link, 1 ms steps; board A answers every command at once.
@@ -131,22 +159,37 @@ impl Link {
             }
             self.keep();
         }
-        for (_, c) in self.server.tick(now) {
-            // Board A (not restarted) runs a sequenced command once: a copy of its last one
-            // is answered, not run.
-            if c.seq != 0 && c.seq != self.board_a_last {
-                self.board_a_last = c.seq;
-                if c.command == mmic::command::Command::Stop {
-                    *self.ran.entry(self.run_count).or_default() += 1;
-                    self.run_count += 1;
+        // Twice, as a shell's pass does: a telecommand about to leave for board A is written
+        // as gone from the queue, then sent, with no restart between the two.
+        for _ in 0..2 {
+            for (_, c) in self.server.tick(now) {
+                // Board A (not restarted) runs a sequenced command once: a copy of its last one
+                // is answered, not run.
+                if c.seq != 0 && c.seq != self.board_a_last {
+                    self.board_a_last = c.seq;
+                    match c.command {
+                        mmic::command::Command::Stop => {
+                            *self.ran.entry(self.run_count).or_default() += 1;
+                            self.run_count += 1;
+                        }
+                        mmic::command::Command::Arm {
+                            target: mmic::command::ServoTarget::Position(p),
+                            ..
+                        } => {
+                            *self.ran.entry(u32::from(p.get()) + 100_000).or_default() += 1;
+                            self.run_count += 1;
+                        }
+                        _ => {}
+                    }
                 }
+                let hb = HeartbeatRepr {
+                    last_seq: self.board_a_last,
+                    mode: Mode::Operational,
+                    ..HeartbeatRepr::default()
+                };
+                self.server.heartbeat(now, &hb);
+                self.keep();
             }
-            let hb = HeartbeatRepr {
-                last_seq: self.board_a_last,
-                mode: Mode::Operational,
-                ..HeartbeatRepr::default()
-            };
-            self.server.heartbeat(now, &hb);
             self.keep();
         }
         let mut buf = [0u8; 256];
@@ -164,9 +207,13 @@ impl Link {
     }
 
     fn send(&mut self, seq: u16, now: u32) {
+        self.send_packet(&stop(seq), now);
+    }
+
+    fn send_packet(&mut self, packet: &[u8], now: u32) {
         let mut up = Vec::new();
         self.ground
-            .send(&stop(seq), now, &mut |f: &[u8]| up.push(f.to_vec()))
+            .send(packet, now, &mut |f: &[u8]| up.push(f.to_vec()))
             .unwrap();
         self.up.extend(up);
     }
@@ -317,4 +364,73 @@ fn an_authentic_frame_refused_after_a_restart_is_not_reported_as_an_attack() {
         let want = if *name == "not-reserved" { 1 } else { 3 };
         assert_eq!(e.severity(), want, "{name}");
     }
+}
+
+/// The server board restarts at every millisecond of a run of three telecommands (each its own
+/// arm move). Whatever the instant, no telecommand runs twice, and every one the store held in
+/// the gateway's queue at the restart runs exactly once after it: FARM-1 acknowledges a frame
+/// only once its telecommand is in the store's queue (no TM frame leaves before), and a
+/// telecommand leaves the queue for board A only once the store says so; one that had left
+/// (handed to the legacy uplink) ran at most once, and a copy the ground sends is answered
+/// from the kept keys. Without the queue kept (the store before this change) a restart
+/// between acceptance and the hand-over loses the telecommand: the last assertion shows it.
+#[test]
+fn a_restart_at_any_instant_runs_every_queued_telecommand_exactly_once() {
+    let pulse_of = |j: &mmic::node::server::gateway::Job| match j.command {
+        mmic::command::Command::Arm {
+            target: mmic::command::ServoTarget::Position(p),
+            ..
+        } => u32::from(p.get()) + 100_000,
+        _ => 0,
+    };
+    let run = |crash: Option<u32>, keep_queue: bool| -> (Link, Vec<u32>) {
+        let mut l = Link::new();
+        let mut queued = Vec::new();
+        for k in 1..=3u16 {
+            l.send_packet(&arm(k, k), 1);
+        }
+        for now in 1..4_000 {
+            if Some(now) == crash {
+                let q = store::queue::queue_load(ONE, &|k| l.flash.get(&k).copied());
+                queued = q.iter().map(|(_, j)| pulse_of(j)).collect();
+                if !keep_queue {
+                    for s in 0..store::queue::QUEUE_SLOTS as u8 {
+                        l.flash.remove(&store::queue::queue_key(ONE, s));
+                    }
+                }
+                l.server = boot_server(&l.flash);
+            }
+            l.step(now);
+        }
+        (l, queued)
+    };
+    let (clean, _) = run(None, true);
+    assert_eq!(clean.run_count, 3);
+    let (mut restored, mut lost_without) = (0, 0);
+    for t in 1..400 {
+        let (l, queued) = run(Some(t), true);
+        assert!(
+            l.ran.values().all(|&n| n == 1),
+            "restart at {t} ms: {:?}",
+            l.ran
+        );
+        for p in &queued {
+            assert_eq!(
+                l.ran.get(p),
+                Some(&1),
+                "restart at {t} ms: queued {p} did not run once"
+            );
+        }
+        restored += queued.len();
+        let (w, q) = run(Some(t), false);
+        lost_without += q.iter().filter(|p| !w.ran.contains_key(p)).count();
+    }
+    assert!(
+        restored > 0 && lost_without > 0,
+        "{restored} {lost_without}: the test shows nothing"
+    );
+    println!(
+        "399 restart instants: {restored} queued telecommands restored, each run once, none twice; \
+         without the queue kept {lost_without} of them lost"
+    );
 }

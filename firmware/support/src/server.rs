@@ -54,8 +54,9 @@ pub const TM_WAITING: usize = 1024;
 pub const TC_DATAGRAM: usize = 257;
 /// Distinct keys of one served robot the store can hold (`store::foreign` counts them as
 /// that robot's): its two SDLS counters, their two fingerprints, FARM-1's progress with and
-/// without SDLS, four kept-key slots. A log of `ENTRIES_PER_ROBOT * R` keys is never full.
-pub const ENTRIES_PER_ROBOT: usize = 10;
+/// without SDLS, four kept-key slots, and the 16 slots of its telecommand queue's ring
+/// (`store::queue`). A log of `ENTRIES_PER_ROBOT * R` keys is never full.
+pub const ENTRIES_PER_ROBOT: usize = 10 + mmic::node::server::store::queue::QUEUE_SLOTS;
 /// Entries of robots the image does not serve kept aside in RAM (and carried over at a
 /// compaction); more are counted and left out.
 pub const FOREIGN: usize = 16;
@@ -409,7 +410,14 @@ impl<St: EntryStore, const R: usize> ServerGlue<St, R> {
         }
         let now = clock.now_ms();
         self.persist(now);
-        for (b, command) in self.gateway.tick(now) {
+        let mut visits = self.gateway.tick(now);
+        // A telecommand the tick held until the store says it left the queue (write-ahead):
+        // written now, and handed to board A in this same pass.
+        if visits.is_empty() && !self.gateway.durable_due::<1>().is_empty() {
+            self.persist(now);
+            visits = self.gateway.tick(now);
+        }
+        for (b, command) in visits {
             if board.command(b, command.to_bytes()) {
                 self.counts.commands = self.counts.commands.wrapping_add(1);
             } else {
@@ -501,6 +509,10 @@ fn build<const R: usize>(
         }
         g.secure(r.board, r.tc.clone(), r.tm.clone(), r.boot.stored)
             .map_err(|e| (i, LinkStop::Secure(e)))?;
+        // The telecommands it had accepted and not yet sent to board A: each runs once.
+        if !r.boot.queue.is_empty() && !g.restore_queue(r.board, &r.boot.queue) {
+            return Err((i, LinkStop::NotServed));
+        }
     }
     Ok(g)
 }

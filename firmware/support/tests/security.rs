@@ -459,6 +459,35 @@ fn the_kept_keys_and_farm_progress_survive_a_restart() {
         .any(|&(seq, stage, ok)| seq == 0 && stage != Stage::Completion && !ok));
 }
 
+/// A telecommand FARM-1 accepted and the gateway still held in its queue when the server board
+/// restarted (board A had not answered yet: the gateway holds telecommands until its first
+/// heartbeat) is restored from the store's queue and runs once after the restart: the ground,
+/// whose CLCW acknowledged it, never sends it again (decision `restart-server`, write-ahead).
+#[test]
+fn a_telecommand_queued_at_a_restart_runs_once_after_it() {
+    let mut bench = Bench::new(clear);
+    bench.board.silent = true;
+    bench.run(100);
+    bench.send(&tc(8, 1, 0, &[6]));
+    bench.run(500);
+    assert_eq!(stops(&bench), 0);
+    assert!(bench.heard.accepted.contains(&0), "{:?}", bench.heard);
+    assert_eq!(bench.glue.gateway().gateway().queued(b(1)).len(), 1);
+    let ram = bench::flash_of(&mut bench.glue);
+    bench.glue = bench::glue([1], &partition(&[1]), ram.reset());
+    assert!(bench.glue.stopped().is_empty());
+    assert_eq!(bench.glue.gateway().gateway().queued(b(1)).len(), 1);
+    bench.board.silent = false;
+    assert!(bench.run_until(3000, |b| stops(b) == 1));
+    bench.run(2000);
+    assert_eq!(stops(&bench), 1, "the restored telecommand ran again");
+    // Its reports may be lost with the first TM frames after the restart (the ground's SDLS
+    // refuses them as beyond its floor: decision sdls-counters); commanding goes on.
+    bench.send(&tc(17, 1, 1, &[]));
+    assert!(bench.run_until(3000, |b| b.heard.completed.contains(&1)));
+    assert_eq!(stops(&bench), 1);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Who may speak.
 

@@ -416,6 +416,10 @@ pub fn boot_gateway(
             }
         }
     }
+    // The telecommands it had accepted and not yet sent to board A: each runs once.
+    if !boot.queue.is_empty() && !g.restore_queue(board, &boot.queue) {
+        return Err(BootError::NotServed(board.get()));
+    }
     Ok(g)
 }
 
@@ -433,6 +437,22 @@ pub fn persist_gateway(g: &mut FrameGateway, d: &Durable) -> bool {
         g.durable_written(e);
     }
     true
+}
+
+/// The gateway's tick with what it asks kept written first and, when the tick held a
+/// telecommand back until the store says it left the queue (write-ahead), written and ticked
+/// again at once: the hand-over to board A follows its write in the same pass.
+pub fn tick_gateway(
+    g: &mut FrameGateway,
+    d: &Durable,
+    now: u32,
+) -> heapless::Vec<(mmic::units::BoardNumber, mmic::wire::command::CommandRepr), 1> {
+    persist_gateway(g, d);
+    let visits = g.tick(now);
+    if visits.is_empty() && !g.durable_due::<1>().is_empty() && persist_gateway(g, d) {
+        return g.tick(now);
+    }
+    visits
 }
 
 /// Secures the ground's end of robot `board`'s link from what `d` kept of its counters.

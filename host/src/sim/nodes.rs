@@ -923,8 +923,7 @@ impl FrameGatewayTask {
             };
             super::durable::persist_gateway(gw, &self.store);
             let mut busy = self.link(&node, gw);
-            super::durable::persist_gateway(gw, &self.store);
-            let visits = gw.tick(node.clock.now_ms());
+            let visits = super::durable::tick_gateway(gw, &self.store, node.clock.now_ms());
             for (board, command) in visits {
                 busy = true;
                 if board == self.robot.0 {

@@ -578,7 +578,14 @@ fn frames_loop(g: &mut ReplayFrameGateway, io: &mut ServerIo<'_>, m: &mut impl M
         m.enter(Phase::Node);
     }
     m.call(Call::Tick, true);
-    let to_robots = g.tick(now);
+    keep(g);
+    let mut to_robots = g.tick(now);
+    // As the engine's `tick_gateway`: a telecommand held until the store says it left the
+    // queue leaves in this pass.
+    if to_robots.is_empty() && !g.durable_due::<1>().is_empty() {
+        keep(g);
+        to_robots = g.tick(now);
+    }
     m.call(Call::Tick, false);
     let visit = to_robots
         .iter()

@@ -1351,12 +1351,12 @@ impl<'c, G: Ground> Engine<'c, G> {
                 Ok(_) => {}
             }
         }
-        self.robots[i].persist();
-        let Board::Frames(g) = &mut self.robots[i].board else {
+        let r = &mut self.robots[i];
+        let Board::Frames(g) = &mut r.board else {
             return;
         };
-        let visit = g
-            .tick(now)
+        // The store written first; a telecommand held until it says so leaves in this pass.
+        let visit = super::durable::tick_gateway(g, &r.store, now)
             .iter()
             .find(|(b, _)| *b == number)
             .map(|(_, c)| c.to_bytes());

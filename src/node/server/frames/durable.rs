@@ -11,16 +11,63 @@
 //! reservations run ahead, and nothing is protected or accepted beyond a confirmed one.
 
 use super::{FrameGateway, RobotLink};
+use crate::node::server::gateway::Job;
+use crate::node::server::store::queue::{job_entry, queue_key, QUEUE_SLOTS};
 use crate::node::server::store::{kept_entries, Entry};
+use crate::units::BoardNumber;
 use heapless::Vec;
 
 /// Entries one robot may have due at once: two SDLS counters, the progress, four kept keys.
 pub const DUE_PER_ROBOT: usize = 7;
 
 impl<const N: usize> RobotLink<N> {
+    /// Follows the gateway's queue in the ring: slots of telecommands that left are freed,
+    /// new ones take the next slots in order (the queue only grows at its end and leaves at its
+    /// head, so it stays one run of slots, oldest first).
+    fn sync_ring(&mut self, queue: &[Job]) {
+        for slot in self.ring.iter_mut() {
+            if slot.is_some_and(|k| !queue.iter().any(|j| j.key() == k)) {
+                *slot = None;
+            }
+        }
+        for j in queue {
+            if !self.ring.contains(&Some(j.key())) {
+                let s = usize::from(self.ring_next) % QUEUE_SLOTS;
+                if let Some(slot) = self.ring.get_mut(s) {
+                    *slot = Some(j.key());
+                }
+                self.ring_next = ((s + 1) % QUEUE_SLOTS) as u8;
+            }
+        }
+    }
+
+    /// What slot `s` should hold: its telecommand, or empty when none, or when it is the head
+    /// about to leave for board A (`wants_out`).
+    fn slot_due(&self, s: usize, queue: &[Job], wants_out: Option<(u16, u16)>) -> Entry {
+        let key = self.ring.get(s).copied().flatten();
+        let job = key
+            .filter(|k| Some(*k) != wants_out)
+            .and_then(|k| queue.iter().find(|j| j.key() == k));
+        job_entry(self.board, s as u8, job)
+    }
+
     /// The gating entries of this link that differ from what the shell confirmed: the
-    /// progress, then each kept key slot.
-    fn gating_due(&self, kept: Option<&super::Kept>, out: &mut impl FnMut(Entry)) {
+    /// progress, each kept key slot, each queue slot.
+    fn gating_due(
+        &self,
+        kept: Option<&super::Kept>,
+        queue: &[Job],
+        wants_out: Option<(u16, u16)>,
+        out: &mut impl FnMut(Entry),
+    ) {
+        for s in 0..QUEUE_SLOTS {
+            let e = self.slot_due(s, queue, wants_out);
+            let written = self.ring_written.get(s).copied().flatten();
+            // An empty slot never written need not be.
+            if Some(e) != written && !(written.is_none() && e.aux == 0) {
+                out(e);
+            }
+        }
         let secured = self.sdls.is_some();
         if self.progress != self.progress_kept {
             out(self.progress.entry(self.board, secured));
@@ -47,7 +94,11 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         let mut due = Vec::new();
         for l in &self.links {
             let kept = self.gateway.kept(l.board);
-            l.gating_due(kept.as_ref(), &mut |e| {
+            let (queue, out) = (
+                self.gateway.queued(l.board),
+                self.gateway.wants_out(l.board),
+            );
+            l.gating_due(kept.as_ref(), queue, out, &mut |e| {
                 let _ = due.push(e);
             });
         }
@@ -75,6 +126,9 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
             }
             return false;
         }
+        if let Some(done) = self.queue_written(e) {
+            return done;
+        }
         for l in self.links.iter_mut() {
             let Some(kept) = self.gateway.kept(l.board) else {
                 continue;
@@ -95,7 +149,13 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     pub(super) fn gated(&self) -> bool {
         self.links.iter().any(|l| {
             let mut any = false;
-            l.gating_due(self.gateway.kept(l.board).as_ref(), &mut |_| any = true);
+            let (queue, out) = (
+                self.gateway.queued(l.board),
+                self.gateway.wants_out(l.board),
+            );
+            l.gating_due(self.gateway.kept(l.board).as_ref(), queue, out, &mut |_| {
+                any = true
+            });
             any
         })
     }
@@ -114,5 +174,61 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 *w = Some(*e);
             }
         }
+    }
+
+    /// A queue slot's entry written: noted; when it is the head's emptied slot, the head may
+    /// leave for board A. `None` when `e` is no queue entry of ours.
+    fn queue_written(&mut self, e: &Entry) -> Option<bool> {
+        let l = self
+            .links
+            .iter_mut()
+            .find(|l| (0..QUEUE_SLOTS as u8).any(|s| queue_key(l.board, s) == e.key))?;
+        let board = l.board;
+        let s = (0..QUEUE_SLOTS).find(|&s| queue_key(board, s as u8) == e.key)?;
+        let queue = self.gateway.queued(board);
+        let wants_out = self.gateway.wants_out(board);
+        if l.slot_due(s, queue, wants_out) != *e {
+            return Some(false);
+        }
+        let fresh = l.ring_written.get(s).copied().flatten() != Some(*e);
+        if let Some(w) = l.ring_written.get_mut(s) {
+            *w = Some(*e);
+        }
+        let head = l.ring.get(s).copied().flatten();
+        if let (Some(k), Some(out)) = (head, wants_out) {
+            if k == out && e.aux == 0 {
+                self.gateway.clear_to_send(board, k);
+            }
+        }
+        Some(fresh)
+    }
+
+    /// Every link's ring follows its gateway queue.
+    pub(super) fn sync_rings(&mut self) {
+        for l in self.links.iter_mut() {
+            l.sync_ring(self.gateway.queued(l.board));
+        }
+    }
+
+    /// After a restart, robot `board`'s queue as its store kept it, `(slot, job)` oldest first
+    /// (`store::Boot::queue`): each runs once. False when the robot is not served or the
+    /// queue could not take them all.
+    pub fn restore_queue(&mut self, board: BoardNumber, queue: &[(u8, Job)]) -> bool {
+        let jobs: Vec<Job, QUEUE_SLOTS> = queue.iter().map(|(_, j)| *j).collect();
+        let all = self.gateway.restore_queue(board, &jobs);
+        let Some(l) = self.links.iter_mut().find(|l| l.board == board) else {
+            return false;
+        };
+        for (slot, job) in queue {
+            let s = usize::from(*slot) % QUEUE_SLOTS;
+            if let Some(r) = l.ring.get_mut(s) {
+                *r = Some(job.key());
+            }
+            if let Some(w) = l.ring_written.get_mut(s) {
+                *w = Some(job_entry(board, s as u8, Some(job)));
+            }
+            l.ring_next = ((s + 1) % QUEUE_SLOTS) as u8;
+        }
+        all
     }
 }

@@ -57,6 +57,7 @@
 use super::gateway::{
     Config as GatewayConfig, Gateway, Kept, Out, TmOut, KEPT_SOURCES, MAX_TM_DATA,
 };
+use super::store::queue::QUEUE_SLOTS;
 use super::store::{Entry, Progress};
 use crate::ccsds::primary::PrimaryHeader;
 use crate::ccsds::tm::TM_MIN_LEN;
@@ -285,6 +286,11 @@ struct RobotLink<const N: usize> {
     progress_kept: Progress,
     /// The kept-key entries the shell last confirmed, by slot.
     kept_written: [Option<Entry>; KEPT_SOURCES],
+    /// The gateway's queue in the store's ring (write-ahead): which telecommand each slot
+    /// holds, the next slot a new one takes, and what the shell last confirmed per slot.
+    ring: [Option<(u16, u16)>; QUEUE_SLOTS],
+    ring_next: u8,
+    ring_written: [Option<Entry>; QUEUE_SLOTS],
 }
 
 impl<const N: usize> RobotLink<N> {
@@ -373,6 +379,8 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         if !added {
             return false;
         }
+        // Every shell of the frame gateway keeps the queue (`durable_due`).
+        self.gateway.write_ahead(board, true);
         self.links
             .push(RobotLink {
                 board,
@@ -386,6 +394,9 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 progress: Progress::default(),
                 progress_kept: Progress::default(),
                 kept_written: [None; KEPT_SOURCES],
+                ring: [None; QUEUE_SLOTS],
+                ring_next: 0,
+                ring_written: [None; QUEUE_SLOTS],
             })
             .is_ok()
     }
@@ -427,6 +438,21 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         link.sdls = Some(table);
         if let Some(p) = stored.progress {
             self.resume(board, p);
+        }
+        // Where the TC window stands now is what a restart must resume from, exactly: kept
+        // before anything leaves, even before the first frame (else a restart would take the
+        // floor, a block ahead, as the last IV accepted, and refuse the ground's next frames).
+        if let Some(link) = self.links.iter_mut().find(|l| l.board == board) {
+            let spi = sdls::mission::tc_spi(board);
+            let last = link
+                .sdls
+                .as_ref()
+                .and_then(|t| t.get(spi))
+                .and_then(|sa| match sa.role() {
+                    sdls::Role::Receive(w) => Some(w.last().get()),
+                    sdls::Role::Send(_) => None,
+                });
+            link.progress.tc_iv = last;
         }
         Ok(())
     }
@@ -640,6 +666,7 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 .tc_packets_refused
                 .wrapping_add(u32::from(result.refused));
         }
+        self.sync_rings();
         result
     }
 
@@ -656,6 +683,7 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
             return Vec::new();
         }
         let out = self.gateway.tick(now);
+        self.sync_rings();
         let mut to_robots = Vec::new();
         for c in &out.to_robots {
             let _ = to_robots.push(*c);

@@ -44,7 +44,9 @@
 
 mod robot;
 
-pub use robot::{Kept, KEPT_SOURCES};
+pub use robot::{Job, Kept, KEPT_SOURCES};
+
+mod ahead;
 
 use crate::ccsds::cuc::Cuc;
 use crate::ccsds::primary::{Apid, SeqCount};
@@ -284,6 +286,9 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
                 counters: [0; 16],
                 marks: kept.clone(),
                 restored: kept,
+                write_ahead: false,
+                cleared: None,
+                wants_out: None,
             })
             .is_ok()
     }

@@ -26,15 +26,27 @@ pub(super) struct Entry {
     pub(super) last: Option<Report>,
 }
 
-/// A telecommand on its way: queued, sent to board A, or running there.
+/// A telecommand on its way to board A: queued, sent, or running there (what a durable
+/// store keeps of a queued one: `node::server::store::job_entry`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub(super) struct Job {
-    pub(super) request: RequestId,
-    pub(super) source_id: u16,
-    pub(super) ack: u8,
-    pub(super) command: Command,
+pub struct Job {
+    /// Its request ID (APID, packet sequence count).
+    pub request: RequestId,
+    /// Its source.
+    pub source_id: u16,
+    /// The ST\[1\] reports asked for (bits 0, 1, 3: acceptance, start, completion).
+    pub ack: u8,
+    /// The command board A runs.
+    pub command: Command,
     /// Are-you-alive: answer TM(17,2) when board A answers.
-    pub(super) alive: bool,
+    pub alive: bool,
+}
+
+impl Job {
+    /// Its key: source ID and sequence count.
+    pub const fn key(&self) -> (u16, u16) {
+        (self.source_id, self.request.seq_count)
+    }
 }
 
 /// One robot's side of the gateway.
@@ -63,6 +75,12 @@ pub(super) struct Robot<const Q: usize, const K: usize> {
     /// restart. After one, `restored` holds what was kept then.
     pub(super) marks: Kept,
     pub(super) restored: Kept,
+    /// Write-ahead (the frame gateway's): the queue's head leaves for board A only once the
+    /// shell has written durably that it left ([`super::Gateway::clear_to_send`]): `cleared`
+    /// is that head's key, `wants_out` the head waiting for it.
+    pub(super) write_ahead: bool,
+    pub(super) cleared: Option<(u16, u16)>,
+    pub(super) wants_out: Option<(u16, u16)>,
 }
 
 /// How many sources (ground stations, operators) a robot's kept keys remember.
@@ -125,6 +143,18 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
         self.log_entry(key, request, None);
         self.mark(key);
         Some(request)
+    }
+
+    /// A queued job restored after a restart: its key logged (a copy is answered, not run)
+    /// with `rep`, its latest report, and marked.
+    pub(super) fn restore_job(&mut self, job: Job, rep: Report) {
+        let request = if job.alive {
+            Request::AreYouAlive
+        } else {
+            Request::Function(job.command)
+        };
+        self.log_entry(job.key(), request, Some(rep));
+        self.mark(job.key());
     }
 
     /// Logs a new key (the oldest forgotten when the log is full).
@@ -260,7 +290,14 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
             }
             return;
         }
-        if !self.queue.is_empty() {
+        if let Some(head) = self.queue.first() {
+            if self.write_ahead && self.cleared != Some(head.key()) {
+                // Not before the store says it left: after a restart it would run again.
+                self.wants_out = Some(head.key());
+                return;
+            }
+            self.wants_out = None;
+            self.cleared = None;
             let job = self.queue.remove(0);
             if let Ok(seq) = self.uplink.submit(job.command) {
                 if job.command == Command::Stop {

@@ -9,6 +9,7 @@
 //! | `0x2000 + n` | V(R) | the last TC IV accepted | FARM-1 and the TC window exactly where they stood |
 //! | `0x2100 + n` | V(R) | 0 | FARM-1 on a link without SDLS |
 //! | `0x3000 + 4n + slot` | 1 (0: empty) | source ID << 16 \| sequence count | the gateway's kept telecommand keys ([`Kept`]) |
+//! | `0x4000 + 16n + slot` | 1 (0: empty) | a queued telecommand ([`queue`]) | the gateway's queue, written before a telecommand is acknowledged and before it leaves for board A |
 //!
 //! A link starts only from a provisioned store ([`boot`]): each of its SPIs needs its key's
 //! fingerprint and its counter. A blank store, a fingerprint of another key, or a counter
@@ -45,6 +46,7 @@
 
 pub mod keys;
 pub mod log;
+pub mod queue;
 
 use super::frames::Stored;
 use super::gateway::{Kept, KEPT_SOURCES};
@@ -265,6 +267,8 @@ pub struct Boot {
     pub stored: Stored,
     /// The gateway's kept telecommand keys (`None`: none kept, a first start).
     pub kept: Option<Kept>,
+    /// The gateway's queue as kept: (slot, telecommand), oldest first.
+    pub queue: heapless::Vec<(u8, crate::node::server::gateway::Job), { queue::QUEUE_SLOTS }>,
 }
 
 /// One association's counter, if its key's fingerprint is the stored one.
@@ -315,6 +319,11 @@ pub fn boot(
         } else {
             None
         },
+        queue: if server {
+            queue::queue_load(board, &lookup)
+        } else {
+            heapless::Vec::new()
+        },
     })
 }
 
@@ -328,6 +337,7 @@ pub fn boot_clear(board: BoardNumber, lookup: impl Fn(u16) -> Option<(u8, u128)>
             progress: Progress::load(board, &lookup),
         },
         kept: kept_load(board, &lookup),
+        queue: queue::queue_load(board, &lookup),
     }
 }
 
@@ -391,6 +401,7 @@ pub fn foreign(served: &[BoardNumber], key: u16) -> bool {
     let robot = match key {
         0x0100..=0x02FF | 0x1100..=0x12FF | 0x2000..=0x21FF => Some((key & 0xFF) as u8),
         0x3000..=0x33FF => Some(((key - 0x3000) / 4) as u8),
+        0x4000..=0x4FFF => Some(((key - 0x4000) / 16) as u8),
         _ => None,
     };
     !robot.is_some_and(|r| served.iter().any(|b| b.get() == r))
