@@ -23,7 +23,8 @@ timeouts) and as the attacker. The kinds of attack:
 - replays: within a run, accepted frames sent again, and the oldest ones: refused;
 - bc-forgery: Set V(R) and Unlock from another address (127.0.0.2): refused `bc-origin`; from the ground's own
   address (another socket on 127.0.0.1: on loopback every local process shares it, documented): obeyed by
-  FARM-1, a denial of service at most: nothing executes, the ground's commands still complete or are reported;
+  FARM-1 (not protected at COP-1, decision sdls-clear-bc): nothing executes, the ground's commands still complete
+  or are reported (the end-to-end guarantee);
 - clcw-relay: an on-path relay between robot and ground drops chosen AD frames, forges Set V(R) past them and
   rewrites every CLCW's N(R) (the FECF made good) so that COP-1 believes them delivered: the ground's own ST[1]
   timeouts find and report each lost command, nothing runs twice;
@@ -782,8 +783,8 @@ class Suite:
         lost = outs.count("lost")
         self.check(all(o in ("complete", "lost") for o in outs), f"BC forgery: the ground's commands {outs}")
         self.notes.append(f"bc-forgery: {len(forged)} from 127.0.0.2 refused bc-origin, FARM-1's V(R) unmoved; "
-                          f"{obeyed} of {len(mine)} from the ground's own address obeyed by FARM-1 (documented: a "
-                          f"denial of service), the ground's 5 commands: {outs.count('complete')} complete, {lost} "
+                          f"{obeyed} of {len(mine)} from the ground's own address obeyed by FARM-1 (documented: not "
+                          f"protected at COP-1), the ground's 5 commands: {outs.count('complete')} complete, {lost} "
                           f"reported lost, none ran unseen")
         self.log(f"  bc forgery: other address {got}; own address {got2}; commands {outs}")
 
