@@ -34,7 +34,9 @@ pub const fn tm_spi(board: BoardNumber) -> u16 {
 /// worst, about 110 transmissions per 30 s FOP-1 cycle, 2^20 is some 80 hours of outage.
 pub const TC_WINDOW: u32 = 1 << 20;
 /// The server board's TC floor is reserved 16 counters at a time (a flash write per 16
-/// frames; a restart refuses at most 24 of the ground's next frames, which COP-1 sends again).
+/// frames). After a restart the window resumes at the exact last IV the store kept with
+/// FARM-1's progress (`node::server::store`), so no frame of the ground is refused as a replay;
+/// from the floor alone it would refuse up to 24 of them, which COP-1 sends again.
 pub const TC_RX_BLOCK: u32 = 16;
 /// The ground's TC counter is reserved 64 at a time.
 pub const TC_TX_BLOCK: u32 = 64;
