@@ -63,13 +63,12 @@ use crate::ccsds::primary::PrimaryHeader;
 use crate::ccsds::tm::TM_MIN_LEN;
 use crate::link::clcw::ClcwVcid;
 use crate::link::farm::{Farm, FarmState, FarmWindow, Verdict};
-use crate::link::sdls::{self, frames as secured, Key256, SaTable, SdlsCounters, SdlsRefusal};
+use crate::link::sdls::{self, frames as secured, SaTable, SdlsRefusal};
 use crate::link::tc_frame::Packets;
 use crate::link::tc_frame::{self, SpacecraftId, TcFrame, TcFrameError, TcPrimaryHeader};
 use crate::link::tm_frame::{TmFrameParams, TM_FRAME_LEN};
 use crate::link::tm_framer::{TmFramer, IDLE_PERIOD_MS};
 use crate::link::FrameKind;
-use crate::pus::event::Event;
 use crate::pus::robot_apid;
 use crate::units::BoardNumber;
 use crate::wire::command::CommandRepr;
@@ -77,6 +76,7 @@ use crate::wire::heartbeat::HeartbeatRepr;
 use heapless::Vec;
 
 mod durable;
+mod secure;
 pub use durable::DUE_PER_ROBOT;
 
 /// The largest telemetry packet the gateway writes.
@@ -294,6 +294,38 @@ struct RobotLink<const N: usize> {
 }
 
 impl<const N: usize> RobotLink<N> {
+    /// A checked TC frame from `origin` before FARM-1: a BC frame only from the ground's
+    /// address; a data frame through SDLS when the link is secured (its plaintext into `plain`,
+    /// its range and IV returned), a refusal counted (and waiting for its ST\[5\] report).
+    fn unwrap_tc(
+        &mut self,
+        frame: &TcFrame<&[u8]>,
+        origin: Origin,
+        plain: &mut [u8; tc_frame::MAX_FRAME_LEN],
+    ) -> Result<(Option<core::ops::Range<usize>>, Option<u128>), FrameRefusal> {
+        let bc = frame.kind() == FrameKind::Bc;
+        if bc && origin != Origin::Ground {
+            self.counters.bc_origin = self.counters.bc_origin.wrapping_add(1);
+            return Err(FrameRefusal::Origin);
+        }
+        let Some(table) = self.sdls.as_mut().filter(|_| !bc) else {
+            return Ok((None, None));
+        };
+        match secured::verify_tc(table, frame, plain) {
+            Ok((v, range)) => Ok((Some(range), Some(v.iv.get()))),
+            Err(e) => {
+                if let Some(a) = self.alarms.get_mut(e.position()) {
+                    a.pending = a.pending.saturating_add(1);
+                    a.spi = frame
+                        .as_bytes()
+                        .get(6..8)
+                        .map_or(0, |b| u16::from_be_bytes([b[0], b[1]]));
+                }
+                Err(e.into())
+            }
+        }
+    }
+
     fn clcw(&self) -> [u8; 4] {
         self.farm
             .clcw(
@@ -401,112 +433,6 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
             .is_ok()
     }
 
-    /// Secures robot `board`'s link with SDLS (`crate::link::sdls::mission`): its TC frames
-    /// are verified under `tc_key` (and refused unless they verify, BC frames excepted), its
-    /// TM frames protected under `tm_key`; `stored`, what the shell kept (the counters, and
-    /// FARM-1's progress, [`FrameGateway::resume`]). Call it right after
-    /// [`FrameGateway::add`], before any frame: the TM framer starts again with room for the
-    /// security header and MAC. An error leaves the link as it was: the shell must not run it
-    /// in clear instead.
-    pub fn secure(
-        &mut self,
-        board: BoardNumber,
-        tc_key: Key256,
-        tm_key: Key256,
-        stored: Stored,
-    ) -> Result<(), SecureError> {
-        let idle = self.cfg.idle_period_ms;
-        let n = board.get();
-        let link = self
-            .links
-            .iter_mut()
-            .find(|l| l.board == board)
-            .ok_or(SecureError::NotServed { board: n })?;
-        let params = link
-            .framer
-            .params()
-            .with_security(sdls::HEADER_LEN as u8, sdls::MAC_LEN as u8)
-            .ok_or(SecureError::Layout { board: n })?;
-        let mut table = SaTable::new();
-        let tc = sdls::mission::tc_receiver(board, tc_key, stored.tc);
-        let tm = sdls::mission::tm_sender(board, tm_key, stored.tm);
-        // Unreachable: an empty table of two places takes two SPIs that differ.
-        if table.add(tc).is_err() || table.add(tm).is_err() {
-            return Err(SecureError::NotServed { board: n });
-        }
-        link.framer = TmFramer::new(params, idle);
-        link.sdls = Some(table);
-        if let Some(p) = stored.progress {
-            self.resume(board, p);
-        }
-        // Where the TC window stands now is what a restart must resume from, exactly: kept
-        // before anything leaves, even before the first frame (else a restart would take the
-        // floor, a block ahead, as the last IV accepted, and refuse the ground's next frames).
-        if let Some(link) = self.links.iter_mut().find(|l| l.board == board) {
-            let spi = sdls::mission::tc_spi(board);
-            let last = link
-                .sdls
-                .as_ref()
-                .and_then(|t| t.get(spi))
-                .and_then(|sa| match sa.role() {
-                    sdls::Role::Receive(w) => Some(w.last().get()),
-                    sdls::Role::Send(_) => None,
-                });
-            link.progress.tc_iv = last;
-        }
-        Ok(())
-    }
-
-    /// Robot `board`'s FARM-1 resumes at the kept V(R) (Open, no flag), and, on a secured link,
-    /// its TC window at the last IV accepted (when the durable floor covers it). False when
-    /// the robot is not served.
-    pub fn resume(&mut self, board: BoardNumber, p: Progress) -> bool {
-        let window = self.cfg.farm_window;
-        let Some(link) = self.links.iter_mut().find(|l| l.board == board) else {
-            return false;
-        };
-        let status = crate::link::farm::FarmStatus {
-            vr: p.vr,
-            ..Farm::new(window).status()
-        };
-        if let Some(farm) = Farm::restore(window, status) {
-            link.farm = farm;
-        }
-        let spi = sdls::mission::tc_spi(board);
-        if let (Some(table), Some(iv)) = (link.sdls.as_mut(), p.tc_iv) {
-            table.resume(spi, iv);
-        }
-        link.progress = p;
-        link.progress_kept = p;
-        true
-    }
-
-    /// SDLS's counters of robot `board`, when its link is secured.
-    pub fn security(&self, board: BoardNumber) -> Option<&SdlsCounters> {
-        self.links
-            .iter()
-            .find(|l| l.board == board)
-            .and_then(|l| l.sdls.as_ref())
-            .map(|t| t.counters())
-    }
-
-    /// The durable numbers to write now, (SPI, value): the shell writes each and confirms it
-    /// with [`FrameGateway::persisted`] once it is durable.
-    pub fn due(&self) -> impl Iterator<Item = (u16, u128)> + '_ {
-        self.links
-            .iter()
-            .filter_map(|l| l.sdls.as_ref())
-            .flat_map(|t| t.due())
-    }
-
-    /// The shell wrote `value` for `spi` durably.
-    pub fn persisted(&mut self, spi: u16, value: u128) -> bool {
-        self.links
-            .iter_mut()
-            .filter_map(|l| l.sdls.as_mut())
-            .any(|t| t.persisted(spi, value))
-    }
-
     /// The gateway behind the link.
     pub const fn gateway(&self) -> &Gateway<R, Q, K> {
         &self.gateway
@@ -588,36 +514,18 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         // SDLS before FARM-1 (355.0-B-2 §2.3.3): a data frame that does not verify changes
         // nothing but SDLS's counter of its reason; the packets come from the plaintext.
         let mut plain = [0u8; tc_frame::MAX_FRAME_LEN];
-        let mut data = if frame.kind() == FrameKind::Bc {
-            &[][..]
-        } else {
-            frame.data()
-        };
-        if frame.kind() == FrameKind::Bc && origin != Origin::Ground {
-            link.counters.bc_origin = link.counters.bc_origin.wrapping_add(1);
-            result.verdict = Err(FrameRefusal::Origin);
-            return result;
-        }
-        let mut iv = None;
-        if let (Some(table), true) = (link.sdls.as_mut(), frame.kind() != FrameKind::Bc) {
-            match secured::verify_tc(table, &frame, &mut plain) {
-                Ok((v, range)) => {
-                    iv = Some(v.iv.get());
-                    data = plain.get(range).unwrap_or(&[]);
-                }
-                Err(e) => {
-                    result.verdict = Err(e.into());
-                    if let Some(a) = link.alarms.get_mut(e.position()) {
-                        a.pending = a.pending.saturating_add(1);
-                        a.spi = bytes
-                            .get(6..8)
-                            .map_or(0, |b| u16::from_be_bytes([b[0], b[1]]));
-                    }
+        let (data, iv) = match link.unwrap_tc(&frame, origin, &mut plain) {
+            Ok((Some(range), iv)) => (plain.get(range).unwrap_or(&[]), iv),
+            Ok((None, iv)) if frame.kind() == FrameKind::Bc => (&[][..], iv),
+            Ok((None, iv)) => (frame.data(), iv),
+            Err(e) => {
+                result.verdict = Err(e);
+                if let FrameRefusal::Security(_) = e {
                     self.security_reports(now);
-                    return result;
                 }
+                return result;
             }
-        }
+        };
         let packets = Packets::new(data).count();
         let room = self.gateway.queue_room(board).unwrap_or(0);
         link.counters.tc_frames = link.counters.tc_frames.wrapping_add(1);
@@ -692,46 +600,6 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         self.release_buffers();
         self.security_reports(now);
         to_robots
-    }
-
-    /// The ST\[5\] reports of SDLS refusals due now: per robot and reason, at most one per
-    /// [`SECURITY_EVENT_PERIOD_MS`], counting every frame refused since the last.
-    fn security_reports(&mut self, now: u32) {
-        let mut due: Vec<(u16, Event), 16> = Vec::new();
-        for l in self.links.iter_mut() {
-            for (reason, a) in l.alarms.iter_mut().enumerate() {
-                if a.ready(now) {
-                    let e = Event::Security {
-                        reason: reason as u8,
-                        refused: a.pending,
-                        spi: a.spi,
-                    };
-                    if due.push((robot_apid(l.board), e)).is_ok() {
-                        a.pending = 0;
-                        a.last = Some(now);
-                    }
-                }
-            }
-        }
-        for (apid, e) in due {
-            self.report(now, &TmOut::new(apid, 5, e.severity(), 0, &e.to_bytes()));
-        }
-    }
-
-    /// Robot `stopped`'s link could not start (`reason`: its place in
-    /// [`crate::pus::event::LINK_STOPPED_REASONS`]): reported as ST\[5\] `link_stopped` in
-    /// every served robot's telemetry, the first chance an operator has to learn it over the
-    /// link (a stopped link has no trusted way to send anything). False when no link runs.
-    pub fn link_stopped(&mut self, now: u32, stopped: BoardNumber, reason: u8) -> bool {
-        let e = Event::LinkStopped {
-            board: stopped.get(),
-            reason,
-        };
-        let apids: Vec<u16, R> = self.links.iter().map(|l| robot_apid(l.board)).collect();
-        for apid in &apids {
-            self.report(now, &TmOut::new(*apid, 5, e.severity(), 0, &e.to_bytes()));
-        }
-        !apids.is_empty()
     }
 
     /// A heartbeat from board A of `hb.board`; the reports go into the TM framer.
