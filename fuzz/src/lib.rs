@@ -37,7 +37,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 18] = [
+pub const TARGETS: [&str; 19] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -56,6 +56,7 @@ pub const TARGETS: [&str; 18] = [
     "sdls_tc_verify",
     "sdls_tm_verify",
     "pus_event",
+    "server_store",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -564,6 +565,7 @@ pub fn seeds() -> Vec<SeedFile> {
     }
     out.extend(tm_seeds());
     out.extend(sdls_seeds());
+    out.extend(store_seeds());
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.
     let packet = |k: PacketKind| {
         valid
@@ -903,4 +905,53 @@ pub fn sdls_seeds() -> Vec<SeedFile> {
             bytes,
         })
         .collect()
+}
+
+/// Seeds of `server_store` (a selector octet, then the reader's input): a log entry record, a
+/// sector header, a keys partition of one key (a fixed test key made at run time: not a secret),
+/// a queued Stop's slot value.
+pub fn store_seeds() -> Vec<SeedFile> {
+    use mmic::node::server::store::{keys, log, queue, Entry};
+    let target = TARGETS[18];
+    let mut out = Vec::new();
+    let mut push = |name: &str, selector: u8, body: &[u8]| {
+        let mut bytes = vec![selector];
+        bytes.extend_from_slice(body);
+        out.push(SeedFile {
+            target,
+            name: name.to_string(),
+            bytes,
+        });
+    };
+    let entry = Entry {
+        key: 0x0201,
+        aux: 0,
+        value: 0x100,
+    };
+    if let Some(r) = log::encode_entry(&entry) {
+        push("log-entry", 0, &r);
+    }
+    push("log-header", 0, &log::encode_header(3));
+    let key = mmic::link::sdls::Key256::from_bytes(core::array::from_fn(|i| {
+        (i as u8).wrapping_mul(31) ^ 0x5c
+    }));
+    let mut part = [0xFFu8; keys::HEADER_LEN + keys::ENTRY_LEN + 4];
+    if keys::emit(&[(257, &key)], &mut part).is_ok() {
+        push("keys-partition", 1, &part);
+    }
+    let job = mmic::node::server::gateway::Job {
+        request: mmic::pus::verification::RequestId {
+            apid: 0x101,
+            seq_count: 7,
+        },
+        source_id: 9,
+        ack: 0xF,
+        command: mmic::command::Command::Stop,
+        alive: false,
+    };
+    let v = queue::job_entry(mmic::units::BoardNumber::ONE, 3, Some(&job)).value;
+    let mut body = vec![1u8, 3];
+    body.extend_from_slice(&v.to_be_bytes()[4..]);
+    push("queue-slot", 2, &body);
+    out
 }

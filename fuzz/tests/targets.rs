@@ -36,6 +36,9 @@
 //!   directly, and through a secured ground link's `tm_frame`, as they are and with the frame
 //!   checks' fields and FECF written over them: refused and counted, nothing changed, no
 //!   packet handed on, unless exactly a frame the (fixed, test) key's holder protected.
+//! * `server_store`: the server board's durable store (`mmic_proofs::store`): a selector
+//!   octet, then 20 octets as a flash log record, any octets as the `mmic_keys` partition, or a
+//!   robot, a slot and 12 octets as a queue slot: refused by name, or read exactly as written.
 //! * `link_clcw`, `link_cop`: COP-1 of the space data link (`mmic_proofs::link_cop`): the
 //!   CLCW's verdict and round trip; FARM-1 taking AD frames once and in order, FOP-1 keeping
 //!   its window and confirming in order, over any sequence of events.
@@ -277,5 +280,29 @@ fn sdls_tm_verify() {
         let input = &input[..input.len().min(300)];
         mmic_proofs::sdls::check_secured_tm_frame(input);
         mmic_proofs::sdls::check_secured_tm_frame_resealed(input);
+    });
+}
+
+/// The server board's durable store (issue 38): a selector octet, then the input of one of its
+/// readers (`mmic_proofs::store`): a flash log record, the keys partition, a queue slot.
+#[test]
+fn server_store() {
+    bolero::check!().for_each(|input: &[u8]| match input {
+        [0, rest @ ..] if rest.len() >= 20 => {
+            let mut r = [0u8; 20];
+            r.copy_from_slice(&rest[..20]);
+            mmic_proofs::store::check_log_record(&r);
+        }
+        [1, rest @ ..] => {
+            mmic_proofs::store::check_keys_partition(&rest[..rest.len().min(600)]);
+        }
+        [2, board, slot, rest @ ..] if rest.len() >= 12 => {
+            if let Ok(b) = mmic::units::BoardNumber::new(*board) {
+                let mut v = [0u8; 16];
+                v[4..].copy_from_slice(&rest[..12]);
+                mmic_proofs::store::check_queue_value(b, *slot % 16, u128::from_be_bytes(v));
+            }
+        }
+        _ => {}
     });
 }

@@ -36,6 +36,7 @@ pub mod link_cop;
 pub mod link_tm;
 pub mod pus;
 pub mod sdls;
+pub mod store;
 
 use core::fmt::Debug;
 use mmic::arbitrary::for_each_variant_class;

@@ -20,6 +20,7 @@ mod safety_timers;
 mod sdls;
 mod sensors_frontend;
 mod sensors_moving_average;
+mod store;
 mod transport;
 
 /// Every harness lands with its ledger row: each `#[test]` function of the harness files (the

@@ -120,6 +120,37 @@ pub enum KeysError {
     },
 }
 
+impl KeysError {
+    /// Every refusal's name.
+    pub const NAMES: [&'static str; 9] = [
+        "blank",
+        "magic",
+        "version",
+        "count",
+        "truncated",
+        "crc",
+        "reserved",
+        "duplicate",
+        "weak-key",
+    ];
+
+    /// The refusal's name ([`KeysError::Room`], a writer's error, is `room`).
+    pub const fn name(&self) -> &'static str {
+        match self {
+            KeysError::Blank => Self::NAMES[0],
+            KeysError::Magic => Self::NAMES[1],
+            KeysError::Version { .. } => Self::NAMES[2],
+            KeysError::Count { .. } => Self::NAMES[3],
+            KeysError::Truncated { .. } => Self::NAMES[4],
+            KeysError::Crc { .. } => Self::NAMES[5],
+            KeysError::Reserved { .. } => Self::NAMES[6],
+            KeysError::Duplicate { .. } => Self::NAMES[7],
+            KeysError::Weak { .. } => Self::NAMES[8],
+            KeysError::Room { .. } => "room",
+        }
+    }
+}
+
 /// The keys read from a partition, by SPI (zeroized when dropped).
 #[derive(Debug, Default)]
 pub struct KeySet {
