@@ -300,18 +300,13 @@ impl Event {
                 }
             }
             4 => Event::Restarted(Boot::from_wire(b[2])),
-            5 => {
-                if b[2] == 0 {
-                    return Err(field("board", 0));
+            5 => match (b[2], b[3]) {
+                (0, _) => return Err(field("board", 0)),
+                (board, reason) if usize::from(reason) < LINK_STOPPED_REASONS.len() => {
+                    Event::LinkStopped { board, reason }
                 }
-                if usize::from(b[3]) >= LINK_STOPPED_REASONS.len() {
-                    return Err(field("reason", u32::from(b[3])));
-                }
-                Event::LinkStopped {
-                    board: b[2],
-                    reason: b[3],
-                }
-            }
+                (_, reason) => return Err(field("reason", u32::from(reason))),
+            },
             0x0100..=0x01FF => Event::Fault {
                 fault: Fault::ALL
                     .into_iter()

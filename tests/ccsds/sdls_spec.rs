@@ -107,6 +107,16 @@ fn the_choices_are_the_codes() {
     assert_eq!(text(&t, "store", "kept_key"), "0x3000 + 4n + slot");
     assert_eq!(store::kept_key(b, 3), 0x3000 + 4 * 7 + 3);
     assert_eq!(text(&t, "sa", "keys_partition"), "mmic_keys");
+    let names = |key: &str| -> Vec<String> {
+        t["store"][key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_str().unwrap().to_string())
+            .collect()
+    };
+    assert_eq!(names("keys_refusals"), store::keys::KeysError::NAMES);
+    assert_eq!(names("link_stopped"), mmic::pus::event::LINK_STOPPED_REASONS);
     assert!(repo("firmware/server/partitions.csv").contains("mmic_keys,"));
     assert_eq!(
         mmic::node::server::frames::FrameRefusal::Origin.name(),

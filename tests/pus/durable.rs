@@ -3,9 +3,6 @@
 //! board, so that after a restart the ground's next transmission is taken at once and its
 //! FOP-1 sees the N(R) it expects; BC frames obeyed only from the ground's address.
 
-use mmic::ccsds::primary::{Apid, SeqCount};
-use mmic::ccsds::tc::TcRepr;
-use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::link::sdls::Key256;
 use mmic::link::tc_frame::{SpacecraftId, TcContent, TcFrameRepr, Vcid};
 use mmic::link::ControlCommand;
@@ -30,21 +27,7 @@ fn key(s: u8) -> Key256 {
 }
 
 fn stop(seq: u16) -> Vec<u8> {
-    let mut b = [0u8; 14];
-    TcRepr {
-        apid: Apid::new(0x101).unwrap(),
-        seq_count: SeqCount::new(seq).unwrap(),
-        header: TcSecondaryHeader {
-            ack: AckFlags::ALL,
-            service: 8,
-            subservice: 1,
-            source_id: 9,
-        },
-        app_data: &[6],
-    }
-    .emit(&mut b)
-    .unwrap();
-    b.to_vec()
+    crate::function_tc(seq, &[6])
 }
 
 /// The server board as it boots from its flash (both ends provisioned for keys 1 and 2).
@@ -73,21 +56,7 @@ fn arm(seq: u16, k: u16) -> Vec<u8> {
     };
     let mut data = [0u8; 16];
     let n = mmic::pus::function::encode(&c, &mut data).unwrap();
-    let mut b = [0u8; 64];
-    let len = TcRepr {
-        apid: Apid::new(0x101).unwrap(),
-        seq_count: SeqCount::new(seq).unwrap(),
-        header: TcSecondaryHeader {
-            ack: AckFlags::ALL,
-            service: 8,
-            subservice: 1,
-            source_id: 9,
-        },
-        app_data: &data[..n],
-    }
-    .emit(&mut b)
-    .unwrap();
-    b[..len].to_vec()
+    crate::function_tc(seq, &data[..n])
 }
 
 /// Both ends over a clean link, 1 ms steps; board A answers every command at once.

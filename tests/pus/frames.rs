@@ -5,9 +5,6 @@
 //! order (its ST[1] acceptance reports, read back through the TM frames, say so), whatever the
 //! channels do; COP-1 retransmits what they lose.
 
-use mmic::ccsds::primary::{Apid, SeqCount};
-use mmic::ccsds::tc::TcRepr;
-use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::ccsds::tm::TmRepr;
 use mmic::link::farm::{DiscardReason, FarmState};
 use mmic::link::fop::FopState;
@@ -86,21 +83,7 @@ impl Channel {
 
 /// TC(8,1) perform function 6, Stop (spec/ccsds/functions.toml), numbered `seq`.
 fn stop(seq: u16) -> Vec<u8> {
-    let mut b = [0u8; 14];
-    TcRepr {
-        apid: Apid::new(0x101).unwrap(),
-        seq_count: SeqCount::new(seq).unwrap(),
-        header: TcSecondaryHeader {
-            ack: AckFlags::ALL,
-            service: 8,
-            subservice: 1,
-            source_id: 9,
-        },
-        app_data: &[6],
-    }
-    .emit(&mut b)
-    .unwrap();
-    b.to_vec()
+    crate::function_tc(seq, &[6])
 }
 
 /// SDLS on both ends, and an attacker on the uplink.
