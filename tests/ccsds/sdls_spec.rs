@@ -116,7 +116,10 @@ fn the_choices_are_the_codes() {
             .collect()
     };
     assert_eq!(names("keys_refusals"), store::keys::KeysError::NAMES);
-    assert_eq!(names("link_stopped"), mmic::pus::event::LINK_STOPPED_REASONS);
+    assert_eq!(
+        names("link_stopped"),
+        mmic::pus::event::LINK_STOPPED_REASONS
+    );
     assert!(repo("firmware/server/partitions.csv").contains("mmic_keys,"));
     assert_eq!(
         mmic::node::server::frames::FrameRefusal::Origin.name(),
