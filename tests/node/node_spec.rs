@@ -6,6 +6,7 @@ use mmic::motion::estimate;
 use mmic::node::exactly_once::uplink;
 use mmic::node::robot::board_a;
 use mmic::node::robot::board_b::{self, BoardB};
+use mmic::node::server::relay;
 use mmic::sensors::frontend;
 use mmic::units::{Axis, PulseWidth, Sign};
 use mmic::wire::b_command::{BCommandRepr, BPower};
@@ -17,6 +18,8 @@ struct Boards {
     board_a: BoardA,
     board_b: BoardB2,
     ground: Ground,
+    server: ServerSpec,
+    ops_line: OpsLine,
     sensor_frontend: Frontend,
     estimate: Estimate,
 }
@@ -43,6 +46,27 @@ struct Ground {
     timeout_ms: u32,
     efficiency_window: u8,
     max_attempts: u8,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ServerSpec {
+    answer_ms: u32,
+    serial_reserve_ms: u32,
+    visit_ms: u32,
+}
+
+/// The serial line's settings: read by the host's opsUI (`mmic opsui`), checked here for
+/// the values only.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(dead_code)]
+struct OpsLine {
+    baud: u32,
+    data_bits: u8,
+    parity: String,
+    stop_bits: u8,
+    flow_control: String,
 }
 
 #[derive(Deserialize)]
@@ -86,6 +110,17 @@ fn the_nodes_defaults_equal_spec_boards() {
         )
     );
     assert_eq!(uplink::Efficiency::WINDOW, s.ground.efficiency_window);
+    assert_eq!(
+        (relay::ANSWER_MS, relay::SERIAL_RESERVE_MS, relay::VISIT_MS),
+        (
+            s.server.answer_ms,
+            s.server.serial_reserve_ms,
+            s.server.visit_ms
+        )
+    );
+    // The relay's window is the opsUI's, less the serial line's share.
+    assert_eq!(s.server.answer_ms, g.timeout_ms);
+    assert_eq!(s.server.visit_ms + s.server.serial_reserve_ms, g.timeout_ms);
     assert_eq!(
         frontend::Config::default().loss_ticks,
         s.sensor_frontend.loss_ticks

@@ -366,7 +366,8 @@ pub struct SimConfig {
     pub ground: uplink::Config,
     /// Stop after this much simulated time, ms.
     pub max_sim_ms: u32,
-    /// How long the server waits for a heartbeat before disconnecting, ms.
+    /// How long the server waits for a heartbeat before disconnecting, ms: the relay's
+    /// [`VISIT_MS`](mmic::node::server::relay::VISIT_MS) unless a test asks otherwise.
     pub visit_ms: u32,
     /// Write the JSON-lines log here (none: keep only the summary).
     pub log_path: Option<PathBuf>,
@@ -629,7 +630,7 @@ impl SimConfig {
                 ..uplink::Config::default()
             },
             max_sim_ms: 900_000,
-            visit_ms: 250,
+            visit_ms: mmic::node::server::relay::VISIT_MS,
             log_path: None,
             log_packets: true,
             progress: false,

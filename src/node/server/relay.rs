@@ -43,6 +43,23 @@ use crate::wire::WireError;
 /// A command packet.
 pub type Packet = [u8; COMMAND_LEN];
 
+/// The opsUI's answer window, ms (Section 8: "If the heartbeat packet is not received within
+/// 0.7 s, the opsUI counts that as a failed communication attempt"); the uplink's default
+/// [`timeout_ms`](crate::node::exactly_once::uplink::Config::timeout_ms).
+pub const ANSWER_MS: u32 = 700;
+
+/// What the serial line and the loops on either side of it take of [`ANSWER_MS`], ms: the
+/// command's 14 octets and the heartbeat's 66 at 115,200 baud (1.2 ms and 5.7 ms), the
+/// server's idle poll of its serial line (10 ms in the image) and the opsUI's own tick, with
+/// room to spare (spec/boards.toml `[server]`, decision `relay-visit-window`).
+pub const SERIAL_RESERVE_MS: u32 = 50;
+
+/// How long the relay's visit of a robot lasts at most, connecting included, ms: as long as the
+/// opsUI's 0.7 s window allows once the serial line's share is set aside. A heartbeat that
+/// comes later could not reach the opsUI in time, which would count the attempt failed anyway
+/// (decision `relay-visit-window`). The simulator and the relay image use this one number.
+pub const VISIT_MS: u32 = ANSWER_MS - SERIAL_RESERVE_MS;
+
 /// What became of an accepted packet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
