@@ -50,9 +50,9 @@ pub const ANSWER_MS: u32 = 700;
 
 /// What the serial line and the loops on either side of it take of [`ANSWER_MS`], ms: the
 /// command's 14 octets and the heartbeat's 66 at 115,200 baud (1.2 ms and 5.7 ms), the
-/// server's idle poll of its serial line (10 ms in the image) and the opsUI's own tick, with
-/// room to spare (spec/boards.toml `[server]`, decision `relay-visit-window`).
-pub const SERIAL_RESERVE_MS: u32 = 50;
+/// server's idle poll of its serial line (10 ms in the image) and the opsUI's 10 ms tick,
+/// 27 ms in all (spec/boards.toml `[server]`, decision `relay-visit-window`).
+pub const SERIAL_RESERVE_MS: u32 = 30;
 
 /// How long the relay's visit of a robot lasts at most, connecting included, ms: as long as the
 /// opsUI's 0.7 s window allows once the serial line's share is set aside. A heartbeat that
