@@ -18,7 +18,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use zeroize::Zeroizing;
 
-/// The keys partition's size (firmware/server/partitions.csv `mmic_keys`).
+/// The keys partition's size (firmware/server-ccsds/partitions.csv `mmic_keys`).
 pub const KEYS_PARTITION: usize = 0x1000;
 /// The counters partition's sector, and its size: two sectors (`mmic_ctr`).
 pub const COUNTER_SECTOR: usize = 0x1000;

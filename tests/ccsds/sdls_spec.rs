@@ -120,7 +120,7 @@ fn the_choices_are_the_codes() {
         names("link_stopped"),
         mmic::pus::event::LINK_STOPPED_REASONS
     );
-    assert!(repo("firmware/server/partitions.csv").contains("mmic_keys,"));
+    assert!(repo("firmware/server-ccsds/partitions.csv").contains("mmic_keys,"));
     assert_eq!(
         mmic::node::server::frames::FrameRefusal::Origin.name(),
         "bc-origin"

@@ -11,6 +11,7 @@ pub mod drivers;
 pub mod durable;
 pub mod link;
 pub mod net;
+pub mod relay;
 pub mod restart;
 pub mod sensors;
 pub mod server;

@@ -103,15 +103,15 @@ pub trait Clock {
 pub enum PartitionFault {
     /// The partition table could not be read or is not valid.
     #[error(
-        "the partition table could not be read: flash with --partition-table server/partitions.csv"
+        "the partition table could not be read: flash with --partition-table server-ccsds/partitions.csv"
     )]
     Table,
     /// No partition of that label.
-    #[error("no such partition: flash with --partition-table server/partitions.csv")]
+    #[error("no such partition: flash with --partition-table server-ccsds/partitions.csv")]
     Absent,
     /// The partition is not data/undefined, or the image cannot use it as it is (an encrypted
     /// counters partition).
-    #[error("the partition's type or flags are not server/partitions.csv's")]
+    #[error("the partition's type or flags are not server-ccsds/partitions.csv's")]
     Kind,
     /// Reading it failed.
     #[error("the partition could not be read")]

@@ -1,4 +1,6 @@
-//! The server board towards the ground over the space data link (issue 28): TC transfer frames
+//! The server board towards the ground over the space data link (issue 28), the CCSDS gateway
+//! image: not the paper's server board, which relays the opsUI's serial line and is
+//! firmware/server-paper. TC transfer frames
 //! arrive on UDP port [`net::TC_PORT`] and go into the library's `FrameGateway` (SDLS, FARM-1
 //! per robot, the PUS gateway); the legacy commands it makes
 //! go to board A in visits (connect, send, the heartbeat by the visit's deadline, disconnect:
@@ -9,7 +11,7 @@
 //! The image carries no key. At start-up it reads the SDLS keys from the flash partition
 //! `mmic_keys` and clears the buffer they were read into; the durable store (SDLS counters, key
 //! fingerprints, FARM-1's progress, the gateway's kept telecommand keys) is the log in
-//! `mmic_ctr` (server/partitions.csv; both written apart from the image, firmware/README.md
+//! `mmic_ctr` (server-ccsds/partitions.csv; both written apart from the image, firmware/README.md
 //! "Keys"). Whatever the flash holds — no partition table, a partition missing, a keys
 //! partition blank, corrupt or with a weak key, a store blank, of another key or of other
 //! robots — nothing here panics: the robots that cannot start have their links stopped, the
@@ -57,9 +59,9 @@ esp_bootloader_esp_idf::esp_app_desc!();
 // `ROBOTS`, from `MMIC_ROBOTS` (build.rs).
 include!(concat!(env!("OUT_DIR"), "/robots.rs"));
 
-/// The flash partition of the SDLS keys (server/partitions.csv): written apart from the image.
+/// The flash partition of the SDLS keys (server-ccsds/partitions.csv): written apart from the image.
 const KEYS_PARTITION: &str = "mmic_keys";
-/// The flash partition of the durable store (server/partitions.csv): two 4 KiB sectors.
+/// The flash partition of the durable store (server-ccsds/partitions.csv): two 4 KiB sectors.
 const COUNTERS_PARTITION: &str = "mmic_ctr";
 /// Robots served.
 const R: usize = ROBOTS.len();
@@ -83,7 +85,7 @@ const ENTRIES: usize = ENTRIES_PER_ROBOT * R;
 const IDLE_MS: u32 = 10;
 /// How often the status line (and the reasons of stopped links) is logged, ms.
 const STATUS_MS: u32 = 30_000;
-/// The partitions' raw type and subtype (server/partitions.csv: data, undefined).
+/// The partitions' raw type and subtype (server-ccsds/partitions.csv: data, undefined).
 const DATA: u8 = 0x01;
 const UNDEFINED: u8 = 0x06;
 
@@ -176,7 +178,7 @@ fn labelled(e: &PartitionEntry, name: &str) -> bool {
     label.get(..len) == Some(name.as_bytes())
 }
 
-/// The partition, if it is there and data/undefined as server/partitions.csv has it (its
+/// The partition, if it is there and data/undefined as server-ccsds/partitions.csv has it (its
 /// type is checked before esp-bootloader-esp-idf reads it as one it knows).
 fn usable(entry: Option<PartitionEntry>) -> Result<PartitionEntry, PartitionFault> {
     let e = entry.ok_or(PartitionFault::Absent)?;
