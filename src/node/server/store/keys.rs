@@ -1,4 +1,4 @@
-//! The keys partition (`mmic_keys`, firmware/server/partitions.csv): the server board's SDLS
+//! The keys partition (`mmic_keys`, firmware/server-ccsds/partitions.csv): the server board's SDLS
 //! keys, flashed apart from the image (the image carries no key), read at start-up.
 //!
 //! | octets | what |
