@@ -5,8 +5,11 @@
 //!
 //! Every row (or cell) that is the project's rather than the paper's carries the mark [`MARK`]
 //! and the spec/decisions.toml entry that introduced it, as spec/ records it
-//! ([`crate::spec::origins`]); a row of the paper says which table it comes from. A reviewer
-//! reading a page as the paper therefore sees at once what the paper does not say.
+//! ([`crate::spec::origins`]); a row of the paper says which table it comes from, followed by
+//! what the project adds to it (an encoding, a preset, a second use of a slot), each marked with
+//! its decision. Below the rows, a byte cell of the paper's grid and a unit cell are marked too
+//! when spec/packets adds to them (`additions`, `unit_decision`). A reviewer reading a page as
+//! the paper therefore sees at once what the paper does not say.
 
 use mmic::arbitrary::for_each_variant_class;
 use mmic::command::{Command, CommandKind};
@@ -42,6 +45,16 @@ pub fn ours(decision: Option<&str>) -> String {
     }
 }
 
+/// A row of the paper's origin cell followed by what the project adds to it, each addition
+/// marked with its decision: `Table 1: Single module; † `hip-presets` (the preset angles)`.
+fn with_additions(paper: String, additions: &[crate::spec::Addition]) -> String {
+    let mut cell = paper;
+    for a in additions {
+        let _ = write!(cell, "; {} ({})", ours(Some(&a.decision)), a.what);
+    }
+    cell
+}
+
 /// Every page: file name and contents.
 pub fn all() -> Vec<(String, String)> {
     let mut v: Vec<(String, String)> = PacketKind::ALL
@@ -68,11 +81,13 @@ pub fn packet(kind: PacketKind) -> String {
     let mut s = String::new();
     let fields = kind.fields();
     let h = kind.header();
-    let (packet_decision, field_decisions) = crate::spec::origins()
+    let origin = crate::spec::origins()
         .packets
         .get(kind.name())
         .cloned()
         .unwrap_or_default();
+    let packet_decision = origin.decision;
+    let field_origin = |name: &str| origin.fields.get(name).cloned().unwrap_or_default();
     let paper_table = match kind {
         PacketKind::Command => Some("Table 2"),
         PacketKind::Heartbeat => Some("Table 3"),
@@ -91,7 +106,22 @@ pub fn packet(kind: PacketKind) -> String {
         String::from_utf8_lossy(&h),
         kind.len() - 3
     );
-    let _ = writeln!(s, "## The paper's grid\n");
+    match paper_table {
+        Some(table) => {
+            let _ = writeln!(
+                s,
+                "## The paper's grid\n\n{table} as printed; a byte marked {MARK} carries something its \
+                 label does not say (the field table below names what, and the decision).\n"
+            );
+        }
+        None => {
+            let _ = writeln!(
+                s,
+                "## Byte grid\n\nThe paper has no such packet: every byte is the project's ({}).\n",
+                ours(packet_decision.as_deref())
+            );
+        }
+    }
     for row in (0..kind.len()).step_by(7) {
         let end = (row + 7).min(kind.len());
         let idx: Vec<String> = (row..row + 7)
@@ -110,6 +140,9 @@ pub fn packet(kind: PacketKind) -> String {
                 let mut l = String::new();
                 if let Some(f) = fields.iter().find(|f| f.range.contains(&i)) {
                     let _ = f.cell(i, &mut l);
+                    if paper_table.is_some() && field_origin(f.name).marks_byte(i) {
+                        let _ = write!(l, " {MARK}");
+                    }
                 }
                 l
             })
@@ -126,17 +159,22 @@ pub fn packet(kind: PacketKind) -> String {
         } else {
             format!("{}–{}", f.range.start, f.range.end - 1)
         };
-        let origin = match (paper_table, field_decisions.get(f.name)) {
+        let fo = field_origin(f.name);
+        let first = match (paper_table, &fo.decision) {
             (Some(table), None) => table.to_string(),
             (Some(_), Some(id)) => ours(Some(id)),
             (None, _) => ours(packet_decision.as_deref()),
         };
+        let mut origin = with_additions(first, &fo.additions);
+        let mut unit = f.unit.name().to_string();
+        if let Some(id) = &fo.unit_decision {
+            let _ = write!(unit, " {MARK}");
+            let _ = write!(origin, "; {} (unit)", ours(Some(id)));
+        }
         let _ = writeln!(
             s,
-            "| {bytes} | `{}` | {} | {} | {origin} |",
-            f.name,
-            f.unit.name(),
-            f.paper
+            "| {bytes} | `{}` | {unit} | {} | {origin} |",
+            f.name, f.paper
         );
     }
     s
@@ -179,8 +217,15 @@ pub fn commands() -> String {
             };
             let kind = c.kind().name();
             let row = origins.table1.iter().find(|(k, _)| k == kind);
+            let additions = origins
+                .opcode_additions
+                .get(&id)
+                .map_or(&[][..], Vec::as_slice);
             let (kind, origin) = match row {
-                Some((_, command_type)) => (kind.to_string(), format!("Table 1: {command_type}")),
+                Some((_, command_type)) => (
+                    kind.to_string(),
+                    with_additions(format!("Table 1: {command_type}"), additions),
+                ),
                 None => (
                     format!("{kind} {MARK}"),
                     ours(origins.extensions.get(kind).map(String::as_str)),
@@ -320,6 +365,7 @@ pub fn modes() -> String {
 pub fn faults() -> String {
     let mut s = String::new();
     let c = Config::default();
+    let origins = crate::spec::origins();
     let _ = writeln!(
         s,
         "{BANNER}\n\n# Faults — Table 8 as implemented (src/safety/)\n\n{LEGEND}\n"
@@ -346,8 +392,15 @@ pub fn faults() -> String {
         } else {
             "event"
         };
+        let additions = origins
+            .fault_additions
+            .get(f.name())
+            .map_or(&[][..], Vec::as_slice);
         let (name, origin) = match f.table8() {
-            Some(row) => (f.name().to_string(), format!("Table 8: {}", row.title())),
+            Some(row) => (
+                f.name().to_string(),
+                with_additions(format!("Table 8: {}", row.title()), additions),
+            ),
             None => {
                 let spec = crate::spec::faults().iter().find(|r| r.bit == f.bit());
                 let id = spec.and_then(|r| r.decision.as_deref());
@@ -363,10 +416,16 @@ pub fn faults() -> String {
     }
     let _ = writeln!(
         s,
-        "\nA fault in standby or safed is latched and reported only. Thresholds (defaults): low battery below {} mV for more than {} ms; \
+        "\nA fault in standby or safed is latched and reported only {}. Thresholds (defaults): low battery below {} mV for more than {} ms; \
          comm loss after {} ms of silence or {} unacknowledged sends; bolting failure after {} failed attempts; idle limits {}/{}/{} mA and absolute limits {}/{}/{} mA \
          (locomotion/gripper/bolter); hip home {} (0.01°) ± {}. The paper gives the low battery's 10 V and 0.5 s and the three \
          attempts; the other values are the project's (spec/modes.toml `[thresholds]`).",
+        ours(
+            origins
+                .rule_decisions
+                .get("faults_change_mode_only_from")
+                .map(String::as_str)
+        ),
         c.low_battery_mv,
         c.low_battery_ms,
         c.comm_timeout_ms,

@@ -338,14 +338,86 @@ pub struct Origins {
     pub accepts_decisions: BTreeMap<String, String>,
     /// Refusal code name → decision.
     pub refusal_decisions: BTreeMap<String, String>,
-    /// Packet name → (decision of a packet the paper does not have, field → decision).
-    pub packets: BTreeMap<String, (Option<String>, BTreeMap<String, String>)>,
+    /// A rule of spec/modes.toml `[rules]` that is the project's → decision.
+    pub rule_decisions: BTreeMap<String, String>,
+    /// Packet name → what of it is the project's.
+    pub packets: BTreeMap<String, PacketOrigin>,
+    /// Opcode → what its row adds to Table 1 (spec/commands.toml `additions`).
+    pub opcode_additions: BTreeMap<u8, Vec<Addition>>,
+    /// Fault name → what the code adds to its Table 8 row (spec/faults.toml `additions`).
+    pub fault_additions: BTreeMap<String, Vec<Addition>>,
+}
+
+/// Something the project adds to a row or field of the paper's (the paper's label stands, the
+/// project says more): what, and the decision that says it.
+#[derive(Debug, Clone, Deserialize, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct Addition {
+    /// What is added, in a few words.
+    pub what: String,
+    /// The spec/decisions.toml entry.
+    pub decision: String,
+    /// For a packet field: the bytes it concerns, when not all of the field's.
+    #[serde(default)]
+    pub bytes: Option<Vec<usize>>,
+}
+
+/// What of one packet field is the project's.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct FieldOrigin {
+    /// The decision that says what the field holds instead of (or beyond) the paper's label.
+    pub decision: Option<String>,
+    /// What the project adds to the paper's label.
+    pub additions: Vec<Addition>,
+    /// The decision that chose the field's unit, which the paper does not give.
+    pub unit_decision: Option<String>,
+}
+
+impl FieldOrigin {
+    /// Whether byte `i` of the field carries something the paper's label does not say: the field's own decision, or an addition over that byte. A unit alone does
+    /// not mark a byte (the unit column says it).
+    pub fn marks_byte(&self, i: usize) -> bool {
+        self.decision.is_some()
+            || self
+                .additions
+                .iter()
+                .any(|a| a.bytes.as_ref().is_none_or(|b| b.contains(&i)))
+    }
+}
+
+/// What of one packet is the project's.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct PacketOrigin {
+    /// The decision that introduced a packet the paper does not have.
+    pub decision: Option<String>,
+    /// Field name → its origin (every field of the packet).
+    pub fields: BTreeMap<String, FieldOrigin>,
 }
 
 #[derive(Deserialize)]
 struct CommandsFile {
     table1: Vec<Table1Row>,
     extension: Vec<ExtensionRow>,
+    opcode: Vec<OpcodeRow>,
+}
+
+#[derive(Deserialize)]
+struct OpcodeRow {
+    opcode: u8,
+    #[serde(default)]
+    additions: Vec<Addition>,
+}
+
+#[derive(Deserialize)]
+struct FaultsAdditionsFile {
+    fault: Vec<FaultAdditions>,
+}
+
+#[derive(Deserialize)]
+struct FaultAdditions {
+    name: String,
+    #[serde(default)]
+    additions: Vec<Addition>,
 }
 
 #[derive(Deserialize)]
@@ -365,6 +437,8 @@ struct ModesFile {
     table7_accepts: BTreeMap<String, Vec<String>>,
     accepts_decisions: BTreeMap<String, String>,
     refusal_decisions: BTreeMap<String, String>,
+    #[serde(default)]
+    rule_decisions: BTreeMap<String, String>,
 }
 
 #[derive(Deserialize)]
@@ -379,6 +453,10 @@ struct PacketField {
     name: String,
     #[serde(default)]
     decision: Option<String>,
+    #[serde(default)]
+    additions: Vec<Addition>,
+    #[serde(default)]
+    unit_decision: Option<String>,
 }
 
 fn read_origins() -> Result<Origins, toml::de::Error> {
@@ -390,10 +468,22 @@ fn read_origins() -> Result<Origins, toml::de::Error> {
         let fields = p
             .field
             .into_iter()
-            .filter_map(|f| Some((f.name, f.decision?)))
+            .map(|f| {
+                let origin = FieldOrigin {
+                    decision: f.decision,
+                    additions: f.additions,
+                    unit_decision: f.unit_decision,
+                };
+                (f.name, origin)
+            })
             .collect();
-        packets.insert(name.to_string(), (p.decision, fields));
+        let origin = PacketOrigin {
+            decision: p.decision,
+            fields,
+        };
+        packets.insert(name.to_string(), origin);
     }
+    let f: FaultsAdditionsFile = toml::from_str(FAULTS_TOML)?;
     Ok(Origins {
         table1: c
             .table1
@@ -408,7 +498,20 @@ fn read_origins() -> Result<Origins, toml::de::Error> {
         table7_accepts: m.table7_accepts,
         accepts_decisions: m.accepts_decisions,
         refusal_decisions: m.refusal_decisions,
+        rule_decisions: m.rule_decisions,
         packets,
+        opcode_additions: c
+            .opcode
+            .into_iter()
+            .filter(|o| !o.additions.is_empty())
+            .map(|o| (o.opcode, o.additions))
+            .collect(),
+        fault_additions: f
+            .fault
+            .into_iter()
+            .filter(|r| !r.additions.is_empty())
+            .map(|r| (r.name, r.additions))
+            .collect(),
     })
 }
 

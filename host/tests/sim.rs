@@ -289,6 +289,35 @@ fn the_demo_plan_parses() {
     assert_eq!(mmic_host::sim::demo_steps().len(), p.steps.len());
 }
 
+/// The demo plan's comments give each reconfiguration's number of primitives (issue 39: one
+/// said three where the plan takes two): each is the chosen plan's length.
+#[test]
+fn the_demo_plans_primitive_counts_are_the_plans() {
+    use mmic::motion::{route, State};
+    let mut checked = 0;
+    for line in mmic_host::sim::DEMO_PLAN.lines() {
+        let Some(rest) = line.strip_prefix("reconfigure ") else {
+            continue;
+        };
+        let Some((pair, comment)) = rest.split_once('#') else {
+            continue;
+        };
+        let Some((count, _)) = comment.trim().split_once(" primitive") else {
+            continue;
+        };
+        let (from, to) = pair.trim().split_once(" -> ").unwrap();
+        let state = |s: &str| State::from_letter(s.chars().next().unwrap()).unwrap();
+        let n = ["one", "two", "three"]
+            .iter()
+            .position(|w| *w == count)
+            .unwrap_or_else(|| panic!("{line}: count {count:?}"))
+            + 1;
+        assert_eq!(route::lookup(state(from), state(to)).len(), n, "{line}");
+        checked += 1;
+    }
+    assert!(checked >= 3, "{checked}");
+}
+
 #[test]
 fn a_malformed_plan_file_is_refused_with_line_and_column() {
     let dir = out_dir("bad_plan");

@@ -3,9 +3,12 @@
 //! readings with exponential smoothing. The estimate runs in both modes, but only the velocity
 //! law uses it: the position law is a PI on the angle error, which meets the settling and
 //! overshoot bounds of spec/control/hip.md without a velocity term (the paper's "again
-//! estimating velocity" read in spec/decisions.toml, `hip-position-law`). Fixed-point integers throughout (the ESP32-C3 has no
-//! FPU); the output is saturated to the configured pulse range and the integrator is clamped
-//! and frozen while the output saturates (anti-windup).
+//! estimating velocity" read in spec/decisions.toml, `hip-position-law`). Beyond the paper, which
+//! names a PI velocity controller only, the velocity law adds a feed-forward term, the pulse
+//! offset the servo needs for 10°/s (`Config::servo_gain`; spec/decisions.toml,
+//! `hip-velocity-feed-forward`). Fixed-point integers throughout (the ESP32-C3 has no FPU);
+//! the output is saturated to the configured pulse range and the integrator is clamped and
+//! frozen while the output saturates (anti-windup).
 //!
 //! Units: angles and angle errors in 0.01°, velocities in 0.01°/s, the output a pulse width in
 //! µs for the continuous-rotation hip servo (1500 µs = stop).
@@ -31,7 +34,9 @@ pub struct Config {
     pub position_band: i32,
     /// Velocity-mode speed, 0.01°/s. Paper: 10°/s.
     pub speed: i32,
-    /// Servo speed per µs away from the stop pulse, 0.01°/s per µs (feed-forward). Default 10.
+    /// Servo speed per µs away from the stop pulse, 0.01°/s per µs, for the velocity law's
+    /// feed-forward (the project's, not the paper's: spec/decisions.toml,
+    /// `hip-velocity-feed-forward`); 0 switches it off. Default 10.
     pub servo_gain: i32,
     /// Velocity mode: proportional gain, µs per (0.01°/s), Q8. Default 13/256 ≈ 0.05.
     pub kp_velocity_q8: i32,

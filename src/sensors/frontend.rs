@@ -4,7 +4,10 @@
 //! size of 50 samples." Here that means the ADS7828's eight codes and the IMU's three
 //! accelerations, one sample per control tick. The hip encoder is not averaged: an average of
 //! angles across the 0°/360° seam is wrong (359° and 1° would give 180°), and the hip
-//! controller smooths its own velocity estimate (spec/decisions.toml, `sensor-filtering`).
+//! controller smooths its own velocity estimate. Nor are the arms' contraction switches and the
+//! bolters' home switches, digital inputs that do not pass through this front end at all (the
+//! boards take them as `arm_contracted` and `bolter_at_home`; spec/decisions.toml,
+//! `sensor-filtering`).
 //!
 //! A device that does not answer gives no reading (`None`), never a made-up one. What follows
 //! is decided here, in one place (spec/decisions.toml, `sensor-loss`): a missing ADC or IMU

@@ -52,6 +52,22 @@ struct FieldRow {
     meaning: String,
     /// The decision that says what a field holds beyond the paper's label.
     decision: Option<String>,
+    /// What the project adds to the paper's label, with its decision (the review page marks it).
+    #[serde(default)]
+    additions: Vec<Addition>,
+    /// The decision that chose the unit, which the paper does not give.
+    unit_decision: Option<String>,
+}
+
+/// Something the project adds to a paper row (spec/packets, spec/commands.toml,
+/// spec/faults.toml): what, its decision and, for a packet field, the bytes it concerns.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Addition {
+    #[allow(dead_code)]
+    what: String,
+    decision: String,
+    bytes: Option<Vec<usize>>,
 }
 
 #[test]
@@ -72,12 +88,23 @@ fn packets_match_spec_field_by_field_and_cell_by_cell() {
             spec.decision.is_some(),
             "{kind}"
         );
-        for id in spec
-            .decision
-            .iter()
-            .chain(spec.field.iter().flat_map(|f| &f.decision))
-        {
+        for id in spec.decision.iter().chain(spec.field.iter().flat_map(|f| {
+            f.decision
+                .iter()
+                .chain(&f.unit_decision)
+                .chain(f.additions.iter().map(|a| &a.decision))
+        })) {
             assert!(ids.contains(&id.as_str()), "{kind}: no decision {id}");
+        }
+        // An addition's bytes are bytes of its field.
+        for f in &spec.field {
+            for b in f.additions.iter().flat_map(|a| a.bytes.iter().flatten()) {
+                assert!(
+                    (f.start..f.start + f.len).contains(b),
+                    "{kind}.{}: addition over byte {b}",
+                    f.name
+                );
+            }
         }
         assert_eq!(spec.packet, kind.name());
         assert_eq!(spec.length, kind.len(), "{kind}: length");
@@ -153,6 +180,8 @@ struct OpcodeRow {
     kind: String,
     variant: String,
     params: Vec<usize>,
+    #[serde(default)]
+    additions: Vec<Addition>,
 }
 
 #[test]
@@ -188,6 +217,15 @@ fn command_set_matches_spec() {
     }
     let mut rows: BTreeMap<u8, &OpcodeRow> = BTreeMap::new();
     for r in &spec.opcode {
+        for a in &r.additions {
+            assert!(
+                a.bytes.is_none(),
+                "{:#04x}: bytes belong to packets",
+                r.opcode
+            );
+            let d = decisions.decision.iter().find(|d| d.id == a.decision);
+            assert!(d.is_some(), "{:#04x}: no decision {}", r.opcode, a.decision);
+        }
         assert!(
             rows.insert(r.opcode, r).is_none(),
             "opcode {:#04x} listed twice",
@@ -235,6 +273,9 @@ struct FaultRow {
     table8: String,
     /// The decision that added a bit no Table 8 row has.
     decision: Option<String>,
+    /// What the code adds to the Table 8 row's trigger.
+    #[serde(default)]
+    additions: Vec<Addition>,
 }
 
 #[test]
@@ -257,6 +298,20 @@ fn fault_bits_match_spec() {
             let d = decisions.decision.iter().find(|d| &d.id == id);
             let d = d.unwrap_or_else(|| panic!("{f}: no decision {id}"));
             assert!(d.decision.contains(f.name()), "{f}: decision {id}");
+        }
+        // An addition to a Table 8 row names a decision that names the fault.
+        for a in &row.additions {
+            assert!(
+                !own && a.bytes.is_none(),
+                "{f}: additions are to Table 8 rows"
+            );
+            let d = decisions.decision.iter().find(|d| d.id == a.decision);
+            let d = d.unwrap_or_else(|| panic!("{f}: no decision {}", a.decision));
+            assert!(
+                d.decision.contains(f.name()),
+                "{f}: decision {}",
+                a.decision
+            );
         }
     }
 }

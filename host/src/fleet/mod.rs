@@ -1,6 +1,7 @@
 //! `mmic fleet`: N robots, each with its own server board and links, against one ground
-//! process — the scale question of the paper's Section 4 (one opsUI polling many robots at its
-//! 1.2 s cadence, every answer due within 0.7 s).
+//! process — the scale question of the paper's Section 3 (one opsUI keeping "multiple persistent
+//! WiFi connections with many robots", a server board each), at Section 8's 1.2 s cadence with
+//! every answer due within 0.7 s.
 //!
 //! Two ways to run the same fleet:
 //!

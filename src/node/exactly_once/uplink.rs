@@ -1,12 +1,13 @@
 //! The opsUI's command uplink for one robot: the sending half of exactly-once commanding.
 //!
-//! Section 4: the ground sends the next command every 1.2 s, counts a heartbeat not received
-//! within 0.7 s as a failed attempt, resends until acknowledged, and shows the WiFi efficiency
-//! over the last 100 attempts (Figure 11). Here each command carries a sequence number; a
-//! heartbeat acknowledges it when its bytes 57–58 carry that number, and its byte 62 then tells
-//! whether board A accepted or refused it. A command is *done* when acknowledged, or when
-//! `max_attempts` attempts went unanswered: it is then reported as unacknowledged (it may or
-//! may not have run, never twice), never silently dropped.
+//! Section 8: in the ground demonstration the opsUI sent a command every 1.2 s, counted a
+//! heartbeat not received within 0.7 s as a failed attempt, and showed the WiFi efficiency over
+//! the last 100 attempts (Figure 11); Section 3: it resends until acknowledged. Here each
+//! command carries a sequence number; a heartbeat acknowledges it when its bytes 57–58 carry
+//! that number, and its byte 62 then tells whether board A accepted or refused it. A command
+//! is *done* when acknowledged, or when `max_attempts` attempts went unanswered: it is then
+//! reported as unacknowledged (it may or may not have run, never twice), never silently
+//! dropped.
 //!
 //! ```
 //! use mmic::command::Command;

@@ -1,7 +1,8 @@
 //! The ground: the [`link`] a command plan runs over (the paper's packets through the legacy
 //! [`Uplink`](crate::node::exactly_once::uplink::Uplink), or PUS telecommands through
 //! [`pus::TcLink`]), and the [`plan_runner`] that sends a plan's commands one at a time over
-//! either and follows the robot's heartbeats (Section 4, Figures 10 and 11).
+//! either and follows the robot's heartbeats (Section 3; the 1.2 s cadence and Figures 10 and
+//! 11 are Section 8's).
 
 pub mod frames;
 pub mod link;

@@ -4,11 +4,16 @@
 //! from the WiFi hand-off queue, at most one internal heartbeat from board B's serial line,
 //! and side A's filtered sensors — and returns side A's module outputs, the A→B command to
 //! send (if one is due), the 66-byte heartbeat answering the command (if one came), and what
-//! happened, as [`Event`]s for logs. Inside, the pieces of the earlier modules are joined in
-//! the order the paper gives: fault detection, then the mode supervisor (Tables 7 and 8),
-//! then the command (exactly-once log, supervisor, dispatch), then motion (reconfiguration
-//! runner, single-module moves), bolting (coordinator and side A's executor), and finally the
-//! servo and hip outputs.
+//! happened, as [`Event`]s for logs. The paper gives no order for these steps (Section 4 lists
+//! what board A embeds; Figure 6, board A's loop, is missing from its text), so the order of a
+//! tick is the project's: board B's heartbeat is taken in; motion and bolting advance first
+//! (the idle checks, the reconfiguration runner and single-module moves, the bolting
+//! coordinator and side A's executor, the motion deadline, the arm-contraction check), so that
+//! what follows knows whether they still run; then fault detection judges the conditions; then
+//! the command is taken (exactly-once log, board A's own checks); then the mode supervisor
+//! (Tables 7 and 8) decides on the faults and the command and dispatches it; finally the servo
+//! and hip outputs and board B's command are driven, and the heartbeat answering the command is
+//! built.
 //!
 //! ```
 //! use mmic::command::Command;
