@@ -808,7 +808,7 @@ fn check_case(c: &Case, s: &Summary, records: &[Value], json: &report::SummaryJs
         // The next reconfiguration is the one refused, and the report says why.
         let line = report::plan_line(s);
         expect(
-            line.contains("(line 12: reconfigure a -> m): refused (initial_state_mismatch)")
+            line.contains("(line 13: reconfigure a -> m): refused (initial_state_mismatch)")
                 && line.contains("the ground sent the reconfiguration from")
                 && line.contains("(initial-state-mismatch injected)"),
             format!("report: {line}"),
