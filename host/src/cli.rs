@@ -227,6 +227,10 @@ pub enum Cmd {
     /// built-in demo without --plan).
     #[command(long_about = crate::simcli::SIM_HELP, after_help = crate::simcli::SIM_AFTER)]
     Sim(Box<crate::simcli::SimArgs>),
+    /// The opsUI on a real serial device: runs a plan (the built-in demo without --plan)
+    /// through the server board on DEV, a command every 1.2 s, answered within 0.7 s.
+    #[command(long_about = crate::opsui::HELP, after_help = crate::opsui::AFTER)]
+    Opsui(Box<crate::opsui::OpsuiArgs>),
     /// The fault swarm: random scenarios (plans, link faults, plant faults, the operator's Stop
     /// and Reset) in virtual time, invariants checked on every tick; a failing seed prints the
     /// command that replays it.
@@ -511,6 +515,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
         }
         Cmd::Sdls(cmd) => crate::sdlscli::run(cmd, out)?,
         Cmd::Sim(args) => crate::simcli::sim(*args, out)?,
+        Cmd::Opsui(args) => crate::opsui::run(*args, out)?,
         Cmd::Swarm(args) => crate::swarm::cli::run(*args, out)?,
         Cmd::Fleet(args) => crate::fleet::cli::run(*args, out)?,
         Cmd::Bench { max, seconds } => crate::simcli::bench(max, seconds, out)?,

@@ -1,7 +1,9 @@
 //! Why a `mmic` command failed, and the exit code each failure maps to.
 
 use crate::codec::CodecError;
-use crate::exit::{EXIT_HOST, EXIT_INPUT, EXIT_IO};
+use crate::exit::{
+    EXIT_HOST, EXIT_INPUT, EXIT_IO, EXIT_LINE_LOST, EXIT_SERIAL_OPEN, EXIT_UNACKNOWLEDGED,
+};
 use std::path::PathBuf;
 
 /// Why `mmic` failed.
@@ -87,6 +89,29 @@ pub enum CliError {
     /// `mmic replay --against`: the two runs' outputs differ (where, in the message).
     #[error("{0}")]
     Replay(String),
+    /// The serial device of the opsUI line cannot be opened or set up.
+    #[error("cannot open serial device {device}: {why}")]
+    SerialOpen {
+        /// The device path.
+        device: String,
+        /// The OS's or the settings' reason.
+        why: String,
+    },
+    /// The opsUI line was lost before the plan ended.
+    #[error("serial line {device} lost at {at_s:.1} s: {why}; {outstanding}")]
+    LineLost {
+        /// The device path.
+        device: String,
+        /// When, on the plan's clock, s.
+        at_s: f64,
+        /// End of file, hang-up, or the I/O error.
+        why: String,
+        /// What became of the command outstanding.
+        outstanding: String,
+    },
+    /// The plan ended at a step the robot never acknowledged.
+    #[error("{0}")]
+    Unacknowledged(String),
     /// Standard output or error is closed.
     #[error("cannot write output: {0}")]
     Output(#[source] std::io::Error),
@@ -106,6 +131,9 @@ impl CliError {
             | CliError::Fleet(_)
             | CliError::Replay(_) => 1,
             CliError::HostBehind { .. } => EXIT_HOST,
+            CliError::SerialOpen { .. } => EXIT_SERIAL_OPEN,
+            CliError::LineLost { .. } => EXIT_LINE_LOST,
+            CliError::Unacknowledged(_) => EXIT_UNACKNOWLEDGED,
             CliError::Write { .. }
             | CliError::Output(_)
             | CliError::Read { .. }

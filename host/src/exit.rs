@@ -11,3 +11,12 @@ pub const EXIT_INPUT: u8 = 2;
 pub const EXIT_IO: u8 = 3;
 /// `mmic sim`: the host fell too far behind the simulated clock for the outcome to count.
 pub const EXIT_HOST: u8 = 4;
+/// `mmic opsui`, `mmic sim --opsui-serial`: the serial device cannot be opened or set up
+/// (nothing was sent).
+pub const EXIT_SERIAL_OPEN: u8 = 5;
+/// `mmic opsui`: the serial line was lost before the plan ended (end of file, hang-up, I/O
+/// error); the command outstanding, if any, ran at most once.
+pub const EXIT_LINE_LOST: u8 = 6;
+/// `mmic opsui`: the plan ended at a step the robot never acknowledged (every attempt went
+/// unanswered; it ran at most once).
+pub const EXIT_UNACKNOWLEDGED: u8 = 7;

@@ -114,12 +114,16 @@ Examples:
   mmic sim --protocol pus                    the demo over PUS: telecommands and telemetry
   mmic sim --wifi-dup 0.2 --wifi-jitter 5    virtual-time links: duplicated, jittered WiFi packets
   mmic sim --realtime --scale 20             the same on real threads, pipes and TCP
+  mmic sim --realtime --opsui-serial /dev/ttyUSB1   robot and server board for `mmic opsui`
+                                             on the far end of the device (no ground here)
 
 Exit codes: 0 the plan completed; 1 it stopped (refused or unacknowledged step, time limit);
 2 bad arguments or a malformed plan file, or a step that does not fit the robot's state
 (line and column are given); 3 an I/O error; 4 (--realtime only) the host fell so far behind
 the simulated clock that the outcome may be the host's (the paced clock prevents this: it
-waits for the slowest node, so a busy host slows the run down instead).";
+waits for the slowest node, so a busy host slows the run down instead). With --opsui-serial:
+0 the run ended (the line closed, or --max-seconds), 1 board A ran a command twice, 5 the
+serial device cannot be opened.";
 
 /// Arguments of `mmic sim`.
 #[derive(Debug, clap::Args)]
@@ -135,9 +139,10 @@ pub struct SimArgs {
     /// link: TC transfer frames under COP-1, fixed-length TM transfer frames with the CLCW).
     #[arg(long, default_value = "packets", value_parser = link_layer)]
     pub link: sim::LinkLayer,
-    /// With --realtime: simulated seconds per wall second.
-    #[arg(long, default_value_t = 10.0)]
-    pub scale: f64,
+    /// With --realtime: simulated seconds per wall second (default 10; 1 with --opsui-serial,
+    /// whose opsUI must then run at the same scale).
+    #[arg(long)]
+    pub scale: Option<f64>,
     /// Seed for losses and fastener locks.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -227,6 +232,15 @@ pub struct SimArgs {
     /// thread, as fast as the host goes.
     #[arg(long)]
     pub realtime: bool,
+    /// With --realtime: the server board's opsUI line on this serial device (spec/boards.toml
+    /// `[ops_line]`) instead of the internal pipe, and no ground of its own: an opsUI at the other
+    /// end (`mmic opsui --serial`) runs the plan. Robot 1 and the paper's server board (legacy
+    /// relay) run until the line closes (end of file or hang-up: the opsUI side finished) or
+    /// --max-seconds; the robot starts in --plan's `start` state (its steps are the opsUI's).
+    /// Prints the server board's summary (commands queued, resent, superseded, refused,
+    /// heartbeats forwarded) and board A's (commands executed, executed twice).
+    #[arg(long, value_name = "DEV", requires = "realtime")]
+    pub opsui_serial: Option<String>,
     /// Virtual time: latency of each direction of the WiFi link, ms (jitter: --wifi-jitter).
     #[arg(long, value_name = "MS")]
     pub wifi_latency: Option<f64>,
@@ -288,19 +302,22 @@ fn probability(s: &str) -> Result<f64, String> {
     }
 }
 
-/// The plan `mmic sim` runs (the built-in demo without `--plan`), with its name for errors.
-fn load_plan(a: &SimArgs) -> Result<(PathBuf, crate::plan::Plan), CliError> {
-    let (path, text) = match &a.plan {
+/// The plan `mmic sim` (and `mmic opsui`) runs (the built-in demo without `--plan`), with its
+/// name for errors.
+pub(crate) fn load_plan(
+    plan: Option<&std::path::Path>,
+) -> Result<(PathBuf, crate::plan::Plan), CliError> {
+    let (path, text) = match plan {
         None => (
             PathBuf::from("host/plans/demo.plan (built in)"),
             sim::DEMO_PLAN.to_string(),
         ),
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|source| CliError::Read {
-                path: path.clone(),
+                path: path.to_path_buf(),
                 source,
             })?;
-            (path.clone(), text)
+            (path.to_path_buf(), text)
         }
     };
     let plan = crate::plan::parse(&text).map_err(|error| CliError::Plan {
@@ -312,10 +329,13 @@ fn load_plan(a: &SimArgs) -> Result<(PathBuf, crate::plan::Plan), CliError> {
 
 /// Runs `mmic sim`.
 pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
-    let (path, plan) = load_plan(&a)?;
+    let (path, plan) = load_plan(a.plan.as_deref())?;
     // Every step must fit the state the robot will be in: refused here, with its line and
     // column, before anything is sent.
     let scheduled = injections(&a)?;
+    if a.opsui_serial.is_some() {
+        crate::opsui::server::refuse(&a, &scheduled)?;
+    }
     let start = plan.start.unwrap_or(SimConfig::DEFAULT_START);
     let states = plan
         .trace(start)
@@ -349,7 +369,9 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     if a.link == sim::LinkLayer::Frames && a.protocol != sim::Protocol::Pus {
         return Err(CliError::Usage("--link frames needs --protocol pus".into()));
     }
-    cfg.scale = a.scale;
+    cfg.scale = a
+        .scale
+        .unwrap_or(if a.opsui_serial.is_some() { 1.0 } else { 10.0 });
     cfg.seed = a.seed;
     cfg.wifi_loss = a.wifi_loss;
     cfg.serial_loss = a.serial_loss;
@@ -371,6 +393,9 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
     cfg.log_path = Some(a.out.join("sim.jsonl"));
     cfg.record = a.record.clone();
     cfg.progress = !a.quiet;
+    if let Some(device) = &a.opsui_serial {
+        return crate::opsui::server::sim(&a, cfg, device, out);
+    }
     let ground = a.ground_tm_to.zip(a.ground_tc_port);
     let sdls = sdls_options(&a, &cfg, ground.is_some())?;
     if let Some((tm_to, tc_port)) = ground {

@@ -24,6 +24,8 @@ pub const SERVICES_TOML: &str = include_str!("../../spec/ccsds/services.toml");
 pub const FAULTS_TOML: &str = include_str!("../../spec/faults.toml");
 /// spec/commands.toml.
 pub const COMMANDS_TOML: &str = include_str!("../../spec/commands.toml");
+/// spec/boards.toml (the nodes' timing, the opsUI's serial line: [`crate::serial`]).
+pub const BOARDS_TOML: &str = include_str!("../../spec/boards.toml");
 /// spec/modes.toml.
 pub const MODES_TOML: &str = include_str!("../../spec/modes.toml");
 /// spec/packets/*.toml, by packet name.

@@ -42,6 +42,7 @@ pub mod inject;
 pub mod lockstep;
 pub mod log;
 pub mod nodes;
+pub mod opsline;
 pub mod plant;
 pub mod progress;
 pub mod realtime;
@@ -404,6 +405,10 @@ pub struct SimConfig {
     /// its nodes with its time, readings and bytes, for `mmic replay` and the RV32 runner
     /// (`benches/rv32`).
     pub record: Option<PathBuf>,
+    /// Realtime, legacy protocol: the server board's opsUI line on a serial device (`mmic sim
+    /// --opsui-serial DEV`, [`opsline`]) instead of the internal pipe, and no ground of its
+    /// own: the run lasts until the line closes or [`SimConfig::max_sim_ms`].
+    pub ops_line: Option<opsline::OpsLine>,
 }
 
 /// An external ground on UDP (`mmic sim --protocol pus --ground-tm-to ADDR --ground-tc-port
@@ -644,6 +649,7 @@ impl SimConfig {
             run_to_end: false,
             record: None,
             sdls: None,
+            ops_line: None,
         }
     }
 }

@@ -523,8 +523,8 @@ fn lose_datagrams(sock: &UdpSocket) {
 pub struct ServerTask {
     /// Packets from the ground's serial line.
     pub from_ground: Receiver<Vec<u8>>,
-    /// The ground's serial line.
-    pub to_ground: Lossy<std::io::PipeWriter>,
+    /// The ground's serial line (an OS pipe, or with `--opsui-serial` a serial device).
+    pub to_ground: Lossy<Box<dyn Write + Send>>,
     /// Each robot's board A and where it listens.
     pub robots: Vec<(BoardNumber, SocketAddr)>,
     /// How long to wait for a heartbeat, simulated ms.

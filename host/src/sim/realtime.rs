@@ -339,17 +339,30 @@ fn spawn_server<'scope, 'env>(
     let cfg = env.cfg;
     match cfg.protocol {
         Protocol::Legacy => {
-            let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
+            let (from_ground, to_ground, ground_end) = match ops_line(scope, env) {
+                // The opsUI is at the other end of a device: the run's ground has no link.
+                Some((rx, write)) => {
+                    let none = std::sync::mpsc::channel().1;
+                    let sink = s.lossy(env, std::io::sink(), "serial_ground", 4);
+                    (rx, write, (sink.boxed(), none, s.board))
+                }
+                None => {
+                    let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
+                    let to_server = s.lossy(env, ground_to_server.write, "serial_ground", 4);
+                    let write: Box<dyn Write + Send> = Box::new(server_to_ground.write);
+                    let end = (to_server.boxed(), server_to_ground.read, s.board);
+                    (ground_to_server.read, write, end)
+                }
+            };
             let server = nodes::ServerTask {
-                from_ground: ground_to_server.read,
-                to_ground: s.lossy(env, server_to_ground.write, "serial_ground", 3),
+                from_ground,
+                to_ground: s.lossy(env, to_ground, "serial_ground", 3),
                 robots: vec![(s.board, s.addr)],
                 visit_ms: cfg.visit_ms,
                 restarts: Downtime::of(cfg, Node::Server),
             };
             scope.spawn(move || server.run(node));
-            let to_server = s.lossy(env, ground_to_server.write, "serial_ground", 4);
-            Ok((to_server.boxed(), server_to_ground.read, s.board))
+            Ok(ground_end)
         }
         Protocol::Pus => {
             let udp = if cfg.link == LinkLayer::Frames {
@@ -368,6 +381,23 @@ fn spawn_server<'scope, 'env>(
             Ok((to_server.boxed(), rx, s.board))
         }
     }
+}
+
+/// The server board's end of its opsUI line: the packets read, and where it writes.
+type ServerLine = (std::sync::mpsc::Receiver<Vec<u8>>, Box<dyn Write + Send>);
+
+/// The server board's opsUI line on a device ([`SimConfig::ops_line`]), the first time it is
+/// asked for: its reader started, the packets it finds, and the device to write to.
+fn ops_line<'scope, 'env>(
+    scope: &'scope std::thread::Scope<'scope, 'env>,
+    env: &RunEnv<'env>,
+) -> Option<ServerLine> {
+    let line = env.cfg.ops_line.as_ref()?;
+    let ends = line.take()?;
+    let (tx, rx) = std::sync::mpsc::channel();
+    let (stats, stop) = (line.stats.clone(), env.stop);
+    scope.spawn(move || super::opsline::reader(ends.read, tx, &stats, stop));
+    Some((rx, Box::new(ends.write)))
 }
 
 /// Runs the simulation on the wall clock to the end of every robot's plan (or the time limit).
@@ -428,9 +458,10 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         for (i, (robot, q)) in robots.into_iter().zip(queues.iter_mut()).enumerate() {
             ground_links.push(spawn_robot(scope, &env, i, robot, q, statuses[i].clone())?);
         }
-        let out = match &cfg.external {
-            None => ground_loop(cfg, ground_links, &keys, clock.node(), env.log.clone()),
-            Some(_) => external_ground(cfg, &clock),
+        let out = match (&cfg.external, &cfg.ops_line) {
+            (None, None) => ground_loop(cfg, ground_links, &keys, clock.node(), env.log.clone()),
+            (None, Some(line)) => super::opsline::wait(cfg, &clock, line),
+            (Some(_), _) => external_ground(cfg, &clock),
         };
         stop.store(true, Ordering::Relaxed);
         Ok(out)

@@ -445,7 +445,7 @@ fn pus_lines(t: &mut String, s: &Summary) {
 
 /// How many attempts were answered in time, and, with WiFi loss, what loss predicts and what
 /// this run lost.
-fn attempts_lines(t: &mut String, s: &Summary) {
+pub fn attempts_lines(t: &mut String, s: &Summary) {
     let (ok, n) = s.attempts;
     let _ = writeln!(
         t,
@@ -495,7 +495,7 @@ fn attempts_lines(t: &mut String, s: &Summary) {
 }
 
 /// Virtual time's guarantee, or how late the real-time run's ticks started.
-fn clock_line(t: &mut String, s: &Summary) {
+pub fn clock_line(t: &mut String, s: &Summary) {
     let held = if s.held_ms > 0 {
         format!("; the clock waited {} ms for slow nodes", s.held_ms)
     } else {
@@ -525,7 +525,7 @@ fn clock_line(t: &mut String, s: &Summary) {
 }
 
 /// How many commands board A executed, answered as copies, or (wrongly) executed twice.
-fn commands_line(t: &mut String, s: &Summary) {
+pub fn commands_line(t: &mut String, s: &Summary) {
     let executed = s.events("executed").count();
     let dups = s.events("duplicate").count() + s.events("stale").count();
     let twice = executed_twice(s);
