@@ -89,7 +89,10 @@ fn the_efficiency_curve_is_the_moving_window_of_the_logged_attempts() {
         .map(|r| r["event"]["ok"].as_bool().unwrap())
         .collect();
     assert_eq!(oks.len(), s.efficiency.len());
-    assert!(oks.iter().any(|&ok| ok) && oks.iter().any(|&ok| !ok), "{oks:?}");
+    assert!(
+        oks.iter().any(|&ok| ok) && oks.iter().any(|&ok| !ok),
+        "{oks:?}"
+    );
     let window = Efficiency::WINDOW as usize;
     for (k, &(_, e)) in s.efficiency.iter().enumerate() {
         let last = &oks[(k + 1).saturating_sub(window)..=k];

@@ -19,6 +19,8 @@ struct Boards {
     board_b: BoardB2,
     ground: Ground,
     server: ServerSpec,
+    /// Read by the host's opsUI (host/src/serial.rs, tested there).
+    #[allow(dead_code)]
     ops_line: OpsLine,
     sensor_frontend: Frontend,
     estimate: Estimate,
