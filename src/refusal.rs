@@ -10,7 +10,7 @@
 use crate::wire_enum::wire_enum;
 
 wire_enum! {
-    /// A refused command's reason. Wire value 1..=10; 0 means accepted. None of these is the
+    /// A refused command's reason. Wire value 1..=11; 0 means accepted. None of these is the
     /// paper's: it has no refusal codes (spec/decisions.toml, `heartbeat-byte-62`).
     #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
     #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -48,11 +48,17 @@ wire_enum! {
         /// after the restart is answered with this; the uplink reports the command
         /// unacknowledged (its outcome unknown), never accepted.
         Restarted = 10 => "restarted",
+        /// Reconfiguration refused: an arm board A commands contracted does not sense its
+        /// contraction (Table 8's arm not fully contracted, latched, Safed). Receiving the
+        /// reconfiguration starts a motion, and a motion must not start on an arm not known to
+        /// be contracted; the ground's belief of where the robot is may well hold
+        /// (spec/decisions.toml, `initial-state-sensors`).
+        ArmNotContracted = 11 => "arm_not_contracted",
     }
 
     /// All reasons, in wire order.
     const ALL;
-    /// Wire value 1..=10.
+    /// Wire value 1..=11.
     pub const fn to_wire(self) -> u8;
     /// Reason from its wire value; `None` for 0 (accepted) and unknown values.
     pub const fn from_wire(b: u8) -> Option<Self>;

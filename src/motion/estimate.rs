@@ -1,20 +1,30 @@
-//! State estimation: which of the 15 states agree with the sensors (both boards' gravity
-//! direction, the arm-contracted switches and the hip angle), given how the structure sits
-//! relative to gravity. Used by the initial-state-mismatch check (Table 8). The paper computes
-//! that state from "IMU measurements and PWM values"; the PWM values are the firmware's own
-//! commands, which a robot positioned by hand in Standby does not change, so the switches and
-//! the encoder that measure what they set are read instead (spec/decisions.toml,
-//! `initial-state-sensors`).
+//! State estimation: which of the 15 states agree with what board A knows of the robot — both
+//! boards' gravity direction, the PWM values it commands the two arms and the hip angle — given
+//! how the structure sits relative to gravity. Used by the initial-state-mismatch check of a
+//! reconfiguration (Table 8), which computes the current state, as Section 7 says, "using IMU
+//! measurements and PWM values" (spec/decisions.toml, `initial-state-sensors`).
+//!
+//! **PWM values.** An arm's PWM value is the pulse width board A commands it: arm A's as its
+//! own servo output writes it, arm B's as the A→B command carries it (board A commands B). Read
+//! against the arm's travel ([`ArmPwm::of`]) it is contracted, extended or between. Entering
+//! Operational sends every actuator home (contracted, Section 7) and reconfigurations are taken
+//! only there, so the commanded values are where the powered arms are. The hip is a continuous
+//! servo whose PWM value is a speed (Section 2), not a position: its angle is the encoder's, the
+//! reading the hip loop closes on.
+//!
+//! **The switches** are not read for the state: they are Table 8's arm check at the start of the
+//! motion ([`unsensed_contraction`]): an arm commanded contracted whose switch does not sense the
+//! contraction is "arm not fully contracted", not a wrong belief of where the robot is.
 //!
 //! **Sensor model** (spec/motion/estimation.md). Each board's IMU frame is fixed to its side:
 //! x along that side's arm (hip → gripper), z along the hip axis, y = z × x. Gravity is one of
 //! the six axis directions of the structure frame (`Config::up` is the structure axis that
 //! points up), so each reading is exactly one axis and sign. In a matched state both arms are
-//! contracted; in a two-face state at least one is extended (the sequencer extends only the
-//! moving arm). The hip angle is 180° when the arms are in
-//! line (matched and stretch states) and 90° or 270° in a turn; in a turn it also fixes the hip
-//! axis (h = dirA × dirB at 90°, −dirA × dirB at 270°), while in line the hip axis may be any of
-//! the four directions across the arms — the estimator tries them all.
+//! commanded contracted; in a two-face state at least one is commanded extended and neither
+//! stands between (the sequencer extends only the moving arm). The hip angle is 180° when the
+//! arms are in line (matched and stretch states) and 90° or 270° in a turn; in a turn it also
+//! fixes the hip axis (h = dirA × dirB at 90°, −dirA × dirB at 270°), while in line the hip
+//! axis may be any of the four directions across the arms — the estimator tries them all.
 //!
 //! ```
 //! use mmic::motion::estimate::{consistent, predict, Config, Readings};
@@ -25,9 +35,12 @@
 //! }
 //! ```
 
+use crate::command::Travel;
+use crate::faults::Fault;
 use crate::pose::geometry::{arm_direction, cross, unit, Vec3};
 use crate::pose::State;
-use crate::units::{Axis, Gravity, HipAngle, Side, Sign};
+use crate::refusal::Refusal;
+use crate::units::{Axis, Gravity, HipAngle, PerSide, PulseWidth, Side, Sign};
 
 /// A set of states (bit i = Table 5 index i).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, PartialOrd, Ord)]
@@ -88,7 +101,46 @@ impl Default for Config {
     }
 }
 
-/// What the sensors say, already filtered.
+/// Where an arm's PWM value puts it: at one end of the arm's travel, or between them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ArmPwm {
+    /// The travel's contracted end ("totally contract", Table 1).
+    Contracted,
+    /// The travel's extended end ("totally extend").
+    Extended,
+    /// Any other pulse: a partial position, which no Table 5 state has.
+    Between,
+}
+
+impl ArmPwm {
+    /// Every value.
+    pub const ALL: [ArmPwm; 3] = [ArmPwm::Contracted, ArmPwm::Extended, ArmPwm::Between];
+
+    /// `pulse` read against the arm's `travel`. The ends are exact: a commanded value is the
+    /// interpolator's, which lands on its target (src/control/interp.rs), and a contraction or
+    /// extension command targets the travel's end itself.
+    ///
+    /// ```
+    /// use mmic::command::Travel;
+    /// use mmic::motion::estimate::ArmPwm;
+    /// use mmic::units::PulseWidth;
+    /// assert_eq!(ArmPwm::of(&Travel::ARM, Travel::ARM.contracted), ArmPwm::Contracted);
+    /// assert_eq!(ArmPwm::of(&Travel::ARM, PulseWidth::new(1500).unwrap()), ArmPwm::Between);
+    /// ```
+    pub fn of(travel: &Travel, pulse: PulseWidth) -> ArmPwm {
+        if pulse == travel.contracted {
+            ArmPwm::Contracted
+        } else if pulse == travel.extended {
+            ArmPwm::Extended
+        } else {
+            ArmPwm::Between
+        }
+    }
+}
+
+/// What board A knows of the robot's state: the IMUs' gravity, already filtered, the arms' PWM
+/// values and the hip encoder.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Readings {
@@ -96,11 +148,9 @@ pub struct Readings {
     pub gravity_a: Option<Gravity>,
     /// Gravity in board B's IMU frame (Table 4 bytes 36–37); none = not used.
     pub gravity_b: Option<Gravity>,
-    /// Arm A's contraction switch.
-    pub arm_a_contracted: bool,
-    /// Arm B's contraction switch (Table 4 byte 44).
-    pub arm_b_contracted: bool,
-    /// Hip encoder angle.
+    /// Each arm's PWM value as board A commands it (arm B's through the A→B command).
+    pub arm: PerSide<ArmPwm>,
+    /// Hip encoder angle (the hip's PWM value is a speed: it gives no position).
     pub hip: HipAngle,
 }
 
@@ -169,22 +219,32 @@ fn gravity(cfg: &Config) -> Vec3 {
     neg(unit(cfg.up.0, cfg.up.1))
 }
 
+/// The arms' PWM values a matched state has: both contracted.
+const MATCHED_ARMS: [PerSide<ArmPwm>; 1] = [PerSide::both(ArmPwm::Contracted)];
+
+/// The arms' PWM values a two-face state has: at least one arm extended, the other extended or
+/// contracted.
+const TWO_FACE_ARMS: [PerSide<ArmPwm>; 3] = [
+    PerSide::both(ArmPwm::Extended),
+    PerSide::new(ArmPwm::Extended, ArmPwm::Contracted),
+    PerSide::new(ArmPwm::Contracted, ArmPwm::Extended),
+];
+
 /// Every reading the model allows in state `s` (per hidden hip-axis choice and, in a two-face
 /// state, per arm combination with at least one arm extended).
 pub fn predict(cfg: &Config, s: State) -> impl Iterator<Item = Readings> {
     let g = gravity(cfg);
     let (a, b) = (arm_direction(s, Side::A), arm_direction(s, Side::B));
-    let arms: &'static [(bool, bool)] = if s.is_matched() {
-        &[(true, true)]
+    let arms: &'static [PerSide<ArmPwm>] = if s.is_matched() {
+        &MATCHED_ARMS
     } else {
-        &[(false, false), (false, true), (true, false)]
+        &TWO_FACE_ARMS
     };
     hip_options(s).flat_map(move |(h, angle)| {
-        arms.iter().map(move |&(ca, cb)| Readings {
+        arms.iter().map(move |&arm| Readings {
             gravity_a: read(g, a, h),
             gravity_b: read(g, b, h),
-            arm_a_contracted: ca,
-            arm_b_contracted: cb,
+            arm,
             hip: HipAngle::new(angle).unwrap_or(HipAngle::ZERO),
         })
     })
@@ -195,15 +255,14 @@ fn hip_close(cfg: &Config, a: HipAngle, b: HipAngle) -> bool {
 }
 
 /// The states consistent with `r`: those for which some hidden hip-axis choice predicts the
-/// same gravity readings (where given), switches, and a hip angle within tolerance.
+/// same gravity readings (where given), arm PWM values, and a hip angle within tolerance.
 pub fn consistent(cfg: &Config, r: &Readings) -> StateSet {
     let mut set = StateSet::EMPTY;
     for s in State::ALL {
         let ok = predict(cfg, s).any(|p| {
             r.gravity_a.is_none_or(|g| p.gravity_a == Some(g))
                 && r.gravity_b.is_none_or(|g| p.gravity_b == Some(g))
-                && p.arm_a_contracted == r.arm_a_contracted
-                && p.arm_b_contracted == r.arm_b_contracted
+                && p.arm == r.arm
                 && hip_close(cfg, p.hip, r.hip)
         });
         if ok {
@@ -217,4 +276,85 @@ pub fn consistent(cfg: &Config, r: &Readings) -> StateSet {
 /// state (when the robot tracks one) and agree with the sensors.
 pub fn initial_state_consistent(initial: State, tracked: Option<State>, sensed: StateSet) -> bool {
     tracked.is_none_or(|t| t == initial) && sensed.contains(initial)
+}
+
+/// Table 8's arm check when a reconfiguration arrives: the first arm (A, then B) whose PWM value
+/// board A commands is the contracted one while its `switch` does not sense the contraction.
+/// Table 8's trigger, "After executing an arm contraction command, the contraction is not sensed
+/// by hardware", holds for it; receiving a reconfiguration is the start of a motion, where
+/// Section 7 says the fault happens. An arm commanded extended or between is not checked: its
+/// switch is open when it works, and Table 8 names no fault for a switch closed on it.
+pub fn unsensed_contraction(arm: PerSide<ArmPwm>, switch: PerSide<bool>) -> Option<Side> {
+    Side::ALL
+        .into_iter()
+        .find(|s| arm[*s] == ArmPwm::Contracted && !switch[*s])
+}
+
+/// Why a reconfiguration is not taken when it arrives: one of Table 8's two faults it can meet.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum InitialStateError {
+    /// Arm not fully contracted: this arm is commanded contracted and its switch does not sense
+    /// it (Safed: the arms stay powered).
+    #[error("arm {0} is commanded contracted but its switch does not sense the contraction")]
+    ArmNotContracted(Side),
+    /// Initial state mismatch: the command's initial state is not the tracked state or not one
+    /// the readings allow (Standby: the robot is gripped).
+    #[error("the initial state is not the state the robot is in")]
+    Mismatch,
+}
+
+impl InitialStateError {
+    /// The Table 8 fault it latches.
+    pub const fn fault(self) -> Fault {
+        match self {
+            InitialStateError::ArmNotContracted(_) => Fault::ArmNotContracted,
+            InitialStateError::Mismatch => Fault::InitialStateMismatch,
+        }
+    }
+
+    /// The refusal code the heartbeat answers the reconfiguration with.
+    pub const fn refusal(self) -> Refusal {
+        match self {
+            InitialStateError::ArmNotContracted(_) => Refusal::ArmNotContracted,
+            InitialStateError::Mismatch => Refusal::InitialStateMismatch,
+        }
+    }
+}
+
+/// A reconfiguration's check on arrival, from `initial`: first the arms (a switch that does not
+/// sense a commanded contraction is a hardware fault whatever the opsUI believes, and the state
+/// estimate does not read the switches), then the initial state against the `tracked` state and
+/// the states the readings allow (`sensed`: empty without a hip reading, so nothing is confirmed).
+///
+/// ```
+/// use mmic::motion::estimate::{check_reconfiguration, consistent, predict, ArmPwm, Config, InitialStateError};
+/// use mmic::motion::State;
+/// use mmic::units::{PerSide, Side};
+/// let cfg = Config::default();
+/// let r = predict(&cfg, State::A).next().unwrap();
+/// let sensed = consistent(&cfg, &r);
+/// let closed = PerSide::both(true);
+/// assert_eq!(check_reconfiguration(State::A, Some(State::A), sensed, r.arm, closed), Ok(()));
+/// assert_eq!(check_reconfiguration(State::D, None, sensed, r.arm, closed), Err(InitialStateError::Mismatch));
+/// let dead_b = PerSide::new(true, false);
+/// assert_eq!(
+///     check_reconfiguration(State::A, Some(State::A), sensed, r.arm, dead_b),
+///     Err(InitialStateError::ArmNotContracted(Side::B))
+/// );
+/// ```
+pub fn check_reconfiguration(
+    initial: State,
+    tracked: Option<State>,
+    sensed: StateSet,
+    arm: PerSide<ArmPwm>,
+    switch: PerSide<bool>,
+) -> Result<(), InitialStateError> {
+    if let Some(side) = unsensed_contraction(arm, switch) {
+        return Err(InitialStateError::ArmNotContracted(side));
+    }
+    if !initial_state_consistent(initial, tracked, sensed) {
+        return Err(InitialStateError::Mismatch);
+    }
+    Ok(())
 }

@@ -38,6 +38,7 @@ use super::policy::{accepts, fault_action, is_condition, powered, regulator_on};
 use crate::command::{Command, PowerTarget};
 use crate::faults::{Fault, Faults};
 use crate::mode::Mode;
+use crate::motion::estimate::InitialStateError;
 use crate::refusal::Refusal;
 
 /// What reached the supervisor from the command link in this tick.
@@ -63,20 +64,22 @@ pub struct Input {
     /// The hip reads within tolerance of its home angle ([`detect::hip_at_home`](super::detect::hip_at_home));
     /// consulted when entering Operational.
     pub hip_at_home: bool,
-    /// A reconfiguration command's initial state agrees with the detected state; consulted
-    /// for reconfiguration commands.
-    pub initial_state_ok: bool,
+    /// A reconfiguration command's check on arrival
+    /// ([`check_reconfiguration`](crate::motion::estimate::check_reconfiguration)): its arms
+    /// sense the contraction commanded and its initial state agrees with the detected state, or
+    /// the Table 8 fault it met; consulted for reconfiguration commands.
+    pub initial_state: Result<(), InitialStateError>,
 }
 
 impl Input {
-    /// No fault, no command, no motion, hip at home, states agree.
+    /// No fault, no command, no motion, hip at home, arms and states agree.
     pub const fn quiet() -> Input {
         Input {
             faults: Faults::EMPTY,
             command: None,
             in_motion: false,
             hip_at_home: true,
-            initial_state_ok: true,
+            initial_state: Ok(()),
         }
     }
 }
@@ -301,13 +304,13 @@ impl Supervisor {
                 }
             }
             Command::Mode(m) => self.enter(m, stop),
-            Command::Reconfigure(_) if !input.initial_state_ok => {
-                self.raise(
-                    Faults::EMPTY.with(Fault::InitialStateMismatch),
-                    input.in_motion,
-                    stop,
-                );
-                return Answer::Refused(Refusal::InitialStateMismatch);
+            Command::Reconfigure(_) => {
+                // Table 8 on arrival: an arm not sensed contracted (Safed) or an initial state
+                // mismatch (Standby), latched and answered by name.
+                if let Err(e) = input.initial_state {
+                    self.raise(Faults::EMPTY.with(e.fault()), input.in_motion, stop);
+                    return Answer::Refused(e.refusal());
+                }
             }
             Command::Power { target, on } => self.switch(target, on),
             _ => {}

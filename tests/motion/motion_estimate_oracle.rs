@@ -7,14 +7,14 @@
 //! in a world where gravity is −Z; each IMU frame is built from the arm and hip-axis vectors
 //! (x = arm, z = hip axis, y = z × x, spec/motion/estimation.md) and reads gravity as its
 //! largest component; hip angles are taken at the nominal value and at both edges of the
-//! tolerance; the switches follow the arm poses the sequencer leaves. For each case the true
+//! tolerance; the arms' PWM values follow the arm poses the sequencer leaves. For each case the true
 //! state must be in the estimated set, and the estimate must not depend on the rotation about
 //! gravity (the claim that six "up" directions cover the 24 orientations).
 
-use mmic::motion::estimate::{consistent, Config, Readings, StateSet};
+use mmic::motion::estimate::{consistent, ArmPwm, Config, Readings, StateSet};
 use mmic::motion::geometry::arm_direction;
 use mmic::motion::{State, StateKind};
-use mmic::units::{Axis, Gravity, HipAngle, Side, Sign};
+use mmic::units::{Axis, Gravity, HipAngle, PerSide, Side, Sign};
 
 type V = [i32; 3];
 
@@ -156,10 +156,13 @@ fn true_state_in_estimate_under_an_independent_simulation_for_all_24_orientation
             } else {
                 vec![(c, 9000), ([-c[0], -c[1], -c[2]], 27000)]
             };
-            let arms: &[(bool, bool)] = if s.is_matched() {
-                &[(true, true)]
+            // The arms' commanded PWM values the sequencer can leave: both contracted in a
+            // match, at least one extended otherwise.
+            let (c, e) = (ArmPwm::Contracted, ArmPwm::Extended);
+            let arms: &[(ArmPwm, ArmPwm)] = if s.is_matched() {
+                &[(c, c)]
             } else {
-                &[(true, false), (false, true), (false, false)]
+                &[(c, e), (e, c), (e, e)]
             };
             for (h, nominal) in poses {
                 let (ga, gb) = (imu(g, a, h), imu(g, b, h));
@@ -172,8 +175,7 @@ fn true_state_in_estimate_under_an_independent_simulation_for_all_24_orientation
                             let r = Readings {
                                 gravity_a: Some(ga).filter(|_| ua),
                                 gravity_b: Some(gb).filter(|_| ub),
-                                arm_a_contracted: ca,
-                                arm_b_contracted: cb,
+                                arm: PerSide::new(ca, cb),
                                 hip,
                             };
                             let set = consistent(&cfg, &r);
@@ -214,14 +216,13 @@ fn estimate_separates_shapes() {
     let r = Readings {
         gravity_a: None,
         gravity_b: None,
-        arm_a_contracted: true,
-        arm_b_contracted: true,
+        arm: PerSide::both(ArmPwm::Contracted),
         hip: hip(18000),
     };
     assert!(consistent(&cfg, &r).iter().all(|s| s.is_matched()));
     assert_eq!(consistent(&cfg, &r).len(), 6);
     let r = Readings {
-        arm_a_contracted: false,
+        arm: PerSide::new(ArmPwm::Extended, ArmPwm::Contracted),
         hip: hip(9000),
         ..r
     };

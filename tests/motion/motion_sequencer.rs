@@ -208,14 +208,18 @@ fn a_failed_primitive_stops_the_reconfiguration() {
 
 /// The pose the sequencer leaves the robot in after each primitive is one the state estimator
 /// accepts for the state the runner tracks: starting from home in each matched state, along the
-/// plan to each of the 15 states, the arm-contracted switches (read from the arm targets) and the
+/// plan to each of the 15 states, the arms' commanded PWM values (the arm targets' pulses) and the
 /// hip angle (the hip target) give a set containing the tracked state. Otherwise the next
 /// reconfiguration would raise a spurious initial-state mismatch. (Before the hip goal became
 /// absolute, 24 of the 30 matched-to-matched reconfigurations ended with the hip at 0°, 90° or
 /// 270° in a matched state, which the estimator rightly excludes.)
 #[test]
 fn every_pose_reached_is_accepted_by_the_estimator() {
-    use mmic::motion::estimate::{consistent, initial_state_consistent, Config as Est, Readings};
+    use mmic::command::Travel;
+    use mmic::motion::estimate::{
+        consistent, initial_state_consistent, ArmPwm, Config as Est, Readings,
+    };
+    let pwm = |t: ServoTarget| ArmPwm::of(&Travel::ARM, Travel::ARM.resolve(t));
     let all = Feedback {
         arm_done: PerSide::both(true),
         gripper_done: PerSide::both(true),
@@ -236,8 +240,7 @@ fn every_pose_reached_is_accepted_by_the_estimator() {
                     let readings = Readings {
                         gravity_a: None,
                         gravity_b: None,
-                        arm_a_contracted: tg.arm.a == ServoTarget::Contract,
-                        arm_b_contracted: tg.arm.b == ServoTarget::Contract,
+                        arm: PerSide::new(pwm(tg.arm.a), pwm(tg.arm.b)),
                         hip: tg.hip,
                     };
                     let set = consistent(&Est::default(), &readings);

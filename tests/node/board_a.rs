@@ -33,8 +33,11 @@ struct Rig {
     last_b: Option<BCommandRepr>,
     /// Each side's arm pulse at the last tick (none: unpowered, where it was).
     arm_pulse: [Option<PulseWidth>; 2],
-    /// A side whose arm switch never closes (an arm stuck short of contracted).
+    /// A side whose arm switch never closes (an arm stuck short of contracted, or a dead
+    /// switch).
     switch_stuck: [bool; 2],
+    /// A side whose arm switch is closed whatever the arm does (a switch stuck closed).
+    switch_stuck_closed: [bool; 2],
     /// Each side's bolter.
     bolters: [Bolter; 2],
     /// Each side's bolter drive at the last tick.
@@ -148,6 +151,7 @@ impl Rig {
             last_b: None,
             arm_pulse: [None; 2],
             switch_stuck: [false; 2],
+            switch_stuck_closed: [false; 2],
             bolters: [Bolter::default(); 2],
             drives: [Drive::Idle; 2],
             electrical: [Inputs::at_home().electrical; 2],
@@ -165,7 +169,9 @@ impl Rig {
     /// Side `i`'s arm switch: closed within 15 µs of the contracted pulse.
     fn switch(&self, i: usize) -> bool {
         let contracted = board_a::Config::default().arm.contracted.micros();
-        !self.switch_stuck[i] && self.arm_pulse[i].is_none_or(|p| p.micros() <= contracted + 15)
+        self.switch_stuck_closed[i]
+            || (!self.switch_stuck[i]
+                && self.arm_pulse[i].is_none_or(|p| p.micros() <= contracted + 15))
     }
 
     fn tick(&mut self, command: Option<Command>) -> Tick {
@@ -1097,6 +1103,159 @@ fn a_reconfiguration_runs_its_primitives_to_its_target() {
     let hb = r.tick(Some(Command::ClearFaults)).hb.unwrap();
     assert!(hb.command_complete);
     assert_eq!(hb.target_state, Some(target));
+}
+
+/// A matched state reached from a without a turn (the rig does not model the hip), through at
+/// least two primitives: the last one contracts an arm into the match, which its switch must
+/// confirm.
+fn straight_target() -> State {
+    use mmic::motion::route;
+    let straight = |p: &Primitive| {
+        matches!(
+            p,
+            Primitive::FwdExtend
+                | Primitive::BackExtend
+                | Primitive::FwdContract
+                | Primitive::BackContract
+        )
+    };
+    State::ALL
+        .into_iter()
+        .find(|s| {
+            let plan = route::lookup(State::A, *s);
+            s.is_matched() && plan.primitives().len() >= 2 && plan.primitives().iter().all(straight)
+        })
+        .expect("a matched state reached without turning")
+}
+
+/// Issue 39 item 4 (spec/decisions.toml, `initial-state-sensors`): a dead arm switch at rest,
+/// then a reconfiguration from where the robot is. The arm is commanded contracted (the PWM
+/// values the state is estimated from agree with the command's initial state), its switch does
+/// not sense it: Table 8's arm not fully contracted, Safed (hip and arms held, powered), the
+/// command refused with arm_not_contracted — not an initial state mismatch and Standby, which
+/// would tell the operator that their belief of where the robot is was wrong. At rest, before
+/// the reconfiguration, nothing checks the switch.
+#[test]
+fn a_dead_arm_switch_at_rest_is_arm_not_contracted_when_a_reconfiguration_arrives() {
+    let target = straight_target();
+    for side in Side::ALL {
+        let mut r = Rig::operational();
+        r.switch_stuck[side as usize] = true;
+        r.run(100);
+        assert!(r.a.faults().is_empty(), "{side:?}: {:?}", r.a.faults());
+        let c = Command::reconfigure(State::A, target).unwrap();
+        let t = r.tick(Some(c));
+        assert_eq!(
+            r.a.faults().iter().collect::<Vec<_>>(),
+            [Fault::ArmNotContracted],
+            "{side:?}"
+        );
+        assert_eq!(r.a.mode(), Mode::Safed, "{side:?}");
+        assert!(t.a.events.contains(&Event::Executed {
+            seq: r.seq,
+            command: Some(c),
+            refusal: Some(Refusal::ArmNotContracted)
+        }));
+        let hb = t.hb.unwrap();
+        assert_eq!(hb.refusal, Some(Refusal::ArmNotContracted), "{side:?}");
+        assert!(hb.faults.contains(Fault::ArmNotContracted));
+        assert!(!hb.faults.contains(Fault::InitialStateMismatch));
+        // Nothing moved: the robot is where it was, its arms held powered and contracted.
+        let t = r.run(300);
+        assert_eq!(r.a.state(), Some(State::A));
+        assert!(!r.a.in_motion());
+        let contracted = board_a::Config::default().arm.contracted;
+        assert_eq!((t.a.arm, t.b.arm), (Some(contracted), Some(contracted)));
+    }
+}
+
+/// The same dead switch during the reconfiguration (as before issue 39): the motion's last
+/// contraction is not confirmed, Table 8's arm not fully contracted, Safed, the target never
+/// reached; no initial state mismatch.
+#[test]
+fn a_switch_that_dies_during_a_reconfiguration_is_arm_not_contracted() {
+    let target = straight_target();
+    for side in Side::ALL {
+        let mut r = Rig::operational();
+        r.send(Command::reconfigure(State::A, target).unwrap());
+        r.run(50);
+        assert!(r.a.in_motion());
+        r.switch_stuck[side as usize] = true;
+        let mut reached = None;
+        for _ in 0..6_000 {
+            let t = r.tick(None);
+            reached = reached.or(t.a.events.iter().find_map(|e| match e {
+                Event::Reached(s) if *s == target => Some(*s),
+                _ => None,
+            }));
+            if !r.a.faults().is_empty() {
+                break;
+            }
+        }
+        assert_eq!(
+            r.a.faults().iter().collect::<Vec<_>>(),
+            [Fault::ArmNotContracted],
+            "{side:?}"
+        );
+        assert_eq!(r.a.mode(), Mode::Safed, "{side:?}");
+        assert_eq!(reached, None, "{side:?}");
+        assert_ne!(r.a.state(), Some(target));
+    }
+}
+
+/// With every switch working, a reconfiguration from any state but the one the robot is in
+/// (a, tracked, arms commanded contracted) is an initial state mismatch: refused by that name,
+/// Standby (the robot is gripped), nothing else latched.
+#[test]
+fn a_wrong_initial_state_with_working_switches_is_an_initial_state_mismatch_from_every_state() {
+    let mut n = 0;
+    for initial in State::ALL.into_iter().filter(|s| *s != State::A) {
+        let target = State::MATCHED.into_iter().find(|s| *s != initial).unwrap();
+        let mut r = Rig::operational();
+        let c = Command::reconfigure(initial, target).unwrap();
+        let hb = r.tick(Some(c)).hb.unwrap();
+        assert_eq!(hb.refusal, Some(Refusal::InitialStateMismatch), "{initial}");
+        assert_eq!(
+            r.a.faults().iter().collect::<Vec<_>>(),
+            [Fault::InitialStateMismatch],
+            "{initial}"
+        );
+        assert_eq!(r.a.mode(), Mode::Standby, "{initial}");
+        n += 1;
+    }
+    assert_eq!(n, 14);
+}
+
+/// The state is estimated from the arms' commanded PWM values, not their switches: an arm
+/// commanded extended puts the robot in no matched state, so a reconfiguration from a (the
+/// tracked state) is an initial state mismatch — with the arm's switch open as it should be,
+/// and also with the switch stuck closed, which a check reading the switches took for a
+/// contracted arm (and accepted the command). Not arm not fully contracted: the arm is not
+/// commanded contracted.
+#[test]
+fn an_arm_commanded_extended_is_in_no_matched_state_whatever_its_switch_says() {
+    let target = straight_target();
+    for side in Side::ALL {
+        for stuck_closed in [false, true] {
+            let what = format!("arm {side:?} extended, switch stuck closed {stuck_closed}");
+            let mut r = Rig::operational();
+            r.send(arm(side, ServoTarget::Extend));
+            until_idle(&mut r);
+            r.switch_stuck_closed[side as usize] = stuck_closed;
+            r.run(10);
+            let hb = r
+                .tick(Some(Command::reconfigure(State::A, target).unwrap()))
+                .hb
+                .unwrap();
+            assert_eq!(
+                r.a.faults().iter().collect::<Vec<_>>(),
+                [Fault::InitialStateMismatch],
+                "{what}"
+            );
+            assert_eq!(hb.refusal, Some(Refusal::InitialStateMismatch), "{what}");
+            assert_eq!(r.a.mode(), Mode::Standby, "{what}");
+        }
+    }
 }
 
 /// A bolting job accepted while board B still reports a bolter order (its last job's) waits

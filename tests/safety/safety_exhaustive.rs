@@ -2,18 +2,20 @@
 //! every start state (Standby, Safed, Operational idle / stopped / with a deferred fault
 //! pending, each with the operator's power mask all-on or partial) × every command variant class
 //! (61 opcodes, the two malformed-packet refusals, and no command) × every subset of the 13
-//! faults × in-motion flag × hip-at-home × initial-state-agrees. Every property below is
+//! faults × in-motion flag × hip-at-home × a reconfiguration's check on arrival (passed, arm
+//! not contracted, initial state mismatch). Every property below is
 //! asserted on every one of those steps; the test prints the domain size.
 
 use mmic::arbitrary::for_each_variant_class;
 use mmic::command::{Command, CommandKind, PowerTarget};
 use mmic::faults::{Fault, Faults};
 use mmic::mode::Mode;
+use mmic::motion::estimate::InitialStateError;
 use mmic::refusal::Refusal;
 use mmic::safety::policy::{accepts, fault_action, is_condition, powered};
 use mmic::safety::supervisor::{Answer, Incoming, Input, Supervisor};
 use mmic::safety::ModuleSet;
-use mmic::units::{HipAngle, Module, PulseWidth};
+use mmic::units::{HipAngle, Module, PulseWidth, Side};
 
 fn cmd(c: Command) -> Input {
     Input {
@@ -113,14 +115,14 @@ fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
         command: c,
         in_motion,
         hip_at_home,
-        initial_state_ok,
+        initial_state,
     } = *input;
     let c = &c;
     let power_before = powered(s0.mode(), s0.enabled());
     let mut s = *s0;
     let out = s.step(input);
     let ctx = || {
-        format!("{name} {s0:?} / {c:?} / faults {faults:?} / motion {in_motion} / hip {hip_at_home} / init {initial_state_ok}")
+        format!("{name} {s0:?} / {c:?} / faults {faults:?} / motion {in_motion} / hip {hip_at_home} / init {initial_state:?}")
     };
 
     // Table 7 (spec/modes.toml [power]), as equalities: Standby powers
@@ -214,11 +216,9 @@ fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
             }
             (Incoming::Command(cm), Answer::Refused(r)) => {
                 let k = cm.kind();
-                let mode_met = if r == Refusal::InitialStateMismatch {
-                    s0.mode()
-                } else {
-                    out.mode
-                };
+                let on_arrival =
+                    matches!(r, Refusal::InitialStateMismatch | Refusal::ArmNotContracted);
+                let mode_met = if on_arrival { s0.mode() } else { out.mode };
                 match r {
                     Refusal::NotAllowedInMode => {
                         assert!(!accepts(mode_met, k), "{}", ctx())
@@ -229,13 +229,19 @@ fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
                         "{}",
                         ctx()
                     ),
-                    Refusal::InitialStateMismatch => {
+                    // A reconfiguration's check on arrival: the fault it met latched and acted
+                    // on (Table 8: arm not fully contracted Safed, the mismatch Standby).
+                    Refusal::InitialStateMismatch | Refusal::ArmNotContracted => {
+                        let e = initial_state.expect_err(&ctx());
                         assert!(
-                            !initial_state_ok && k == CommandKind::Reconfiguration,
+                            e.refusal() == r && k == CommandKind::Reconfiguration,
                             "{}",
                             ctx()
                         );
-                        assert!(out.faults.contains(Fault::InitialStateMismatch));
+                        assert!(out.faults.contains(e.fault()), "{}", ctx());
+                        if s0.mode() == Mode::Operational {
+                            assert_eq!(out.mode, fault_action(e.fault()).mode, "{}", ctx());
+                        }
                     }
                     Refusal::Stopped => {
                         assert!(s0.stopped() && k.moves(), "{}", ctx())
@@ -280,6 +286,25 @@ fn check_step(name: &str, s0: &Supervisor, input: &Input) -> Supervisor {
     s
 }
 
+/// The hip and reconfiguration facts (hip at home; the reconfiguration's check on arrival: passed,
+/// arm not contracted, initial state mismatch), enumerated for the two commands that read them.
+fn facts(c: &Option<Incoming>) -> &'static [(bool, Result<(), InitialStateError>)] {
+    const ARM: Result<(), InitialStateError> = Err(InitialStateError::ArmNotContracted(Side::A));
+    const MISMATCH: Result<(), InitialStateError> = Err(InitialStateError::Mismatch);
+    match c {
+        Some(Incoming::Command(Command::Mode(Mode::Operational)))
+        | Some(Incoming::Command(Command::Reconfigure(_))) => &[
+            (true, Ok(())),
+            (true, ARM),
+            (true, MISMATCH),
+            (false, Ok(())),
+            (false, ARM),
+            (false, MISMATCH),
+        ],
+        _ => &[(true, Ok(()))],
+    }
+}
+
 #[test]
 fn supervisor_properties_hold_on_the_whole_domain() {
     let starts = start_states();
@@ -289,23 +314,17 @@ fn supervisor_properties_hold_on_the_whole_domain() {
     for (name, s0) in &starts {
         for c in &cmds {
             // hip/initial-state facts only matter to two commands: enumerate them there.
-            let facts: &[(bool, bool)] = match c {
-                Some(Incoming::Command(Command::Mode(Mode::Operational)))
-                | Some(Incoming::Command(Command::Reconfigure(_))) => {
-                    &[(true, true), (true, false), (false, true), (false, false)]
-                }
-                _ => &[(true, true)],
-            };
+            let facts = facts(c);
             for raw in 0..n_faults {
                 let faults = Faults::from_wire([raw as u8, (raw >> 8) as u8]).unwrap();
                 for in_motion in [false, true] {
-                    for &(hip_at_home, initial_state_ok) in facts {
+                    for &(hip_at_home, initial_state) in facts {
                         let input = Input {
                             faults,
                             command: *c,
                             in_motion,
                             hip_at_home,
-                            initial_state_ok,
+                            initial_state,
                         };
                         check_step(name, s0, &input);
                         steps += 1;
@@ -317,7 +336,7 @@ fn supervisor_properties_hold_on_the_whole_domain() {
     println!("supervisor: {steps} steps checked ({} start states x {} inputs x {n_faults} fault subsets x 2 motion flags, + hip/initial-state facts)", starts.len(), cmds.len());
     assert_eq!(
         steps,
-        starts.len() as u64 * (cmds.len() as u64 + 2 * 3) * n_faults as u64 * 2
+        starts.len() as u64 * (cmds.len() as u64 + 2 * 5) * n_faults as u64 * 2
     );
 }
 
@@ -369,22 +388,16 @@ fn every_reachable_supervisor_state_satisfies_the_properties() {
         stopped_safed_latched +=
             usize::from(s0.stopped() && s0.mode() == Mode::Safed && !s0.faults().is_empty());
         for c in &cmds {
-            let facts: &[(bool, bool)] = match c {
-                Some(Incoming::Command(Command::Mode(Mode::Operational)))
-                | Some(Incoming::Command(Command::Reconfigure(_))) => {
-                    &[(true, true), (true, false), (false, true), (false, false)]
-                }
-                _ => &[(true, true)],
-            };
+            let facts = facts(c);
             for &f in &faults {
                 for in_motion in [false, true] {
-                    for &(hip_at_home, initial_state_ok) in facts {
+                    for &(hip_at_home, initial_state) in facts {
                         let input = Input {
                             faults: f,
                             command: *c,
                             in_motion,
                             hip_at_home,
-                            initial_state_ok,
+                            initial_state,
                         };
                         let s = check_step("reachable", &s0, &input);
                         steps += 1;

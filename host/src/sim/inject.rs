@@ -140,7 +140,7 @@ impl Injection {
             Injection::Fault(r) => match r {
                 Table8::BoltingFailure => "a jammed fastener: from then on no fastener locks",
                 Table8::ArmNotContracted => {
-                    "arm A's contraction switch dies: from then on it never closes"
+                    "arm A's contraction switch dies: from then on it never closes (seen at the next contraction, or when the next reconfiguration arrives)"
                 }
                 Table8::BolterOvercurrent => {
                     "an obstacle on bolter A: its current rises by 2.6 A for 0.5 s"

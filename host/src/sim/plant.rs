@@ -527,12 +527,12 @@ pub fn imu_gravity(s: State) -> (Gravity, Gravity) {
 #[cfg(test)]
 mod gravity_tests {
     use super::imu_gravity;
-    use mmic::motion::estimate::{consistent, Config, Readings};
+    use mmic::motion::estimate::{consistent, ArmPwm, Config, Readings};
     use mmic::motion::State;
-    use mmic::units::HipAngle;
+    use mmic::units::{HipAngle, PerSide};
 
     /// The plant's gravity (its own geometry) against the library's estimator: in every state,
-    /// with the hip at the state's angle and the switches of its pose, the estimate holds the
+    /// with the hip at the state's angle and the arms' PWM values of its pose, the estimate holds the
     /// true state. A plant that read its gravity through `predict` could not fail this.
     #[test]
     fn the_plants_gravity_is_estimated_as_the_true_state() {
@@ -543,10 +543,11 @@ mod gravity_tests {
             } else {
                 &[18000]
             };
-            let arms: &[(bool, bool)] = if s.is_matched() {
-                &[(true, true)]
+            let (c, e) = (ArmPwm::Contracted, ArmPwm::Extended);
+            let arms: &[(ArmPwm, ArmPwm)] = if s.is_matched() {
+                &[(c, c)]
             } else {
-                &[(true, false), (false, true), (false, false)]
+                &[(c, e), (e, c), (e, e)]
             };
             let mut found = false;
             for &h in hips {
@@ -554,8 +555,7 @@ mod gravity_tests {
                     let r = Readings {
                         gravity_a: Some(ga),
                         gravity_b: Some(gb),
-                        arm_a_contracted: ca,
-                        arm_b_contracted: cb,
+                        arm: PerSide::new(ca, cb),
                         hip: HipAngle::new(h).unwrap(),
                     };
                     found |= consistent(&Config::default(), &r).contains(s);

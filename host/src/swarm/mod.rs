@@ -55,10 +55,12 @@ pub struct Expect {
 /// entering Operational after an encoder offset, the next reconfiguration after a misstated
 /// one): for them the swarm checks only that, once raised, the fault reaches its mode.
 ///
-/// Two ground commands raise a fault when board A accepts them: the System fault command
-/// (assembly system) and a reconfiguration refused for its initial state (initial state
-/// mismatch); each accepted (refused) one is expected to have latched its fault by the time
-/// the ground heard of it, unless board A restarted since the command was first sent.
+/// Two ground commands raise a fault when board A answers them: the System fault command
+/// (assembly system) and a reconfiguration refused on arrival, for its initial state (initial
+/// state mismatch) or for an arm commanded contracted whose switch is open (arm not fully
+/// contracted, refused by the fault's name); each accepted (refused) one is expected to have
+/// latched its fault by the time the ground heard of it, unless board A restarted since the
+/// command was first sent.
 pub fn expectations(s: &Scenario, summary: &Summary) -> Vec<Expect> {
     let cfg = &s.cfg;
     let adc_a_alive_until = |to: u32| cfg.plant.adc_silent_at[0].is_none_or(|t| t > to);
@@ -130,6 +132,10 @@ pub fn expectations(s: &Scenario, summary: &Summary) -> Vec<Expect> {
             && e["outcome"]["refused"] == "initial_state_mismatch"
         {
             Some(Fault::InitialStateMismatch)
+        } else if e["command"].get("reconfigure").is_some()
+            && e["outcome"]["refused"] == "arm_not_contracted"
+        {
+            Some(Fault::ArmNotContracted)
         } else {
             None
         };

@@ -10,12 +10,13 @@ use crate::bolter::{BolterDirection, Job};
 use crate::command::{preset_angle, BolterCommand, Command, PrimitiveMove, ServoTarget};
 use crate::faults::Faults;
 use crate::mode::Mode;
-use crate::motion::estimate::{self, initial_state_consistent, Readings, StateSet};
+use crate::motion::estimate::{self, ArmPwm, InitialStateError, Readings, StateSet};
 use crate::motion::State;
 use crate::node::exactly_once::Admission;
 use crate::refusal::Refusal;
 use crate::safety::detect;
 use crate::safety::supervisor::{Answer, Incoming, Input, Output};
+use crate::units::PerSide;
 use crate::wire::command::{CommandPacket, CommandRepr, COMMAND_LEN};
 use crate::wire::WireError;
 
@@ -92,7 +93,7 @@ impl BoardA {
             hip_at_home: inp
                 .hip
                 .is_some_and(|h| detect::hip_at_home(&self.cfg.safety, h)),
-            initial_state_ok: self.initial_state_ok(inp, taken.incoming),
+            initial_state: self.initial_state(inp, taken.incoming),
         });
         self.obey(now, &s, out);
         if let (Some(seq), Some(a)) = (taken.answer, s.answer) {
@@ -113,17 +114,35 @@ impl BoardA {
         s
     }
 
-    /// A reconfiguration's initial state against what board A knows: the state it tracked and
-    /// the states its sensors allow. Without a hip reading the state cannot be confirmed from
-    /// the sensors. Any other command has no initial state to check.
-    fn initial_state_ok(&self, inp: &Inputs, incoming: Option<Incoming>) -> bool {
+    /// A reconfiguration's check on arrival (Table 8, Section 7): each arm board A commands
+    /// contracted must have its switch closed, and the initial state must be the state it
+    /// tracked and one its readings allow (the IMUs, the arms' PWM values, the hip encoder).
+    /// Without a hip reading the state cannot be confirmed. Any other command has no initial
+    /// state to check.
+    fn initial_state(
+        &self,
+        inp: &Inputs,
+        incoming: Option<Incoming>,
+    ) -> Result<(), InitialStateError> {
         let Some(Incoming::Command(Command::Reconfigure(r))) = incoming else {
-            return true;
+            return Ok(());
         };
         let sensed = self.readings(inp).map_or(StateSet::EMPTY, |r| {
             estimate::consistent(&self.cfg.estimate, &r)
         });
-        initial_state_consistent(r.initial(), self.tracked, sensed)
+        let switch = PerSide::new(inp.arm_contracted, self.b.arm_contracted);
+        estimate::check_reconfiguration(r.initial(), self.tracked, sensed, self.arm_pwm(), switch)
+    }
+
+    /// The arms' PWM values as board A commands them, read against the arm travel: arm A's
+    /// pulse as its servo output writes it, arm B's target as the A→B command carries it.
+    /// Section 7's "PWM values": what the firmware drives the arms to, not what they measure.
+    fn arm_pwm(&self) -> PerSide<ArmPwm> {
+        let travel = &self.cfg.arm;
+        PerSide::new(
+            ArmPwm::of(travel, self.arm.now()),
+            ArmPwm::of(travel, travel.resolve(self.motion.targets.arm.b)),
+        )
     }
 
     /// The supervisor's orders: stop (a Stop keeps the motion for Reset), resume, go home.
@@ -260,14 +279,13 @@ impl BoardA {
         m.is_move_from(from).then_some((from, m.target()))
     }
 
-    /// What board A senses of the robot's state: both IMUs, both arm switches, the hip; none
-    /// without a hip reading.
+    /// What board A knows of the robot's state: both IMUs, the arms' PWM values, the hip
+    /// encoder; none without a hip reading.
     fn readings(&self, inp: &Inputs) -> Option<Readings> {
         Some(Readings {
             gravity_a: inp.gravity,
             gravity_b: self.b.gravity,
-            arm_a_contracted: inp.arm_contracted,
-            arm_b_contracted: self.b.arm_contracted,
+            arm: self.arm_pwm(),
             hip: inp.hip?,
         })
     }
