@@ -246,7 +246,11 @@ fn the_visit_ends_at_visit_ms_without_an_answer() {
     assert!(ops.to_opsui.is_empty());
     assert_eq!(lab.ended, ["close"]);
     assert_eq!(relay.counts().unanswered, 1);
-    assert_eq!(VISIT_MS, 650);
+    // The visit is the opsUI's window less the serial line's share (decision relay-visit-window).
+    assert_eq!(
+        VISIT_MS + mmic::node::server::relay::SERIAL_RESERVE_MS,
+        mmic::node::server::relay::ANSWER_MS
+    );
 }
 
 #[test]
