@@ -282,6 +282,15 @@ fn low_battery_during_a_motion_enters_standby_only_after_the_motion_completes() 
     );
 }
 
+/// The demo plan's line (1-based) that starts with `step`.
+fn demo_line(step: &str) -> usize {
+    mmic_host::sim::DEMO_PLAN
+        .lines()
+        .position(|l| l.starts_with(step))
+        .map(|i| i + 1)
+        .expect("the step is in the demo plan")
+}
+
 #[test]
 fn the_demo_plan_parses() {
     let p = plan::parse(mmic_host::sim::DEMO_PLAN).unwrap();
@@ -808,8 +817,10 @@ fn check_case(c: &Case, s: &Summary, records: &[Value], json: &report::SummaryJs
         // The next reconfiguration is the one refused, and the report says why.
         let line = report::plan_line(s);
         expect(
-            line.contains("(line 13: reconfigure a -> m): refused (initial_state_mismatch)")
-                && line.contains("the ground sent the reconfiguration from")
+            line.contains(&format!(
+                "(line {}: reconfigure a -> m): refused (initial_state_mismatch)",
+                demo_line("reconfigure a -> m")
+            )) && line.contains("the ground sent the reconfiguration from")
                 && line.contains("(initial-state-mismatch injected)"),
             format!("report: {line}"),
         );
@@ -1001,8 +1012,10 @@ fn a_dead_arm_switch_is_arm_not_contracted_at_rest_and_during_a_motion() {
             assert_eq!(json.refusals, ["arm_not_contracted"], "{name}");
             let line = report::plan_line(&s);
             assert!(
-                line.contains("(line 12: reconfigure a -> m): refused (arm_not_contracted)")
-                    && line.contains("robot in safed (faults: arm_not_contracted)"),
+                line.contains(&format!(
+                    "(line {}: reconfigure a -> m): refused (arm_not_contracted)",
+                    demo_line("reconfigure a -> m")
+                )) && line.contains("robot in safed (faults: arm_not_contracted)"),
                 "{name}: {line}"
             );
         } else {
