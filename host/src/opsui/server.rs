@@ -146,21 +146,7 @@ fn line_lines(t: &mut String, s: &Summary, line: &OpsLine) {
 fn board_lines(t: &mut String, s: &Summary) {
     report::clock_line(t, s);
     report::commands_line(t, s);
-    let b = report::bolting(s);
-    let _ = writeln!(
-        t,
-        "bolting: {} pairs; first attempt {}, second {}, third {}, failed {}",
-        b.iter().sum::<u64>(),
-        b[0],
-        b[1],
-        b[2],
-        b[3]
-    );
-    let _ = writeln!(
-        t,
-        "robot: mode {}, state {}, faults {}",
-        s.status["mode"], s.status["state"], s.status["faults"]
-    );
+    report::robot_lines(t, s);
 }
 
 /// 0, unless the host fell behind (4) or a command ran twice (1).

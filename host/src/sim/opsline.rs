@@ -23,7 +23,6 @@ use mmic::wire::PacketKind;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::Sender;
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
 
 /// The two ends of the device: what the server board reads, and what it writes to.
 pub struct Ends {
@@ -162,16 +161,5 @@ pub fn wait(
     clock: &Clock,
     line: &OpsLine,
 ) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
-    while clock.now_ms() < cfg.max_sim_ms && !line.stats.closed.load(Ordering::Acquire) {
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let stats = GroundStats {
-        sim_ms: clock.now_ms(),
-        ..GroundStats::default()
-    };
-    (
-        vec![None; cfg.robots.max(1) as usize],
-        stats,
-        FrameStats::default(),
-    )
+    super::realtime::without_ground(cfg, clock, || line.stats.closed.load(Ordering::Acquire))
 }

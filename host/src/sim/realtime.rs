@@ -461,7 +461,7 @@ pub fn run(cfg: &SimConfig) -> std::io::Result<Summary> {
         let out = match (&cfg.external, &cfg.ops_line) {
             (None, None) => ground_loop(cfg, ground_links, &keys, clock.node(), env.log.clone()),
             (None, Some(line)) => super::opsline::wait(cfg, &clock, line),
-            (Some(_), _) => external_ground(cfg, &clock),
+            (Some(_), _) => without_ground(cfg, &clock, || false),
         };
         stop.store(true, Ordering::Relaxed);
         Ok(out)
@@ -516,13 +516,15 @@ fn spawn_log_writer(
     })
 }
 
-/// An external ground does the commanding: wait out the run's time.
-fn external_ground(
+/// The run has no ground of its own (an external ground, or the opsUI on a device): wait
+/// until the run's time is out or `done` says so; no plan of the run's own ends.
+pub(super) fn without_ground(
     cfg: &SimConfig,
     clock: &Clock,
+    done: impl Fn() -> bool,
 ) -> (Vec<Option<PlanEnd>>, GroundStats, FrameStats) {
-    while clock.now_ms() < cfg.max_sim_ms {
-        std::thread::sleep(Duration::from_millis(20));
+    while clock.now_ms() < cfg.max_sim_ms && !done() {
+        std::thread::sleep(Duration::from_millis(10));
     }
     let stats = GroundStats {
         sim_ms: clock.now_ms(),

@@ -359,18 +359,8 @@ fn mismatch(s: &Summary, step: usize) -> String {
     format!("{expected}; {reported}")
 }
 
-/// The summary as text: one line per aspect of the run, each from a function below.
-pub fn text(s: &Summary) -> String {
-    let mut t = String::new();
-    let _ = writeln!(t, "{}", plan_line(s));
-    time_line(&mut t, s);
-    if s.protocol == super::Protocol::Pus {
-        pus_lines(&mut t, s);
-    }
-    attempts_lines(&mut t, s);
-    clock_line(&mut t, s);
-    commands_line(&mut t, s);
-    injected_line(&mut t, s);
+/// The bolting outcomes (Figure 10's counts) and robot 1's final mode, state and faults.
+pub fn robot_lines(t: &mut String, s: &Summary) {
     let b = bolting(s);
     let _ = writeln!(
         t,
@@ -386,6 +376,21 @@ pub fn text(s: &Summary) -> String {
         "robot: mode {}, state {}, faults {}",
         s.status["mode"], s.status["state"], s.status["faults"]
     );
+}
+
+/// The summary as text: one line per aspect of the run, each from a function below.
+pub fn text(s: &Summary) -> String {
+    let mut t = String::new();
+    let _ = writeln!(t, "{}", plan_line(s));
+    time_line(&mut t, s);
+    if s.protocol == super::Protocol::Pus {
+        pus_lines(&mut t, s);
+    }
+    attempts_lines(&mut t, s);
+    clock_line(&mut t, s);
+    commands_line(&mut t, s);
+    injected_line(&mut t, s);
+    robot_lines(&mut t, s);
     t
 }
 
