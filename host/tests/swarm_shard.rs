@@ -325,3 +325,33 @@ fn a_shard_needs_a_fixed_range_and_a_shard_stopped_at_its_failures_is_merged_as_
         "{seeds:?}"
     );
 }
+
+/// Issue 40: the Slurm recipe docs/swarm-and-fleets.md shows is, verbatim, the files CI submits
+/// (.ci/slurm runs docs/campaigns/slurm/submit on a single-node cluster): each file's name on
+/// the page is followed by a block that is the file.
+#[test]
+fn the_docs_show_the_slurm_recipe_ci_submits_as_it_is() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let page = std::fs::read_to_string(root.join("docs/swarm-and-fleets.md")).unwrap();
+    let ci = std::fs::read_to_string(root.join(".ci/slurm")).unwrap();
+    assert!(ci.contains("\"$root/docs/campaigns/slurm/submit\""));
+    for f in ["submit", "swarm.sbatch", "merge.sbatch"] {
+        let path = format!("docs/campaigns/slurm/{f}");
+        let file = std::fs::read_to_string(root.join(&path)).unwrap();
+        let named = format!("`{path}`");
+        let at = page
+            .find(&named)
+            .unwrap_or_else(|| panic!("the page does not name {path}"));
+        let rest = &page[at..];
+        let open = rest.find("```sh\n").expect("a block after the name") + "```sh\n".len();
+        let len = rest[open..].find("```\n").expect("the block's end");
+        assert_eq!(
+            &rest[open..open + len],
+            file,
+            "the page's {path} is not the file"
+        );
+    }
+    // The submit script and the jobs it submits.
+    let submit = std::fs::read_to_string(root.join("docs/campaigns/slurm/submit")).unwrap();
+    assert!(submit.contains("\"$here/swarm.sbatch\"") && submit.contains("\"$here/merge.sbatch\""));
+}
