@@ -603,6 +603,10 @@ mod tests {
     }
 
     #[test]
+    #[cfg_attr(
+        miri,
+        ignore = "u8 arithmetic only, no dependency's unsafe code: nothing for Miri to find"
+    )]
     fn window_places_match_the_bounds_of_table_6_1() {
         let w = FarmWindow::new(10).unwrap(); // PW = NW = 5
         let mut places = [WindowPlace::Expected; 256];

@@ -172,7 +172,19 @@ mod tests {
     fn every_length_and_start_equals_the_crc_crate() {
         // Every length 0..=80 (so every remainder after whole 16-octet blocks), from the
         // algorithm's start and from other registers, against the `crc` crate's own loop.
-        for pattern in [0u8, 0x5a, 0xff] {
+        // Under Miri one pattern and two registers: every length still runs (the tables'
+        // indexing and the block loop's tails, what Miri checks, depend on the length only).
+        let patterns: &[u8] = if cfg!(miri) {
+            &[0x5a]
+        } else {
+            &[0, 0x5a, 0xff]
+        };
+        let starts: &[u16] = if cfg!(miri) {
+            &[0x1d0f, 0xffff]
+        } else {
+            &[0, 1, 0x8000, 0x1d0f, 0xffff, 0xa5c3]
+        };
+        for &pattern in patterns {
             let mut bytes = [0u8; 80];
             for (i, b) in bytes.iter_mut().enumerate() {
                 *b = (i as u8).wrapping_mul(151).wrapping_mul(pattern & 1) ^ pattern;
@@ -180,7 +192,7 @@ mod tests {
             for len in 0..=bytes.len() {
                 let b = &bytes[..len];
                 assert_eq!(crc16(b), CRC.checksum(b), "{len}");
-                for start in [0u16, 1, 0x8000, 0x1d0f, 0xffff, 0xa5c3] {
+                for &start in starts {
                     let mut d = CRC.digest_with_initial(start);
                     d.update(b);
                     assert_eq!(update(start, b), d.finalize(), "{len} from {start:#06x}");
@@ -196,7 +208,8 @@ mod tests {
             assert_eq!(PacketKind::ALL[kind as usize], kind);
             let mut body = [0u8; 64];
             body[..4].copy_from_slice(&kind.header());
-            for len in 4..=64 {
+            // Under Miri every length 4..=20 (each tail after a 16-octet block) and 64.
+            for len in (4..=64).filter(|l| !cfg!(miri) || *l <= 20 || *l == 64) {
                 for (i, b) in body.iter_mut().enumerate().take(len).skip(4) {
                     *b = (i as u8).wrapping_mul(37) ^ len as u8;
                 }

@@ -411,9 +411,9 @@ mod tests {
                 ..HeartbeatRepr::default()
             },
         ];
-        // Under Miri (about 100x slower) every 51st value of each octet, both edges among them:
-        // 0, 51, 102, 153, 204, 255; natively all 256.
-        let step = if cfg!(miri) { 51 } else { 1 };
+        // Under Miri (about 100x slower) each octet's two edges, 0 and 255: the view's code
+        // (zerocopy's cast, what Miri checks) does not depend on the values; natively all 256.
+        let step = if cfg!(miri) { 255 } else { 1 };
         let mut checked = 0u32;
         for repr in samples {
             let good = repr.to_bytes();

@@ -241,7 +241,10 @@ fn a_lost_frame_drops_only_the_packets_it_touches() {
         .map(Step::Push)
         .collect();
     let r = run::<4096>(p, &steps);
-    for i in 0..r.frames.len() {
+    // Under Miri the first, a middle and the last frame lost (the extractor's code paths: a
+    // packet cut at either end and within); natively every frame.
+    let n = r.frames.len();
+    for i in (0..n).filter(|i| !cfg!(miri) || [0, n / 2, n - 1].contains(i)) {
         let mut lost = vec![false; r.frames.len()];
         lost[i] = true;
         check(&p, &r, &lost);
