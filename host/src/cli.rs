@@ -202,15 +202,21 @@ pub enum Cmd {
         out: Option<PathBuf>,
     },
     /// The RV32 runner's costs (benches/rv32): instructions and stack per node over the cost
-    /// files, as a Markdown table; with --budget, exit 1 if any call took more instructions.
+    /// files, as a Markdown table; with --budget or --robot-budget, exit 1 if any call took more
+    /// instructions than its node's budget.
     #[command(name = "rv32-costs")]
     Rv32Costs {
         /// Cost files written by the runner.
         #[arg(required = true)]
         files: Vec<PathBuf>,
-        /// The most instructions any one call may take.
+        /// The most instructions any one call may take (of the robot's boards too, unless
+        /// --robot-budget is given).
         #[arg(long, value_name = "INSTRUCTIONS")]
         budget: Option<u32>,
+        /// The most instructions one call of the robot's boards (board A's control and WiFi
+        /// tasks, board B) may take.
+        #[arg(long, value_name = "INSTRUCTIONS")]
+        robot_budget: Option<u32>,
     },
     /// The reconfiguration map (Figure 9): which primitive takes one state to another.
     Map {
@@ -499,7 +505,11 @@ pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), Cli
             out: to,
             ..
         } => crate::replay::cli(&trace, against.as_deref(), to.as_deref(), out)?,
-        Cmd::Rv32Costs { files, budget } => crate::replay::cli_costs(&files, budget, out)?,
+        Cmd::Rv32Costs {
+            files,
+            budget,
+            robot_budget,
+        } => crate::replay::cli_costs(&files, (budget, robot_budget), out)?,
         Cmd::Replay { .. } => {
             return Err(CliError::Usage(
                 "mmic replay: give a TRACE or --record-scenarios DIR".into(),

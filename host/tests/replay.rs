@@ -201,3 +201,67 @@ fn a_changed_output_is_named_by_record_and_field() {
     }
     assert_eq!(again, trace);
 }
+
+/// `mmic rv32-costs`'s budgets: the robot's boards are held to --robot-budget, the server board
+/// to --budget (and the robot's boards too when no --robot-budget is given); a call over its
+/// node's budget fails the run, naming the node.
+#[test]
+fn each_node_is_held_to_its_own_budget() {
+    use mmic_replay::cost::{Cost, COST_LEN};
+    use mmic_replay::trace::Node;
+    let call = |node: Node, glue: u32| {
+        let mut b = [0u8; COST_LEN];
+        let node = node as u8;
+        let c = Cost {
+            tag: 1,
+            node,
+            t: 10,
+            phases: [glue, 0, 0, 7],
+            stack_node: 0,
+            stack_all: 0,
+        };
+        c.emit(&mut b);
+        b
+    };
+    let f = std::env::temp_dir().join(format!("mmic-costs-{}.cost", std::process::id()));
+    let mut bytes = call(Node::AControl, 12_000).to_vec();
+    bytes.extend(call(Node::B, 2_000));
+    bytes.extend(call(Node::Server, 40_000));
+    std::fs::write(&f, bytes).unwrap();
+    let costs = |all, robot| {
+        let mut out = Vec::new();
+        let r = mmic_host::replay::cli_costs(std::slice::from_ref(&f), (all, robot), &mut out);
+        (
+            r.map_err(|e| e.to_string()),
+            String::from_utf8(out).unwrap(),
+        )
+    };
+    let (r, out) = costs(Some(60_000), Some(16_000));
+    assert!(r.is_ok(), "{r:?}");
+    assert!(
+        out.contains(
+            "worst call of board A control: 12000 instructions, within its budget of 16000"
+        ),
+        "{out}"
+    );
+    assert!(
+        out.contains("worst call of server board: 40000 instructions, within its budget of 60000"),
+        "{out}"
+    );
+    let (r, _) = costs(Some(60_000), Some(11_999));
+    let e = r.unwrap_err();
+    assert!(
+        e.contains("board A control (12000 > 11999)") && !e.contains("server"),
+        "{e}"
+    );
+    let (r, _) = costs(Some(39_999), None);
+    let e = r.unwrap_err();
+    assert!(
+        e.contains("server board (40000 > 39999)") && !e.contains("board A"),
+        "{e}"
+    );
+    let (r, _) = costs(Some(11_999), None);
+    assert!(r.unwrap_err().contains("board A control (12000 > 11999)"));
+    assert!(costs(None, None).0.is_ok());
+    let _ = std::fs::remove_file(&f);
+}

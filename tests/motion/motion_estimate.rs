@@ -10,7 +10,7 @@ use mmic::motion::estimate::{
     ArmPwm, Config, InitialStateError, Readings, StateSet,
 };
 use mmic::motion::State;
-use mmic::units::{Axis, PerSide, PulseWidth, Side, Sign};
+use mmic::units::{Axis, Gravity, HipAngle, PerSide, PulseWidth, Side, Sign};
 use std::collections::BTreeSet;
 use std::fmt::Write;
 
@@ -343,4 +343,81 @@ fn a_dead_switch_is_arm_not_contracted_and_a_wrong_belief_a_mismatch() {
             }
         }
     }
+}
+
+/// Every gravity reading a board can give, and none.
+fn gravities() -> Vec<Option<Gravity>> {
+    let mut g = vec![None];
+    for axis in Axis::ALL {
+        for sign in [Sign::Positive, Sign::Negative] {
+            g.push(Some(Gravity { axis, sign }));
+        }
+    }
+    g
+}
+
+/// The hip angles checked at tolerance `tol`: every whole degree, and both sides of each
+/// tolerance edge around 90°, 180° and 270° (the only angles a state predicts).
+fn hips(tol: u16) -> Vec<HipAngle> {
+    let mut h: Vec<i32> = (0..360).map(|d| d * 100).collect();
+    for a in [9000, 18000, 27000] {
+        for d in [0, i32::from(tol), i32::from(tol) + 1] {
+            h.extend([a + d, a - d]);
+        }
+    }
+    h.into_iter()
+        .map(|c| HipAngle::new(c.rem_euclid(36000) as u16).unwrap())
+        .collect()
+}
+
+/// `consistent` (its terms taken cheapest first, issue 40) is the search it replaced: the states
+/// one of whose [`predict`]ed readings has the same gravity readings where given, the same arm
+/// PWM values and a hip angle within tolerance. Over every up, every gravity reading of each
+/// board (none included), every pair of arm PWM values, and the hip angles of [`hips`], for
+/// tolerances from 0 to u16::MAX.
+#[test]
+fn consistent_is_the_search_over_every_prediction() {
+    let mut checked = 0u64;
+    for up in ups() {
+        for tol in [0, 1000, 4499, 4500, u16::MAX] {
+            let cfg = Config {
+                up,
+                hip_tolerance: tol,
+            };
+            let predicted: Vec<Vec<Readings>> = State::ALL
+                .iter()
+                .map(|s| predict(&cfg, *s).collect())
+                .collect();
+            let hips = hips(tol);
+            for gravity_a in gravities() {
+                for gravity_b in gravities() {
+                    for arm in arm_pairs() {
+                        for &hip in &hips {
+                            let r = Readings {
+                                gravity_a,
+                                gravity_b,
+                                arm,
+                                hip,
+                            };
+                            let mut want = StateSet::EMPTY;
+                            for (s, ps) in State::ALL.iter().zip(&predicted) {
+                                if ps.iter().any(|p| {
+                                    gravity_a.is_none_or(|g| p.gravity_a == Some(g))
+                                        && gravity_b.is_none_or(|g| p.gravity_b == Some(g))
+                                        && p.arm == arm
+                                        && p.hip.distance(hip) <= tol
+                                }) {
+                                    want = want.with(*s);
+                                }
+                            }
+                            assert_eq!(consistent(&cfg, &r), want, "{cfg:?} {r:?}");
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // 6 ups × 5 tolerances × 7 × 7 gravity readings × 9 arm pairs × 378 hip angles.
+    assert_eq!(checked, 6 * 5 * 7 * 7 * 9 * 378);
 }
