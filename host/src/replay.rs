@@ -25,8 +25,8 @@ pub const FAULTS: &[(&str, Protocol)] = &[
 
 /// The scenarios CI replays on RV32 (benches/rv32/README.md), by name: the demo plan over
 /// both protocols, the demo over lossy, duplicating and reordering links, the demo over the
-/// space data link with loss on the ground link (`frames`: TC frames under COP-1, TM frames),
-/// and one run per Table 8 fault (`fault-NAME`). Each runs in virtual time, deterministically.
+/// space data link with loss on the ground link (`frames`: TC frames under COP-1, TM frames;
+/// `frames-sdls`: the same secured with SDLS), and one run per Table 8 fault (`fault-NAME`). Each runs in virtual time, deterministically.
 pub fn scenarios() -> Vec<(String, SimConfig)> {
     let demo = |protocol| {
         let mut c = SimConfig::demo();
@@ -52,11 +52,16 @@ pub fn scenarios() -> Vec<(String, SimConfig)> {
     frames.max_sim_ms = 400_000;
     frames.wifi_loss = 0.1;
     frames.serial_loss = 0.1;
+    // The same run with the link secured by SDLS: every TC frame verified and decrypted,
+    // every TM frame protected, under test keys made for this recording (in the trace).
+    let mut frames_sdls = frames.clone();
+    frames_sdls.sdls = Some(crate::sim::SdlsConfig::recorded());
     let mut all = vec![
         ("demo-legacy".to_string(), demo(Protocol::Legacy)),
         ("demo-pus".to_string(), demo(Protocol::Pus)),
         ("lossy".to_string(), lossy),
         ("frames".to_string(), frames),
+        ("frames-sdls".to_string(), frames_sdls),
     ];
     for (f, protocol) in FAULTS {
         let mut c = demo(*protocol);

@@ -73,7 +73,7 @@ fn replay_sends_what_the_engine_sent_in_every_scenario() {
     let dir = std::env::temp_dir().join(format!("mmic-replay-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let all = scenarios();
-    assert_eq!(all.len(), 4 + FAULTS.len());
+    assert_eq!(all.len(), 5 + FAULTS.len());
     for (name, mut cfg) in all {
         let path = dir.join(format!("{name}.trace"));
         cfg.record = Some(path.clone());
@@ -126,7 +126,14 @@ fn replay_sends_what_the_engine_sent_in_every_scenario() {
         if cfg.link == mmic_host::sim::LinkLayer::Frames {
             // The frame gateway ran: TC frames in (some retransmitted after the ground link
             // lost them), every TM frame out in the streams compared above.
-            assert_eq!(t.header.protocol, Protocol::PusFrames, "{name}");
+            let secured = cfg.sdls.is_some();
+            let protocol = if secured {
+                Protocol::PusFramesSdls
+            } else {
+                Protocol::PusFrames
+            };
+            assert_eq!(t.header.protocol, protocol, "{name}");
+            assert_eq!(t.header.sdls.is_some(), secured, "{name}");
             assert!(summary.completed(), "{name}");
             let f = summary.frames.expect("the link's figures");
             assert!(f.retransmissions > 0 && f.tm_lost > 0, "{name}: {f:?}");
@@ -139,6 +146,13 @@ fn replay_sends_what_the_engine_sent_in_every_scenario() {
             assert_eq!(count(Field::TmFrame), f.tm_frames, "{name}");
             assert!(count(Field::TcFrame) > 0, "{name}");
             assert_eq!(count(Field::Report), 0, "{name}: no bare packets");
+            if secured {
+                // The server board verified the ground's TC frames and protected every TM
+                // frame it sent, the replay's the same (compared above, byte for byte).
+                let s = f.sdls.expect("SDLS's figures");
+                assert!(s.server.verified > 0, "{name}: {s:?}");
+                assert_eq!(s.server.protected, f.tm_frames, "{name}: {s:?}");
+            }
         }
         if let Some(f) = name.strip_prefix("fault-") {
             let raised = mmic_host::sim::report::faults_raised(&summary);
@@ -264,4 +278,50 @@ fn each_node_is_held_to_its_own_budget() {
     assert!(r.unwrap_err().contains("board A control (12000 > 11999)"));
     assert!(costs(None, None).0.is_ok());
     let _ = std::fs::remove_file(&f);
+}
+
+#[test]
+fn a_trace_holds_only_test_keys_made_for_its_run() {
+    use mmic_host::sim::{SdlsConfig, SdlsKeys};
+    let (_, frames) = scenarios()
+        .into_iter()
+        .find(|(n, _)| n == "frames-sdls")
+        .unwrap();
+    let path = std::env::temp_dir().join(format!("mmic-replay-keys-{}.trace", std::process::id()));
+    // Keys given from files, or a run with an attacker, are never recorded.
+    let given = SdlsConfig {
+        keys: SdlsKeys::Seeded,
+        ..SdlsConfig::recorded()
+    };
+    let attacked = SdlsConfig {
+        attack: 0.1,
+        ..SdlsConfig::recorded()
+    };
+    for sdls in [given, attacked] {
+        let mut cfg = frames.clone();
+        cfg.max_sim_ms = 1_000;
+        cfg.record = Some(path.clone());
+        cfg.sdls = Some(sdls);
+        let e = mmic_host::sim::run(&cfg).unwrap_err();
+        assert!(e.to_string().contains("only test keys"), "{e}");
+        assert!(!path.exists());
+    }
+    // Two recordings, two sets of keys; never shown.
+    let (a, b) = (SdlsConfig::recorded(), SdlsConfig::recorded());
+    let (ka, kb) = (a.trace_keys().unwrap(), b.trace_keys().unwrap());
+    assert_ne!(ka, kb);
+    assert_eq!(format!("{ka:?}"), "TestKeys(..)");
+    assert_eq!(
+        format!("{a:?}"),
+        r#"SdlsConfig { keys: "recorded", attack: 0.0 }"#
+    );
+    // A trace whose key is weak (here all zeros) is refused, not replayed.
+    let mut h = mmic_replay::trace::Header::demo(Protocol::PusFramesSdls);
+    h.sdls = Some(mmic_replay::trace::TestKeys::new([0; 32], [7; 32]));
+    let mut bytes = Vec::new();
+    h.emit(&mut bytes);
+    assert!(matches!(
+        Trace::parse(&bytes).map(|_| ()),
+        Err(TraceError::Header { .. })
+    ));
 }

@@ -581,6 +581,8 @@ fn keys_never_show() {
         assert!(!text.to_lowercase().contains("a5"), "{text}");
         assert!(!text.contains("165"), "{text}");
     }
+    // The association keeps its key as a schedule, shown as nothing either.
+    assert!(format!("{t:?}").contains("Schedule(..)"));
     assert_eq!(
         Key256::from_slice(&[0; 31]).unwrap_err(),
         SdlsError::KeyLength {

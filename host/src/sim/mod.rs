@@ -454,6 +454,10 @@ pub enum SdlsKeys {
     Random,
     /// Read from files (`--sdls-keys DIR`): each robot's (TC, TM) keys, by robot index.
     Given(Vec<(Key256, Key256)>),
+    /// Test keys made at random for one recorded run (`mmic replay --record-scenarios`),
+    /// robot 1's, written into its replay trace (the other robots' derived from the seed):
+    /// the only keys a trace may hold.
+    Recorded(mmic_replay::trace::TestKeys),
 }
 
 /// SDLS in a run's own grounds ([`SimConfig::sdls`]).
@@ -478,6 +482,7 @@ impl std::fmt::Debug for SdlsConfig {
             SdlsKeys::Seeded => "seeded",
             SdlsKeys::Random => "random",
             SdlsKeys::Given(_) => "given",
+            SdlsKeys::Recorded(_) => "recorded",
         };
         f.debug_struct("SdlsConfig")
             .field("keys", &keys)
@@ -506,7 +511,10 @@ impl SdlsConfig {
         };
         match &self.keys {
             SdlsKeys::Given(v) if i < v.len() => Ok(v[i].clone()),
-            SdlsKeys::Given(_) | SdlsKeys::Seeded => Ok((seeded(1), seeded(2))),
+            SdlsKeys::Recorded(k) if i == 0 => Ok(k.keys()),
+            SdlsKeys::Given(_) | SdlsKeys::Seeded | SdlsKeys::Recorded(_) => {
+                Ok((seeded(1), seeded(2)))
+            }
             SdlsKeys::Random => {
                 let read = || -> std::io::Result<Key256> {
                     let mut b = zeroize::Zeroizing::new([0u8; mmic::link::sdls::KEY_LEN]);
@@ -523,6 +531,33 @@ impl SdlsConfig {
 }
 
 impl SdlsConfig {
+    /// SDLS for a recorded scenario: robot 1's keys made at random now (fresh for every
+    /// recording: test keys, written into the trace), no attacker, no state file.
+    pub fn recorded() -> SdlsConfig {
+        let mut rng = fastrand::Rng::new();
+        let mut key = || {
+            let mut b = [0u8; mmic::link::sdls::KEY_LEN];
+            rng.fill(&mut b);
+            b
+        };
+        let (tc, tm) = (key(), key());
+        SdlsConfig {
+            keys: SdlsKeys::Recorded(mmic_replay::trace::TestKeys::new(tc, tm)),
+            state: None,
+            attack: 0.0,
+        }
+    }
+
+    /// The keys a replay trace of this run may hold: the recorded run's test keys, when there
+    /// is no attacker (the replay runs the ground's frames only). `None`: the run cannot be
+    /// recorded with SDLS (given keys never go into a file beside their state).
+    pub fn trace_keys(&self) -> Option<mmic_replay::trace::TestKeys> {
+        match &self.keys {
+            SdlsKeys::Recorded(k) if self.attack == 0.0 => Some(*k),
+            _ => None,
+        }
+    }
+
     /// The state file of given keys' counters, opened (`None`: no given keys).
     pub fn open_state(&self) -> std::io::Result<Option<durable::Durable>> {
         match (&self.keys, &self.state) {

@@ -2,12 +2,23 @@
 //!
 //! A key is never shown: its `Debug` prints `Key256(..)`, it has no `Display`, no serde and no
 //! accessor that hands the octets out of the crate; its octets are overwritten with zeros when
-//! it is dropped (`zeroize`). The AES key schedule and the GHASH key built from it for one frame
-//! are dropped before the call returns, and zeroized there by `aes`, `ghash` and `polyval`
-//! (their `zeroize` features, asserted below at compile time) — except on x86, x86_64 and
-//! aarch64 hosts, where polyval 0.6's run-time CPU detection keeps its state in a union
-//! without `Drop`: the GHASH key of a frame stays in freed stack memory there (the host
-//! simulator; the ESP32 targets use the software backend, which zeroizes).
+//! it is dropped (`zeroize`).
+//!
+//! A security association keeps its key only as a [`Schedule`]: the AES-256 key schedule and
+//! the GHASH key built from it once, when the association is made, and kept for its lifetime
+//! (built per frame, they cost some 16,000 instructions of every frame on RV32:
+//! benches/rv32/README.md). The schedule is never shown either (`Schedule(..)`), and is
+//! zeroized when the association is dropped or replaced (a link secured again under new keys
+//! drops its old table) by `aes`, `ghash` and `polyval` (their `zeroize` features, asserted
+//! below at compile time) — except on x86, x86_64 and aarch64 hosts, where polyval 0.6's
+//! run-time CPU detection keeps its state in a union without `Drop`: the GHASH key H of a
+//! dropped association stays in freed memory there (the host simulator; the ESP32 targets use
+//! the software backend, which zeroizes; the AES key schedule is zeroized on every target).
+//! What this covers is the value dropped: a copy the compiler left behind when an association
+//! was moved (into its table, say) is not cleared, for the schedule as for the key. The RV32
+//! runner (`mmic-rv32 --sdls`, run by `benches/rv32/run` in CI) checks on the ESP32-C3's
+//! software backends that every octet of a dropped association's schedule and GHASH key is
+//! zero; no test reads freed memory on the host.
 //!
 //! What a durable store may record of a key is its [`Fingerprint`], a key check value: the
 //! first 8 octets of AES-256 under the key of one fixed block, [`FINGERPRINT_BLOCK`]. It tells
@@ -34,6 +45,7 @@
 //! assert!(key.check().is_ok());
 //! assert_eq!(key.fingerprint(), key.clone().fingerprint());
 //! assert_eq!(format!("{:?}", key.fingerprint()), "Fingerprint(..)");
+//! assert_eq!(format!("{:?}", key.schedule()), "Schedule(..)");
 //! ```
 
 use zeroize::{Zeroize, ZeroizeOnDrop};
@@ -184,11 +196,37 @@ impl Key256 {
         &self.0
     }
 
-    /// The key schedule for one operation (crate-private: the octets never leave the crate).
-    pub(crate) fn cipher(&self) -> aes_gcm::Aes256Gcm {
+    /// The key schedule and GHASH key, built once for an association's lifetime.
+    pub fn schedule(&self) -> Schedule {
         use aes_gcm::KeyInit;
         // A reference conversion: no copy of the octets is left on the stack.
-        aes_gcm::Aes256Gcm::new((&self.0).into())
+        Schedule(aes_gcm::Aes256Gcm::new((&self.0).into()))
+    }
+}
+
+/// A key's AES-256 key schedule and GHASH key ([`Key256::schedule`]): what a security
+/// association keeps instead of the key, so that a frame costs no key expansion. Never shown,
+/// no accessor; zeroized on drop as the module's documentation says.
+#[derive(Clone)]
+pub struct Schedule(aes_gcm::Aes256Gcm);
+
+impl Schedule {
+    /// The cipher (crate-private: the schedule never leaves the crate).
+    pub(crate) fn cipher(&self) -> &aes_gcm::Aes256Gcm {
+        &self.0
+    }
+}
+
+impl core::fmt::Debug for Schedule {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("Schedule(..)")
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Schedule {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(f, "Schedule(..)")
     }
 }
 

@@ -16,7 +16,7 @@
 
 use super::counter::{ReplayWindow, TxCounter};
 use super::iv::{Iv, IV_LEN};
-use super::key::Key256;
+use super::key::{Key256, Schedule};
 use super::{SdlsError, SdlsRefusal, HEADER_LEN, MAC_LEN, OVERHEAD, SPI_LEN};
 use aes_gcm::aead::AeadInPlace;
 
@@ -99,18 +99,21 @@ pub enum Role {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SecurityAssociation {
     spi: u16,
-    key: Key256,
+    /// The key as its schedule, built once (the key itself is dropped, zeroized, in `new`).
+    schedule: Schedule,
     channel: Channel,
     mask: AuthMask,
     role: Role,
 }
 
 impl SecurityAssociation {
-    /// An association of `spi` under `key` for `channel`, its AAD masked by `mask`.
+    /// An association of `spi` under `key` for `channel`, its AAD masked by `mask`. The key
+    /// schedule is built here, once for the association's lifetime; the key is dropped
+    /// (zeroized).
     pub fn new(spi: u16, key: Key256, channel: Channel, mask: AuthMask, role: Role) -> Self {
         SecurityAssociation {
             spi,
-            key,
+            schedule: key.schedule(),
             channel,
             mask,
             role,
@@ -211,7 +214,7 @@ impl SecurityAssociation {
         let body = mac_end - sec_start - HEADER_LEN;
         let (plain, trailer) = rest.split_at_mut(body - MAC_LEN);
         let tag = self
-            .key
+            .schedule
             .cipher()
             .encrypt_in_place_detached(&iv.to_bytes().into(), aad, plain)
             .map_err(|_| SdlsError::Cipher)?;
@@ -265,16 +268,17 @@ impl SecurityAssociation {
             .and_then(|t| t.try_into().ok())
             .ok_or(malformed)?;
         // aes-gcm checks the tag before it decrypts: a refused frame is left as it came.
-        self.key
+        self.schedule
             .cipher()
             .decrypt_in_place_detached(&iv_bytes.into(), aad, cipher_text, &tag.into())
             .map_err(|_| SdlsRefusal::BadMac { spi: self.spi })?;
         if let Err(e) = window.admit(iv) {
             // Put the ciphertext back: a refused frame is left as it came.
-            let _ = self
-                .key
-                .cipher()
-                .encrypt_in_place_detached(&iv_bytes.into(), aad, cipher_text);
+            let _ = self.schedule.cipher().encrypt_in_place_detached(
+                &iv_bytes.into(),
+                aad,
+                cipher_text,
+            );
             return Err(e);
         }
         Ok(iv)

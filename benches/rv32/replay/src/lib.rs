@@ -233,6 +233,7 @@ impl Replay {
                 g.add(h.board);
                 Board::Frames(g)
             }
+            Protocol::PusFramesSdls => Board::Frames(secured(h)),
         };
         Replay {
             header: *h,
@@ -566,12 +567,14 @@ fn gateway_loop(g: &mut ReplayGateway, io: &mut ServerIo<'_>, m: &mut impl Meter
 #[inline(never)]
 fn frames_loop(g: &mut ReplayFrameGateway, io: &mut ServerIo<'_>, m: &mut impl Meter) {
     let (number, now) = (io.number, io.now);
-    // As the engine's `frames_loop`: the TC frames through FARM-1 into the
-    // gateway, the tick, the TM frames due, the next visit.
+    // As the engine's `frames_loop`: what is due kept first, the TC frames through FARM-1
+    // into the gateway (nothing kept between them: an SDLS window's next reservation is
+    // written after the batch, as the engine does), the tick, the TM frames due, the next
+    // visit.
+    keep(g);
     while let Some(f) = io.inbox.pop_front() {
         m.call(Call::TcFrame, true);
         let got = g.tc_frame(now, &f);
-        keep(g);
         m.call(Call::TcFrame, false);
         m.enter(Phase::Record);
         io.w.debug(Field::TcFrame, &got);
@@ -604,6 +607,36 @@ fn frames_loop(g: &mut ReplayFrameGateway, io: &mut ServerIo<'_>, m: &mut impl M
     }
 }
 
+/// The frame gateway of a [`Protocol::PusFramesSdls`] trace, as the engine boots it with keys
+/// made for the run (`sim::durable::provision_memory`, then `boot_gateway`): the server
+/// board's store provisioned for the header's test keys, booted from it, the link secured,
+/// what it asks to keep confirmed. Fails closed: if any step refuses (unreachable with the
+/// keys `Trace::parse` checked), the gateway serves no robot and every frame is refused.
+fn secured(h: &Header) -> ReplayFrameGateway {
+    use mmic::node::server::store::{self, End, Resume};
+    let mut g = ReplayFrameGateway::new(h.frame_config());
+    let Some((tc, tm)) = h.sdls.as_ref().map(trace::TestKeys::keys) else {
+        return g;
+    };
+    let Ok(entries) = store::provision(End::Server, h.board, &tc, &tm, Resume::FRESH) else {
+        return g;
+    };
+    let lookup = |k: u16| {
+        entries
+            .iter()
+            .find(|e| e.key == k)
+            .map(|e| (e.aux, e.value))
+    };
+    let Ok(boot) = store::boot(End::Server, h.board, &tc, &tm, lookup) else {
+        return g;
+    };
+    if !g.add(h.board) || g.secure(h.board, tc, tm, boot.stored).is_err() {
+        return ReplayFrameGateway::new(h.frame_config());
+    }
+    keep(&mut g);
+    g
+}
+
 /// What the gateway asks to keep, confirmed at once (the engine's store in memory, written
 /// before anything that depends on it leaves: `sim::durable::persist_gateway`).
 fn keep(g: &mut ReplayFrameGateway) {
@@ -613,7 +646,10 @@ fn keep(g: &mut ReplayFrameGateway) {
 }
 
 /// The TM frames due at `now`, each into the record (as the engine's `tm_frames` sends them).
+/// What is due is kept first (the engine's `tm_frames`: with SDLS, a TM frame waits for its
+/// counter's reservation).
 fn tm_frames(w: &mut RecordWriter, g: &mut ReplayFrameGateway, now: u32, m: &mut impl Meter) {
+    keep(g);
     let mut buf = [0u8; TM_FRAME_LEN];
     loop {
         m.call(Call::Frame, true);

@@ -3,8 +3,10 @@
 //! its time and the bytes or readings it was given. Little-endian throughout.
 //!
 //! ```text
-//! header  "MMICRPL1" protocol:u8 board:u8 state:u8      (protocol: 0 legacy, 1 PUS, 2 PUS over frames)
+//! header  "MMICRPL1" protocol:u8 board:u8 state:u8      (protocol: 0 legacy, 1 PUS, 2 PUS over frames,
+//!                                                        3 PUS over frames secured with SDLS)
 //!         period_ms:u32 timeout_ms:u32 max_attempts:u8 poll_ms:u32 hk_interval_ms:u32 hk_enabled:u8
+//!         [tc_key:32 tm_key:32]                          (protocol 3 only: the run's test keys)
 //! record  tag:u8 t_ms:u32 body            (body by tag, see [`Record`])
 //! reading flags:u8 [adc:8×u16] [accel:3×i16] [encoder:u16]
 //!         flags: 1 adc, 2 accel, 4 encoder, 8 arm contracted, 16 bolter at home
@@ -14,7 +16,8 @@
 //! The format has one version: a trace of an older build reads the same (protocol 2 only
 //! added a value, and with it the server board's `ServerIn` records carry TC transfer frames
 //! instead of PUS packets; the link's own settings are [`FrameConfig`]'s defaults with the
-//! header's gateway timing, as the engine runs it).
+//! header's gateway timing, as the engine runs it; protocol 3 added the run's SDLS test keys
+//! after the header, [`TestKeys`]).
 //!
 //! ```
 //! use mmic_replay::trace::{Header, Protocol, Reading, Record, Trace};
@@ -30,6 +33,7 @@
 //! ```
 
 use crate::Sink;
+use mmic::link::sdls::{Key256, KEY_LEN};
 use mmic::motion::State;
 use mmic::node::exactly_once::uplink;
 use mmic::node::server::frames::FrameConfig;
@@ -39,7 +43,7 @@ use mmic::units::BoardNumber;
 
 /// The file's first eight bytes.
 pub const MAGIC: &[u8; 8] = b"MMICRPL1";
-/// The header's length, bytes.
+/// The header's length, bytes (a protocol-3 trace's two keys follow it: 64 more).
 pub const HEADER_LEN: usize = 8 + 3 + 4 + 4 + 1 + 4 + 4 + 1;
 
 /// Why a trace cannot be read.
@@ -85,6 +89,39 @@ pub enum Protocol {
     /// frame gateway (`mmic::node::server::frames`), the ground's bytes are TC transfer frames
     /// and what it sends back TM transfer frames.
     PusFrames = 2,
+    /// [`Protocol::PusFrames`] with the link secured by SDLS (`mmic sim --link frames --sdls`):
+    /// the TC frames are verified and decrypted, the TM frames protected, under the
+    /// [`Header::sdls`] test keys.
+    PusFramesSdls = 3,
+}
+
+/// The SDLS keys of a [`Protocol::PusFramesSdls`] trace, robot 1's TC and TM keys: **test
+/// keys**, made at random for the one simulation run that recorded the trace (`mmic replay
+/// --record-scenarios`) and written into it so that a replay verifies and protects the same
+/// frames. Never a mission's keys: the engine refuses to record a run whose keys were given
+/// (`--sdls-keys`). Never shown: `Debug` prints `TestKeys(..)`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct TestKeys {
+    tc: [u8; KEY_LEN],
+    tm: [u8; KEY_LEN],
+}
+
+impl TestKeys {
+    /// The keys' octets (made by the recorder for its run).
+    pub const fn new(tc: [u8; KEY_LEN], tm: [u8; KEY_LEN]) -> TestKeys {
+        TestKeys { tc, tm }
+    }
+
+    /// The TC and TM keys.
+    pub fn keys(&self) -> (Key256, Key256) {
+        (Key256::from_bytes(self.tc), Key256::from_bytes(self.tm))
+    }
+}
+
+impl core::fmt::Debug for TestKeys {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("TestKeys(..)")
+    }
 }
 
 /// The scenario's fixed settings.
@@ -98,6 +135,8 @@ pub struct Header {
     pub start: State,
     /// The gateway's timing (used with [`Protocol::Pus`] and [`Protocol::PusFrames`]).
     pub gateway: gateway::Config,
+    /// With [`Protocol::PusFramesSdls`] (and only then): the run's SDLS test keys.
+    pub sdls: Option<TestKeys>,
 }
 
 impl Header {
@@ -117,6 +156,7 @@ impl Header {
             board: BoardNumber::ONE,
             start: State::A,
             gateway: gateway::Config::default(),
+            sdls: None,
         }
     }
 
@@ -135,6 +175,10 @@ impl Header {
         out.put(&g.poll_ms.to_le_bytes());
         out.put(&g.hk_interval_ms.to_le_bytes());
         out.put(&[u8::from(g.hk_enabled)]);
+        if let (Protocol::PusFramesSdls, Some(k)) = (self.protocol, &self.sdls) {
+            out.put(&k.tc);
+            out.put(&k.tm);
+        }
     }
 
     fn parse(r: &mut Reader<'_>) -> Result<Header, TraceError> {
@@ -145,6 +189,7 @@ impl Header {
             0 => Protocol::Legacy,
             1 => Protocol::Pus,
             2 => Protocol::PusFrames,
+            3 => Protocol::PusFramesSdls,
             p => return Err(header("protocol", p.into())),
         };
         let b = r.u8()?;
@@ -162,13 +207,33 @@ impl Header {
             hk_interval_ms: r.u32()?,
             hk_enabled: r.u8()? != 0,
         };
+        let sdls = match protocol {
+            Protocol::PusFramesSdls => Some(test_keys(r)?),
+            _ => None,
+        };
         Ok(Header {
             protocol,
             board,
             start,
             gateway,
+            sdls,
         })
     }
+}
+
+/// A protocol-3 header's two keys, each refused if [`Key256::check`] would refuse it (the
+/// engine could not have secured a link with it: the replay would not either).
+fn test_keys(r: &mut Reader<'_>) -> Result<TestKeys, TraceError> {
+    let mut key = |field: &'static str| -> Result<[u8; KEY_LEN], TraceError> {
+        let b: [u8; KEY_LEN] = r.take(KEY_LEN)?.try_into().map_err(|_| header(field, 0))?;
+        match Key256::from_bytes(b).check() {
+            Ok(()) => Ok(b),
+            Err(_) => Err(header(field, 0)),
+        }
+    };
+    let tc = key("TC key (a weak key)")?;
+    let tm = key("TM key (a weak key)")?;
+    Ok(TestKeys { tc, tm })
 }
 
 fn header(field: &'static str, found: u32) -> TraceError {
@@ -391,6 +456,8 @@ pub struct Trace<'a> {
     /// The settings.
     pub header: Header,
     body: &'a [u8],
+    /// Where the body starts in the file ([`HEADER_LEN`], and the keys of a protocol-3 trace).
+    offset: usize,
 }
 
 impl<'a> Trace<'a> {
@@ -400,7 +467,8 @@ impl<'a> Trace<'a> {
         let header = Header::parse(&mut r)?;
         Ok(Trace {
             header,
-            body: bytes.get(HEADER_LEN..).unwrap_or(&[]),
+            body: bytes.get(r.at..).unwrap_or(&[]),
+            offset: r.at,
         })
     }
 
@@ -412,6 +480,7 @@ impl<'a> Trace<'a> {
                 at: 0,
             },
             failed: false,
+            offset: self.offset,
         }
     }
 }
@@ -421,6 +490,7 @@ impl<'a> Trace<'a> {
 pub struct Records<'a> {
     r: Reader<'a>,
     failed: bool,
+    offset: usize,
 }
 
 impl<'a> Iterator for Records<'a> {
@@ -439,7 +509,7 @@ impl<'a> Iterator for Records<'a> {
 impl<'a> Records<'a> {
     fn read(&mut self) -> Result<Record<'a>, TraceError> {
         let r = &mut self.r;
-        let at = r.at + HEADER_LEN;
+        let at = r.at + self.offset;
         let tag = r.u8()?;
         let t = r.u32()?;
         Ok(match tag {

@@ -176,8 +176,9 @@ fn parsers() -> Result<(), &'static str> {
 /// 16 runs) and stack, as Markdown rows: verifying a protected TC frame (YAMCS's first frame:
 /// one 13-octet TC(17,1), 51 octets), refusing one with a flipped data bit (the MAC's cost)
 /// and a replay (no cryptography), protecting a 256-octet TM frame. Each run starts from a
-/// copy of the same association, made before the count starts; the key schedule is part of
-/// every operation (the library builds it per frame). The key is a fixed test pattern.
+/// copy of the same association, made before the count starts; the key schedule is not part
+/// of an operation (an association builds it once, when it is made). The key is a fixed test
+/// pattern. Then checks that a dropped association's key schedule is all zeros.
 fn sdls() -> Result<(), &'static str> {
     use mmic::ccsds::primary::{Apid, SeqCount};
     use mmic::ccsds::tc::TcRepr;
@@ -295,6 +296,43 @@ fn sdls() -> Result<(), &'static str> {
         frames::protect_tm(&mut t[k], mission::tm_spi(one), &params, &mut frame).is_ok()
     })?;
     println!("| protect a 256-octet TM frame (214 octets encrypted, FECF again) | {i} | {st} |");
+    dropped_sa_is_zeroized(mission::tc_receiver(one, key(), None), &key().schedule())?;
+    println!("\nmmic-rv32: a dropped security association's key schedule and GHASH key: all zeros");
+    Ok(())
+}
+
+/// Checks, on the ESP32-C3's software backends, that dropping `sa` zeroizes the key schedule
+/// and GHASH key it kept (`mmic::link::sdls::key`'s `zeroize` guarantee): finds the bytes of
+/// `same` (a schedule of the same key: the backends build it deterministically) inside the
+/// association, drops it in place and reads them again. Fails if the schedule is not found
+/// (or is all zeros before the drop), or if one octet of it is not zero after.
+fn dropped_sa_is_zeroized(
+    sa: mmic::link::sdls::SecurityAssociation,
+    same: &mmic::link::sdls::key::Schedule,
+) -> Result<(), &'static str> {
+    use core::mem::{size_of, MaybeUninit};
+    let len = size_of::<mmic::link::sdls::key::Schedule>();
+    let n = size_of::<mmic::link::sdls::SecurityAssociation>();
+    let read = |a: usize| -> u8 {
+        // SAFETY: `a` is inside `same` or `slot` below, live memory this function owns or
+        // borrows; a volatile read of an octet, as the stack paint's.
+        unsafe { core::ptr::read_volatile(a as *const u8) }
+    };
+    let pattern = same as *const _ as usize;
+    if (0..len).all(|i| read(pattern + i) == 0) {
+        return Err("a key schedule is all zeros before any drop");
+    }
+    let mut slot = MaybeUninit::new(sa);
+    let base = slot.as_ptr() as usize;
+    let at = (0..=n - len)
+        .find(|&o| (0..len).all(|i| read(base + o + i) == read(pattern + i)))
+        .ok_or("a security association holds no copy of its key's schedule")?;
+    // SAFETY: `slot` was initialised above and is dropped once; its storage stays in place
+    // (and is only read) until this function returns.
+    unsafe { slot.assume_init_drop() };
+    if (0..len).any(|i| read(base + at + i) != 0) {
+        return Err("a dropped security association left its key schedule in memory");
+    }
     Ok(())
 }
 

@@ -385,9 +385,9 @@ pub fn run_watched(cfg: &SimConfig, watched: bool) -> std::io::Result<(Summary, 
             "an external ground runs on the wall clock: use the realtime engine",
         ));
     }
-    if cfg.sdls.is_some() && cfg.record.is_some() {
+    if cfg.record.is_some() && cfg.sdls.as_ref().is_some_and(|s| s.trace_keys().is_none()) {
         return Err(std::io::Error::other(
-            "a replay trace has no keys: --record runs without --sdls",
+            "a replay trace holds only test keys made for it: --record runs without --sdls",
         ));
     }
     let n = cfg.robots.max(1) as usize;
@@ -1481,10 +1481,18 @@ impl<'c, G: Ground> Engine<'c, G> {
 
 /// The replay trace's header of a run (`mmic sim --record`).
 fn record_header(cfg: &SimConfig) -> trace::Header {
+    let frames = cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames;
+    let sdls = cfg
+        .sdls
+        .as_ref()
+        .filter(|_| frames)
+        .and_then(|s| s.trace_keys());
     trace::Header {
+        sdls,
         protocol: match cfg.protocol {
             Protocol::Legacy => trace::Protocol::Legacy,
-            Protocol::Pus if cfg.link == LinkLayer::Frames => trace::Protocol::PusFrames,
+            Protocol::Pus if sdls.is_some() => trace::Protocol::PusFramesSdls,
+            Protocol::Pus if frames => trace::Protocol::PusFrames,
             Protocol::Pus => trace::Protocol::Pus,
         },
         board: board_number(0),
