@@ -426,17 +426,23 @@ pub fn boot_gateway(
 /// Writes what the gateway asks to keep and confirms it once durable; false when the write
 /// failed (nothing confirmed: the gateway holds back what needs it, and asks again).
 pub fn persist_gateway(g: &mut FrameGateway, d: &Durable) -> bool {
+    write_due(g, d).is_some()
+}
+
+/// [`persist_gateway`], telling how many entries were due (and written): none when the write
+/// failed. With none due, the gateway asks nothing more until it is called again.
+pub fn write_due(g: &mut FrameGateway, d: &Durable) -> Option<usize> {
     let due: heapless::Vec<Entry, 64> = g.durable_due();
     if due.is_empty() {
-        return true;
+        return Some(0);
     }
     if d.write(Section::Server, &due).is_err() {
-        return false;
+        return None;
     }
     for e in &due {
         g.durable_written(e);
     }
-    true
+    Some(due.len())
 }
 
 /// The gateway's tick with what it asks kept written first and, when the tick held a

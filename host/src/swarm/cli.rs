@@ -1,7 +1,7 @@
 //! `mmic swarm`: arguments and output around [`super::swarm`] and its replay.
 
 use super::scenario::{LinkDraw, Options, RestartDraw, Scenario, SdlsDraw};
-use super::shard::{self, SeedDigest, SeedRange, Shard};
+use super::shard::{self, SeedRange, Shard};
 use super::{judge, replay_command, swarm_over};
 use crate::error::CliError;
 use crate::sim::engine::PlantedBug;
@@ -103,6 +103,10 @@ pub struct SwarmArgs {
     /// the same.
     #[arg(long, default_value = "any", value_parser = restart_draw)]
     pub restarts: RestartDraw,
+    /// Seeds run at once, each on a thread of its own (default: the cores this process may
+    /// use). The report is the same for any number: the runs are counted in seed order.
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
     /// Replay this one seed: print its scenario and violations, write its whole log.
     #[arg(long, value_name = "SEED")]
     pub replay: Option<u64>,
@@ -204,17 +208,16 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
             (seeds, Duration::from_secs_f64(a.seconds), None)
         }
     };
-    let mut digest = SeedDigest::default();
-    let report = {
-        let mut seeds = seeds.inspect(|s| digest.add(*s));
-        swarm_over(
-            &mut seeds,
-            budget,
-            a.max_failures.max(1),
-            &opts,
-            &mut |line| eprintln!("swarm: {line}"),
-        )
-    };
+    let mut seeds = seeds;
+    let report = swarm_over(
+        &mut seeds,
+        budget,
+        a.max_failures.max(1),
+        a.jobs.unwrap_or_else(super::pool::default_jobs).max(1),
+        &opts,
+        &mut |line| eprintln!("swarm: {line}"),
+    );
+    let digest = report.seeds;
     let mut text = report.text(&opts);
     let mut json = report.json(&opts);
     json["options"] = serde_json::json!({

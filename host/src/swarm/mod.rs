@@ -17,6 +17,7 @@
 //! ```
 
 pub mod cli;
+pub mod pool;
 pub mod scenario;
 pub mod shard;
 
@@ -319,6 +320,8 @@ pub struct Report {
     pub restart_runs: u64,
     /// Restarts of board A, board B and the server board, all runs.
     pub restarts: [u64; 4],
+    /// The seeds these runs were (count and digest).
+    pub seeds: shard::SeedDigest,
 }
 
 /// Adds `b`'s figures to `a`'s.
@@ -466,7 +469,8 @@ impl Report {
 }
 
 /// Runs seeds from `seed_start` on until `budget` of wall time is spent (or `max_runs` runs,
-/// or `stop_at_failures` failures); `progress` gets a line every few seconds.
+/// or `stop_at_failures` failures), on every core ([`pool::default_jobs`]); `progress` gets a
+/// line every few seconds.
 pub fn swarm(
     seed_start: u64,
     budget: Duration,
@@ -480,28 +484,67 @@ pub fn swarm(
         &mut (seed_start..=u64::MAX).take(runs),
         budget,
         stop_at_failures,
+        pool::default_jobs(),
         opts,
         progress,
     )
 }
 
-/// Runs the seeds `seeds` gives, in its order, until it ends or `budget` of wall time is spent
-/// (or `stop_at_failures` failures); `progress` gets a line every few seconds. A seed is taken
-/// from `seeds` only to be run: what it has given is what ran (`mmic swarm --shard` counts
-/// and digests the seeds this way).
+/// Runs the seeds `seeds` gives, on `jobs` threads, until it ends or `budget` of wall time is
+/// spent (or `stop_at_failures` failures); `progress` gets a line every few seconds. The report
+/// counts the seeds in the order `seeds` gives them, whatever the threads, and says which it
+/// counted ([`Report::seeds`]: `mmic swarm --shard` digests them).
 pub fn swarm_over(
     seeds: &mut dyn Iterator<Item = u64>,
     budget: Duration,
     stop_at_failures: usize,
+    jobs: usize,
     opts: &Options,
     progress: &mut dyn FnMut(String),
 ) -> Report {
     let start = Instant::now();
     let mut last = start;
     let mut r = Report::default();
-    while start.elapsed() < budget {
-        let Some(seed) = seeds.next() else { break };
-        let mut o = run_one(seed, opts);
+    let go_on = || start.elapsed() < budget;
+    let run = |seed| run_one(seed, opts);
+    pool::in_order(seeds, jobs, &go_on, &run, &mut |seed, o| {
+        r.add(seed, o, opts, progress);
+        if r.failures.len() >= stop_at_failures {
+            return false;
+        }
+        if last.elapsed() >= Duration::from_secs(10) {
+            last = Instant::now();
+            // A shard has no budget: it runs its share.
+            let left = if budget < Duration::MAX {
+                let left = budget.saturating_sub(start.elapsed());
+                format!(", {:.0} s left", left.as_secs_f64())
+            } else {
+                String::new()
+            };
+            progress(format!(
+                "{} runs, {:.1} simulated hours, {} failed{left}",
+                r.runs,
+                r.sim_ms as f64 / 3_600_000.0,
+                r.failures.len(),
+            ));
+        }
+        true
+    });
+    r.wall = start.elapsed();
+    r
+}
+
+impl Report {
+    /// Counts seed `seed`'s run `o` (a failure with its replay command to `progress`).
+    fn add(
+        &mut self,
+        seed: u64,
+        mut o: RunOutcome,
+        opts: &Options,
+        progress: &mut dyn FnMut(String),
+    ) {
+        let r = self;
+        r.seeds.add(seed);
         r.runs += 1;
         r.sim_ms += o.sim_ms as u64;
         r.expected += o.expected;
@@ -516,15 +559,15 @@ pub fn swarm_over(
         if let Some(f) = o.summary.as_ref().and_then(|s| s.frames.as_ref()) {
             add_frames(&mut r.frames, f);
         }
-        let c = &mut r.checked;
-        c.admissions += o.checked.admissions;
-        c.motion_ticks += o.checked.motion_ticks;
-        c.standby_ticks += o.checked.standby_ticks;
-        c.faults_raised += o.checked.faults_raised;
-        c.commands_ended += o.checked.commands_ended;
-        c.attack_frames += o.checked.attack_frames;
-        c.restarts += o.checked.restarts;
-        c.executed_twice += o.checked.executed_twice;
+        let (c, k) = (&mut r.checked, &o.checked);
+        c.admissions += k.admissions;
+        c.motion_ticks += k.motion_ticks;
+        c.standby_ticks += k.standby_ticks;
+        c.faults_raised += k.faults_raised;
+        c.commands_ended += k.commands_ended;
+        c.attack_frames += k.attack_frames;
+        c.restarts += k.restarts;
+        c.executed_twice += k.executed_twice;
         if let Some(s) = &o.summary {
             for (t, n) in r.restarts.iter_mut().zip(s.restarts) {
                 *t += u64::from(n);
@@ -543,27 +586,6 @@ pub fn swarm_over(
                 replay_command(seed, opts)
             ));
             r.failures.push(o);
-            if r.failures.len() >= stop_at_failures {
-                break;
-            }
-        }
-        if last.elapsed() >= Duration::from_secs(10) {
-            last = Instant::now();
-            // A shard has no budget: it runs its share.
-            let left = if budget < Duration::MAX {
-                let left = budget.saturating_sub(start.elapsed());
-                format!(", {:.0} s left", left.as_secs_f64())
-            } else {
-                String::new()
-            };
-            progress(format!(
-                "{} runs, {:.1} simulated hours, {} failed{left}",
-                r.runs,
-                r.sim_ms as f64 / 3_600_000.0,
-                r.failures.len(),
-            ));
         }
     }
-    r.wall = start.elapsed();
-    r
 }

@@ -30,8 +30,8 @@
 //! Injected faults being raised, and no panic, are judged by the swarm from the run's outcome
 //! ([`crate::swarm`]).
 
-use super::SimConfig;
 use crate::sim::plant::Plant;
+use crate::sim::SimConfig;
 use mmic::bolter::Drive;
 use mmic::control::interp::Travel;
 use mmic::faults::{Fault, Faults};
@@ -492,10 +492,15 @@ impl Watch {
     ) {
         let r = &mut self.robots[i];
         let before = commanded.or(r.last_mode).unwrap_or(mode);
-        let new: Vec<Fault> = faults
-            .iter()
-            .filter(|f| !r.last_faults.contains(*f))
-            .collect();
+        // Most ticks raise nothing: the set compared before any list is made.
+        let new: Vec<Fault> = if faults == r.last_faults {
+            Vec::new()
+        } else {
+            faults
+                .iter()
+                .filter(|f| !r.last_faults.contains(*f))
+                .collect()
+        };
         r.last_faults = faults;
         r.last_mode = Some(mode);
         let deferred_since = r.deferred_since;
