@@ -48,6 +48,8 @@ impl FarmEvent {
 
 /// The event numbers of 232.1-B-2 Table 6-1 (E11, "report", is [`Farm::clcw`]: it changes
 /// nothing).
+///
+/// [`Farm::clcw`]: super::Farm::clcw
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]

@@ -96,5 +96,7 @@ pub enum FopOutput<P> {
     /// The AD service stopped ("Alert").
     Alert(AlertCode),
     /// The AD service was suspended (timeout type 1); [`Directive::Resume`] takes it up.
+    ///
+    /// [`Directive::Resume`]: super::Directive::Resume
     Suspended,
 }

@@ -23,6 +23,9 @@
 /// FECF (the length says where the FECF is), the addressing after the FECF (a corrupted
 /// spacecraft ID or VCID is reported as corruption, a foreign one only when the frame is
 /// intact), and the content last.
+///
+/// [`TcFrame::new_checked`]: super::TcFrame::new_checked
+/// [`TcFrame::packets`]: super::TcFrame::packets
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]

@@ -1,5 +1,5 @@
-//! Why octets are not a TM frame under the given parameters, and why a frame could not be
-//! written: one variant a check, each with its name (`spec/ccsds/bad-inputs.toml`, parser `tm-frame`).
+//! Why octets are not a TM frame under the given parameters, and why a frame could not be written:
+//! one variant a check, each with its name (`spec/ccsds/bad-inputs.toml`, parser `tm-frame`).
 
 /// Why octets are not a TM transfer frame under the given [`TmFrameParams`]. Each variant
 /// names one check; [`TmFrameRepr::parse`] runs them in the order of [`TmFrameError::NAMES`]
@@ -17,6 +17,9 @@
 /// corrupted ID is reported as corruption and a foreign one only when the frame is intact. The
 /// synchronisation flag and its companions come before the first header pointer because they
 /// say whether the pointer means anything (with the synch flag set it is undefined, §4.1.2.7.6).
+///
+/// [`TmFrameParams`]: super::TmFrameParams
+/// [`TmFrameRepr::parse`]: super::TmFrameRepr::parse
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
@@ -156,6 +159,8 @@ pub enum TmEmitError {
     #[error("the data field must be {expected} octets, found {found}")]
     DataLength {
         /// [`TmFrameParams::data_len`].
+        ///
+        /// [`TmFrameParams::data_len`]: super::TmFrameParams::data_len
         expected: usize,
         /// Octets given.
         found: usize,
@@ -164,6 +169,8 @@ pub enum TmEmitError {
     #[error("the channel's OCF flag is {expected}, the frame has an OCF: {found}")]
     Ocf {
         /// [`TmFrameParams::ocf`].
+        ///
+        /// [`TmFrameParams::ocf`]: super::TmFrameParams::ocf
         expected: bool,
         /// Whether the repr holds an OCF.
         found: bool,

@@ -53,6 +53,8 @@
 //! let f = TmFrameRepr::parse(&tm[..len], &params).unwrap();
 //! assert_eq!(Clcw::parse(&f.ocf.unwrap()).unwrap().report_value, 1);
 //! ```
+//!
+//! [`TcFrame::new_checked`]: crate::link::tc_frame::TcFrame::new_checked
 
 use super::gateway::{Config as GatewayConfig, Gateway, Kept, KEPT_SOURCES};
 use super::store::queue::QUEUE_SLOTS;

@@ -15,6 +15,8 @@ const MAX_TM_LEN: usize = TM_MIN_LEN + MAX_TM_DATA;
 impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGateway<R, Q, K, N> {
     /// The next TM frame due at `now` of any robot, written into `out` (at least
     /// [`TM_FRAME_LEN`] octets): the robot and the frame's length. Call until `None`.
+    ///
+    /// [`TM_FRAME_LEN`]: crate::link::tm_frame::TM_FRAME_LEN
     pub fn frame(&mut self, now: u32, out: &mut [u8]) -> Option<(BoardNumber, usize)> {
         let gather = self.cfg.gather_ms;
         let link = self.links.iter_mut().find(|l| {
