@@ -246,39 +246,14 @@ impl<const N: usize> Extractor<N> {
     fn feed(&mut self, bytes: &[u8], starts: bool, on_packet: &mut impl FnMut(&[u8])) -> usize {
         let mut at = 0;
         while at < bytes.len() {
+            let rest = bytes.get(at..).unwrap_or(&[]);
             match self.state {
                 State::Sync => break,
-                State::Header => {
-                    let need = PRIMARY_LEN - self.buf.len();
-                    let take = need.min(bytes.len() - at);
-                    for &b in bytes.get(at..at + take).unwrap_or(&[]) {
-                        let _ = self.buf.push(b);
-                    }
-                    at += take;
-                    if let Some(h) = PrimaryHeader::read(&self.buf) {
-                        let total = h.total_len();
-                        let kind = if h.apid == IDLE_APID {
-                            Kind::Idle
-                        } else if total > N {
-                            self.counters.too_long = self.counters.too_long.wrapping_add(1);
-                            Kind::TooLong
-                        } else {
-                            Kind::Keep
-                        };
-                        if kind != Kind::Keep {
-                            self.buf.clear();
-                        }
-                        self.state = State::Body {
-                            total,
-                            got: PRIMARY_LEN,
-                            kind,
-                        };
-                    }
-                }
+                State::Header => at += self.feed_header(rest),
                 State::Body { total, got, kind } => {
-                    let take = (total - got).min(bytes.len() - at);
+                    let take = (total - got).min(rest.len());
                     if kind == Kind::Keep {
-                        for &b in bytes.get(at..at + take).unwrap_or(&[]) {
+                        for &b in rest.get(..take).unwrap_or(&[]) {
                             let _ = self.buf.push(b);
                         }
                     }
@@ -288,17 +263,7 @@ impl<const N: usize> Extractor<N> {
                         self.state = State::Body { total, got, kind };
                         continue;
                     }
-                    match kind {
-                        Kind::Keep => {
-                            self.counters.packets = self.counters.packets.wrapping_add(1);
-                            on_packet(&self.buf);
-                        }
-                        Kind::Idle => {
-                            self.counters.idle_packets = self.counters.idle_packets.wrapping_add(1)
-                        }
-                        Kind::TooLong => {}
-                    }
-                    self.buf.clear();
+                    self.packet_end(kind, on_packet);
                     self.state = if starts { State::Header } else { State::Sync };
                     if !starts {
                         break;
@@ -307,5 +272,48 @@ impl<const N: usize> Extractor<N> {
             }
         }
         at
+    }
+
+    /// Takes what `bytes` holds of the primary header in reassembly; once whole, the packet's
+    /// length and what becomes of it (kept, idle, or too long for the buffer: counted, and
+    /// skipped). Returns the octets used.
+    fn feed_header(&mut self, bytes: &[u8]) -> usize {
+        let take = (PRIMARY_LEN - self.buf.len()).min(bytes.len());
+        for &b in bytes.get(..take).unwrap_or(&[]) {
+            let _ = self.buf.push(b);
+        }
+        if let Some(h) = PrimaryHeader::read(&self.buf) {
+            let total = h.total_len();
+            let kind = if h.apid == IDLE_APID {
+                Kind::Idle
+            } else if total > N {
+                self.counters.too_long = self.counters.too_long.wrapping_add(1);
+                Kind::TooLong
+            } else {
+                Kind::Keep
+            };
+            if kind != Kind::Keep {
+                self.buf.clear();
+            }
+            self.state = State::Body {
+                total,
+                got: PRIMARY_LEN,
+                kind,
+            };
+        }
+        take
+    }
+
+    /// A packet's last octet arrived: a kept one handed out, an idle one counted.
+    fn packet_end(&mut self, kind: Kind, on_packet: &mut impl FnMut(&[u8])) {
+        match kind {
+            Kind::Keep => {
+                self.counters.packets = self.counters.packets.wrapping_add(1);
+                on_packet(&self.buf);
+            }
+            Kind::Idle => self.counters.idle_packets = self.counters.idle_packets.wrapping_add(1),
+            Kind::TooLong => {}
+        }
+        self.buf.clear();
     }
 }

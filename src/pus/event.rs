@@ -270,27 +270,32 @@ impl Event {
             found: data.len(),
         })?;
         let id = u16::from_be_bytes([b[0], b[1]]);
+        let event = Event::decode(id, &b)?;
+        if event.to_bytes() != b {
+            return Err(EventError::Padding { id });
+        }
+        if event.severity() != subservice {
+            return Err(EventError::Severity {
+                id,
+                expected: event.severity(),
+                found: subservice,
+            });
+        }
+        Ok(event)
+    }
+
+    /// The event `id` names, its fields from the octets after the ID (`b` is the whole source
+    /// data); a field no event of that kind has is refused by name. Padding and severity are
+    /// [`Event::parse`]'s.
+    fn decode(id: u16, b: &[u8; EVENT_LEN]) -> Result<Event, EventError> {
         let field = |field, found: u32| EventError::Field { id, field, found };
         let mode = |name, x: u8| Mode::from_wire(x).ok_or(field(name, u32::from(x)));
-        let event = match id {
+        Ok(match id {
             1 => Event::ModeChanged {
                 from: mode("from", b[2])?,
                 to: mode("to", b[3])?,
             },
-            2 => Event::Attempt {
-                pair: BolterPair::from_number(b[2]).ok_or(field("pair", u32::from(b[2])))?,
-                attempt: match b[3] {
-                    1..=3 => b[3],
-                    x => return Err(field("attempt", u32::from(x))),
-                },
-                result: match b[4] {
-                    0 => AttemptResult::Done,
-                    1 => AttemptResult::Failed,
-                    2 => AttemptResult::GaveUp,
-                    3 => AttemptResult::Interrupted,
-                    x => return Err(field("result", u32::from(x))),
-                },
-            },
+            2 => Event::decode_attempt(id, b)?,
             3 => {
                 let bits = u32::from_be_bytes([b[2], b[3], b[4], b[5]]);
                 let wire = u16::try_from(bits).map(u16::to_le_bytes);
@@ -326,18 +331,30 @@ impl Event {
                 }
             }
             _ => return Err(EventError::UnknownId(id)),
+        })
+    }
+
+    /// A bolting attempt's fields (event 2): the pair, the attempt (1 to 3) and its result.
+    fn decode_attempt(id: u16, b: &[u8; EVENT_LEN]) -> Result<Event, EventError> {
+        let field = |field, found: u8| EventError::Field {
+            id,
+            field,
+            found: u32::from(found),
         };
-        if event.to_bytes() != b {
-            return Err(EventError::Padding { id });
-        }
-        if event.severity() != subservice {
-            return Err(EventError::Severity {
-                id,
-                expected: event.severity(),
-                found: subservice,
-            });
-        }
-        Ok(event)
+        Ok(Event::Attempt {
+            pair: BolterPair::from_number(b[2]).ok_or(field("pair", b[2]))?,
+            attempt: match b[3] {
+                1..=3 => b[3],
+                x => return Err(field("attempt", x)),
+            },
+            result: match b[4] {
+                0 => AttemptResult::Done,
+                1 => AttemptResult::Failed,
+                2 => AttemptResult::GaveUp,
+                3 => AttemptResult::Interrupted,
+                x => return Err(field("result", x)),
+            },
+        })
     }
 }
 

@@ -254,6 +254,8 @@ impl Supervisor {
         }
     }
 
+    /// One command of this tick, admitted ([`Supervisor::admit`]) and obeyed: its answer; what
+    /// it asks of the motion (stop, go home, resume) through the flags.
     fn command(
         &mut self,
         incoming: Incoming,
@@ -263,17 +265,10 @@ impl Supervisor {
         go_home: &mut bool,
         resume: &mut bool,
     ) -> Answer {
-        let cmd = match incoming {
-            Incoming::Command(c) => c,
-            Incoming::Malformed(r) => return Answer::Refused(r),
+        let cmd = match self.admit(incoming) {
+            Ok(c) => c,
+            Err(r) => return Answer::Refused(r),
         };
-        let kind = cmd.kind();
-        if !accepts(self.mode, kind) {
-            return Answer::Refused(Refusal::NotAllowedInMode);
-        }
-        if self.stopped && kind.moves() {
-            return Answer::Refused(Refusal::Stopped);
-        }
         match cmd {
             Command::Stop => {
                 // Every actuator holds; a motion in progress waits for Reset. A second Stop
@@ -316,6 +311,25 @@ impl Supervisor {
             _ => {}
         }
         Answer::Accepted(cmd)
+    }
+
+    /// The command `incoming` is, if it is one, the present mode accepts its kind (Table 7),
+    /// and no Stop holds the motion it asks for; otherwise the refusal, before anything
+    /// changes.
+    #[inline]
+    fn admit(&self, incoming: Incoming) -> Result<Command, Refusal> {
+        let cmd = match incoming {
+            Incoming::Command(c) => c,
+            Incoming::Malformed(r) => return Err(r),
+        };
+        let kind = cmd.kind();
+        if !accepts(self.mode, kind) {
+            return Err(Refusal::NotAllowedInMode);
+        }
+        if self.stopped && kind.moves() {
+            return Err(Refusal::Stopped);
+        }
+        Ok(cmd)
     }
 
     /// A mode command to Operational from another mode: refused while a fault condition

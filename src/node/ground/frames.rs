@@ -45,7 +45,9 @@
 
 use crate::link::clcw::Clcw;
 use crate::link::extract::{ExtractCounters, Extractor};
-use crate::link::fop::{AlertCode, Directive, Fop, FopConfig, FopOutput, FopState, FrameData};
+use crate::link::fop::{
+    AlertCode, Directive, Fop, FopConfig, FopFrame, FopOutput, FopState, FrameData,
+};
 use crate::link::sdls::{self, frames as secured, Key256, SaTable, SdlsCounters, SdlsRefusal};
 use crate::link::tc_frame::{self, MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
 use crate::link::tm_frame::{TmFrameError, TmFrameParams, TmFrameRepr};
@@ -351,51 +353,7 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
         let mut back: Vec<Packet, M> = Vec::new();
         for o in outs {
             match o {
-                FopOutput::Transmit(f) => {
-                    let c = &mut self.counters;
-                    let content = match &f.data {
-                        FrameData::Fdu(p) if f.kind == FrameKind::Ad => {
-                            c.ad_frames = c.ad_frames.wrapping_add(1);
-                            TcContent::Ad {
-                                map_id: MapId::new(tc_frame::MISSION_MAP_ID).ok(),
-                                data: p,
-                            }
-                        }
-                        FrameData::Fdu(p) => TcContent::Bd {
-                            map_id: MapId::new(tc_frame::MISSION_MAP_ID).ok(),
-                            data: p,
-                        },
-                        FrameData::Control(cmd) => {
-                            c.bc_frames = c.bc_frames.wrapping_add(1);
-                            TcContent::Bc(*cmd)
-                        }
-                    };
-                    let repr = TcFrameRepr {
-                        spacecraft_id: self.spacecraft_id,
-                        vcid: Vcid::new(tc_frame::MISSION_VCID).unwrap_or_default(),
-                        seq: f.ns,
-                        content,
-                    };
-                    let mut buf = [0u8; MAX_FRAME_LEN];
-                    let spi = tc_spi(self.spacecraft_id);
-                    let n = match self.sdls.as_mut() {
-                        Some(t) if f.kind != FrameKind::Bc => {
-                            // Each transmission under a fresh IV; one that cannot be
-                            // protected yet (its counter not reserved) is not sent, and
-                            // FOP-1's timer sends it again.
-                            let n = secured::protect_tc(t, spi, &repr, &mut buf);
-                            if n.is_err() {
-                                self.counters.unprotected =
-                                    self.counters.unprotected.wrapping_add(1);
-                            }
-                            n.ok()
-                        }
-                        _ => repr.emit(&mut buf).ok(),
-                    };
-                    if let Some(n) = n {
-                        emit(buf.get(..n).unwrap_or(&[]));
-                    }
-                }
+                FopOutput::Transmit(f) => self.transmit(&f, emit),
                 FopOutput::Confirmed { .. } => {
                     self.counters.confirmed = self.counters.confirmed.wrapping_add(1);
                 }
@@ -426,26 +384,78 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
             .ad_frames
             .wrapping_sub(self.counters.packets.min(self.counters.ad_frames));
         if alerted {
-            self.counters.initiations = self.counters.initiations.wrapping_add(1);
-            if self.locked_out {
-                // FARM-1 obeys Set V(R) in Open and Wait only (232.1-B-2 Table 6-1, E8): out
-                // of Lockout it takes an Unlock, sent first. Without it a link locked out
-                // (a forged Set V(R) into the lockout area, a restarted FARM-1 at V(R) = 0)
-                // stayed locked for good, every re-initiation ignored.
-                self.emit_bc(ControlCommand::Unlock, 0, emit);
+            self.reinitiate(now, emit);
+        }
+    }
+
+    /// A frame FOP-1 sends: written (a data frame under SDLS when the link is secured),
+    /// counted, and emitted.
+    fn transmit(&mut self, f: &FopFrame<Packet>, emit: &mut impl FnMut(&[u8])) {
+        let c = &mut self.counters;
+        let content = match &f.data {
+            FrameData::Fdu(p) if f.kind == FrameKind::Ad => {
+                c.ad_frames = c.ad_frames.wrapping_add(1);
+                TcContent::Ad {
+                    map_id: MapId::new(tc_frame::MISSION_MAP_ID).ok(),
+                    data: p,
+                }
             }
-            let vs = self.fop.vs();
-            let mut again: Vec<FopOutput<Packet>, 4> = Vec::new();
-            self.fop
-                .directive(Directive::InitiateWithSetVr(vs), now, &mut |o| {
-                    let _ = again.push(o);
-                });
-            // One level deep: an initiation's outputs are a BC frame and no alert.
-            for o in again {
-                if let FopOutput::Transmit(f) = o {
-                    if let FrameData::Control(cmd) = f.data {
-                        self.emit_bc(cmd, f.ns, emit);
-                    }
+            FrameData::Fdu(p) => TcContent::Bd {
+                map_id: MapId::new(tc_frame::MISSION_MAP_ID).ok(),
+                data: p,
+            },
+            FrameData::Control(cmd) => {
+                c.bc_frames = c.bc_frames.wrapping_add(1);
+                TcContent::Bc(*cmd)
+            }
+        };
+        let repr = TcFrameRepr {
+            spacecraft_id: self.spacecraft_id,
+            vcid: Vcid::new(tc_frame::MISSION_VCID).unwrap_or_default(),
+            seq: f.ns,
+            content,
+        };
+        let mut buf = [0u8; MAX_FRAME_LEN];
+        let spi = tc_spi(self.spacecraft_id);
+        let n = match self.sdls.as_mut() {
+            Some(t) if f.kind != FrameKind::Bc => {
+                // Each transmission under a fresh IV; one that cannot be protected yet (its
+                // counter not reserved) is not sent, and FOP-1's timer sends it again.
+                let n = secured::protect_tc(t, spi, &repr, &mut buf);
+                if n.is_err() {
+                    self.counters.unprotected = self.counters.unprotected.wrapping_add(1);
+                }
+                n.ok()
+            }
+            _ => repr.emit(&mut buf).ok(),
+        };
+        if let Some(n) = n {
+            emit(buf.get(..n).unwrap_or(&[]));
+        }
+    }
+
+    /// After an alert: the AD service initiated again with Set V(R) = V(S), counted, so that
+    /// commanding goes on without an operator.
+    fn reinitiate(&mut self, now: u32, emit: &mut impl FnMut(&[u8])) {
+        self.counters.initiations = self.counters.initiations.wrapping_add(1);
+        if self.locked_out {
+            // FARM-1 obeys Set V(R) in Open and Wait only (232.1-B-2 Table 6-1, E8): out
+            // of Lockout it takes an Unlock, sent first. Without it a link locked out
+            // (a forged Set V(R) into the lockout area, a restarted FARM-1 at V(R) = 0)
+            // stayed locked for good, every re-initiation ignored.
+            self.emit_bc(ControlCommand::Unlock, 0, emit);
+        }
+        let vs = self.fop.vs();
+        let mut again: Vec<FopOutput<Packet>, 4> = Vec::new();
+        self.fop
+            .directive(Directive::InitiateWithSetVr(vs), now, &mut |o| {
+                let _ = again.push(o);
+            });
+        // One level deep: an initiation's outputs are a BC frame and no alert.
+        for o in again {
+            if let FopOutput::Transmit(f) = o {
+                if let FrameData::Control(cmd) = f.data {
+                    self.emit_bc(cmd, f.ns, emit);
                 }
             }
         }
@@ -467,12 +477,12 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
     }
 }
 
-/// The counter index of an alert code.
 /// The TC SPI of the robot with this spacecraft ID (`sdls::mission::tc_spi`).
 const fn tc_spi(scid: SpacecraftId) -> u16 {
     scid.get()
 }
 
+/// The counter index of an alert code.
 const fn alert_index(code: AlertCode) -> usize {
     match code {
         AlertCode::Limit => 0,

@@ -41,18 +41,20 @@
 //! ```
 
 use super::link::{Link, LinkTick, MotionEnd};
-use crate::ccsds::primary::{Apid, SeqCount};
-use crate::ccsds::tc::{TcRepr, TC_MIN_LEN};
-use crate::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
-use crate::ccsds::EmitError;
+
+mod pending;
+mod tc_out;
+
+use crate::ccsds::primary::SeqCount;
+use crate::ccsds::tc::TC_MIN_LEN;
 use crate::command::Command;
 use crate::faults::Faults;
 use crate::link::fop::FopConfig;
 use crate::mode::Mode;
 use crate::node::exactly_once::uplink::{Done, Efficiency, Outcome};
-use crate::pus::function::{self, FunctionError};
+use crate::pus::function;
 use crate::pus::housekeeping;
-use crate::pus::request::{ST_EVENT, ST_FUNCTION, ST_HOUSEKEEPING, ST_TEST, ST_VERIFICATION};
+use crate::pus::request::{ST_EVENT, ST_HOUSEKEEPING, ST_VERIFICATION};
 use crate::pus::robot_apid;
 use crate::pus::verification::{
     Failure, Report, RequestId, Stage, ABANDONED, RESTARTED, UNACKNOWLEDGED,
@@ -60,6 +62,8 @@ use crate::pus::verification::{
 use crate::refusal::Refusal;
 use crate::units::{BoardNumber, Instant};
 use crate::wire::heartbeat::HeartbeatRepr;
+use pending::{Due, Pending};
+pub use tc_out::{TcOut, TcOutError};
 
 /// The longest telecommand the link sends, bytes: headers, the longest function, CRC.
 pub const MAX_TC_LEN: usize = TC_MIN_LEN + function::MAX_LEN;
@@ -123,64 +127,6 @@ impl Config {
     }
 }
 
-/// A telecommand to send: its key and the command it carries.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct TcOut {
-    /// APID and sequence count.
-    pub request: RequestId,
-    /// Source ID.
-    pub source_id: u16,
-    /// The command: a TC(8,1) function, or TC(17,1) for [`Command::Heartbeat`].
-    pub command: Command,
-}
-
-/// Why a telecommand could not be written.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum TcOutError {
-    /// The command is no function.
-    #[error("{0}")]
-    Function(FunctionError),
-    /// The buffer is too short.
-    #[error("{0}")]
-    Emit(EmitError),
-}
-
-impl TcOut {
-    /// Service and subservice: (8, 1), or (17, 1) for a heartbeat request.
-    pub const fn service(&self) -> (u8, u8) {
-        match self.command {
-            Command::Heartbeat => (ST_TEST, 1),
-            _ => (ST_FUNCTION, 1),
-        }
-    }
-
-    /// Writes the telecommand (every acknowledgement flag set); returns its length (at most
-    /// [`MAX_TC_LEN`]).
-    pub fn emit(&self, out: &mut [u8]) -> Result<usize, TcOutError> {
-        let mut data = [0u8; function::MAX_LEN];
-        let n = match self.command {
-            Command::Heartbeat => 0,
-            c => function::encode(&c, &mut data).map_err(TcOutError::Function)?,
-        };
-        let (service, subservice) = self.service();
-        TcRepr {
-            apid: Apid::new(self.request.apid).unwrap_or_default(),
-            seq_count: SeqCount::new(self.request.seq_count).unwrap_or_default(),
-            header: TcSecondaryHeader {
-                ack: AckFlags::ALL,
-                service,
-                subservice,
-                source_id: self.source_id,
-            },
-            app_data: data.get(..n).unwrap_or(&[]),
-        }
-        .emit(out)
-        .map_err(TcOutError::Emit)
-    }
-}
-
 /// What a report told the link.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -196,90 +142,6 @@ pub struct Heard {
     pub rejected: Option<(u16, Failure)>,
     /// A housekeeping report: the robot's status now.
     pub status: Option<HeartbeatRepr>,
-}
-
-/// A telecommand on its way.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-struct Pending {
-    tc: TcOut,
-    /// When last transmitted (for a running motion: when its query timer started).
-    sent: Option<Instant>,
-    /// The last transmission awaits its first report.
-    open: bool,
-    /// Transmissions in a row with no report.
-    unanswered: u8,
-    /// Transmissions made.
-    attempts: u8,
-    /// The gateway accepted it (TM(1,1)).
-    accepted: bool,
-}
-
-/// What [`Pending::due`] decided.
-enum Due {
-    /// Nothing yet.
-    Wait,
-    /// Transmit (again); `failed`: the previous transmission went unanswered.
-    Send { failed: bool },
-    /// `max_attempts` transmissions in a row went unanswered.
-    GiveUp,
-}
-
-impl Pending {
-    const fn new(tc: TcOut) -> Pending {
-        Pending {
-            tc,
-            sent: None,
-            open: false,
-            unanswered: 0,
-            attempts: 0,
-            accepted: false,
-        }
-    }
-
-    /// Whether to transmit at `now`, when a transmission waits `limit` ms for an answer.
-    fn due(&mut self, now: Instant, limit: u32, max: u8) -> Due {
-        let Some(t) = self.sent else {
-            return Due::Send { failed: false };
-        };
-        if now.since(t).millis() < limit {
-            return Due::Wait;
-        }
-        let failed = self.open;
-        if failed {
-            self.open = false;
-            self.unanswered = self.unanswered.saturating_add(1);
-        }
-        if self.unanswered >= max.max(1) {
-            Due::GiveUp
-        } else {
-            Due::Send { failed }
-        }
-    }
-
-    fn transmit(&mut self, now: Instant) -> TcOut {
-        self.sent = Some(now);
-        self.open = true;
-        self.attempts = self.attempts.saturating_add(1);
-        self.tc
-    }
-
-    /// A report about it arrived: closes the open transmission (an answered attempt).
-    fn answered(&mut self) -> Option<bool> {
-        let was = self.open;
-        self.open = false;
-        self.unanswered = 0;
-        was.then_some(true)
-    }
-
-    const fn done(&self, outcome: Outcome) -> Done {
-        Done {
-            seq: self.tc.request.seq_count,
-            command: self.tc.command,
-            outcome,
-            attempts: self.attempts,
-        }
-    }
 }
 
 /// One robot's telecommand link at the ground.

@@ -53,34 +53,32 @@
 //! let f = TmFrameRepr::parse(&tm[..len], &params).unwrap();
 //! assert_eq!(Clcw::parse(&f.ocf.unwrap()).unwrap().report_value, 1);
 //! ```
+//!
+//! [`TcFrame::new_checked`]: crate::link::tc_frame::TcFrame::new_checked
 
-use super::gateway::{
-    Config as GatewayConfig, Gateway, Kept, Out, TmOut, KEPT_SOURCES, MAX_TM_DATA,
-};
+use super::gateway::{Config as GatewayConfig, Gateway, Kept, KEPT_SOURCES};
 use super::store::queue::QUEUE_SLOTS;
-use super::store::{Entry, Progress};
-use crate::ccsds::primary::PrimaryHeader;
-use crate::ccsds::tm::TM_MIN_LEN;
-use crate::link::clcw::ClcwVcid;
-use crate::link::farm::{Farm, FarmState, FarmWindow, Verdict};
-use crate::link::sdls::{self, frames as secured, SaTable, SdlsRefusal};
-use crate::link::tc_frame::Packets;
-use crate::link::tc_frame::{self, SpacecraftId, TcFrame, TcFrameError, TcPrimaryHeader};
+use super::store::Progress;
+use crate::link::farm::{Farm, FarmState, FarmWindow};
+use crate::link::sdls::SdlsRefusal;
+use crate::link::tc_frame::{SpacecraftId, TcFrameError};
 use crate::link::tm_frame::{TmFrameParams, TM_FRAME_LEN};
 use crate::link::tm_framer::{TmFramer, IDLE_PERIOD_MS};
-use crate::link::FrameKind;
-use crate::pus::robot_apid;
 use crate::units::BoardNumber;
 use crate::wire::command::CommandRepr;
 use crate::wire::heartbeat::HeartbeatRepr;
 use heapless::Vec;
 
 mod durable;
+mod robot_link;
 mod secure;
-pub use durable::DUE_PER_ROBOT;
+mod tc_in;
+mod tm_out;
 
-/// The largest telemetry packet the gateway writes.
-const MAX_TM_LEN: usize = TM_MIN_LEN + MAX_TM_DATA;
+pub use super::store::Stored;
+pub use durable::DUE_PER_ROBOT;
+use robot_link::{Alarm, RobotLink};
+pub use tc_in::{FrameIn, FrameRefusal, Origin};
 
 /// Packets in one TC frame at most: a 256-octet frame of 13-octet telecommands (the shortest
 /// PUS TC) holds 19.
@@ -121,36 +119,6 @@ pub const GATHER_MS: u32 = 20;
 /// none goes unreported, and a flood of bad frames makes at most seven reports a second.
 pub const SECURITY_EVENT_PERIOD_MS: u32 = 1000;
 
-/// One reason's refusals waiting to be reported.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-struct Alarm {
-    /// Frames refused since the last report.
-    pending: u16,
-    /// The last one's SPI.
-    spi: u16,
-    /// When the last report went.
-    last: Option<u32>,
-}
-
-impl Alarm {
-    /// Whether a report waits and may go at `now`.
-    fn ready(&self, now: u32) -> bool {
-        self.pending > 0
-            && self
-                .last
-                .is_none_or(|t| now.wrapping_sub(t) >= SECURITY_EVENT_PERIOD_MS)
-    }
-
-    /// How long from `now` until the waiting report may go, if one waits.
-    fn wait(&self, now: u32) -> Option<u32> {
-        (self.pending > 0).then(|| {
-            self.last.map_or(0, |t| {
-                SECURITY_EVENT_PERIOD_MS.saturating_sub(now.wrapping_sub(t))
-            })
-        })
-    }
-}
-
 /// What the link did, per robot. Each counter wraps at `u32::MAX`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -175,64 +143,6 @@ pub struct LinkCounters {
     pub bc_origin: u32,
 }
 
-/// Why a TC frame went no further than the link.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
-pub enum FrameRefusal {
-    /// A frame check ([`TcFrameError`]).
-    #[error(transparent)]
-    Frame(#[from] TcFrameError),
-    /// SDLS ([`SdlsRefusal`]): nothing of the frame reached FARM-1.
-    #[error(transparent)]
-    Security(#[from] SdlsRefusal),
-    /// A BC frame not from the ground's address ([`Origin`]): FARM-1 never saw it.
-    #[error("a BC frame from elsewhere than the ground's address: not obeyed")]
-    Origin,
-}
-
-impl FrameRefusal {
-    /// The check's name ([`TcFrameError::NAMES`], [`SdlsRefusal::NAMES`], or `bc-origin`).
-    pub const fn name(&self) -> &'static str {
-        match self {
-            FrameRefusal::Frame(e) => e.name(),
-            FrameRefusal::Security(e) => e.name(),
-            FrameRefusal::Origin => "bc-origin",
-        }
-    }
-
-    /// `frame`, `sdls` or `cop`.
-    pub const fn layer(&self) -> &'static str {
-        match self {
-            FrameRefusal::Frame(_) => "frame",
-            FrameRefusal::Security(_) => "sdls",
-            FrameRefusal::Origin => "cop",
-        }
-    }
-}
-
-/// What the shell kept in durable storage, per robot ([`super::store`]): where the TC
-/// window's floor and the TM counter's reservation stood (`None`: a new association), and
-/// where FARM-1 and the TC window stood after the last accepted frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-pub struct Stored {
-    /// The TC floor.
-    pub tc: Option<u128>,
-    /// The TM reservation.
-    pub tm: Option<u128>,
-    /// FARM-1's V(R) and the last TC IV accepted (`None`: FARM-1 starts at V(R) = 0).
-    pub progress: Option<Progress>,
-}
-
-/// Where a TC frame came from, as the shell's transport tells it: FARM-1 obeys a BC frame
-/// (Unlock, Set V(R), which go in clear) only from the ground's configured address (decision
-/// `sdls-bc-origin`); data frames are judged by SDLS wherever they come from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Origin {
-    /// The configured ground address.
-    Ground,
-    /// Anywhere else.
-    Elsewhere,
-}
-
 /// Why [`FrameGateway::secure`] could not secure a robot's link: the shell must not run it
 /// in clear instead.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
@@ -249,102 +159,6 @@ pub enum SecureError {
         /// The robot.
         board: u8,
     },
-}
-
-/// What became of one TC frame.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct FrameIn {
-    /// The robot the frame was for, when it is one of ours.
-    pub robot: Option<BoardNumber>,
-    /// The check that refused it (the frame's or SDLS's), or FARM-1's verdict.
-    pub verdict: Result<Verdict, FrameRefusal>,
-    /// Packets handed to the gateway.
-    pub accepted: u8,
-    /// Packets refused at the PUS layer (or for another robot's APID).
-    pub refused: u8,
-}
-
-/// One robot's end of the link.
-#[derive(Debug, Clone)]
-struct RobotLink<const N: usize> {
-    board: BoardNumber,
-    farm: Farm,
-    framer: TmFramer<N>,
-    /// When the oldest report still waiting in the framer was written.
-    oldest: Option<u32>,
-    /// The CLCW of the last frame sent.
-    clcw_sent: Option<[u8; 4]>,
-    counters: LinkCounters,
-    /// SDLS, when the robot's link is secured: its TC (receiving) and TM (sending)
-    /// associations.
-    sdls: Option<SaTable<2>>,
-    /// SDLS refusals waiting for their ST\[5\] report, by reason.
-    alarms: [Alarm; SdlsRefusal::NAMES.len()],
-    /// Where FARM-1 and the TC window stand now, and what the shell last confirmed durable
-    /// (no TM frame and no visit leaves while they differ: `durable`).
-    progress: Progress,
-    progress_kept: Progress,
-    /// The kept-key entries the shell last confirmed, by slot.
-    kept_written: [Option<Entry>; KEPT_SOURCES],
-    /// The gateway's queue in the store's ring (write-ahead): which telecommand each slot
-    /// holds, the next slot a new one takes, and what the shell last confirmed per slot.
-    ring: [Option<(u16, u16)>; QUEUE_SLOTS],
-    ring_next: u8,
-    ring_written: [Option<Entry>; QUEUE_SLOTS],
-}
-
-impl<const N: usize> RobotLink<N> {
-    /// A checked TC frame from `origin` before FARM-1: a BC frame only from the ground's
-    /// address; a data frame through SDLS when the link is secured (its plaintext into `plain`,
-    /// its range and IV returned), a refusal counted (and waiting for its ST\[5\] report).
-    fn unwrap_tc(
-        &mut self,
-        frame: &TcFrame<&[u8]>,
-        origin: Origin,
-        plain: &mut [u8; tc_frame::MAX_FRAME_LEN],
-    ) -> Result<(Option<core::ops::Range<usize>>, Option<u128>), FrameRefusal> {
-        let bc = frame.kind() == FrameKind::Bc;
-        if bc && origin != Origin::Ground {
-            self.counters.bc_origin = self.counters.bc_origin.wrapping_add(1);
-            return Err(FrameRefusal::Origin);
-        }
-        let Some(table) = self.sdls.as_mut().filter(|_| !bc) else {
-            return Ok((None, None));
-        };
-        match secured::verify_tc(table, frame, plain) {
-            Ok((v, range)) => Ok((Some(range), Some(v.iv.get()))),
-            Err(e) => {
-                if let Some(a) = self.alarms.get_mut(e.position()) {
-                    a.pending = a.pending.saturating_add(1);
-                    a.spi = frame
-                        .as_bytes()
-                        .get(6..8)
-                        .map_or(0, |b| u16::from_be_bytes([b[0], b[1]]));
-                }
-                Err(e.into())
-            }
-        }
-    }
-
-    fn clcw(&self) -> [u8; 4] {
-        self.farm
-            .clcw(
-                ClcwVcid::new(tc_frame::MISSION_VCID).unwrap_or(ClcwVcid::ZERO),
-                false,
-                false,
-            )
-            .emit()
-    }
-
-    /// Whether a frame should go now: the framer's own rule (a full data field, the idle
-    /// period), a report that waited `gather_ms`, or a CLCW the ground has not seen.
-    fn due(&self, now: u32, gather_ms: u32) -> bool {
-        self.framer.frame_due(now)
-            || self
-                .oldest
-                .is_some_and(|t| now.wrapping_sub(t) >= gather_ms)
-            || self.clcw_sent != Some(self.clcw())
-    }
 }
 
 /// The PUS gateway for up to `R` robots (`Q` waiting telecommands and `K` remembered keys
@@ -460,124 +274,6 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         &self.refused
     }
 
-    /// A TC frame from the ground's address, at `now` ([`FrameGateway::tc_frame_from`]).
-    pub fn tc_frame(&mut self, now: u32, bytes: &[u8]) -> FrameIn {
-        self.tc_frame_from(now, bytes, Origin::Ground)
-    }
-
-    /// A TC frame from `origin`, at `now`.
-    pub fn tc_frame_from(&mut self, now: u32, bytes: &[u8], origin: Origin) -> FrameIn {
-        // The robot by the header's spacecraft ID (before any check: it only picks the
-        // configuration; the checks then say whether the frame is sound and whether it is
-        // really for that robot).
-        let scid = TcPrimaryHeader::read(bytes).map(|h| h.spacecraft_id);
-        let at = self
-            .links
-            .iter()
-            .position(|l| Some(SpacecraftId::of_board(l.board).get()) == scid)
-            .unwrap_or(0);
-        let board = self.links.get(at).map(|l| l.board);
-        let config =
-            tc_frame::mission(board.map_or(SpacecraftId::default(), SpacecraftId::of_board));
-        let frame = match TcFrame::new_checked(bytes, &config) {
-            Ok(f) => f,
-            Err(e) => {
-                if let Some(c) = self.refused.get_mut(e.position()) {
-                    *c = c.wrapping_add(1);
-                }
-                return FrameIn {
-                    robot: None,
-                    verdict: Err(e.into()),
-                    accepted: 0,
-                    refused: 0,
-                };
-            }
-        };
-        let Some(board) = board else {
-            // Unreachable: with no robot the spacecraft ID check refuses every frame.
-            return FrameIn {
-                robot: None,
-                verdict: Ok(Verdict::Discard(crate::link::farm::DiscardReason::Invalid)),
-                accepted: 0,
-                refused: 0,
-            };
-        };
-        let mut result = FrameIn {
-            robot: Some(board),
-            verdict: Ok(Verdict::Released),
-            accepted: 0,
-            refused: 0,
-        };
-        let Some(link) = self.links.get_mut(at) else {
-            return result;
-        };
-        // SDLS before FARM-1 (355.0-B-2 §2.3.3): a data frame that does not verify changes
-        // nothing but SDLS's counter of its reason; the packets come from the plaintext.
-        let mut plain = [0u8; tc_frame::MAX_FRAME_LEN];
-        let (data, iv) = match link.unwrap_tc(&frame, origin, &mut plain) {
-            Ok((Some(range), iv)) => (plain.get(range).unwrap_or(&[]), iv),
-            Ok((None, iv)) if frame.kind() == FrameKind::Bc => (&[][..], iv),
-            Ok((None, iv)) => (frame.data(), iv),
-            Err(e) => {
-                result.verdict = Err(e);
-                if let FrameRefusal::Security(_) = e {
-                    self.security_reports(now);
-                }
-                return result;
-            }
-        };
-        let packets = Packets::new(data).count();
-        let room = self.gateway.queue_room(board).unwrap_or(0);
-        link.counters.tc_frames = link.counters.tc_frames.wrapping_add(1);
-        let verdict = link.farm.frame(
-            frame.kind(),
-            frame.seq(),
-            frame.control_command(),
-            room >= packets,
-        );
-        result.verdict = Ok(verdict);
-        if let Verdict::Discard(_) = verdict {
-            link.counters.tc_discarded = link.counters.tc_discarded.wrapping_add(1);
-        }
-        // What a restart must resume from: V(R) (a BC frame may have moved it) and the IV of
-        // a frame SDLS verified (the window moved to it whatever FARM-1 did with the frame).
-        link.progress.vr = link.farm.vr();
-        if iv.is_some() {
-            link.progress.tc_iv = iv;
-        }
-        if verdict != Verdict::Accept || frame.kind() == FrameKind::Bc {
-            return result;
-        }
-        let apid = robot_apid(board);
-        for packet in Packets::new(data) {
-            let out = match packet {
-                Ok(p) if PrimaryHeader::read(p).is_some_and(|h| h.apid == apid) => {
-                    self.gateway.tc_packet(p).ok()
-                }
-                _ => None,
-            };
-            match out {
-                Some(out) => {
-                    result.accepted = result.accepted.saturating_add(1);
-                    self.downlink(now, out);
-                }
-                None => result.refused = result.refused.saturating_add(1),
-            }
-        }
-        if let Some(link) = self.links.get_mut(at) {
-            link.counters.tc_packets = link
-                .counters
-                .tc_packets
-                .wrapping_add(u32::from(result.accepted));
-            link.counters.tc_packets_refused = link
-                .counters
-                .tc_packets_refused
-                .wrapping_add(u32::from(result.refused));
-        }
-        self.sync_rings();
-        result
-    }
-
     /// Time passes: the gateway's resends, polls and housekeeping (their reports go into the
     /// TM framers); the legacy commands due now, at most one per robot. A robot whose queue
     /// has room again releases FARM-1's buffer.
@@ -607,99 +303,6 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         let out = self.gateway.heartbeat(now, hb);
         self.downlink(now, out);
         self.release_buffers();
-    }
-
-    /// The next TM frame due at `now` of any robot, written into `out` (at least
-    /// [`TM_FRAME_LEN`] octets): the robot and the frame's length. Call until `None`.
-    pub fn frame(&mut self, now: u32, out: &mut [u8]) -> Option<(BoardNumber, usize)> {
-        let gather = self.cfg.gather_ms;
-        let link = self.links.iter_mut().find(|l| {
-            l.due(now, gather)
-                // The CLCW would report a V(R) a restart could not resume from.
-                && l.progress == l.progress_kept
-                && l.sdls
-                    .as_ref()
-                    .is_none_or(|t| t.ready(sdls::mission::tm_spi(l.board)))
-        })?;
-        let clcw = link.clcw();
-        let n = link.framer.next_frame(now, clcw, out).ok()?;
-        if let Some(table) = link.sdls.as_mut() {
-            let params = *link.framer.params();
-            let spi = sdls::mission::tm_spi(link.board);
-            // Unreachable (the association is ready, the layout the framer's): counted.
-            if secured::protect_tm(table, spi, &params, out).is_err() {
-                link.counters.tm_unprotected = link.counters.tm_unprotected.wrapping_add(1);
-                return None;
-            }
-        }
-        link.clcw_sent = Some(clcw);
-        link.counters.tm_frames = link.counters.tm_frames.wrapping_add(1);
-        link.oldest = (link.framer.waiting() > 0).then_some(now);
-        Some((link.board, n))
-    }
-
-    /// The earliest time from `now` on when something is due: the gateway's next deadline, a
-    /// TM frame (the idle period, a gathered report). `now` when something is due already.
-    pub fn next_deadline(&self, now: u32) -> Option<u32> {
-        let wait = |t: u32| {
-            let d = t.wrapping_sub(now);
-            if d > i32::MAX as u32 {
-                0
-            } else {
-                d
-            }
-        };
-        let mut best = self.gateway.next_deadline(now).map(wait);
-        for l in &self.links {
-            let d = if l.due(now, self.cfg.gather_ms) {
-                0
-            } else {
-                let idle = self.cfg.idle_period_ms;
-                let gathered = l.oldest.map(|t| wait(t.wrapping_add(self.cfg.gather_ms)));
-                let idle_at = l
-                    .framer
-                    .last_frame_ms()
-                    .map_or(0, |t| wait(t.wrapping_add(idle)));
-                gathered.map_or(idle_at, |g| g.min(idle_at))
-            };
-            let alarm = l.alarms.iter().filter_map(|a| a.wait(now)).min();
-            let d = alarm.map_or(d, |a| a.min(d));
-            best = Some(best.map_or(d, |b| b.min(d)));
-        }
-        best.map(|d| now.wrapping_add(d))
-    }
-
-    /// Writes the reports of `out` into their robots' framers.
-    fn downlink<const M: usize>(&mut self, now: u32, out: Out<M>) {
-        for tm in &out.reports {
-            self.report(now, tm);
-        }
-        if out.overflow > 0 {
-            if let Some(l) = self.links.first_mut() {
-                l.counters.tm_overflow =
-                    l.counters.tm_overflow.wrapping_add(u32::from(out.overflow));
-            }
-        }
-    }
-
-    fn report(&mut self, now: u32, tm: &TmOut) {
-        let mut buf = [0u8; MAX_TM_LEN];
-        let Ok(n) = self.gateway.encode(tm, now, &mut buf) else {
-            return;
-        };
-        let Some(link) = self
-            .links
-            .iter_mut()
-            .find(|l| robot_apid(l.board) == tm.apid)
-        else {
-            return;
-        };
-        match link.framer.push(buf.get(..n).unwrap_or(&[])) {
-            Ok(()) => {
-                link.oldest.get_or_insert(now);
-            }
-            Err(_) => link.counters.tm_overflow = link.counters.tm_overflow.wrapping_add(1),
-        }
     }
 
     /// FARM-1's buffer release for each robot waiting on a queue that has room again.

@@ -48,7 +48,6 @@ pub mod keys;
 pub mod log;
 pub mod queue;
 
-use super::frames::Stored;
 use super::gateway::{Kept, KEPT_SOURCES};
 use crate::link::sdls::key::{Fingerprint, WeakKey};
 use crate::link::sdls::{mission, Key256};
@@ -259,6 +258,19 @@ const _: () = {
         i += 1;
     }
 };
+
+/// What the shell kept in durable storage, per robot (this module's entries): where the TC
+/// window's floor and the TM counter's reservation stood (`None`: a new association), and
+/// where FARM-1 and the TC window stood after the last accepted frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct Stored {
+    /// The TC floor.
+    pub tc: Option<u128>,
+    /// The TM reservation.
+    pub tm: Option<u128>,
+    /// FARM-1's V(R) and the last TC IV accepted (`None`: FARM-1 starts at V(R) = 0).
+    pub progress: Option<Progress>,
+}
 
 /// What a link starts from.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -1,0 +1,64 @@
+//! The TC primary header's five octets and their fields, decoded but not judged: the one place
+//! that knows where each field's bits lie (232.0-B-4 §4.1.2).
+
+use super::TC_PRIMARY_HEADER_LEN;
+
+/// The primary header's fields as they lie in the octets, decoded but not judged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct TcPrimaryHeader {
+    /// Transfer frame version number (2 bits).
+    pub version: u8,
+    /// Bypass flag.
+    pub bypass: bool,
+    /// Control command flag.
+    pub control: bool,
+    /// Reserved spare (2 bits).
+    pub spare: u8,
+    /// Spacecraft ID (10 bits).
+    pub spacecraft_id: u16,
+    /// Virtual channel ID (6 bits).
+    pub vcid: u8,
+    /// Frame length field: octets in the frame minus 1 (10 bits).
+    pub frame_length: u16,
+    /// Frame sequence number N(S).
+    pub seq: u8,
+}
+
+impl TcPrimaryHeader {
+    /// Decodes the first five octets of `bytes`; `None` if there are fewer.
+    pub fn read(bytes: &[u8]) -> Option<TcPrimaryHeader> {
+        let h: &[u8; TC_PRIMARY_HEADER_LEN] = bytes.first_chunk()?;
+        let [b0, b1, b2, b3, seq] = *h;
+        Some(TcPrimaryHeader {
+            version: b0 >> 6,
+            bypass: b0 & 0x20 != 0,
+            control: b0 & 0x10 != 0,
+            spare: (b0 >> 2) & 0b11,
+            spacecraft_id: ((b0 & 0b11) as u16) << 8 | b1 as u16,
+            vcid: b2 >> 2,
+            frame_length: ((b2 & 0b11) as u16) << 8 | b3 as u16,
+            seq,
+        })
+    }
+
+    /// The frame's total length in octets as the frame length field says: field + 1.
+    pub const fn total_len(&self) -> usize {
+        self.frame_length as usize + 1
+    }
+
+    /// The five octets (fields wider than their bits are masked).
+    pub const fn to_bytes(&self) -> [u8; TC_PRIMARY_HEADER_LEN] {
+        [
+            (self.version & 0b11) << 6
+                | (self.bypass as u8) << 5
+                | (self.control as u8) << 4
+                | (self.spare & 0b11) << 2
+                | ((self.spacecraft_id >> 8) & 0b11) as u8,
+            self.spacecraft_id as u8,
+            (self.vcid & 0x3f) << 2 | ((self.frame_length >> 8) & 0b11) as u8,
+            self.frame_length as u8,
+            self.seq,
+        ]
+    }
+}
