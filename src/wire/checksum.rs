@@ -58,7 +58,8 @@ pub fn crc16(bytes: &[u8]) -> u16 {
 /// final xor, so the register is the CRC so far): 16 octets at a time as the `crc` crate
 /// does, then the remaining 0–15 octets in one step too (module docs, "The loop"). Never
 /// inlined: one copy serves every packet (inlined, each caller had its own, 460 octets more
-/// flash per copy on the ESP32-C3, and no faster on the host).
+/// flash per copy on the ESP32-C3, and no faster on the host), but for the two whose body
+/// after the header is shorter than a block ([`checked_packet_crc`]).
 #[cfg(not(feature = "small-crc-table"))]
 #[inline(never)]
 fn update(mut crc: u16, bytes: &[u8]) -> u16 {
@@ -75,6 +76,16 @@ fn update(mut crc: u16, bytes: &[u8]) -> u16 {
         let (x0, x1) = (block[0] ^ (crc >> 8) as u8, block[1] ^ crc as u8);
         crc = r ^ t[14][x1 as usize] ^ t[15][x0 as usize];
     }
+    remainder(crc, tail)
+}
+
+/// The register after the 0–15 octets `tail`, from register `crc`, in one step (module docs,
+/// "The loop"). Always inlined: in [`update`], and in [`checked_packet_crc`] for the packets
+/// shorter than a block after the header, where the length is a constant.
+#[cfg(not(feature = "small-crc-table"))]
+#[inline(always)]
+fn remainder(crc: u16, tail: &[u8]) -> u16 {
+    let t = CRC.table();
     let n = tail.len();
     let mut r = match n {
         0 => return crc,
@@ -141,6 +152,17 @@ const HEADER_CRC: [u16; 4] = [
     CRC.checksum(&PacketKind::ALL[3].header()),
 ];
 
+/// The register after `kind`'s header.
+#[inline]
+const fn header_crc(kind: PacketKind) -> u16 {
+    match kind {
+        PacketKind::Command => HEADER_CRC[0],
+        PacketKind::Heartbeat => HEADER_CRC[1],
+        PacketKind::InternalHeartbeat => HEADER_CRC[2],
+        PacketKind::BCommand => HEADER_CRC[3],
+    }
+}
+
 /// CRC-16/CCITT-FALSE of a packet body (`body` = every byte before the checksum) whose first
 /// four bytes are `kind`'s header, which the caller has already checked. Equal to
 /// `crc16(body)`, with the header's share precomputed (unless the body is whole 16-octet
@@ -155,13 +177,24 @@ pub fn packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
     }
     // The algorithm has no reflection and no final xor, so the register after the header is
     // the header's CRC and the computation can resume from it.
-    let start = match kind {
-        PacketKind::Command => HEADER_CRC[0],
-        PacketKind::Heartbeat => HEADER_CRC[1],
-        PacketKind::InternalHeartbeat => HEADER_CRC[2],
-        PacketKind::BCommand => HEADER_CRC[3],
-    };
-    update(start, body.get(HEADER_LEN..).unwrap_or(&[]))
+    update(header_crc(kind), body.get(HEADER_LEN..).unwrap_or(&[]))
+}
+
+/// [`packet_crc`] for a caller that has checked `body`'s length against `kind` (the packets'
+/// [`check`](super::check)), so that once inlined the length is a constant. A body of fewer
+/// than 16 octets after the header, the command's 8 and the B command's 9, then takes the
+/// remainder step in line, unrolled for its length: no call, no tests of the length, and the
+/// header's share a constant. The call was a quarter of the instructions of the command's
+/// parse on x86-64 (callgrind; issue 40, `benches/README.md`). Longer bodies go through the one copy of [`update`].
+#[inline(always)]
+pub(crate) fn checked_packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
+    #[cfg(not(feature = "small-crc-table"))]
+    if let Some(rest) = body.get(HEADER_LEN..) {
+        if rest.len() < 16 {
+            return remainder(header_crc(kind), rest);
+        }
+    }
+    packet_crc(kind, body)
 }
 
 #[cfg(test)]
@@ -215,6 +248,11 @@ mod tests {
                 }
                 assert_eq!(
                     packet_crc(kind, &body[..len]),
+                    crc16(&body[..len]),
+                    "{kind} {len}"
+                );
+                assert_eq!(
+                    checked_packet_crc(kind, &body[..len]),
                     crc16(&body[..len]),
                     "{kind} {len}"
                 );

@@ -264,7 +264,11 @@ pub trait Packet: FromBytes + KnownLayout + Immutable + Unaligned + Sized {
     const KIND: PacketKind;
 }
 
-/// Length, header and checksum checks; on success a view of the bytes as `P`.
+/// Length, header and checksum checks; on success a view of the bytes as `P`. Inlined into
+/// its few callers (each packet's parse, board A's answer to a command that does not decode),
+/// where `P`'s length is a constant that the checksum's step depends on
+/// (`checksum::checked_packet_crc`).
+#[inline]
 pub fn check<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
     let kind = P::KIND;
     let expected = kind.len();
@@ -285,7 +289,7 @@ pub fn check<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
         });
     }
     let carried = u16::from_le_bytes([crc[0], crc[1]]);
-    let computed = checksum::packet_crc(kind, body);
+    let computed = checksum::checked_packet_crc(kind, body);
     if carried != computed {
         return Err(WireError::Checksum {
             kind,

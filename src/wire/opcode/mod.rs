@@ -202,25 +202,75 @@ fn put_u16(p: &mut [u8; PARAM_LEN], slot: Slot, v: u16) {
     p[o + 1] = b[1];
 }
 
-/// `id` is one of the `n` opcodes from `first` on.
-const fn in_block(id: u8, first: u8, n: u8) -> bool {
-    id >= first && id - first < n
+/// Which of the six parameter bytes a command uses, as a mask over them read as one
+/// little-endian word ([`params_word`]): byte `i` is bits `8 * i..8 * i + 8`.
+type Used = u64;
+
+/// No parameter byte used.
+const NONE: Used = 0;
+
+/// The two bytes of `slot`.
+const fn slot_bytes(slot: Slot) -> Used {
+    0xffff << (8 * slot.offset())
 }
 
-/// Arm and gripper opcodes: per module two blocks of four (side A, side B), each contract,
-/// extend, position and one unassigned.
+/// Parameter byte `i` alone.
+const fn byte(i: usize) -> Used {
+    0xff << (8 * i)
+}
+
+/// The six parameter bytes as one word, byte `i` in bits `8 * i..8 * i + 8`.
+#[inline]
+fn params_word(p: &[u8; PARAM_LEN]) -> u64 {
+    let mut w = [0u8; 8];
+    w[..PARAM_LEN].copy_from_slice(p);
+    u64::from_le_bytes(w)
+}
+
+/// Parameter bytes a command does not use must be zero. The six are tested as one word, so
+/// that a valid packet takes one test and no branch per byte; the error names the first
+/// nonzero byte outside `used`, as a test of byte after byte would.
+#[inline]
+fn unused_zero(id: u8, p: &[u8; PARAM_LEN], used: Used) -> Result<(), CommandError> {
+    let stray = params_word(p) & !used;
+    if stray == 0 {
+        return Ok(());
+    }
+    // `used` covers whole bytes, so the lowest stray byte is the packet's byte as it is.
+    let i = stray.trailing_zeros() as usize / 8;
+    Err(CommandError::UnusedNotZero {
+        id,
+        index: PARAM_OFFSET + i,
+        found: (stray >> (8 * i)) as u8,
+    })
+}
+
+// The last opcode of each block, for [`decode`]'s ranges.
+const MODE_LAST: u8 = MODE + 2;
+const SERVO_LAST: u8 = GRIPPER + 7;
+const HIP_LAST: u8 = HIP + 4;
+const BOLT_LAST: u8 = BOLT + 4;
+const UNBOLT_LAST: u8 = UNBOLT + 4;
+const PRIMITIVE_FIRST: u8 = PRIMITIVE + 1;
+const PRIMITIVE_LAST: u8 = PRIMITIVE + 8;
+const POWER_LAST: u8 = POWER_OFF + 7;
+const _: () = assert!(GRIPPER == ARM + 8 && POWER_OFF == POWER_ON + 8);
+
+/// Arm and gripper opcodes (`ARM..=SERVO_LAST`): per module two blocks of four (side A,
+/// side B), each contract, extend, position and one unassigned.
 const fn is_servo(id: u8) -> bool {
-    (in_block(id, ARM, 8) || in_block(id, GRIPPER, 8)) && (id - ARM) % 4 != 3
+    (id - ARM) % 4 != 3
 }
 
 /// An arm or gripper command; a position uses its side's parameter slot.
-fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+#[inline(always)] // one caller, `decode`
+fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandError> {
     let base = if id < GRIPPER { ARM } else { GRIPPER };
     let side = side_of(id, base);
     let slot = Slot::for_side(side);
     let (target, used) = match (id - base) % 4 {
-        0 => (ServoTarget::Contract, 0),
-        1 => (ServoTarget::Extend, 0),
+        0 => (ServoTarget::Contract, NONE),
+        1 => (ServoTarget::Extend, NONE),
         _ => {
             let raw = get_u16(p, slot);
             let index = PARAM_OFFSET + slot.offset();
@@ -241,7 +291,7 @@ fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandErr
                         min: e.min,
                         max: e.max,
                     })?;
-            (target, 0b11 << slot.offset())
+            (target, slot_bytes(slot))
         }
     };
     let cmd = if base == ARM {
@@ -253,24 +303,26 @@ fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandErr
 }
 
 /// A hip command: the four presets, or an angle in the hip slot.
-fn decode_hip(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+#[inline(always)] // one caller, `decode`
+fn decode_hip(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandError> {
     Ok(match id - HIP {
-        0 => (Command::Hip(HipTarget::Home), 0),
-        1 => (Command::Hip(HipTarget::Straight), 0),
-        2 => (Command::Hip(HipTarget::RightAngleCw), 0),
-        3 => (Command::Hip(HipTarget::RightAngleCcw), 0),
+        0 => (Command::Hip(HipTarget::Home), NONE),
+        1 => (Command::Hip(HipTarget::Straight), NONE),
+        2 => (Command::Hip(HipTarget::RightAngleCw), NONE),
+        3 => (Command::Hip(HipTarget::RightAngleCcw), NONE),
         _ => {
             let raw = get_u16(p, Slot::Hip);
             let a = HipAngle::new(raw).map_err(|_| CommandError::HipAngle {
                 index: PARAM_OFFSET,
                 found: raw,
             })?;
-            (Command::Hip(HipTarget::Angle(a)), 0b11)
+            (Command::Hip(HipTarget::Angle(a)), slot_bytes(Slot::Hip))
         }
     })
 }
 
 /// A bolt or unbolt command: pairs 1..=4, then all four.
+#[inline]
 fn decode_bolter(id: u8) -> BolterCommand {
     let base = if id < UNBOLT { BOLT } else { UNBOLT };
     let which = match BolterPair::from_number(id - base + 1) {
@@ -285,6 +337,7 @@ fn decode_bolter(id: u8) -> BolterCommand {
 }
 
 /// The state in parameter byte `i`: missing when 0, invalid when no Table 5 letter.
+#[inline]
 fn state_at(p: &[u8; PARAM_LEN], i: usize) -> Result<State, CommandError> {
     let index = PARAM_OFFSET + i;
     match p[i] {
@@ -295,13 +348,14 @@ fn state_at(p: &[u8; PARAM_LEN], i: usize) -> Result<State, CommandError> {
 
 /// A reconfiguration: target state in the first parameter byte, initial state in the second
 /// (Table 2's "final state / init state").
-fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+#[inline(always)] // one caller, `decode`
+fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandError> {
     let at = Slot::ArmA.offset();
     let target = state_at(p, at)?;
     let initial = state_at(p, at + 1)?;
     Ok((
         Command::Reconfigure(Reconfiguration::new(initial, target)?),
-        0b11 << at,
+        slot_bytes(Slot::ArmA),
     ))
 }
 
@@ -309,7 +363,8 @@ fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError
 /// state", as for a reconfiguration). The initial state (byte 9) is not carried: a primitive
 /// starts where board A tracks the robot, which checks that the move is the primitive's cell
 /// of the map from there (spec/decisions.toml: primitive-final-state).
-fn decode_primitive(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), CommandError> {
+#[inline(always)] // one caller, `decode`
+fn decode_primitive(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandError> {
     let Some(primitive) = Primitive::from_number(id - PRIMITIVE) else {
         return Err(CommandError::UnknownId { id });
     };
@@ -317,11 +372,12 @@ fn decode_primitive(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, u8), Comman
     let target = state_at(p, at)?;
     Ok((
         Command::Primitive(PrimitiveMove::new(primitive, target)?),
-        1 << at,
+        byte(at),
     ))
 }
 
 /// A power command: on or off, one of the seven modules or all.
+#[inline]
 fn decode_power(id: u8) -> Command {
     let on = id < POWER_OFF;
     let i = (id - POWER_ON) % 8;
@@ -401,39 +457,78 @@ pub fn encode(c: &Command) -> (u8, [u8; PARAM_LEN]) {
 }
 
 /// The command for opcode `id` and parameter bytes `p` (packet bytes 6..=11). Each block
-/// of opcodes is recognised from its opcode constant; parameter bytes the command does
-/// not use must be zero.
+/// of opcodes is recognised from its opcode constant, in one match over ranges; parameter
+/// bytes the command does not use must be zero.
+///
+/// The decoders of the blocks are always inlined here, their one caller: left out of line
+/// (the compiler did so for the servo one), the command and its mask came back through
+/// memory written byte by byte and read back a word at a time, and the command packet's
+/// parse took longer than before the mask was a word (issue 40, `benches/README.md`).
 pub fn decode(id: u8, p: [u8; PARAM_LEN]) -> Result<Command, CommandError> {
-    // The command, and which parameter bytes it uses as a bit mask over p[0..6].
-    let (cmd, used): (Command, u8) = match id {
-        HEARTBEAT => (Command::Heartbeat, 0),
-        STOP => (Command::Stop, 0),
-        RESET => (Command::Reset, 0),
-        SYSTEM_FAULT => (Command::SystemFault, 0),
-        CLEAR_FAULTS => (Command::ClearFaults, 0),
-        BOLTERS_DOWN => (Command::Bolter(BolterCommand::Down), 0),
-        RECONFIGURE => decode_reconfigure(&p)?,
-        _ if in_block(id, MODE, 3) => match Mode::from_wire(id - MODE + 1) {
-            Some(m) => (Command::Mode(m), 0),
+    // The command, and which parameter bytes it uses.
+    let (cmd, used): (Command, Used) = match id {
+        HEARTBEAT => (Command::Heartbeat, NONE),
+        STOP => (Command::Stop, NONE),
+        RESET => (Command::Reset, NONE),
+        SYSTEM_FAULT => (Command::SystemFault, NONE),
+        CLEAR_FAULTS => (Command::ClearFaults, NONE),
+        MODE..=MODE_LAST => match Mode::from_wire(id - MODE + 1) {
+            Some(m) => (Command::Mode(m), NONE),
             None => return Err(CommandError::UnknownId { id }),
         },
-        _ if is_servo(id) => decode_servo(id, &p)?,
-        _ if in_block(id, HIP, 5) => decode_hip(id, &p)?,
-        _ if in_block(id, BOLT, 5) || in_block(id, UNBOLT, 5) => {
-            (Command::Bolter(decode_bolter(id)), 0)
-        }
-        _ if in_block(id, PRIMITIVE + 1, 8) => decode_primitive(id, &p)?,
-        _ if in_block(id, POWER_ON, 16) => (decode_power(id), 0),
+        ARM..=SERVO_LAST if is_servo(id) => decode_servo(id, &p)?,
+        HIP..=HIP_LAST => decode_hip(id, &p)?,
+        BOLT..=BOLT_LAST | UNBOLT..=UNBOLT_LAST => (Command::Bolter(decode_bolter(id)), NONE),
+        BOLTERS_DOWN => (Command::Bolter(BolterCommand::Down), NONE),
+        PRIMITIVE_FIRST..=PRIMITIVE_LAST => decode_primitive(id, &p)?,
+        RECONFIGURE => decode_reconfigure(&p)?,
+        POWER_ON..=POWER_LAST => (decode_power(id), NONE),
         _ => return Err(CommandError::UnknownId { id }),
     };
-    for (i, &b) in p.iter().enumerate() {
-        if used & (1 << i) == 0 && b != 0 {
-            return Err(CommandError::UnusedNotZero {
-                id,
-                index: PARAM_OFFSET + i,
-                found: b,
-            });
+    unused_zero(id, &p, used)?;
+    Ok(cmd)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rule as it was written before the word-wide test: the first nonzero byte, in
+    /// order, that `used` does not cover.
+    fn byte_by_byte(id: u8, p: &[u8; PARAM_LEN], used: Used) -> Result<(), CommandError> {
+        for (i, &b) in p.iter().enumerate() {
+            if used & byte(i) == 0 && b != 0 {
+                return Err(CommandError::UnusedNotZero {
+                    id,
+                    index: PARAM_OFFSET + i,
+                    found: b,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn unused_bytes_are_refused_as_byte_by_byte() {
+        // Every mask a decoder returns, over every combination of four values per byte
+        // (4^6 blocks): the same result and, on a refusal, the same byte and value.
+        let masks = [
+            NONE,
+            slot_bytes(Slot::Hip),
+            slot_bytes(Slot::ArmA),
+            slot_bytes(Slot::ArmB),
+            byte(Slot::ArmA.offset()),
+        ];
+        let values = [0u8, 0x01, 0x80, 0xff];
+        for used in masks {
+            for k in 0..4usize.pow(PARAM_LEN as u32) {
+                let p: [u8; PARAM_LEN] = core::array::from_fn(|i| values[(k >> (2 * i)) & 3]);
+                assert_eq!(
+                    unused_zero(0x26, &p, used),
+                    byte_by_byte(0x26, &p, used),
+                    "{p:02x?} {used:#x}"
+                );
+            }
         }
     }
-    Ok(cmd)
 }
