@@ -144,8 +144,19 @@ class Yamcs:
 
     # -- set-up ---------------------------------------------------------------------------------
     def _prune(self, keep: int = 5) -> None:
-        """Remove all but the newest `keep` earlier run directories (about 7 MB each)."""
-        runs = sorted(self.run_dir.parent.glob("yamcs-*"), key=lambda p: p.stat().st_mtime)
+        """Remove all but the newest `keep` earlier run directories (about 7 MB each), never one whose
+        process (the pid that ends its name) is alive: with pytest-xdist's two workers (ground/run-tests),
+        the other worker's YAMCS may be running in an older directory."""
+        def alive(p: Path) -> bool:
+            try:
+                os.kill(int(p.name.rsplit("-", 1)[1]), 0)
+                return True
+            except (ValueError, IndexError, ProcessLookupError):
+                return False
+            except PermissionError:
+                return True
+        runs = sorted((p for p in self.run_dir.parent.glob("yamcs-*") if not alive(p)),
+                      key=lambda p: p.stat().st_mtime)
         for old in runs[:-keep] if len(runs) > keep else []:
             shutil.rmtree(old, ignore_errors=True)
 
