@@ -1,4 +1,6 @@
-//! Moving average with a running sum: O(1) per sample.
+//! Moving averages with a running sum: O(1) per sample. [`MovingAverage`] is one channel;
+//! [`Averages`] is `K` channels sampled together (a sensor front end's ADC or IMU), sharing
+//! one slot index and count so a tick's samples cost one index update, not one per channel.
 
 /// Mean of the last `N` samples (fewer before `N` have arrived), rounded down.
 ///
@@ -37,26 +39,28 @@ impl<const N: usize> MovingAverage<N> {
         }
     }
 
-    /// Adds a sample, dropping the oldest once the window is full.
+    /// Adds a sample, dropping the oldest once the window is full. The slot index wraps by a
+    /// comparison, not `%`: the division it replaces was a large part of every sample's cost
+    /// in the fault swarm's profile (issue 40). The sum cannot overflow (the compile-time
+    /// check above), so its wrapping arithmetic is exact and has no overflow check to panic.
     pub fn push(&mut self, sample: u16) {
-        if self.count == N {
-            // The slot at `next` holds the oldest sample.
-            self.sum -= self.window[self.next % N] as u32;
-        } else {
+        let full = self.count == N;
+        if let Some(slot) = self.window.get_mut(self.next) {
+            // The slot at `next` holds the oldest sample once the window is full.
+            let old = if full { u32::from(*slot) } else { 0 };
+            self.sum = self.sum.wrapping_sub(old).wrapping_add(u32::from(sample));
+            *slot = sample;
+        }
+        if !full {
             self.count += 1;
         }
-        self.window[self.next % N] = sample;
-        self.sum += sample as u32;
-        self.next = (self.next + 1) % N;
+        self.next = wrap_next::<N>(self.next);
     }
 
-    /// The mean, or `None` before the first sample.
+    /// The mean, or `None` before the first sample. Once the window is full (nearly always)
+    /// the divisor is the constant `N`, which compiles to a multiplication.
     pub fn mean(&self) -> Option<u16> {
-        if self.count == 0 {
-            None
-        } else {
-            Some((self.sum / self.count as u32) as u16)
-        }
+        mean_of::<N>(self.sum, self.count)
     }
 
     /// Samples in the window (≤ N).
@@ -67,5 +71,129 @@ impl<const N: usize> MovingAverage<N> {
     /// No sample yet.
     pub const fn is_empty(&self) -> bool {
         self.count == 0
+    }
+}
+
+/// The slot after `i` in a window of `N`, back to 0 after the last.
+const fn wrap_next<const N: usize>(i: usize) -> usize {
+    if i + 1 < N {
+        i + 1
+    } else {
+        0
+    }
+}
+
+/// `sum / count` rounded down, or `None` when `count` is 0; the divisor is the constant `N`
+/// when the window is full, so that common case needs no run-time division.
+fn mean_of<const N: usize>(sum: u32, count: usize) -> Option<u16> {
+    match count {
+        0 => None,
+        c if c == N => Some((sum / N as u32) as u16),
+        // `c` < N ≤ 65537 (FITS), so the cast is exact; the mean of u16 samples fits a u16.
+        c => Some((sum / c as u32) as u16),
+    }
+}
+
+/// The moving averages of `K` channels sampled together, each the mean of its last `N`
+/// samples (fewer before `N` ticks), rounded down: per channel exactly what a
+/// [`MovingAverage<N>`] fed the same samples gives (`tests` and the front end's proof hold
+/// it to that), at one index update per tick instead of `K`.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Averages<const N: usize, const K: usize> {
+    /// A tick's samples per slot.
+    window: [[u16; K]; N],
+    next: usize,
+    count: usize,
+    sum: [u32; K],
+}
+
+impl<const N: usize, const K: usize> Default for Averages<N, K> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize, const K: usize> Averages<N, K> {
+    /// Empty filters.
+    pub const fn new() -> Self {
+        #[allow(clippy::let_unit_value)]
+        let () = MovingAverage::<N>::FITS;
+        Averages {
+            window: [[0; K]; N],
+            next: 0,
+            count: 0,
+            sum: [0; K],
+        }
+    }
+
+    /// Adds one tick's samples, dropping the oldest tick's once the window is full.
+    pub fn push(&mut self, samples: [u16; K]) {
+        let full = self.count == N;
+        if let Some(row) = self.window.get_mut(self.next) {
+            for ((sum, old), new) in self.sum.iter_mut().zip(row.iter()).zip(samples.iter()) {
+                let old = if full { u32::from(*old) } else { 0 };
+                // Exact: a channel's sum never exceeds N × 65535 (FITS).
+                *sum = sum.wrapping_sub(old).wrapping_add(u32::from(*new));
+            }
+            *row = samples;
+        }
+        if !full {
+            self.count += 1;
+        }
+        self.next = wrap_next::<N>(self.next);
+    }
+
+    /// Every channel's mean, or `None` before the first tick's samples; as
+    /// [`MovingAverage::mean`], a constant divisor once the window is full.
+    pub fn means(&self) -> Option<[u16; K]> {
+        match self.count {
+            0 => None,
+            c if c == N => Some(self.sum.map(|s| (s / N as u32) as u16)),
+            // `c` < N ≤ 65537 (FITS): the cast is exact, the mean of u16 samples a u16.
+            c => Some(self.sum.map(|s| (s / c as u32) as u16)),
+        }
+    }
+
+    /// Ticks in the window (≤ N).
+    pub const fn len(&self) -> usize {
+        self.count
+    }
+
+    /// No sample yet.
+    pub const fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Per channel, [`Averages`] gives what a [`MovingAverage`] gives, before and after the
+    /// window fills and across its wrap, with the extreme samples.
+    #[test]
+    fn averages_equal_one_moving_average_per_channel() {
+        let mut all = Averages::<5, 3>::new();
+        let mut one: [MovingAverage<5>; 3] = core::array::from_fn(|_| MovingAverage::new());
+        assert_eq!(all.means(), None);
+        let mut x: u32 = 0x1234_5678;
+        for t in 0..40u32 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let samples = match t % 4 {
+                0 => [u16::MAX; 3],
+                1 => [0, u16::MAX, 1],
+                _ => [x as u16, (x >> 16) as u16, (x >> 8) as u16],
+            };
+            all.push(samples);
+            for (f, &s) in one.iter_mut().zip(samples.iter()) {
+                f.push(s);
+            }
+            let want = one.each_ref().map(|f| f.mean().unwrap_or(0));
+            assert_eq!(all.means(), Some(want), "t = {t}");
+            assert_eq!(all.len(), one[0].len());
+        }
     }
 }

@@ -46,7 +46,7 @@
 //! ```
 
 use super::adc::{self, Scaling};
-use super::{encoder, imu, MovingAverage};
+use super::{encoder, imu, Averages};
 use crate::units::{Electrical, Gravity, HipAngle};
 
 /// The paper's window: 50 samples (Section 2).
@@ -138,9 +138,10 @@ pub struct Filtered {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Frontend<const N: usize> {
     cfg: Config,
-    adc: [MovingAverage<N>; 8],
+    /// The eight ADC channels, sampled together (one slot index for all: issue 40).
+    adc: Averages<N, 8>,
     /// Accelerations offset by 32768 so that the unsigned filter averages them exactly.
-    accel: [MovingAverage<N>; 3],
+    accel: Averages<N, 3>,
     /// Ticks in a row without a reading (saturating), per device: ADC, IMU, encoder.
     silent: Silence,
 }
@@ -177,8 +178,8 @@ impl<const N: usize> Frontend<N> {
     pub const fn new(cfg: Config) -> Self {
         Frontend {
             cfg,
-            adc: [const { MovingAverage::new() }; 8],
-            accel: [const { MovingAverage::new() }; 3],
+            adc: Averages::new(),
+            accel: Averages::new(),
             silent: Silence {
                 adc: u16::MAX,
                 imu: u16::MAX,
@@ -197,16 +198,12 @@ impl<const N: usize> Frontend<N> {
             encoder: count(self.silent.encoder, raw.encoder.is_some()),
         };
         if let Some(codes) = raw.adc {
-            for (f, &code) in self.adc.iter_mut().zip(codes.iter()) {
-                f.push(code);
-            }
+            self.adc.push(codes);
         }
         if let Some(accel) = raw.accel {
-            for (f, &a) in self.accel.iter_mut().zip(accel.iter()) {
-                f.push(unsign(a));
-            }
+            self.accel.push(accel.map(unsign));
         } else if self.silent.imu >= self.cfg.loss_ticks {
-            self.accel = [const { MovingAverage::new() }; 3];
+            self.accel = Averages::new();
         }
         self.filtered(raw.encoder)
     }
@@ -221,16 +218,9 @@ impl<const N: usize> Frontend<N> {
 
     /// The filtered values now, with `encoder` as the hip reading.
     pub fn filtered(&self, encoder: Option<u16>) -> Filtered {
-        let codes = self.adc.each_ref().map(|f| f.mean().unwrap_or(0));
-        let accel = if self.accel[0].is_empty() {
-            None
-        } else {
-            Some(
-                self.accel
-                    .each_ref()
-                    .map(|f| resign(f.mean().unwrap_or(0x8000))),
-            )
-        };
+        // All zero before the first ADC sample; the IMU's channels are empty together.
+        let codes = self.adc.means().unwrap_or([0; 8]);
+        let accel = self.accel.means().map(|m| m.map(resign));
         Filtered {
             electrical: adc::electrical(&self.cfg.scaling, codes),
             gravity: accel.and_then(imu::gravity),

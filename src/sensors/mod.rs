@@ -16,4 +16,4 @@ mod filter;
 pub mod frontend;
 pub mod imu;
 
-pub use filter::MovingAverage;
+pub use filter::{Averages, MovingAverage};

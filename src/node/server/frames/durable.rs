@@ -61,8 +61,13 @@ impl<const N: usize> RobotLink<N> {
         out: &mut impl FnMut(Entry),
     ) {
         for s in 0..QUEUE_SLOTS {
-            let e = self.slot_due(s, queue, wants_out);
             let written = self.ring_written.get(s).copied().flatten();
+            // A slot that holds nothing and was never written is not due: skip encoding its
+            // empty entry (most slots, most calls; issue 40).
+            if written.is_none() && self.ring.get(s).copied().flatten().is_none() {
+                continue;
+            }
+            let e = self.slot_due(s, queue, wants_out);
             // An empty slot never written need not be.
             if Some(e) != written && !(written.is_none() && e.aux == 0) {
                 out(e);
