@@ -481,17 +481,10 @@ impl Watch {
         }
     }
 
-    fn fault_modes(
-        &mut self,
-        i: usize,
-        now: u32,
-        faults: Faults,
-        mode: Mode,
-        in_motion: bool,
-        commanded: Option<Mode>,
-    ) {
+    /// Robot `i`'s fault set and mode at `now` remembered; the faults raised since the last
+    /// tick returned (and counted, and logged with their time).
+    fn record_faults(&mut self, i: usize, now: u32, faults: Faults, mode: Mode) -> Vec<Fault> {
         let r = &mut self.robots[i];
-        let before = commanded.or(r.last_mode).unwrap_or(mode);
         // Most ticks raise nothing: the set compared before any list is made.
         let new: Vec<Fault> = if faults == r.last_faults {
             Vec::new()
@@ -503,7 +496,6 @@ impl Watch {
         };
         r.last_faults = faults;
         r.last_mode = Some(mode);
-        let deferred_since = r.deferred_since;
         if self.faults[i].last().map(|(_, f)| *f) != Some(faults) {
             self.faults[i].push((now, faults));
         }
@@ -511,6 +503,21 @@ impl Watch {
             self.raised[i].push((now, *f));
         }
         self.checked.faults_raised += new.len() as u64;
+        new
+    }
+
+    fn fault_modes(
+        &mut self,
+        i: usize,
+        now: u32,
+        faults: Faults,
+        mode: Mode,
+        in_motion: bool,
+        commanded: Option<Mode>,
+    ) {
+        let before = commanded.or(self.robots[i].last_mode).unwrap_or(mode);
+        let deferred_since = self.robots[i].deferred_since;
+        let new = self.record_faults(i, now, faults, mode);
         let expect = |f: &Fault| fault_action(*f);
         match before {
             Mode::Operational if !new.is_empty() => {
