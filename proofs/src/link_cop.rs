@@ -266,7 +266,7 @@ pub fn check_fop_inputs(t: u8, inputs: &[(u8, u8)]) {
                 assert!(outstanding <= 4);
                 // With `restart_t1_after_wait` T1 runs while frames are outstanding outside
                 // Retransmit with Wait (without it, leaving that state can leave T1 stopped:
-                // host/tests/protocol/cop1.rs, case d).
+                // proofs/tests/protocol/cop1.rs, case d).
                 if fop.sent_len() > 0 && fop.state() != FopState::RetransmitWithWait && t & 4 == 0 {
                     assert!(
                         fop.timer_deadline().is_some(),

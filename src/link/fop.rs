@@ -125,7 +125,7 @@ pub struct FopConfig {
     /// (dariol83/ccsds and YAMCS do nothing then, so T1 stops), and leaving S3 by E6
     /// ("remove acknowledged frames, look for FDU") starts nothing: when FARM-1 has meanwhile
     /// cleared its Retransmit flag by accepting a late copy, no CLCW and no timer ever sends
-    /// the remaining frames again (the COP-1 model in host/tests/protocol/cop1.rs finds the
+    /// the remaining frames again (the COP-1 model in proofs/tests/protocol/cop1.rs finds the
     /// path). `false` is the table as written; the mission sets `true`.
     pub restart_t1_after_wait: bool,
 }

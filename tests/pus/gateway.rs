@@ -464,7 +464,7 @@ fn a_deferred_fault_lets_the_motion_complete() {
 
 /// The kept key of a source never moves back: telecommands 2 then 1 (reordered on the way)
 /// keep 2, so that after a restart a copy of 2 is answered RESTARTED, never run again (the
-/// counterexample of host/tests/protocol/restarts.rs).
+/// counterexample of proofs/tests/protocol/restarts.rs).
 #[test]
 fn kept_key_never_moves_back_on_reordered_telecommands() {
     let mut g = gateway();

@@ -17,7 +17,7 @@
 //! robot, which [`Server::accept`] reports as [`Accepted::Superseded`]. The ground sends one
 //! command at a time per robot, so it replaces a command only after it has finished with it
 //! (acknowledged, or reported unacknowledged); the stateright model in
-//! host/tests/protocol/protocol_exactly_once.rs checks exactly that.
+//! proofs/tests/protocol/protocol_exactly_once.rs checks exactly that.
 //!
 //! ```
 //! use mmic::command::Command;

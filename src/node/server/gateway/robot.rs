@@ -168,7 +168,7 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
     /// `key` was taken from its source: the kept mark moves to it unless it holds a newer one
     /// (telecommands can arrive out of order: a mark that went back would let a copy of the
     /// newer one run again after a restart; the stateright model in
-    /// host/tests/protocol/restarts.rs found it). The source moves to the end; the least
+    /// proofs/tests/protocol/restarts.rs found it). The source moves to the end; the least
     /// recently heard one is forgotten when they are full.
     fn mark(&mut self, (source, seq): (u16, u16)) {
         let mut seq = seq;
