@@ -232,7 +232,7 @@ const TWO_FACE_ARMS: [PerSide<ArmPwm>; 3] = [
 
 /// Every reading the model allows in state `s` (per hidden hip-axis choice and, in a two-face
 /// state, per arm combination with at least one arm extended).
-pub fn predict(cfg: &Config, s: State) -> impl Iterator<Item = Readings> {
+pub fn predict(cfg: &Config, s: State) -> impl Iterator<Item = Readings> + use<> {
     let g = gravity(cfg);
     let (a, b) = (arm_direction(s, Side::A), arm_direction(s, Side::B));
     hip_options(s).flat_map(move |(h, angle)| {

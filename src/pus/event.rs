@@ -392,7 +392,7 @@ fn attempts(
     b: &HeartbeatRepr,
     stopped: bool,
     raised: Faults,
-) -> impl Iterator<Item = Event> {
+) -> impl Iterator<Item = Event> + use<> {
     let (pair, k) = match a.active_bolter {
         Some(p) if a.bolter_attempt.get() > 0 => (Some(p), a.bolter_attempt.get()),
         _ => (None, 0),

@@ -18,10 +18,14 @@ pub const PROPTEST_DEFAULT_CASES: u32 = 256;
 
 /// `cases` scaled by `PROPTEST_CASES / 256` when that variable is set (at least 1).
 pub fn scaled(cases: u32) -> u32 {
-    match std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok())
-    {
+    scaled_by(cases, std::env::var("PROPTEST_CASES").ok().as_deref())
+}
+
+/// `cases` scaled by `proptest_cases / 256` (at least 1), or as it is when the variable is
+/// unset or not a number: [`scaled`] with the variable's value passed in, so that a test can
+/// check the rule without changing the process's environment under the other tests' threads.
+pub fn scaled_by(cases: u32, proptest_cases: Option<&str>) -> u32 {
+    match proptest_cases.and_then(|v| v.trim().parse::<u64>().ok()) {
         Some(env) => {
             let n = cases as u64 * env / PROPTEST_DEFAULT_CASES as u64;
             n.clamp(1, u32::MAX as u64) as u32

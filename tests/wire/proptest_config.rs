@@ -4,7 +4,7 @@
 
 use proptest::test_runner::{FailurePersistence, PersistedSeed, TestCaseError, TestRunner};
 
-use crate::common::prop::{config, scaled, CommittedRegressions};
+use crate::common::prop::{config, scaled, scaled_by, CommittedRegressions};
 
 #[test]
 fn committed_seeds_are_replayed() {
@@ -43,21 +43,19 @@ fn a_new_failure_is_not_written_into_the_tree() {
 
 #[test]
 fn case_counts_scale_with_proptest_cases() {
-    // This binary's only test that reads the variable; the others do not depend on it.
-    let before = std::env::var("PROPTEST_CASES").ok();
-    std::env::remove_var("PROPTEST_CASES");
-    assert_eq!(scaled(200), 200);
-    std::env::set_var("PROPTEST_CASES", "25600");
+    // The rule with the variable's value passed in: setting it here would race with the
+    // other tests' threads, which read it.
+    assert_eq!(scaled_by(200, None), 200);
+    assert_eq!(scaled_by(200, Some("not a number")), 200);
     assert_eq!(
-        scaled(200),
+        scaled_by(200, Some("25600")),
         20_000,
         "100x proptest's default: 100x each test's count"
     );
-    assert_eq!(config(2048).cases, 204_800);
-    std::env::set_var("PROPTEST_CASES", "1");
-    assert_eq!(scaled(200), 1, "never zero");
-    match before {
-        Some(v) => std::env::set_var("PROPTEST_CASES", v),
-        None => std::env::remove_var("PROPTEST_CASES"),
-    }
+    assert_eq!(scaled_by(2048, Some(" 25600 ")), 204_800);
+    assert_eq!(scaled_by(200, Some("1")), 1, "never zero");
+    // And what the tests use reads the variable through it.
+    let env = std::env::var("PROPTEST_CASES").ok();
+    assert_eq!(scaled(200), scaled_by(200, env.as_deref()));
+    assert_eq!(config(2048).cases, scaled_by(2048, env.as_deref()));
 }
