@@ -131,12 +131,14 @@ impl<const N: usize, const K: usize> Averages<N, K> {
     pub fn push(&mut self, samples: [u16; K]) {
         let full = self.count == N;
         if let Some(row) = self.window.get_mut(self.next) {
-            for ((sum, old), new) in self.sum.iter_mut().zip(row.iter()).zip(samples.iter()) {
-                let old = if full { u32::from(*old) } else { 0 };
+            // The row written in the same loop: `*row = samples` after it was a call of
+            // `memcpy` per tick on RV32 (issue 40, `benches/rv32/README.md`).
+            for ((sum, slot), new) in self.sum.iter_mut().zip(row.iter_mut()).zip(samples) {
+                let old = if full { u32::from(*slot) } else { 0 };
                 // Exact: a channel's sum never exceeds N × 65535 (FITS).
-                *sum = sum.wrapping_sub(old).wrapping_add(u32::from(*new));
+                *sum = sum.wrapping_sub(old).wrapping_add(u32::from(new));
+                *slot = new;
             }
-            *row = samples;
         }
         if !full {
             self.count += 1;
@@ -149,9 +151,19 @@ impl<const N: usize, const K: usize> Averages<N, K> {
     pub fn means(&self) -> Option<[u16; K]> {
         match self.count {
             0 => None,
-            c if c == N => Some(self.sum.map(|s| (s / N as u32) as u16)),
+            _ => Some(self.means_or([0; K])),
+        }
+    }
+
+    /// Every channel's mean, or `empty` before the first tick's samples: [`means`](Self::means)
+    /// without the `Option`, whose array the caller copied out again (through `memcpy` on
+    /// RV32, about 100 instructions a tick).
+    pub fn means_or(&self, empty: [u16; K]) -> [u16; K] {
+        match self.count {
+            0 => empty,
+            c if c == N => self.sum.map(|s| (s / N as u32) as u16),
             // `c` < N ≤ 65537 (FITS): the cast is exact, the mean of u16 samples a u16.
-            c => Some(self.sum.map(|s| (s / c as u32) as u16)),
+            c => self.sum.map(|s| (s / c as u32) as u16),
         }
     }
 
@@ -177,6 +189,7 @@ mod tests {
         let mut all = Averages::<5, 3>::new();
         let mut one: [MovingAverage<5>; 3] = core::array::from_fn(|_| MovingAverage::new());
         assert_eq!(all.means(), None);
+        assert_eq!(all.means_or([7; 3]), [7; 3]);
         let mut x: u32 = 0x1234_5678;
         for t in 0..40u32 {
             x ^= x << 13;
@@ -193,6 +206,7 @@ mod tests {
             }
             let want = one.each_ref().map(|f| f.mean().unwrap_or(0));
             assert_eq!(all.means(), Some(want), "t = {t}");
+            assert_eq!(all.means_or([7; 3]), want, "t = {t}");
             assert_eq!(all.len(), one[0].len());
         }
     }

@@ -219,7 +219,7 @@ impl<const N: usize> Frontend<N> {
     /// The filtered values now, with `encoder` as the hip reading.
     pub fn filtered(&self, encoder: Option<u16>) -> Filtered {
         // All zero before the first ADC sample; the IMU's channels are empty together.
-        let codes = self.adc.means().unwrap_or([0; 8]);
+        let codes = self.adc.means_or([0; 8]);
         let accel = self.accel.means().map(|m| m.map(resign));
         Filtered {
             electrical: adc::electrical(&self.cfg.scaling, codes),

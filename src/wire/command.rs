@@ -17,7 +17,7 @@
 
 use super::layout::{span, FieldSpec, Unit};
 use super::opcode::{seq_slot, Slot, PARAM_LEN, PARAM_OFFSET};
-use super::{check, field_err, seal, Packet, PacketKind, WireError};
+use super::{check_inline, field_err, seal, Packet, PacketKind, WireError};
 use crate::command::Command;
 use crate::units::BoardNumber;
 use zerocopy::byteorder::little_endian::U16;
@@ -55,7 +55,7 @@ impl Packet for CommandPacket {
 
 const _: () = assert!(core::mem::size_of::<CommandPacket>() == COMMAND_LEN);
 
-/// Read-only accessors, for a packet whose length, header and checksum [`check`]
+/// Read-only accessors, for a packet whose length, header and checksum [`check`](super::check)
 /// has passed but whose opcode or parameters may not decode: board A still answers such a
 /// packet, with its sequence number, so the ground stops resending it.
 ///
@@ -189,7 +189,7 @@ pub struct CommandRepr {
 impl CommandRepr {
     /// Checks length, header, checksum, board number, opcode and parameters.
     pub fn parse(bytes: &[u8]) -> Result<CommandRepr, WireError> {
-        let p: &CommandPacket = check(bytes)?;
+        let p: &CommandPacket = check_inline(bytes)?;
         let board = BoardNumber::new(p.board).map_err(|_| {
             field_err(
                 PacketKind::Command,

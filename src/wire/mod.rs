@@ -264,12 +264,21 @@ pub trait Packet: FromBytes + KnownLayout + Immutable + Unaligned + Sized {
     const KIND: PacketKind;
 }
 
-/// Length, header and checksum checks; on success a view of the bytes as `P`. Inlined into
-/// its few callers (each packet's parse, board A's answer to a command that does not decode),
-/// where `P`'s length is a constant that the checksum's step depends on
-/// (`checksum::checked_packet_crc`).
-#[inline]
+/// Length, header and checksum checks; on success a view of the bytes as `P`.
+///
+/// Left to the compiler's choice, as before issue 40: with `#[inline]` here (for the command
+/// parse, `check_inline`) every packet's check went in line, and on RV32 board A's and board
+/// B's ticks then copied their packets through `memcpy` byte by byte on every tick, about 200
+/// instructions more in each board's median tick (`benches/rv32/README.md`, "The medians
+/// rose").
 pub fn check<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
+    check_inline(bytes)
+}
+
+/// [`check`], always inlined: for the command's parse, where `P`'s length is a constant
+/// that the checksum's step depends on (`checksum::checked_packet_crc`).
+#[inline(always)]
+pub(crate) fn check_inline<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
     let kind = P::KIND;
     let expected = kind.len();
     if bytes.len() != expected {
