@@ -436,7 +436,7 @@ async fn ground_task<G: Ground>(
                     return Ok(ground.finish(now));
                 }
                 for (i, addr) in servers.iter().enumerate() {
-                    for p in ground.tick(i, now) {
+                    if let Some(p) = ground.tick(i, now) {
                         let _ = sock.send_to(&p, addr).await;
                     }
                 }
@@ -445,7 +445,7 @@ async fn ground_task<G: Ground>(
                 let (k, from) = r?;
                 if let Some(&i) = robot_of.get(&from) {
                     let now = shared.now_ms();
-                    for p in ground.receive(i, now, &buf[..k]) {
+                    if let Some(p) = ground.receive(i, now, &buf[..k]) {
                         let _ = sock.send_to(&p, servers[i]).await;
                     }
                 }

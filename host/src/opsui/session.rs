@@ -145,7 +145,7 @@ impl Session {
 
     /// The runner's tick at `now`: what it sends, written.
     fn tick(&mut self, now: u32) -> Result<(), String> {
-        for p in self.ground.tick(0, now) {
+        if let Some(p) = self.ground.tick(0, now) {
             self.send(now, &p)?;
         }
         Ok(())
@@ -204,7 +204,7 @@ impl Session {
             return Ok(());
         }
         self.line.heartbeats += 1;
-        for q in self.ground.receive(0, t, p) {
+        if let Some(q) = self.ground.receive(0, t, p) {
             self.send(t, &q)?;
         }
         Ok(())

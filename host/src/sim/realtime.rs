@@ -692,12 +692,12 @@ fn run_ground<G: Ground>(
         }
         for (i, (writer, rx, _)) in links.iter_mut().enumerate() {
             let Some(gl) = fops.get_mut(i).and_then(|f| f.as_deref_mut()) else {
-                for p in ground.tick(i, now) {
+                if let Some(p) = ground.tick(i, now) {
                     writer.send(now, &p);
                 }
                 while let Ok(bytes) = rx.try_recv() {
                     let t = clock.now_ms();
-                    for p in ground.receive(i, t, &bytes) {
+                    if let Some(p) = ground.receive(i, t, &bytes) {
                         writer.send(t, &p);
                     }
                 }
@@ -708,7 +708,7 @@ fn run_ground<G: Ground>(
             };
             persist(i, gl);
             gl.tick(now, &mut emit);
-            for p in ground.tick(i, now) {
+            if let Some(p) = ground.tick(i, now) {
                 if gl.send(&p, now, &mut emit).is_err() {
                     ground_event(&log, now, json!({"type": "ground_outbox_full"}));
                 }
@@ -729,7 +729,7 @@ fn run_ground<G: Ground>(
                 }
                 persist(i, gl);
                 for p in packets {
-                    for q in ground.receive(i, t, &p) {
+                    if let Some(q) = ground.receive(i, t, &p) {
                         if gl.send(&q, t, &mut emit).is_err() {
                             ground_event(&log, t, json!({"type": "ground_outbox_full"}));
                         }

@@ -55,16 +55,15 @@ impl SideA {
         command: Option<[u8; COMMAND_LEN]>,
         from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
     ) -> board_a::Outputs {
-        let (out, s) = tick_a_sensed(
+        tick_a_into(
             &mut self.board,
             &mut self.sensors,
             plant,
             now,
             command,
             from_b,
-        );
-        self.sensed = Some(s);
-        out
+            &mut self.sensed,
+        )
     }
 
     /// Board A's mode, faults, state and motion for a run's summary, at `now`.
@@ -109,9 +108,14 @@ impl SideB {
         now: u32,
         command: Option<[u8; B_COMMAND_LEN]>,
     ) -> board_b::Outputs {
-        let (out, s) = tick_b_sensed(&mut self.board, &mut self.sensors, plant, now, command);
-        self.sensed = Some(s);
-        out
+        tick_b_into(
+            &mut self.board,
+            &mut self.sensors,
+            plant,
+            now,
+            command,
+            &mut self.sensed,
+        )
     }
 }
 
@@ -124,20 +128,24 @@ pub fn tick_a(
     command: Option<[u8; COMMAND_LEN]>,
     from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
 ) -> board_a::Outputs {
-    tick_a_sensed(board, sensors, plant, now, command, from_b).0
+    tick_a_into(board, sensors, plant, now, command, from_b, &mut None)
 }
 
-/// [`tick_a`], also returning what side A sensed.
-pub fn tick_a_sensed(
+/// [`tick_a`], also writing what side A sensed to `sensed`: the outputs are returned straight from
+/// board A's tick, not moved through a tuple (board A's [`board_a::Outputs`], its events
+/// inline, is the biggest value of a tick; the swarm runs this one twice a simulated 10 ms).
+pub fn tick_a_into(
     board: &mut BoardA,
     sensors: &mut Frontend<WINDOW>,
     plant: &mut Plant,
     now: u32,
     command: Option<[u8; COMMAND_LEN]>,
     from_b: Option<[u8; INTERNAL_HEARTBEAT_LEN]>,
-) -> (board_a::Outputs, Senses) {
+    sensed: &mut Option<Senses>,
+) -> board_a::Outputs {
     plant.advance(now);
     let s = plant.sense(0, now);
+    *sensed = Some(s);
     let f = sensors.push(&s.raw);
     let inputs = board_a::Inputs::sensed(&f, s.arm_contracted, s.bolter_at_home, command, from_b);
     let out = board.tick(now, &inputs);
@@ -156,7 +164,7 @@ pub fn tick_a_sensed(
             plant.set_state(*st);
         }
     }
-    (out, s)
+    out
 }
 
 /// [`SideB::tick`] on its parts.
@@ -167,18 +175,20 @@ pub fn tick_b(
     now: u32,
     command: Option<[u8; B_COMMAND_LEN]>,
 ) -> board_b::Outputs {
-    tick_b_sensed(board, sensors, plant, now, command).0
+    tick_b_into(board, sensors, plant, now, command, &mut None)
 }
 
-/// [`tick_b`], also returning what side B sensed.
-pub fn tick_b_sensed(
+/// [`tick_b`], writing what side B sensed to `sensed` (as [`tick_a_into`]).
+pub fn tick_b_into(
     board: &mut BoardB,
     sensors: &mut Frontend<WINDOW>,
     plant: &mut Plant,
     now: u32,
     command: Option<[u8; B_COMMAND_LEN]>,
-) -> (board_b::Outputs, Senses) {
+    sensed: &mut Option<Senses>,
+) -> board_b::Outputs {
     let s = plant.sense(1, now);
+    *sensed = Some(s);
     let f = sensors.push(&s.raw);
     let inputs = board_b::Inputs::sensed(&f, s.arm_contracted, s.bolter_at_home, command);
     let out = board.tick(now, &inputs);
@@ -189,7 +199,7 @@ pub fn tick_b_sensed(
         bolter: out.bolter,
         mux: out.mux,
     });
-    (out, s)
+    out
 }
 
 /// The packets a deframer finds in `bytes` (a stream's next read).
@@ -465,14 +475,15 @@ impl<G: Ground> GroundSide<G> {
         }
     }
 
-    /// Robot `i` at `now`: the injections due, then the runner's tick. Returns the packets to
+    /// Robot `i` at `now`: the injections due, then the runner's tick. Returns the packet to
     /// send to its server board. A runner whose plan ended still runs its link (resends and
     /// answers of a command outstanding when the plan ended; an injection is then refused by
-    /// the runner, and logged so).
-    pub fn tick(&mut self, i: usize, now: u32) -> Vec<Vec<u8>> {
+    /// the runner, and logged so). One packet at most, as an `Option` rather than a vector: the
+    /// engines call this every 10 ms per robot, and most calls send nothing.
+    pub fn tick(&mut self, i: usize, now: u32) -> Option<Vec<u8>> {
         self.stats.sim_ms = self.stats.sim_ms.max(now);
         if i >= self.runners.len() {
-            return Vec::new();
+            return None;
         }
         while let Some(inj) = self
             .injections
@@ -492,21 +503,19 @@ impl<G: Ground> GroundSide<G> {
             );
         }
         let t = self.runners[i].tick(&self.steps, now);
-        self.handle(i, now, t).into_iter().collect()
+        self.handle(i, now, t)
     }
 
-    /// A packet from robot `i`'s server board at `now`; returns the packets to send.
-    pub fn receive(&mut self, i: usize, now: u32, bytes: &[u8]) -> Vec<Vec<u8>> {
+    /// A packet from robot `i`'s server board at `now`; returns the packet to send, if any.
+    pub fn receive(&mut self, i: usize, now: u32, bytes: &[u8]) -> Option<Vec<u8>> {
         if i >= self.runners.len() {
-            return Vec::new();
+            return None;
         }
-        let Some((t, answers)) = self.runners[i].receive(&self.steps, now, bytes) else {
-            return Vec::new();
-        };
+        let (t, answers) = self.runners[i].receive(&self.steps, now, bytes)?;
         if let (Some(s), true) = (self.sent_at[i], answers) {
             self.stats.max_latency_ms = self.stats.max_latency_ms.max(now.saturating_sub(s));
         }
-        self.handle(i, now, t).into_iter().collect()
+        self.handle(i, now, t)
     }
 
     /// Logs and measures one tick's outcome; the packet to send, if any.

@@ -39,7 +39,7 @@ impl<G: Ground> Engine<'_, G> {
         let out = r.a.tick(&mut r.plant, now, command, from_b);
         r.kept_a = Some(r.a.board.durable());
         self.count_executions(i, &out);
-        if let Some(s) = self.robots[i].a.sensed {
+        if let (Some(s), true) = (self.robots[i].a.sensed, self.trace.is_some()) {
             self.record(i, |t| Record::TickA {
                 t,
                 reading: reading(&s),
@@ -58,7 +58,7 @@ impl<G: Ground> Engine<'_, G> {
                 self.node_event(i, 0, event_json(e));
             }
         }
-        self.a_outputs(i, out);
+        self.a_outputs(i, &out);
     }
 
     /// Counts board A's accepted executions of each sequenced command (nothing but a
@@ -80,7 +80,7 @@ impl<G: Ground> Engine<'_, G> {
 
     /// Board A's tick's outputs to its links: the command to board B, the heartbeat to the
     /// WiFi task's queue.
-    fn a_outputs(&mut self, i: usize, out: board_a::Outputs) {
+    fn a_outputs(&mut self, i: usize, out: &board_a::Outputs) {
         if let Some(b) = out.to_b {
             self.send(i, Hop::AToB, 0, &b);
         }

@@ -103,7 +103,7 @@ impl<G: Ground> Engine<'_, G> {
             Protocol::Pus => vec![bytes],
         };
         for p in packets {
-            for out in self.ground.receive(i, now, &p) {
+            if let Some(out) = self.ground.receive(i, now, &p) {
                 self.ground_sends(i, &out);
             }
         }

@@ -26,7 +26,7 @@ impl<G: Ground> Engine<'_, G> {
             if self.robots[i].down[Node::Ground as usize] {
                 continue;
             }
-            for p in self.ground.tick(i, now) {
+            if let Some(p) = self.ground.tick(i, now) {
                 self.ground_sends(i, &p);
             }
         }

@@ -9,7 +9,7 @@
 //! let mut l = Link::new(model, 0.0, 7, true);
 //! let sent = l.send(10_000);
 //! assert_eq!(sent.fate, Fate::Delivered);
-//! assert_eq!(sent.at_us, vec![12_000]);
+//! assert_eq!(sent.at_us, [12_000]);
 //! ```
 
 /// How one direction of a link treats packets (the loss comes from the run's per-link loss
@@ -89,8 +89,8 @@ impl Fate {
 pub struct Sent {
     /// What became of it.
     pub fate: Fate,
-    /// Arrival times of its copies, µs.
-    pub at_us: Vec<u64>,
+    /// Arrival times of its copies, µs (inline: a packet sent is no allocation).
+    pub at_us: heapless::Vec<u64, 2>,
 }
 
 /// One direction of a link.
@@ -130,13 +130,13 @@ impl Link {
         if self.model.cut_at((now_us / 1000) as u32) {
             return Sent {
                 fate: Fate::Cut,
-                at_us: Vec::new(),
+                at_us: heapless::Vec::new(),
             };
         }
         if lost < self.loss {
             return Sent {
                 fate: Fate::Lost,
-                at_us: Vec::new(),
+                at_us: heapless::Vec::new(),
             };
         }
         let held = reorder < self.model.reorder;
@@ -146,9 +146,11 @@ impl Link {
         } else if self.stream {
             first = first.max(self.last_at);
         }
-        let mut at_us = vec![first];
+        let mut at_us = heapless::Vec::new();
+        // Two copies at most: the vector holds them, so neither push can fail.
+        let _ = at_us.push(first);
         if dup < self.model.duplicate {
-            at_us.push(first.max(now_us + self.model.latency_us + j2));
+            let _ = at_us.push(first.max(now_us + self.model.latency_us + j2));
         }
         if !held {
             self.last_at = self.last_at.max(*at_us.iter().max().unwrap_or(&first));
