@@ -41,9 +41,18 @@ fn events<'a>(s: &'a Summary, ty: &'a str) -> Vec<&'a Value> {
 
 #[test]
 fn the_demo_completes_over_real_transports_as_in_virtual_time() {
-    for protocol in [Protocol::Legacy, Protocol::Pus] {
+    // Both protocols' realtime runs side by side (they wait on the wall clock, each on its own
+    // sockets and pipes), then each checked against its virtual-time run.
+    let protocols = [Protocol::Legacy, Protocol::Pus];
+    let runs: Vec<_> = std::thread::scope(|scope| {
+        let handles: Vec<_> = protocols
+            .map(|p| scope.spawn(move || realtime::run(&realtime_demo(p)).unwrap()))
+            .into_iter()
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for (protocol, real) in protocols.into_iter().zip(runs) {
         let cfg = realtime_demo(protocol);
-        let real = realtime::run(&cfg).unwrap();
         assert!(real.realtime);
         assert!(real.completed(), "{}", report::text(&real));
         assert!(!real.host_fell_behind());

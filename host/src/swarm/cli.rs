@@ -48,7 +48,7 @@ aside), refusing a shard missing or given twice, or shards whose options differ.
 /// `mmic swarm --help`'s examples and exit codes.
 pub const AFTER: &str = "\
 Examples:
-  mmic swarm --seconds 120                    two minutes of seeds from 1 (CI's budget)
+  mmic swarm --seconds 60                     a minute of seeds from 1 (CI's budget)
   mmic swarm --seconds 60 --seed-start 5000   other seeds
   mmic swarm --runs 200 --json target/swarm.json
   mmic swarm --replay 85 --out target/swarm-85   one seed again, with its whole log
