@@ -122,33 +122,7 @@ pub fn packet(kind: PacketKind) -> String {
             );
         }
     }
-    for row in (0..kind.len()).step_by(7) {
-        let end = (row + 7).min(kind.len());
-        let idx: Vec<String> = (row..row + 7)
-            .map(|i| {
-                if i < end {
-                    i.to_string()
-                } else {
-                    String::new()
-                }
-            })
-            .collect();
-        let _ = writeln!(s, "| {} |", idx.join(" | "));
-        let _ = writeln!(s, "|{}", "---|".repeat(7));
-        let labels: Vec<String> = (row..row + 7)
-            .map(|i| {
-                let mut l = String::new();
-                if let Some(f) = fields.iter().find(|f| f.range.contains(&i)) {
-                    let _ = f.cell(i, &mut l);
-                    if paper_table.is_some() && field_origin(f.name).marks_byte(i) {
-                        let _ = write!(l, " {MARK}");
-                    }
-                }
-                l
-            })
-            .collect();
-        let _ = writeln!(s, "| {} |\n", labels.join(" | "));
-    }
+    byte_grid(&mut s, kind, paper_table.is_some(), &field_origin);
     let _ = writeln!(
         s,
         "## Fields\n\n| bytes | name (JSON) | unit | paper label | origin |\n|---|---|---|---|---|"
@@ -178,6 +152,45 @@ pub fn packet(kind: PacketKind) -> String {
         );
     }
     s
+}
+
+/// The packet's bytes seven to a row, each labelled with its field's cell; with `marked` (a
+/// packet of the paper's tables), a byte whose field carries more than its label says gets
+/// the mark.
+fn byte_grid(
+    s: &mut String,
+    kind: PacketKind,
+    marked: bool,
+    field_origin: &impl Fn(&str) -> crate::spec::FieldOrigin,
+) {
+    let fields = kind.fields();
+    for row in (0..kind.len()).step_by(7) {
+        let end = (row + 7).min(kind.len());
+        let idx: Vec<String> = (row..row + 7)
+            .map(|i| {
+                if i < end {
+                    i.to_string()
+                } else {
+                    String::new()
+                }
+            })
+            .collect();
+        let _ = writeln!(s, "| {} |", idx.join(" | "));
+        let _ = writeln!(s, "|{}", "---|".repeat(7));
+        let labels: Vec<String> = (row..row + 7)
+            .map(|i| {
+                let mut l = String::new();
+                if let Some(f) = fields.iter().find(|f| f.range.contains(&i)) {
+                    let _ = f.cell(i, &mut l);
+                    if marked && field_origin(f.name).marks_byte(i) {
+                        let _ = write!(l, " {MARK}");
+                    }
+                }
+                l
+            })
+            .collect();
+        let _ = writeln!(s, "| {} |\n", labels.join(" | "));
+    }
 }
 
 /// The opcode table.

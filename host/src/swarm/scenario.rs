@@ -294,6 +294,38 @@ fn draw_link(seed: u64, protocol: Protocol, opts: &Options, cfg: &mut SimConfig)
     link
 }
 
+/// Faults: none to three plant or link faults, each once; the operator's Stop (and, usually,
+/// Reset) and the System fault command, which may repeat. Gives the latest time a fault is
+/// drawn at, which the restarts' draws share.
+fn draw_faults(rng: &mut fastrand::Rng, cfg: &mut SimConfig, horizon: u32) -> u32 {
+    let latest = horizon.saturating_sub(3_000).max(2_000);
+    let at = |rng: &mut fastrand::Rng| rng.u32(1_000..latest);
+    let mut pool = faults();
+    rng.shuffle(&mut pool);
+    let k = [0, 0, 1, 1, 1, 2, 2, 3][rng.usize(..8)];
+    for injection in pool.into_iter().take(k) {
+        let t = at(rng);
+        let _ = cfg.inject(Scheduled {
+            injection,
+            at_ms: t,
+        });
+    }
+    for _ in 0..[0, 0, 1, 1, 2][rng.usize(..5)] {
+        let t = at(rng);
+        let _ = cfg.inject(Scheduled {
+            injection: Injection::Stop,
+            at_ms: t,
+        });
+        if rng.f64() < 0.8 {
+            let _ = cfg.inject(Scheduled {
+                injection: Injection::Reset,
+                at_ms: (t + rng.u32(100..8_000)).min(latest),
+            });
+        }
+    }
+    latest
+}
+
 impl Scenario {
     /// The scenario of `seed`.
     pub fn from_seed(seed: u64, opts: &Options) -> Scenario {
@@ -359,33 +391,7 @@ impl Scenario {
                 cuts: cuts(&mut rng, 0.1, horizon),
             },
         };
-        // Faults: none to three plant or link faults, each once; the operator's Stop (and,
-        // usually, Reset) and the System fault command, which may repeat.
-        let latest = horizon.saturating_sub(3_000).max(2_000);
-        let at = |rng: &mut fastrand::Rng| rng.u32(1_000..latest);
-        let mut pool = faults();
-        rng.shuffle(&mut pool);
-        let k = [0, 0, 1, 1, 1, 2, 2, 3][rng.usize(..8)];
-        for injection in pool.into_iter().take(k) {
-            let t = at(&mut rng);
-            let _ = cfg.inject(Scheduled {
-                injection,
-                at_ms: t,
-            });
-        }
-        for _ in 0..[0, 0, 1, 1, 2][rng.usize(..5)] {
-            let t = at(&mut rng);
-            let _ = cfg.inject(Scheduled {
-                injection: Injection::Stop,
-                at_ms: t,
-            });
-            if rng.f64() < 0.8 {
-                let _ = cfg.inject(Scheduled {
-                    injection: Injection::Reset,
-                    at_ms: (t + rng.u32(100..8_000)).min(latest),
-                });
-            }
-        }
+        let latest = draw_faults(&mut rng, &mut cfg, horizon);
         let link = draw_link(seed, protocol, opts, &mut cfg);
         draw_restarts(seed, opts, &mut cfg, latest);
         Scenario {
