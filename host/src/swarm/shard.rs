@@ -477,37 +477,7 @@ pub fn merge(reports: &[(String, Value)]) -> Result<Value, MergeError> {
     let first = parts.first().ok_or(MergeError::Empty)?;
     let options = &first.report["options"];
     let n = first.shard.n();
-    let mut by_k: BTreeMap<u32, &Part> = BTreeMap::new();
-    for p in &parts {
-        let mismatch = |flag: &str, found: String, expected: String| MergeError::Mismatch {
-            file: p.file.to_string(),
-            flag: flag.to_string(),
-            found,
-            first: first.file.to_string(),
-            expected,
-        };
-        if p.shard.n() != n {
-            return Err(mismatch(
-                "--shard N",
-                p.shard.n().to_string(),
-                n.to_string(),
-            ));
-        }
-        for (key, flag) in OPTION_FLAGS {
-            let (found, expected) = (&p.report["options"][key], &options[key]);
-            if found != expected {
-                return Err(mismatch(flag, bare(found), bare(expected)));
-            }
-        }
-        if let Some(other) = by_k.insert(p.shard.k(), p) {
-            return Err(MergeError::Overlap {
-                file: p.file.to_string(),
-                other: other.file.to_string(),
-                shard: p.shard,
-                seeds: p.seeds.count(),
-            });
-        }
-    }
+    let by_k = by_shard(&parts, first)?;
     // Checked in `part`: whole numbers.
     let range = SeedRange::new(
         options["seed_start"].as_u64().unwrap_or(0),
@@ -531,28 +501,7 @@ pub fn merge(reports: &[(String, Value)]) -> Result<Value, MergeError> {
             given: ranges(&by_k.keys().copied().collect::<Vec<_>>()),
         });
     }
-    let mut seeds = SeedDigest::default();
-    let mut unrun = 0;
-    for p in by_k.values() {
-        let share = p.shard.share(range);
-        let expected = SeedDigest::of(
-            p.shard
-                .seeds(range)
-                .take(usize::try_from(p.seeds.count()).unwrap_or(usize::MAX)),
-        );
-        if p.seeds.count() > share || expected != p.seeds {
-            return Err(MergeError::Seeds {
-                file: p.file.to_string(),
-                shard: p.shard,
-                count: p.seeds.count(),
-                share,
-                found: p.report["seeds"]["digest"].to_string(),
-                expected: format!("{:016x}", expected.sum),
-            });
-        }
-        unrun += share - p.seeds.count();
-        seeds = seeds.merged(p.seeds);
-    }
+    let (seeds, unrun) = checked_seeds(&by_k, range)?;
     let mut out = Map::new();
     let (mut wall, mut machine) = (0.0f64, 0.0f64);
     let mut failures: Vec<Value> = Vec::new();
@@ -593,6 +542,79 @@ pub fn merge(reports: &[(String, Value)]) -> Result<Value, MergeError> {
         serde_json::json!({ "shards": n, "complete": unrun == 0, "unrun": unrun }),
     );
     Ok(Value::Object(out))
+}
+
+/// The parts by shard number, each checked against the first: the same N and the same options,
+/// no shard given twice.
+fn by_shard<'p, 'a>(
+    parts: &'p [Part<'a>],
+    first: &Part<'a>,
+) -> Result<BTreeMap<u32, &'p Part<'a>>, MergeError> {
+    let options = &first.report["options"];
+    let n = first.shard.n();
+    let mut by_k: BTreeMap<u32, &Part> = BTreeMap::new();
+    for p in parts {
+        let mismatch = |flag: &str, found: String, expected: String| MergeError::Mismatch {
+            file: p.file.to_string(),
+            flag: flag.to_string(),
+            found,
+            first: first.file.to_string(),
+            expected,
+        };
+        if p.shard.n() != n {
+            return Err(mismatch(
+                "--shard N",
+                p.shard.n().to_string(),
+                n.to_string(),
+            ));
+        }
+        for (key, flag) in OPTION_FLAGS {
+            let (found, expected) = (&p.report["options"][key], &options[key]);
+            if found != expected {
+                return Err(mismatch(flag, bare(found), bare(expected)));
+            }
+        }
+        if let Some(other) = by_k.insert(p.shard.k(), p) {
+            return Err(MergeError::Overlap {
+                file: p.file.to_string(),
+                other: other.file.to_string(),
+                shard: p.shard,
+                seeds: p.seeds.count(),
+            });
+        }
+    }
+    Ok(by_k)
+}
+
+/// Every shard ran a prefix of its own seeds (count and digest): the campaign's digest and
+/// how many of its seeds did not run.
+fn checked_seeds(
+    by_k: &BTreeMap<u32, &Part<'_>>,
+    range: SeedRange,
+) -> Result<(SeedDigest, u64), MergeError> {
+    let mut seeds = SeedDigest::default();
+    let mut unrun = 0;
+    for p in by_k.values() {
+        let share = p.shard.share(range);
+        let expected = SeedDigest::of(
+            p.shard
+                .seeds(range)
+                .take(usize::try_from(p.seeds.count()).unwrap_or(usize::MAX)),
+        );
+        if p.seeds.count() > share || expected != p.seeds {
+            return Err(MergeError::Seeds {
+                file: p.file.to_string(),
+                shard: p.shard,
+                count: p.seeds.count(),
+                share,
+                found: p.report["seeds"]["digest"].to_string(),
+                expected: format!("{:016x}", expected.sum),
+            });
+        }
+        unrun += share - p.seeds.count();
+        seeds = seeds.merged(p.seeds);
+    }
+    Ok((seeds, unrun))
 }
 
 /// The merged report as text: the campaign, its figures, and each failure with its replay.
