@@ -151,6 +151,43 @@ fn restart_draw(s: &str) -> Result<RestartDraw, String> {
     s.parse().map_err(|e| format!("--restarts: {e}"))
 }
 
+/// The seeds of a run, in the order they run.
+type Seeds = Box<dyn Iterator<Item = u64>>;
+
+/// The seeds a run takes, its wall-clock budget and, for a shard, the campaign's range: a
+/// shard's seeds are a fixed share of a fixed range; a single run's, the range (or every seed
+/// from --seed-start) cut by the budget.
+fn seeds_of(a: &SwarmArgs) -> Result<(Seeds, Duration, Option<SeedRange>), CliError> {
+    Ok(match a.shard {
+        Some(s) => {
+            let runs = a.runs.ok_or_else(|| {
+                CliError::Usage(format!(
+                    "--shard {s} needs --runs R: the shards split the seeds --seed-start .. \
+                     --seed-start + R between them, and a wall-clock budget (--seconds) would \
+                     make their union depend on each machine's speed"
+                ))
+            })?;
+            let range =
+                SeedRange::new(a.seed_start, runs).map_err(|e| CliError::Usage(e.to_string()))?;
+            eprintln!(
+                "swarm: shard {s}: {} of the {runs} seeds from {} (offset {} modulo {})",
+                s.share(range),
+                a.seed_start,
+                s.k() - 1,
+                s.n(),
+            );
+            (Box::new(s.seeds(range)), Duration::MAX, Some(range))
+        }
+        None => {
+            let runs = a
+                .runs
+                .map_or(usize::MAX, |r| usize::try_from(r).unwrap_or(usize::MAX));
+            let seeds = Box::new((a.seed_start..=u64::MAX).take(runs));
+            (seeds, Duration::from_secs_f64(a.seconds), None)
+        }
+    })
+}
+
 /// Runs `mmic swarm`.
 pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
     if !a.merge.is_empty() {
@@ -178,36 +215,7 @@ pub fn run(a: SwarmArgs, out: &mut dyn Write) -> Result<(), CliError> {
     if let Some(seed) = a.replay {
         return replay(seed, &opts, &a.out, out);
     }
-    // A shard's seeds are a fixed share of a fixed range; a single run's, the range (or every
-    // seed from --seed-start) cut by the budget.
-    let (seeds, budget, range): (Box<dyn Iterator<Item = u64>>, Duration, _) = match a.shard {
-        Some(s) => {
-            let runs = a.runs.ok_or_else(|| {
-                CliError::Usage(format!(
-                    "--shard {s} needs --runs R: the shards split the seeds --seed-start .. \
-                     --seed-start + R between them, and a wall-clock budget (--seconds) would \
-                     make their union depend on each machine's speed"
-                ))
-            })?;
-            let range =
-                SeedRange::new(a.seed_start, runs).map_err(|e| CliError::Usage(e.to_string()))?;
-            eprintln!(
-                "swarm: shard {s}: {} of the {runs} seeds from {} (offset {} modulo {})",
-                s.share(range),
-                a.seed_start,
-                s.k() - 1,
-                s.n(),
-            );
-            (Box::new(s.seeds(range)), Duration::MAX, Some(range))
-        }
-        None => {
-            let runs = a
-                .runs
-                .map_or(usize::MAX, |r| usize::try_from(r).unwrap_or(usize::MAX));
-            let seeds = Box::new((a.seed_start..=u64::MAX).take(runs));
-            (seeds, Duration::from_secs_f64(a.seconds), None)
-        }
-    };
+    let (seeds, budget, range) = seeds_of(&a)?;
     let mut seeds = seeds;
     let report = swarm_over(
         &mut seeds,
