@@ -6,6 +6,7 @@ use crate::sim::inject::{InjectError, Injection, Scheduled};
 use crate::sim::{self, report, SimConfig};
 use mmic::faults::Table8;
 use mmic::link::sdls::Key256;
+use mmic::motion::State;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -341,58 +342,14 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
         .trace(start)
         .map_err(|error| CliError::Plan { path, error })?;
     if a.check_plan {
-        let mut path_of_states = vec![start.letter().to_string()];
-        for s in &states {
-            if path_of_states.last().map(String::as_str) != Some(&s.letter().to_string()) {
-                path_of_states.push(s.letter().to_string());
-            }
-        }
-        writeln!(
-            out,
-            "plan OK: {} steps for robot {}, states {}",
-            plan.steps.len(),
-            plan.robot.get(),
-            path_of_states.join(" -> ")
-        )
-        .map_err(CliError::Output)?;
-        return Ok(());
+        return plan_ok(&plan, start, &states, out);
     }
     let steps = sim::steps_of(&plan);
     std::fs::create_dir_all(&a.out).map_err(|source| CliError::Write {
         path: a.out.clone(),
         source,
     })?;
-    let mut cfg = SimConfig::with_steps(steps);
-    cfg.start_state = start;
-    cfg.protocol = a.protocol;
-    cfg.link = a.link;
-    if a.link == sim::LinkLayer::Frames && a.protocol != sim::Protocol::Pus {
-        return Err(CliError::Usage("--link frames needs --protocol pus".into()));
-    }
-    cfg.scale = a
-        .scale
-        .unwrap_or(if a.opsui_serial.is_some() { 1.0 } else { 10.0 });
-    cfg.seed = a.seed;
-    cfg.wifi_loss = a.wifi_loss;
-    cfg.serial_loss = a.serial_loss;
-    cfg.ab_loss = a.ab_loss;
-    for s in scheduled {
-        cfg.inject(s)?;
-    }
-    cfg.realtime = a.realtime;
-    if let Some(l) = a.wifi_latency {
-        cfg.links.wifi.latency_us = (l.max(0.0) * 1000.0) as u64;
-    }
-    if let Some(j) = a.wifi_jitter {
-        cfg.links.wifi.jitter_us = (j.max(0.0) * 1000.0) as u64;
-    }
-    cfg.links.wifi.duplicate = a.wifi_dup;
-    cfg.links.wifi.reorder = a.wifi_reorder;
-    cfg.links.wifi.reorder_us = 50_000;
-    cfg.max_sim_ms = ms(Some(a.max_seconds)).unwrap_or(u32::MAX);
-    cfg.log_path = Some(a.out.join("sim.jsonl"));
-    cfg.record = a.record.clone();
-    cfg.progress = !a.quiet;
+    let mut cfg = config(&a, steps, start, scheduled)?;
     if let Some(device) = &a.opsui_serial {
         return crate::opsui::server::sim(&a, cfg, device, out);
     }
@@ -443,6 +400,71 @@ pub fn sim(a: SimArgs, out: &mut dyn Write) -> Result<(), CliError> {
         })?;
     }
     verdict
+}
+
+/// `--check-plan`: the plan's step count, robot and the states it passes through.
+fn plan_ok(
+    plan: &crate::plan::Plan,
+    start: State,
+    states: &[State],
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let mut path_of_states = vec![start.letter().to_string()];
+    for s in states {
+        if path_of_states.last().map(String::as_str) != Some(&s.letter().to_string()) {
+            path_of_states.push(s.letter().to_string());
+        }
+    }
+    writeln!(
+        out,
+        "plan OK: {} steps for robot {}, states {}",
+        plan.steps.len(),
+        plan.robot.get(),
+        path_of_states.join(" -> ")
+    )
+    .map_err(CliError::Output)
+}
+
+/// The simulation's configuration from the command line: the plan's steps from `start`, the
+/// links, the scheduled injections, the pace and the outputs.
+fn config(
+    a: &SimArgs,
+    steps: Vec<sim::SimStep>,
+    start: State,
+    scheduled: Vec<Scheduled>,
+) -> Result<SimConfig, CliError> {
+    let mut cfg = SimConfig::with_steps(steps);
+    cfg.start_state = start;
+    cfg.protocol = a.protocol;
+    cfg.link = a.link;
+    if a.link == sim::LinkLayer::Frames && a.protocol != sim::Protocol::Pus {
+        return Err(CliError::Usage("--link frames needs --protocol pus".into()));
+    }
+    cfg.scale = a
+        .scale
+        .unwrap_or(if a.opsui_serial.is_some() { 1.0 } else { 10.0 });
+    cfg.seed = a.seed;
+    cfg.wifi_loss = a.wifi_loss;
+    cfg.serial_loss = a.serial_loss;
+    cfg.ab_loss = a.ab_loss;
+    for s in scheduled {
+        cfg.inject(s)?;
+    }
+    cfg.realtime = a.realtime;
+    if let Some(l) = a.wifi_latency {
+        cfg.links.wifi.latency_us = (l.max(0.0) * 1000.0) as u64;
+    }
+    if let Some(j) = a.wifi_jitter {
+        cfg.links.wifi.jitter_us = (j.max(0.0) * 1000.0) as u64;
+    }
+    cfg.links.wifi.duplicate = a.wifi_dup;
+    cfg.links.wifi.reorder = a.wifi_reorder;
+    cfg.links.wifi.reorder_us = 50_000;
+    cfg.max_sim_ms = ms(Some(a.max_seconds)).unwrap_or(u32::MAX);
+    cfg.log_path = Some(a.out.join("sim.jsonl"));
+    cfg.record = a.record.clone();
+    cfg.progress = !a.quiet;
+    Ok(cfg)
 }
 
 /// The SDLS a run was asked for: its keys and, for given keys, their durable store.
