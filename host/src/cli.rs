@@ -418,50 +418,63 @@ pub fn parse_kind(name: &str) -> Result<PacketKind, CliError> {
     })
 }
 
+/// `mmic encode`: the packet or frame of `json`, in hex.
+fn encode(kind: AnyKind, json: &str, out: &mut dyn Write) -> Result<(), CliError> {
+    let bytes = match kind {
+        AnyKind::Legacy(k) => codec::encode(k, json)?,
+        AnyKind::PusTc => pus::encode_tc(json)?,
+        AnyKind::PusTm => pus::encode_tm(json)?,
+        AnyKind::TcFrame => link::encode_tc_frame(json, &[])?,
+        AnyKind::TmFrame => link::encode_tm_frame(json)?,
+        AnyKind::Clcw => link::encode_clcw(json)?,
+    };
+    writeln!(out, "{}", codec::to_hex(&bytes)).map_err(CliError::Output)
+}
+
+/// `mmic decode`: the packet or frame of `hex` as JSON; `apids` the PUS packets' (the robot's
+/// when none), `frame` a frame's parameters.
+fn decode(
+    kind: AnyKind,
+    hex: &str,
+    apids: Vec<u16>,
+    frame: &FrameArgs,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    if frame.given() && !matches!(kind, AnyKind::TcFrame | AnyKind::TmFrame) {
+        return Err(CliError::Usage(
+            "--spacecraft-id, --vcid, --map-id, --frame-len, --no-segment-header, \
+             --no-fecf and --no-ocf are for tc-frame and tm-frame only"
+                .into(),
+        ));
+    }
+    let bytes = codec::from_hex(hex)?;
+    let options = frame.options(&apids);
+    let apids = if apids.is_empty() {
+        pus::robot_apids()
+    } else {
+        apids
+    };
+    let json = match kind {
+        AnyKind::Legacy(k) => codec::decode(k, &bytes)?,
+        AnyKind::PusTc => pus::decode_tc(&bytes, &apids)?.to_string(),
+        AnyKind::PusTm => pus::decode_tm(&bytes, &apids)?.to_string(),
+        AnyKind::TcFrame => link::decode_tc_frame(&bytes, &options)?.to_string(),
+        AnyKind::TmFrame => link::decode_tm_frame(&bytes, &options)?.to_string(),
+        AnyKind::Clcw => link::decode_clcw(&bytes)?.to_string(),
+    };
+    writeln!(out, "{json}").map_err(CliError::Output)
+}
+
 /// Runs one command: results on `out`, progress notes (`spec --write`) on `log`.
 pub fn run(cli: Cli, out: &mut dyn Write, log: &mut dyn Write) -> Result<(), CliError> {
     match cli.cmd {
-        Cmd::Encode { kind, json } => {
-            let bytes = match kind {
-                AnyKind::Legacy(k) => codec::encode(k, &json)?,
-                AnyKind::PusTc => pus::encode_tc(&json)?,
-                AnyKind::PusTm => pus::encode_tm(&json)?,
-                AnyKind::TcFrame => link::encode_tc_frame(&json, &[])?,
-                AnyKind::TmFrame => link::encode_tm_frame(&json)?,
-                AnyKind::Clcw => link::encode_clcw(&json)?,
-            };
-            writeln!(out, "{}", codec::to_hex(&bytes)).map_err(CliError::Output)?;
-        }
+        Cmd::Encode { kind, json } => encode(kind, &json, out)?,
         Cmd::Decode {
             kind,
             hex,
             apids,
             frame,
-        } => {
-            if frame.given() && !matches!(kind, AnyKind::TcFrame | AnyKind::TmFrame) {
-                return Err(CliError::Usage(
-                    "--spacecraft-id, --vcid, --map-id, --frame-len, --no-segment-header, \
-                     --no-fecf and --no-ocf are for tc-frame and tm-frame only"
-                        .into(),
-                ));
-            }
-            let bytes = codec::from_hex(&hex)?;
-            let options = frame.options(&apids);
-            let apids = if apids.is_empty() {
-                pus::robot_apids()
-            } else {
-                apids
-            };
-            let json = match kind {
-                AnyKind::Legacy(k) => codec::decode(k, &bytes)?,
-                AnyKind::PusTc => pus::decode_tc(&bytes, &apids)?.to_string(),
-                AnyKind::PusTm => pus::decode_tm(&bytes, &apids)?.to_string(),
-                AnyKind::TcFrame => link::decode_tc_frame(&bytes, &options)?.to_string(),
-                AnyKind::TmFrame => link::decode_tm_frame(&bytes, &options)?.to_string(),
-                AnyKind::Clcw => link::decode_clcw(&bytes)?.to_string(),
-            };
-            writeln!(out, "{json}").map_err(CliError::Output)?;
-        }
+        } => decode(kind, &hex, apids, &frame, out)?,
         Cmd::Xtce { ccsdspy } => {
             let text = if ccsdspy {
                 xtce::ccsdspy_csv()
