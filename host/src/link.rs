@@ -276,6 +276,63 @@ fn kind_name(kind: FrameKind) -> &'static str {
     }
 }
 
+/// A TC frame's content from its JSON's parts: a BC frame has its control and nothing else,
+/// an AD or BD frame its data (and segment header) and no control.
+fn tc_content(
+    kind: FrameKind,
+    map_id: Option<MapId>,
+    control: Option<ControlCommand>,
+    data: &[u8],
+) -> Result<TcContent<'_>, PusCodecError> {
+    Ok(match (kind, control) {
+        (FrameKind::Bc, Some(c)) => {
+            if map_id.is_some() || !data.is_empty() {
+                return Err(tc_input(
+                    "a BC frame has no segment header (map_id) and no data, only its control"
+                        .into(),
+                ));
+            }
+            TcContent::Bc(c)
+        }
+        (FrameKind::Bc, None) => {
+            return Err(tc_input(
+                "a BC frame needs \"control\": \"unlock\" or {\"set-vr\":N}".into(),
+            ))
+        }
+        (_, Some(_)) => {
+            return Err(tc_input(
+                "\"control\" belongs to BC frames (kind \"bc\") only".into(),
+            ))
+        }
+        (FrameKind::Ad, None) => TcContent::Ad { map_id, data },
+        (FrameKind::Bd, None) => TcContent::Bd { map_id, data },
+    })
+}
+
+/// The frame's `packets`, when the JSON gives them: by their octets, the frame's own (their
+/// `pus_tc` depends on the APIDs decode was given).
+fn check_packets(m: &Map<String, Value>, decoded: &Value) -> Result<(), PusCodecError> {
+    if let Some(given) = m.get("packets") {
+        let octets = |v: &Value| -> Vec<Value> {
+            v.as_array()
+                .map(|a| {
+                    a.iter()
+                        .map(|p| p.get("hex").cloned().unwrap_or(Value::Null))
+                        .collect()
+                })
+                .unwrap_or_default()
+        };
+        let found = octets(&decoded["packets"]);
+        if !given.is_array() || octets(given) != found {
+            return Err(tc_input(format!(
+                "packets = {given} disagrees with the frame, whose packets are {}",
+                Value::Array(found)
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Encodes a TC frame from its JSON form (see the module docs); its packets are decoded as
 /// telecommands of `apids` (every robot's when empty) for the derived keys' check only.
 pub fn encode_tc_frame(json: &str, apids: &[u16]) -> Result<Vec<u8>, PusCodecError> {
@@ -319,35 +376,7 @@ pub fn encode_tc_frame(json: &str, apids: &[u16]) -> Result<Vec<u8>, PusCodecErr
             })?,
         ),
     };
-    let content = match (kind, control) {
-        (FrameKind::Bc, Some(c)) => {
-            if map_id.is_some() || !data.is_empty() {
-                return Err(tc_input(
-                    "a BC frame has no segment header (map_id) and no data, only its control"
-                        .into(),
-                ));
-            }
-            TcContent::Bc(c)
-        }
-        (FrameKind::Bc, None) => {
-            return Err(tc_input(
-                "a BC frame needs \"control\": \"unlock\" or {\"set-vr\":N}".into(),
-            ))
-        }
-        (_, Some(_)) => {
-            return Err(tc_input(
-                "\"control\" belongs to BC frames (kind \"bc\") only".into(),
-            ))
-        }
-        (FrameKind::Ad, None) => TcContent::Ad {
-            map_id,
-            data: &data,
-        },
-        (FrameKind::Bd, None) => TcContent::Bd {
-            map_id,
-            data: &data,
-        },
-    };
+    let content = tc_content(kind, map_id, control, &data)?;
     let fecf = !matches!(m.get("fecf"), Some(Value::Null));
     let repr = TcFrameRepr {
         spacecraft_id: SpacecraftId::new(spacecraft_id).map_err(|e| tc_input(e.to_string()))?,
@@ -381,25 +410,7 @@ pub fn encode_tc_frame(json: &str, apids: &[u16]) -> Result<Vec<u8>, PusCodecErr
     if fecf {
         derived.push("fecf");
     }
-    // The packets by their octets (their `pus_tc` depends on the APIDs decode was given).
-    if let Some(given) = m.get("packets") {
-        let octets = |v: &Value| -> Vec<Value> {
-            v.as_array()
-                .map(|a| {
-                    a.iter()
-                        .map(|p| p.get("hex").cloned().unwrap_or(Value::Null))
-                        .collect()
-                })
-                .unwrap_or_default()
-        };
-        let found = octets(&decoded["packets"]);
-        if !given.is_array() || octets(given) != found {
-            return Err(tc_input(format!(
-                "packets = {given} disagrees with the frame, whose packets are {}",
-                Value::Array(found)
-            )));
-        }
-    }
+    check_packets(m, &decoded)?;
     check_derived(m, &decoded, &derived, tc_input)?;
     Ok(buf)
 }
