@@ -620,20 +620,13 @@ fn run_ground<G: Ground>(
         cfg.progress,
         log.clone(),
     );
-    // The ground's durable SDLS counters: each robot's store (memory for the run, or the
-    // state file of given keys).
-    let persist = |i: usize, gl: &mut SimFopLink| {
-        if let Some((_, d)) = keys.get(i) {
-            super::durable::persist_ground(gl, d);
-        }
-    };
     let mut restarts = Downtime::of(cfg, Node::Ground);
     // The link's figures of the ground's earlier lives.
     let mut past = FrameStats::default();
     // FOP-1 initiates the AD service; it runs once a CLCW confirms it.
     for (i, ((writer, _, _), fop)) in links.iter_mut().zip(fops.iter_mut()).enumerate() {
         if let Some(gl) = fop {
-            persist(i, gl);
+            persist(keys, i, gl);
             gl.start(clock.now_ms(), &mut |f: &[u8]| {
                 writer.send(clock.now_ms(), f);
             });
@@ -666,27 +659,15 @@ fn run_ground<G: Ground>(
                 continue;
             }
             Phase::CameUp => {
-                for (i, (writer, _, b)) in links.iter_mut().enumerate() {
-                    ground.restart(i, now);
-                    if cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames {
-                        let mut gl = Box::new(SimFopLink::new(*b));
-                        if let Some((k, d)) = keys.get(i) {
-                            if let Err(e) = super::durable::boot_ground(&mut gl, *b, d, k.clone()) {
-                                ground_event(
-                                    &log,
-                                    now,
-                                    json!({"type": "link_stopped", "why": e.to_string()}),
-                                );
-                                continue;
-                            }
-                        }
-                        persist(i, &mut gl);
-                        gl.start(now, &mut |f: &[u8]| {
-                            writer.send(clock.now_ms(), f);
-                        });
-                        fops[i] = Some(gl);
-                    }
-                }
+                boot_links(
+                    cfg,
+                    &mut links,
+                    &mut fops,
+                    keys,
+                    &mut ground,
+                    (&clock, now),
+                    &log,
+                );
                 ground_event(&log, now, json!({"type": "boot", "boot": null}));
             }
         }
@@ -703,39 +684,7 @@ fn run_ground<G: Ground>(
                 }
                 continue;
             };
-            let mut emit = |f: &[u8]| {
-                writer.send(clock.now_ms(), f);
-            };
-            persist(i, gl);
-            gl.tick(now, &mut emit);
-            if let Some(p) = ground.tick(i, now) {
-                if gl.send(&p, now, &mut emit).is_err() {
-                    ground_event(&log, now, json!({"type": "ground_outbox_full"}));
-                }
-            }
-            while let Ok(bytes) = rx.try_recv() {
-                let t = clock.now_ms();
-                let mut packets = Vec::new();
-                let taken = gl.tm_frame(t, &bytes, &mut emit, &mut |p: &[u8]| {
-                    packets.push(p.to_vec())
-                });
-                if let Err(e) = taken {
-                    ground_event(
-                        &log,
-                        t,
-                        json!({"type": "tm_frame_refused", "check": e.name(),
-                               "sdls": log::sdls_header(&bytes)}),
-                    );
-                }
-                persist(i, gl);
-                for p in packets {
-                    if let Some(q) = ground.receive(i, t, &p) {
-                        if gl.send(&q, t, &mut emit).is_err() {
-                            ground_event(&log, t, json!({"type": "ground_outbox_full"}));
-                        }
-                    }
-                }
-            }
+            frames_step(gl, i, (writer, rx), &mut ground, (&clock, now), &log, keys);
         }
         ground.progress(now);
         std::thread::sleep(Duration::from_micros(500));
@@ -747,6 +696,99 @@ fn run_ground<G: Ground>(
     }
     let _ = std::io::stderr().flush();
     (ends, stats, frames)
+}
+
+/// The ground back up (`Phase::CameUp`): each runner from what the disk kept and, over frames,
+/// each robot's FOP-1 afresh with SDLS from the stored counters (a link whose store cannot be
+/// read stays stopped, logged).
+fn boot_links<G: Ground>(
+    cfg: &SimConfig,
+    links: &mut [GroundLink],
+    fops: &mut [Option<Box<SimFopLink>>],
+    keys: &[Keys],
+    ground: &mut GroundSide<G>,
+    (clock, now): (&clock::NodeClock<'_>, u32),
+    log: &Option<log::Log>,
+) {
+    for (i, (writer, _, b)) in links.iter_mut().enumerate() {
+        ground.restart(i, now);
+        if cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames {
+            let mut gl = Box::new(SimFopLink::new(*b));
+            if let Some((k, d)) = keys.get(i) {
+                if let Err(e) = super::durable::boot_ground(&mut gl, *b, d, k.clone()) {
+                    ground_event(
+                        log,
+                        now,
+                        json!({"type": "link_stopped", "why": e.to_string()}),
+                    );
+                    continue;
+                }
+            }
+            persist(keys, i, &mut gl);
+            gl.start(now, &mut |f: &[u8]| {
+                writer.send(clock.now_ms(), f);
+            });
+            fops[i] = Some(gl);
+        }
+    }
+}
+
+/// One loop of a robot's link over frames: FOP-1's timers, the runner's next telecommand
+/// into a TC frame, and every TM frame read taken apart (its CLCW to FOP-1, its packets to
+/// the runner, whose answers go out again).
+fn frames_step<G: Ground>(
+    gl: &mut SimFopLink,
+    i: usize,
+    (writer, rx): (
+        &mut Lossy<Box<dyn Write + Send>>,
+        &mut std::sync::mpsc::Receiver<Vec<u8>>,
+    ),
+    ground: &mut GroundSide<G>,
+    (clock, now): (&clock::NodeClock<'_>, u32),
+    log: &Option<log::Log>,
+    keys: &[Keys],
+) {
+    let mut emit = |f: &[u8]| {
+        writer.send(clock.now_ms(), f);
+    };
+    persist(keys, i, gl);
+    gl.tick(now, &mut emit);
+    if let Some(p) = ground.tick(i, now) {
+        if gl.send(&p, now, &mut emit).is_err() {
+            ground_event(log, now, json!({"type": "ground_outbox_full"}));
+        }
+    }
+    while let Ok(bytes) = rx.try_recv() {
+        let t = clock.now_ms();
+        let mut packets = Vec::new();
+        let taken = gl.tm_frame(t, &bytes, &mut emit, &mut |p: &[u8]| {
+            packets.push(p.to_vec())
+        });
+        if let Err(e) = taken {
+            ground_event(
+                log,
+                t,
+                json!({"type": "tm_frame_refused", "check": e.name(),
+                       "sdls": log::sdls_header(&bytes)}),
+            );
+        }
+        persist(keys, i, gl);
+        for p in packets {
+            if let Some(q) = ground.receive(i, t, &p) {
+                if gl.send(&q, t, &mut emit).is_err() {
+                    ground_event(log, t, json!({"type": "ground_outbox_full"}));
+                }
+            }
+        }
+    }
+}
+
+/// The ground's durable SDLS counters of robot `i`'s link: its store (memory for the run, or
+/// the state file of given keys).
+fn persist(keys: &[Keys], i: usize, gl: &mut SimFopLink) {
+    if let Some((_, d)) = keys.get(i) {
+        super::durable::persist_ground(gl, d);
+    }
 }
 
 /// An event of the ground's end of the space data link.
