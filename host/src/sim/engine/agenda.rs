@@ -65,8 +65,19 @@ impl Ev {
     }
 }
 
-/// An event's place in time: its instant (µs), then its sequence number.
-type Key = (u64, u64);
+/// An event's place in time: its instant (µs) in the high half, then its sequence number:
+/// ordered as the pair (instant, sequence number) is, in one comparison.
+type Key = u128;
+
+/// The key of an event at `at` µs scheduled `seq`-th.
+fn key(at: u64, seq: u64) -> Key {
+    (u128::from(at) << 64) | u128::from(seq)
+}
+
+/// The instant of a key, µs.
+fn instant(k: Key) -> u64 {
+    (k >> 64) as u64
+}
 
 struct Queued {
     key: Key,
@@ -91,12 +102,24 @@ impl Ord for Queued {
 }
 
 /// The pending events, earliest first.
-#[derive(Default)]
 pub(super) struct Agenda {
     seq: u64,
     heap: BinaryHeap<Reverse<Queued>>,
-    /// The pending board A tick, board B tick and ground tick.
-    periodic: [Option<Key>; 3],
+    /// The pending board A tick, board B tick and ground tick ([`NONE`] where none is).
+    periodic: [Key; 3],
+}
+
+/// An empty periodic slot: after every key an event can have.
+const NONE: Key = Key::MAX;
+
+impl Default for Agenda {
+    fn default() -> Agenda {
+        Agenda {
+            seq: 0,
+            heap: BinaryHeap::new(),
+            periodic: [NONE; 3],
+        }
+    }
 }
 
 impl Agenda {
@@ -104,35 +127,28 @@ impl Agenda {
     /// periodic event replaces its pending one (each is scheduled again only once it ran).
     pub(super) fn at(&mut self, at: u64, ev: Ev) {
         self.seq += 1;
-        let key = (at, self.seq);
+        let key = key(at, self.seq);
         match ev.slot() {
-            Some(k) => self.periodic[k] = Some(key),
+            Some(k) => self.periodic[k] = key,
             None => self.heap.push(Reverse(Queued { key, ev })),
         }
     }
 
     /// The next event and its instant, µs.
     pub(super) fn pop(&mut self) -> Option<(u64, Ev)> {
-        let mut first: Option<(Key, usize)> = None;
-        for (k, slot) in self.periodic.iter().enumerate() {
-            if let Some(key) = *slot {
-                if first.is_none_or(|(f, _)| key < f) {
-                    first = Some((key, k));
-                }
-            }
+        let [a, b, g] = self.periodic;
+        let (key, k) = if a < b { (a, 0) } else { (b, 1) };
+        let (key, k) = if key < g { (key, k) } else { (g, 2) };
+        if key != NONE && self.heap.peek().is_none_or(|Reverse(q)| key < q.key) {
+            self.periodic[k] = NONE;
+            let ev = match k {
+                0 => Ev::TickA,
+                1 => Ev::TickB,
+                _ => Ev::GroundTick,
+            };
+            return Some((instant(key), ev));
         }
-        if let Some((key, k)) = first {
-            if self.heap.peek().is_none_or(|Reverse(q)| key < q.key) {
-                self.periodic[k] = None;
-                let ev = match k {
-                    0 => Ev::TickA,
-                    1 => Ev::TickB,
-                    _ => Ev::GroundTick,
-                };
-                return Some((key.0, ev));
-            }
-        }
-        self.heap.pop().map(|Reverse(q)| (q.key.0, q.ev))
+        self.heap.pop().map(|Reverse(q)| (instant(q.key), q.ev))
     }
 }
 
