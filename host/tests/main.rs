@@ -18,4 +18,5 @@ mod security;
 mod sim;
 mod sim_timing;
 mod swarm;
+mod swarm_equivalence;
 mod swarm_shard;

@@ -409,6 +409,11 @@ pub struct SimConfig {
     /// --opsui-serial DEV`, [`opsline`]) instead of the internal pipe, and no ground of its
     /// own: the run lasts until the line closes or [`SimConfig::max_sim_ms`].
     pub ops_line: Option<opsline::OpsLine>,
+    /// Virtual time: the engine's exact shortcuts (the plant's hip angle kept within its turn
+    /// without libm's `fmod` where it already is). On by default; off computes everything the
+    /// long way, for the swarm's equivalence test (`host/tests/swarm_equivalence.rs`), which
+    /// finds the same runs byte for byte.
+    pub shortcuts: bool,
 }
 
 /// An external ground on UDP (`mmic sim --protocol pus --ground-tm-to ADDR --ground-tc-port
@@ -685,6 +690,7 @@ impl SimConfig {
             record: None,
             sdls: None,
             ops_line: None,
+            shortcuts: true,
         }
     }
 }

@@ -177,6 +177,8 @@ pub struct Plant {
     /// Per side (0 = A, 1 = B): the arm's contraction switch is dead and never closes.
     pub dead_switch: [bool; 2],
     gravity: (Option<Gravity>, Option<Gravity>),
+    /// Whether `turn` may skip libm's `fmod` ([`Plant::set_shortcuts`]).
+    shortcuts: bool,
 }
 
 const SERVO_US_PER_S: f64 = 2000.0;
@@ -202,6 +204,17 @@ pub const BOLTER_OBSTACLE_MA: f64 = 2600.0;
 const NOISE: i32 = 5;
 /// How long an injected obstacle lasts, ms.
 const OBSTACLE_MS: u32 = 500;
+
+/// `c` centidegrees within one turn: `c.rem_euclid(36000.0)`, without libm's `fmod` (a
+/// software loop on x86-64) when `c` is already in the turn and `shortcut` (nearly every call:
+/// the hip turns a little per tick), where `fmod` gives `c` itself, exactly.
+fn turn(c: f64, shortcut: bool) -> f64 {
+    if shortcut && (0.0..36000.0).contains(&c) {
+        c
+    } else {
+        c.rem_euclid(36000.0)
+    }
+}
 
 /// `now` is at or after the injection time `at`, if one is set.
 fn at_or_after(at: Option<u32>, now: u32) -> bool {
@@ -237,10 +250,18 @@ impl Plant {
             stuck_bolter_ma: 0.0,
             dead_switch: [false; 2],
             gravity: (None, None),
+            shortcuts: true,
             cfg,
         };
         p.set_state(state);
         p
+    }
+
+    /// Whether the plant takes its exact shortcuts (`turn` without `fmod` where the angle is
+    /// already within the turn): on by default; off for the swarm's equivalence test, which
+    /// finds the same readings.
+    pub fn set_shortcuts(&mut self, on: bool) {
+        self.shortcuts = on;
     }
 
     /// The robot reached `s`: its IMUs now read gravity in that pose.
@@ -329,7 +350,7 @@ impl Plant {
             _ => 0.0,
         };
         self.hip_speed += (cmd - self.hip_speed) * (dt / 50.0).min(1.0);
-        self.hip = (self.hip + self.hip_speed * dt / 1000.0).rem_euclid(36000.0);
+        self.hip = turn(self.hip + self.hip_speed * dt / 1000.0, self.shortcuts);
     }
 
     /// The configuration, to schedule a fault at a time chosen during a run (the lock-step
@@ -366,7 +387,7 @@ impl Plant {
         } else {
             0.0
         };
-        (((self.hip + off).rem_euclid(36000.0) / 36000.0 * 4096.0).floor() as u32 % 4096) as u16
+        ((turn(self.hip + off, self.shortcuts) / 36000.0 * 4096.0).floor() as u32 % 4096) as u16
     }
 
     /// What side `side` (0 = A, 1 = B) reads at `now`.

@@ -179,13 +179,14 @@ impl Robot {
     ) -> std::io::Result<Robot> {
         let number = board_number(i);
         let seed = cfg.seed.wrapping_mul(1000).wrapping_add(i as u64);
-        let plant = Plant::new(
+        let mut plant = Plant::new(
             PlantConfig {
                 seed,
                 ..cfg.plant.clone()
             },
             cfg.start_state,
         );
+        plant.set_shortcuts(cfg.shortcuts);
         let frames = cfg.protocol == Protocol::Pus && cfg.link == LinkLayer::Frames;
         let mut ground_link = frames.then(|| Box::new(SimGroundLink::new(number)));
         let (keys, store, attacker) = match cfg.sdls.as_ref().filter(|_| frames) {
