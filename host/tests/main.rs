@@ -2,8 +2,8 @@
 //! transports, the fault swarm and its shards, fleets, replay, restarts, SDLS and the security
 //! checks of every host mode. The CLI's tests are `tests/cli/`.
 //!
-//! One test binary, each file a module: libtest runs the tests that wait on the wall clock
-//! beside the ones that compute, and the binary links once.
+//! One test binary, each file a module: the binary links once, and the tests that wait on the
+//! wall clock run side by side in one test (`wall_clock`), after the ones that compute.
 
 mod engine;
 mod fidelity;
@@ -20,3 +20,4 @@ mod sim_timing;
 mod swarm;
 mod swarm_equivalence;
 mod swarm_shard;
+mod wall_clock;

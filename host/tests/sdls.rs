@@ -353,8 +353,8 @@ fn the_watch_flags_more_frames_verified_than_protected() {
     assert_eq!(Invariant::ForgedFrame.name(), "forged-frame");
 }
 
-#[test]
-fn the_realtime_engine_secures_its_own_ground_with_keys_made_at_run_time() {
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
+pub(crate) fn the_realtime_engine_secures_its_own_ground_with_keys_made_at_run_time() {
     let mut cfg = secured(1, 0.0, 0.0);
     cfg.realtime = true;
     cfg.scale = 10.0;
