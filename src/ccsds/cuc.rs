@@ -35,7 +35,10 @@ pub const CUC_LEN: usize = 6;
 
 /// The P-field this time code would carry if it were sent (it is not; see the module docs).
 // Grouped as the fields: extension | time code ID | coarse octets - 1 | fine octets.
-#[allow(clippy::unusual_byte_groupings)]
+#[expect(
+    clippy::unusual_byte_groupings,
+    reason = "grouped as the P-field's own fields"
+)]
 pub const P_FIELD: u8 = 0b0_010_11_10;
 
 /// The CUC T-field, byte for byte.

@@ -145,7 +145,10 @@ impl<'a> TcRepr<'a> {
 
     /// Octets of the packet (saturating at `usize::MAX` for data no packet can hold, which
     /// [`TcRepr::emit`] refuses).
-    #[allow(clippy::len_without_is_empty)] // never empty
+    #[expect(
+        clippy::len_without_is_empty,
+        reason = "a length of this type is never zero"
+    )]
     pub const fn len(&self) -> usize {
         TC_MIN_LEN.saturating_add(self.app_data.len())
     }

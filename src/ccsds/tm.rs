@@ -156,7 +156,10 @@ impl<'a> TmRepr<'a> {
 
     /// Octets of the packet (saturating at `usize::MAX` for data no packet can hold, which
     /// [`TmRepr::emit`] refuses).
-    #[allow(clippy::len_without_is_empty)] // never empty
+    #[expect(
+        clippy::len_without_is_empty,
+        reason = "a length of this type is never zero"
+    )]
     pub const fn len(&self) -> usize {
         TM_MIN_LEN.saturating_add(self.source_data.len())
     }

@@ -134,7 +134,6 @@ impl<const N: usize> Extractor<N> {
 
     /// An extractor that has seen no frame.
     pub const fn new() -> Extractor<N> {
-        #[allow(clippy::let_unit_value)]
         let () = Self::_ROOM_FOR_A_HEADER;
         Extractor {
             buf: heapless::Vec::new(),

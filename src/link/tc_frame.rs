@@ -252,7 +252,10 @@ impl ControlCommand {
     pub const MAX_LEN: usize = 3;
 
     /// Octets of the command: 1 (Unlock) or 3 (Set V(R)).
-    #[allow(clippy::len_without_is_empty)] // never empty
+    #[expect(
+        clippy::len_without_is_empty,
+        reason = "a length of this type is never zero"
+    )]
     pub const fn len(&self) -> usize {
         match self {
             ControlCommand::Unlock => UNLOCK.len(),

@@ -83,10 +83,10 @@ pub fn targets(from: State, p: Primitive) -> impl Iterator<Item = State> {
 pub const fn reaches(p: Primitive, to: State) -> bool {
     let mut i = 0;
     while i < N {
-        if let Some(q) = MODEL[i][to.index()] {
-            if q as u8 == p as u8 {
-                return true;
-            }
+        if let Some(q) = MODEL[i][to.index()]
+            && q as u8 == p as u8
+        {
+            return true;
         }
         i += 1;
     }

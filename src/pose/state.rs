@@ -28,7 +28,7 @@ wire_enum! {
         derive(serde::Serialize, serde::Deserialize),
         serde(try_from = "char", into = "char")
     )]
-    #[allow(missing_docs)] // the letters are documented by `name()` and Table 5
+    #[expect(missing_docs, reason = "the letters are documented by `name()` and Table 5")]
     pub enum State {
         A = b'a' => "Xneg match",
         B = b'b' => "Yneg match",

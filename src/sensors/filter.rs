@@ -29,7 +29,6 @@ impl<const N: usize> MovingAverage<N> {
 
     /// An empty filter.
     pub const fn new() -> Self {
-        #[allow(clippy::let_unit_value)]
         let () = Self::FITS;
         MovingAverage {
             window: [0; N],
@@ -117,7 +116,6 @@ impl<const N: usize, const K: usize> Default for Averages<N, K> {
 impl<const N: usize, const K: usize> Averages<N, K> {
     /// Empty filters.
     pub const fn new() -> Self {
-        #[allow(clippy::let_unit_value)]
         let () = MovingAverage::<N>::FITS;
         Averages {
             window: [[0; K]; N],

@@ -172,7 +172,7 @@ pub fn packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
     // A body of whole 16-octet blocks (the heartbeat's 64) is faster from the start than as
     // three blocks and a 12-octet remainder after the header.
     #[cfg(not(feature = "small-crc-table"))]
-    if body.len() % 16 == 0 {
+    if body.len().is_multiple_of(16) {
         return crc16(body);
     }
     // The algorithm has no reflection and no final xor, so the register after the header is
@@ -189,10 +189,10 @@ pub fn packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
 #[inline(always)]
 pub(crate) fn checked_packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
     #[cfg(not(feature = "small-crc-table"))]
-    if let Some(rest) = body.get(HEADER_LEN..) {
-        if rest.len() < 16 {
-            return remainder(header_crc(kind), rest);
-        }
+    if let Some(rest) = body.get(HEADER_LEN..)
+        && rest.len() < 16
+    {
+        return remainder(header_crc(kind), rest);
     }
     packet_crc(kind, body)
 }

@@ -120,7 +120,6 @@ impl<const N: usize> Deframer<N> {
 
     /// An empty deframer.
     pub const fn new() -> Self {
-        #[allow(clippy::let_unit_value)]
         let () = Self::CAPACITY_OK;
         Deframer {
             buf: [0; N],

@@ -33,7 +33,10 @@ const KIND: PacketKind = PacketKind::Heartbeat;
     Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
-#[allow(missing_docs)] // each field is described in FIELDS and spec/packets/heartbeat.toml
+#[expect(
+    missing_docs,
+    reason = "each field is described in FIELDS and spec/packets/heartbeat.toml"
+)]
 pub struct HeartbeatPacket {
     pub header: [u8; 4],
     pub board: u8,

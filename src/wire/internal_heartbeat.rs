@@ -28,7 +28,10 @@ const KIND: PacketKind = PacketKind::InternalHeartbeat;
     Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
-#[allow(missing_docs)] // each field is described in FIELDS and spec/packets/internal-heartbeat.toml
+#[expect(
+    missing_docs,
+    reason = "each field is described in FIELDS and spec/packets/internal-heartbeat.toml"
+)]
 pub struct InternalHeartbeatPacket {
     pub header: [u8; 4],
     pub arm_b_target: U16,

@@ -13,7 +13,7 @@ use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
     Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
-#[allow(missing_docs)] // the fields are those of `Electrical`
+#[expect(missing_docs, reason = "the fields are those of `Electrical`")]
 pub struct ElectricalLayout {
     pub v_bat: U16,
     pub i_bat: U16,
@@ -74,7 +74,7 @@ macro_rules! fields {
     (@munch $t:ty; [$($c:item)*] [$($s:expr,)*];) => {
         /// Byte ranges of every field, from the layout (the same ranges as [`FIELDS`], by name).
         pub mod field {
-            #[allow(unused_imports)]
+            #[allow(unused_imports, reason = "a packet whose fields need no name of the module above leaves the import unused; the macro cannot tell")]
             use super::*;
             $($c)*
         }

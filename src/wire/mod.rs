@@ -75,7 +75,10 @@ impl PacketKind {
     }
 
     /// Total length in bytes, header and checksum included.
-    #[allow(clippy::len_without_is_empty)] // a packet length is never zero
+    #[expect(
+        clippy::len_without_is_empty,
+        reason = "a length of this type is never zero"
+    )]
     pub const fn len(self) -> usize {
         match self {
             PacketKind::Command => command::COMMAND_LEN,

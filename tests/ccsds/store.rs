@@ -270,7 +270,7 @@ fn every_queued_telecommand_round_trips_through_its_entry() {
             source_id: n as u16,
             ack: (n % 16) as u8,
             command,
-            alive: n % 7 == 0,
+            alive: n.is_multiple_of(7),
         };
         let e = job_entry(b, (n % 16) as u8, Some(&job));
         assert_eq!((e.key, e.aux), (queue_key(b, (n % 16) as u8), 1));

@@ -90,10 +90,10 @@ fn simulate(start: f64, target: u16, load: f64, phase: f64, seconds: u32) -> Run
             approach = Some(true_err.signum());
         }
         // Overshoot: error of the opposite sign to the approach.
-        if let Some(dir) = approach {
-            if true_err * dir < 0.0 {
-                run.overshoot = run.overshoot.max(true_err.abs());
-            }
+        if let Some(dir) = approach
+            && true_err * dir < 0.0
+        {
+            run.overshoot = run.overshoot.max(true_err.abs());
         }
         // Settled: within TOL from this tick to the end of the run. Any later tick outside
         // the band, by any amount, un-settles it.

@@ -304,16 +304,17 @@ impl Attacker {
         let index = self.up_index;
         self.up_index += 1;
         let mut out = Vec::new();
-        if let Some(Scripted::Bc(i, cmd)) = self.script {
-            if i == index {
-                self.forge(&mut out, cmd);
-            }
+        if let Some(Scripted::Bc(i, cmd)) = self.script
+            && i == index
+        {
+            self.forge(&mut out, cmd);
         }
-        if let Some(Scripted::DropAndAck(i, _)) = self.script {
-            if i == index && ad {
-                self.dropped += 1;
-                return out;
-            }
+        if let Some(Scripted::DropAndAck(i, _)) = self.script
+            && i == index
+            && ad
+        {
+            self.dropped += 1;
+            return out;
         }
         let t = self.tactics;
         if now < t.until {
@@ -434,18 +435,17 @@ impl BoardA {
     fn command(&mut self, now: u32, seq: u16, command: Command) {
         let new = self.seqs.insert(seq);
         let mut starts = false;
-        if new {
-            if let Command::Arm {
+        if new
+            && let Command::Arm {
                 target: ServoTarget::Position(pw),
                 ..
             } = command
-            {
-                let k = pw.get() - 900;
-                *self.runs.entry(k).or_default() += 1;
-                self.ran_at.entry(k).or_insert(now);
-                self.moving_until = now + 30;
-                starts = true;
-            }
+        {
+            let k = pw.get() - 900;
+            *self.runs.entry(k).or_default() += 1;
+            self.ran_at.entry(k).or_insert(now);
+            self.moving_until = now + 30;
+            starts = true;
         }
         self.answers.push((now + 3, seq, starts));
     }
@@ -618,10 +618,10 @@ fn run(n: u16, seed: u64, tactics: Tactics, script: Option<Scripted>, limit_ms: 
                     // Confirmed now: N(S) from the old NN(R) up to the new.
                     let mut ns = nnr;
                     while ns != ground.fop().nnr() {
-                        if let Some(t) = first_tx[ns as usize].take() {
-                            if accepted_at[ns as usize].is_none_or(|a| a < t) {
-                                bites += 1;
-                            }
+                        if let Some(t) = first_tx[ns as usize].take()
+                            && accepted_at[ns as usize].is_none_or(|a| a < t)
+                        {
+                            bites += 1;
                         }
                         ns = ns.wrapping_add(1);
                     }

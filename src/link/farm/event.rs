@@ -53,7 +53,10 @@ impl FarmEvent {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[allow(missing_docs)]
+#[expect(
+    missing_docs,
+    reason = "the events are named E1 to E10 as in 232.1-B-2 Table 6-1; the type's docs say so"
+)]
 pub enum EventId {
     E1,
     E2,

@@ -27,7 +27,7 @@ impl FarmWindow {
 
     /// The window of width `w`, refused unless even and within 2..=254.
     pub const fn new(w: u8) -> Result<FarmWindow, FarmWindowError> {
-        if w >= 2 && w <= 254 && w % 2 == 0 {
+        if w >= 2 && w <= 254 && w.is_multiple_of(2) {
             Ok(FarmWindow(w))
         } else {
             Err(FarmWindowError { found: w })

@@ -8,7 +8,6 @@ use crate::link::clcw::Clcw;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[allow(missing_docs)]
 pub enum ClcwEvent {
     /// N(R) = V(S) = NN(R), no flag: nothing outstanding, nothing new.
     E1,

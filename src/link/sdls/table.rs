@@ -69,7 +69,10 @@ impl<const N: usize> SaTable<N> {
 
     /// Adds `sa`; hands it back when the table is full or has its SPI already (heapless's
     /// way: nothing is dropped silently, so the error is as large as the association).
-    #[allow(clippy::result_large_err)]
+    #[expect(
+        clippy::result_large_err,
+        reason = "heapless's way: the error hands the association back, so nothing is dropped silently"
+    )]
     pub fn add(&mut self, sa: SecurityAssociation) -> Result<(), SecurityAssociation> {
         if self.get(sa.spi()).is_some() {
             return Err(sa);

@@ -113,7 +113,10 @@ impl<'a> TcFrameRepr<'a> {
 
     /// Octets of the frame with an FECF (saturating for data no frame holds, which
     /// [`TcFrameRepr::emit`] refuses).
-    #[allow(clippy::len_without_is_empty)] // never empty
+    #[expect(
+        clippy::len_without_is_empty,
+        reason = "a length of this type is never zero"
+    )]
     pub const fn len(&self) -> usize {
         self.len_with(true)
     }

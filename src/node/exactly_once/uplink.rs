@@ -303,12 +303,12 @@ impl Uplink {
     pub fn tick(&mut self, now: u32) -> Tick {
         let mut t = Tick::default();
         let Some(mut o) = self.out else { return t };
-        if let Some(sent) = o.open_since {
-            if Instant::from_millis(now).since(sent).millis() > self.cfg.timeout_ms {
-                o.open_since = None;
-                self.eff.push(false);
-                t.attempt = Some(false);
-            }
+        if let Some(sent) = o.open_since
+            && Instant::from_millis(now).since(sent).millis() > self.cfg.timeout_ms
+        {
+            o.open_since = None;
+            self.eff.push(false);
+            t.attempt = Some(false);
         }
         let slot_due = self
             .last_send

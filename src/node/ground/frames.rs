@@ -453,10 +453,10 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
             });
         // One level deep: an initiation's outputs are a BC frame and no alert.
         for o in again {
-            if let FopOutput::Transmit(f) = o {
-                if let FrameData::Control(cmd) = f.data {
-                    self.emit_bc(cmd, f.ns, emit);
-                }
+            if let FopOutput::Transmit(f) = o
+                && let FrameData::Control(cmd) = f.data
+            {
+                self.emit_bc(cmd, f.ns, emit);
             }
         }
     }

@@ -398,28 +398,29 @@ impl Link for TcLink {
                 }
             }
         }
-        if out.send.is_none() && out.done.is_none() {
-            if let Some(mut p) = self.running.take() {
-                match p.sent {
-                    // The query timer starts now.
-                    None => {
-                        p.sent = Some(t);
-                        p.open = false;
+        if out.send.is_none()
+            && out.done.is_none()
+            && let Some(mut p) = self.running.take()
+        {
+            match p.sent {
+                // The query timer starts now.
+                None => {
+                    p.sent = Some(t);
+                    p.open = false;
+                    self.running = Some(p);
+                }
+                Some(_) => match p.due(t, cfg.query_ms, cfg.max_attempts) {
+                    Due::Wait => self.running = Some(p),
+                    Due::Send { failed } => {
+                        out.attempt = failed.then_some(false);
+                        out.send = Some(p.transmit(t));
                         self.running = Some(p);
                     }
-                    Some(_) => match p.due(t, cfg.query_ms, cfg.max_attempts) {
-                        Due::Wait => self.running = Some(p),
-                        Due::Send { failed } => {
-                            out.attempt = failed.then_some(false);
-                            out.send = Some(p.transmit(t));
-                            self.running = Some(p);
-                        }
-                        Due::GiveUp => {
-                            out.attempt = Some(false);
-                            out.ended = Some((p.tc.request.seq_count, MotionEnd::Unacknowledged));
-                        }
-                    },
-                }
+                    Due::GiveUp => {
+                        out.attempt = Some(false);
+                        out.ended = Some((p.tc.request.seq_count, MotionEnd::Unacknowledged));
+                    }
+                },
             }
         }
         if let Some(ok) = out.attempt {

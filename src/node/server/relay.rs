@@ -168,12 +168,11 @@ impl<const N: usize> Server<N> {
     /// The packet reached `board` (written to its connection). Clears the slot only if that
     /// packet is still the pending one (a newer one stays).
     pub fn delivered(&mut self, board: BoardNumber, packet: &Packet) {
-        if let Some(i) = self.slot_of(board) {
-            if let Some((b, Some(p))) = self.slots[i] {
-                if p == *packet {
-                    self.slots[i] = Some((b, None));
-                }
-            }
+        if let Some(i) = self.slot_of(board)
+            && let Some((b, Some(p))) = self.slots[i]
+            && p == *packet
+        {
+            self.slots[i] = Some((b, None));
         }
     }
 

@@ -132,10 +132,11 @@ impl Visit {
         }
         let mut answer = None;
         self.reader.feed(bytes, |e| {
-            if let Deframed::Frame(f) = e {
-                if answer.is_none() && f.kind() == PacketKind::Heartbeat {
-                    answer = Heartbeat::try_from(f.as_bytes()).ok();
-                }
+            if let Deframed::Frame(f) = e
+                && answer.is_none()
+                && f.kind() == PacketKind::Heartbeat
+            {
+                answer = Heartbeat::try_from(f.as_bytes()).ok();
             }
         });
         self.answered = answer.is_some();

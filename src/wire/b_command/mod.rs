@@ -41,7 +41,10 @@ const KIND: PacketKind = PacketKind::BCommand;
     Debug, Clone, Copy, PartialEq, Eq, Hash, FromBytes, IntoBytes, KnownLayout, Immutable, Unaligned,
 )]
 #[repr(C)]
-#[allow(missing_docs)] // each field is described in FIELDS and spec/packets/b-command.toml
+#[expect(
+    missing_docs,
+    reason = "each field is described in FIELDS and spec/packets/b-command.toml"
+)]
 pub struct BCommandPacket {
     pub header: [u8; 4],
     pub seq: u8,

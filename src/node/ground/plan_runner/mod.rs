@@ -321,10 +321,11 @@ impl<L: Link> PlanRunner<L> {
     /// poll while a motion settles or a wait runs. True when the current step ended here and
     /// the slot is free again.
     fn use_slot(&mut self, steps: &[PlanStep], now: u32, t: &mut PlanTick<L::Packet>) -> bool {
-        if self.up.is_idle() && self.end().is_none() {
-            if let Some(c) = self.take_interjection() {
-                self.submit(c, Sent::Interjection);
-            }
+        if self.up.is_idle()
+            && self.end().is_none()
+            && let Some(c) = self.take_interjection()
+        {
+            self.submit(c, Sent::Interjection);
         }
         if !self.up.is_idle() {
             return false;

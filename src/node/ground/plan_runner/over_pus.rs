@@ -31,14 +31,16 @@ impl PlanRunner<TcLink> {
             t.done = Some(d);
             self.finished(d, status.as_ref());
         }
-        if let Some((seq, _)) = h.rejected {
-            if self.end().is_none() && self.up.is_idle() && self.is_ours(seq) {
-                self.sent = Sent::Step;
-                self.phase = Phase::Ended(PlanEnd::Rejected {
-                    step: self.next,
-                    code: h.rejected.map_or(0, |(_, f)| f.code),
-                });
-            }
+        if let Some((seq, _)) = h.rejected
+            && self.end().is_none()
+            && self.up.is_idle()
+            && self.is_ours(seq)
+        {
+            self.sent = Sent::Step;
+            self.phase = Phase::Ended(PlanEnd::Rejected {
+                step: self.next,
+                code: h.rejected.map_or(0, |(_, f)| f.code),
+            });
         }
         if let Some((seq, e)) = h.ended {
             self.motion_ended(seq, e);
@@ -51,11 +53,11 @@ impl PlanRunner<TcLink> {
                 ..
             },
         ) = (h.status, self.phase)
+            && !self.held
+            && settled(&hb)
         {
-            if !self.held && settled(&hb) {
-                self.next += 1;
-                self.phase = Phase::Ready;
-            }
+            self.next += 1;
+            self.phase = Phase::Ready;
         }
         t.end = self.end();
         t

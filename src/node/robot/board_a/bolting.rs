@@ -42,14 +42,14 @@ impl BoardA {
     /// A new job waits until B reports idle, so that B's executor cannot mistake the job's
     /// first order for its previous one (spec/control/bolter.md).
     pub(super) fn bolting_start(&mut self, now: u32) {
-        if let Some(q) = self.motion.waiting_job {
-            if self.b.bolter_aux.step.is_none() || !self.b_heard {
-                match q {
-                    Queued::Job(job) => self.motion.coord.start(job, now),
-                    Queued::Down => self.motion.coord.start_down(now),
-                }
-                self.motion.waiting_job = None;
+        if let Some(q) = self.motion.waiting_job
+            && (self.b.bolter_aux.step.is_none() || !self.b_heard)
+        {
+            match q {
+                Queued::Job(job) => self.motion.coord.start(job, now),
+                Queued::Down => self.motion.coord.start_down(now),
             }
+            self.motion.waiting_job = None;
         }
     }
 

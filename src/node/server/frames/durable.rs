@@ -139,12 +139,12 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
                 continue;
             };
             let entries = kept_entries(l.board, &kept);
-            if let Some(slot) = entries.iter().position(|k| k == e) {
-                if let Some(w) = l.kept_written.get_mut(slot) {
-                    let fresh = *w != Some(*e);
-                    *w = Some(*e);
-                    return fresh;
-                }
+            if let Some(slot) = entries.iter().position(|k| k == e)
+                && let Some(w) = l.kept_written.get_mut(slot)
+            {
+                let fresh = *w != Some(*e);
+                *w = Some(*e);
+                return fresh;
             }
         }
         e.aux == 0 && self.persisted(e.key, e.value)
@@ -200,10 +200,11 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
             *w = Some(*e);
         }
         let head = l.ring.get(s).copied().flatten();
-        if let (Some(k), Some(out)) = (head, wants_out) {
-            if k == out && e.aux == 0 {
-                self.gateway.clear_to_send(board, k);
-            }
+        if let (Some(k), Some(out)) = (head, wants_out)
+            && k == out
+            && e.aux == 0
+        {
+            self.gateway.clear_to_send(board, k);
         }
         Some(fresh)
     }

@@ -80,11 +80,10 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         for tm in &out.reports {
             self.report(now, tm);
         }
-        if out.overflow > 0 {
-            if let Some(l) = self.links.first_mut() {
-                l.counters.tm_overflow =
-                    l.counters.tm_overflow.wrapping_add(u32::from(out.overflow));
-            }
+        if out.overflow > 0
+            && let Some(l) = self.links.first_mut()
+        {
+            l.counters.tm_overflow = l.counters.tm_overflow.wrapping_add(u32::from(out.overflow));
         }
     }
 

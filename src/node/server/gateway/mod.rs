@@ -397,10 +397,10 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
         let robot = robot_of_apid(tc.request.apid)
             .and_then(|b| self.robots.iter_mut().find(|r| r.board == b));
         // The CCSDS layer admits only the APIDs of robots served; nothing to answer otherwise.
-        if let Some(r) = robot {
-            if let Some(request) = r.admit(tc, &mut out) {
-                r.run(tc, request, &mut out);
-            }
+        if let Some(r) = robot
+            && let Some(request) = r.admit(tc, &mut out)
+        {
+            r.run(tc, request, &mut out);
         }
         out
     }
@@ -419,10 +419,10 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
             if let Some(d) = t.done {
                 r.finished(&mut out, d);
             }
-            if let Some(send) = t.send {
-                if out.to_robots.push((r.board, send)).is_err() {
-                    out.overflow = out.overflow.saturating_add(1);
-                }
+            if let Some(send) = t.send
+                && out.to_robots.push((r.board, send)).is_err()
+            {
+                out.overflow = out.overflow.saturating_add(1);
             }
             r.housekeeping(now, &mut out);
         }

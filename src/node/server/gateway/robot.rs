@@ -127,18 +127,18 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
             }
             return None;
         }
-        if let Some(&(_, mark)) = self.restored.iter().find(|(src, _)| *src == tc.source_id) {
-            if !newer14(tc.request.seq_count, mark) {
-                // Taken before the restart, or older: it may have run; never again.
-                let f = Failure {
-                    code: RESTARTED,
-                    data: u32::from(mark),
-                };
-                let rep = report(Stage::Start, tc.request, Some(f));
-                self.log_entry(key, request, Some(rep));
-                self.verify(out, rep, tc.ack, tc.source_id);
-                return None;
-            }
+        if let Some(&(_, mark)) = self.restored.iter().find(|(src, _)| *src == tc.source_id)
+            && !newer14(tc.request.seq_count, mark)
+        {
+            // Taken before the restart, or older: it may have run; never again.
+            let f = Failure {
+                code: RESTARTED,
+                data: u32::from(mark),
+            };
+            let rep = report(Stage::Start, tc.request, Some(f));
+            self.log_entry(key, request, Some(rep));
+            self.verify(out, rep, tc.ack, tc.source_id);
+            return None;
         }
         self.log_entry(key, request, None);
         self.mark(key);
