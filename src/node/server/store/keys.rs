@@ -171,7 +171,7 @@ impl KeySet {
 
 /// Reads a keys partition (its first octets at least; the rest is ignored).
 pub fn parse(part: &[u8]) -> Result<KeySet, KeysError> {
-    let head = part.get(..HEADER_LEN).ok_or(KeysError::Truncated {
+    let head: &[u8; HEADER_LEN] = part.first_chunk().ok_or(KeysError::Truncated {
         needed: HEADER_LEN,
         found: part.len(),
     })?;
@@ -197,19 +197,27 @@ pub fn parse(part: &[u8]) -> Result<KeySet, KeysError> {
     if head[10..12] != [0, 0] {
         return Err(KeysError::Reserved { at: 10 });
     }
-    let body = HEADER_LEN + n * ENTRY_LEN;
-    let all = part.get(..body + 4).ok_or(KeysError::Truncated {
+    let body = signed_len(n);
+    let truncated = KeysError::Truncated {
         needed: body + 4,
         found: part.len(),
-    })?;
-    let (signed, crc) = all.split_at(body);
-    let found = u32::from_be_bytes([crc[0], crc[1], crc[2], crc[3]]);
+    };
+    let (signed, crc) = part
+        .get(..body + 4)
+        .and_then(<[u8]>::split_last_chunk::<4>)
+        .ok_or(truncated)?;
+    let found = u32::from_be_bytes(*crc);
     let expected = CRC32.checksum(signed);
     if found != expected {
         return Err(KeysError::Crc { expected, found });
     }
+    // `signed` is the header and `n` whole entries: `as_chunks` leaves nothing over.
+    let (entries, _) = signed
+        .get(HEADER_LEN..)
+        .unwrap_or_default()
+        .as_chunks::<ENTRY_LEN>();
     let mut set = KeySet::default();
-    for (i, e) in signed[HEADER_LEN..].chunks_exact(ENTRY_LEN).enumerate() {
+    for (i, e) in entries.iter().enumerate() {
         let spi = u16::from_be_bytes([e[0], e[1]]);
         if e[2..4] != [0, 0] {
             return Err(KeysError::Reserved {
@@ -219,10 +227,7 @@ pub fn parse(part: &[u8]) -> Result<KeySet, KeysError> {
         if set.get(spi).is_some() {
             return Err(KeysError::Duplicate { spi });
         }
-        let key = Key256::from_slice(&e[4..]).map_err(|_| KeysError::Truncated {
-            needed: body + 4,
-            found: part.len(),
-        })?;
+        let key = Key256::from_slice(&e[4..]).map_err(|_| truncated)?;
         key.check()
             .map_err(|reason| KeysError::Weak { spi, reason })?;
         // Unreachable past MAX_KEYS (n is checked above).
@@ -231,43 +236,53 @@ pub fn parse(part: &[u8]) -> Result<KeySet, KeysError> {
     Ok(set)
 }
 
+/// The octets the CRC covers for `n` keys: the header and the entries.
+const fn signed_len(n: usize) -> usize {
+    HEADER_LEN + n * ENTRY_LEN
+}
+
 /// Writes `keys` in the partition's layout at the start of `out` (the caller erases the rest
 /// and clears `out` once it is written out: it holds the keys). Weak keys and repeated SPIs
 /// are refused. Returns the octets written.
 pub fn emit(keys: &[(u16, &Key256)], out: &mut [u8]) -> Result<usize, KeysError> {
+    let count = KeysError::Count {
+        max: MAX_KEYS,
+        found: keys.len(),
+    };
+    let n = u8::try_from(keys.len()).map_err(|_| count)?;
     if keys.is_empty() || keys.len() > MAX_KEYS {
-        return Err(KeysError::Count {
-            max: MAX_KEYS,
-            found: keys.len(),
-        });
+        return Err(count);
     }
-    let body = HEADER_LEN + keys.len() * ENTRY_LEN;
+    let body = signed_len(keys.len());
+    let room = KeysError::Room {
+        needed: body + 4,
+        found: out.len(),
+    };
     if out.len() < body + 4 {
-        return Err(KeysError::Room {
-            needed: body + 4,
-            found: out.len(),
-        });
+        return Err(room);
     }
     for (i, (spi, key)) in keys.iter().enumerate() {
         key.check()
             .map_err(|reason| KeysError::Weak { spi: *spi, reason })?;
-        if keys[..i].iter().any(|(s, _)| s == spi) {
+        if keys.iter().take(i).any(|(s, _)| s == spi) {
             return Err(KeysError::Duplicate { spi: *spi });
         }
     }
-    let (head, rest) = out.split_at_mut(HEADER_LEN);
+    let (signed, crc) = out
+        .get_mut(..body + 4)
+        .and_then(<[u8]>::split_last_chunk_mut::<4>)
+        .ok_or(room)?;
+    let (head, rest) = signed.split_first_chunk_mut::<HEADER_LEN>().ok_or(room)?;
     head[..8].copy_from_slice(&MAGIC);
     head[8] = VERSION;
-    head[9] = keys.len() as u8;
+    head[9] = n;
     head[10..12].fill(0);
-    for ((spi, key), e) in keys.iter().zip(rest.chunks_exact_mut(ENTRY_LEN)) {
+    let (entries, _) = rest.as_chunks_mut::<ENTRY_LEN>();
+    for ((spi, key), e) in keys.iter().zip(entries) {
         e[..2].copy_from_slice(&spi.to_be_bytes());
         e[2..4].fill(0);
         e[4..].copy_from_slice(key.octets());
     }
-    let crc = CRC32.checksum(out.get(..body).unwrap_or(&[]));
-    if let Some(c) = out.get_mut(body..body + 4) {
-        c.copy_from_slice(&crc.to_be_bytes());
-    }
+    *crc = CRC32.checksum(signed).to_be_bytes();
     Ok(body + 4)
 }
