@@ -117,28 +117,23 @@ impl<const N: usize> Server<N> {
     /// Takes a packet from the ground's serial line.
     pub fn accept(&mut self, packet: &Packet) -> Result<Accepted, ServerError> {
         let board = CommandRepr::parse(packet)?.board;
-        let slot = match self.slot_of(board) {
-            Some(i) => i,
-            None => match self
-                .slots
+        // The robot's own slot, else the first free one (empty, or a robot with nothing pending).
+        let known = self.slot_of(board);
+        let free = || {
+            self.slots
                 .iter()
                 .position(|s| s.is_none_or(|(_, p)| p.is_none()))
-            {
-                Some(i) => {
-                    self.slots[i] = Some((board, None));
-                    i
-                }
-                None => {
-                    return Err(ServerError::Full {
-                        board,
-                        capacity: N,
-                        packet: *packet,
-                    })
-                }
-            },
         };
-        let pending = self.slots[slot].and_then(|(_, p)| p);
-        self.slots[slot] = Some((board, Some(*packet)));
+        let Some(slot) = known.or_else(free).and_then(|i| self.slots.get_mut(i)) else {
+            return Err(ServerError::Full {
+                board,
+                capacity: N,
+                packet: *packet,
+            });
+        };
+        // A free slot has nothing pending; the robot's own may.
+        let pending = slot.and_then(|(b, p)| if b == board { p } else { None });
+        *slot = Some((board, Some(*packet)));
         Ok(match pending {
             None => Accepted::Queued,
             Some(old) if old == *packet => Accepted::Resend,
@@ -155,31 +150,43 @@ impl<const N: usize> Server<N> {
     /// The next robot to visit and the packet to deliver, round robin over robots with a
     /// pending command. The packet stays pending until [`delivered`](Self::delivered).
     pub fn next_visit(&mut self) -> Option<(BoardNumber, Packet)> {
-        for k in 0..N {
-            let i = (self.cursor + k) % N;
-            if let Some((b, Some(p))) = self.slots[i] {
-                self.cursor = (i + 1) % N;
-                return Some((b, p));
-            }
-        }
-        None
+        // From the cursor to the end, then from the start: the slots in visiting order.
+        let (before, after) = self.slots.split_at(self.cursor.min(N));
+        let start = before.len();
+        let (i, b, p) = after
+            .iter()
+            .zip(start..)
+            .chain(before.iter().zip(0..))
+            .find_map(|(s, i)| match *s {
+                Some((b, Some(p))) => Some((i, b, p)),
+                _ => None,
+            })?;
+        self.cursor = if i + 1 < N { i + 1 } else { 0 };
+        Some((b, p))
     }
 
     /// The packet reached `board` (written to its connection). Clears the slot only if that
     /// packet is still the pending one (a newer one stays).
     pub fn delivered(&mut self, board: BoardNumber, packet: &Packet) {
-        if let Some(i) = self.slot_of(board)
-            && let Some((b, Some(p))) = self.slots[i]
+        let slot = self
+            .slots
+            .iter_mut()
+            .find(|s| matches!(s, Some((b, _)) if *b == board));
+        if let Some(slot) = slot
+            && let Some((b, Some(p))) = *slot
             && p == *packet
         {
-            self.slots[i] = Some((b, None));
+            *slot = Some((b, None));
         }
     }
 
     /// The packet pending for `board`.
     pub fn pending(&self, board: BoardNumber) -> Option<Packet> {
-        self.slot_of(board)
-            .and_then(|i| self.slots[i].and_then(|(_, p)| p))
+        self.slots
+            .iter()
+            .flatten()
+            .find(|(b, _)| *b == board)
+            .and_then(|(_, p)| *p)
     }
 
     /// Robots with a pending packet.
