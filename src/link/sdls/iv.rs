@@ -51,23 +51,19 @@ impl Iv {
 
     /// Big-endian, as it goes into the security header.
     pub const fn to_bytes(self) -> [u8; IV_LEN] {
-        let b = self.0.to_be_bytes();
-        let mut out = [0u8; IV_LEN];
-        let mut i = 0;
-        while i < IV_LEN {
-            out[i] = b[16 - IV_LEN + i];
-            i += 1;
+        // The low IV_LEN octets of the 16 (IV_LEN <= 16: the `None` arm is never taken).
+        match self.0.to_be_bytes().split_last_chunk::<IV_LEN>() {
+            Some((_, low)) => *low,
+            None => [0; IV_LEN],
         }
-        out
     }
 
     /// Read from the security header.
     pub const fn from_bytes(bytes: [u8; IV_LEN]) -> Iv {
         let mut b = [0u8; 16];
-        let mut i = 0;
-        while i < IV_LEN {
-            b[16 - IV_LEN + i] = bytes[i];
-            i += 1;
+        // The low IV_LEN octets of the 16 (IV_LEN <= 16: always `Some`).
+        if let Some((_, low)) = b.split_last_chunk_mut::<IV_LEN>() {
+            *low = bytes;
         }
         Iv(u128::from_be_bytes(b))
     }

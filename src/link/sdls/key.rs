@@ -111,7 +111,7 @@ pub fn test_keys() -> [(&'static str, [u8; KEY_LEN]); 3] {
         ("proofs test_key(1)", proofs(1)),
         (
             "GCM test case 16",
-            core::array::from_fn(|i| GCM16[i % GCM16.len()]),
+            core::array::from_fn(|i| GCM16.get(i % GCM16.len()).copied().unwrap_or(0)),
         ),
     ]
 }

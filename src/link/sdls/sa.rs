@@ -45,14 +45,20 @@ impl AuthMask {
     /// The first [`MAX_MASK_LEN`] octets at most (for the constant masks, all shorter).
     pub(crate) const fn truncated(octets: &[u8]) -> AuthMask {
         let mut bytes = [0u8; MAX_MASK_LEN];
-        let mut i = 0;
-        while i < octets.len() && i < MAX_MASK_LEN {
-            bytes[i] = octets[i];
-            i += 1;
+        let n = if octets.len() < MAX_MASK_LEN {
+            octets.len()
+        } else {
+            MAX_MASK_LEN
+        };
+        // Both splits are at most their slice's length: always `Some`.
+        if let (Some((from, _)), Some((to, _))) =
+            (octets.split_at_checked(n), bytes.split_at_mut_checked(n))
+        {
+            to.copy_from_slice(from);
         }
         AuthMask {
             bytes,
-            len: i as u8,
+            len: n as u8,
         }
     }
 

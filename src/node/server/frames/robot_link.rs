@@ -97,8 +97,9 @@ impl<const N: usize> RobotLink<N> {
                     a.pending = a.pending.saturating_add(1);
                     a.spi = frame
                         .as_bytes()
-                        .get(6..8)
-                        .map_or(0, |b| u16::from_be_bytes([b[0], b[1]]));
+                        .get(6..)
+                        .and_then(<[u8]>::first_chunk::<2>)
+                        .map_or(0, |b| u16::from_be_bytes(*b));
                 }
                 Err(e.into())
             }
