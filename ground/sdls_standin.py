@@ -81,6 +81,10 @@ class StandIn:
         self.seq = 0
         self.packets: list[bytes] = []
         self.lock = threading.Lock()
+        # Held from taking a frame's IV to its sendto: the periodic sender and a test's
+        # send_packet would otherwise race, and a frame with the lower IV sent second is a replay
+        # to YAMCS (an "Invalid frames" count seen once in CI, on a loaded machine).
+        self.send_lock = threading.Lock()
         self.stop_event = threading.Event()
         self.rx = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         self.rx.bind(("127.0.0.1", self.tc_port))
@@ -126,8 +130,9 @@ class StandIn:
         return sdls.protect_tm(SCID, 0, mc, mc, fhp, data, clcw(v_r), self.tm_sa, iv)
 
     def send_tm(self) -> bytes:
-        f = self.make_tm()
-        self.send_raw_tm(f)
+        with self.send_lock:
+            f = self.make_tm()
+            self.send_raw_tm(f)
         return f
 
     def send_raw_tm(self, frame: bytes) -> None:
