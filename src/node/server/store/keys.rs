@@ -211,7 +211,12 @@ pub fn parse(part: &[u8]) -> Result<KeySet, KeysError> {
     if found != expected {
         return Err(KeysError::Crc { expected, found });
     }
-    // `signed` is the header and `n` whole entries: `as_chunks` leaves nothing over.
+    read_entries(signed, truncated)
+}
+
+/// The entries after the header of `signed` (the header and whole entries: `as_chunks` leaves
+/// nothing over), each checked; `truncated` is the error of a key cut short.
+fn read_entries(signed: &[u8], truncated: KeysError) -> Result<KeySet, KeysError> {
     let (entries, _) = signed
         .get(HEADER_LEN..)
         .unwrap_or_default()
