@@ -21,6 +21,9 @@
 //!     pub const fn from_wire(b: u8) -> Option<Self>;  // by matching the values (any name)
 //!     /// Doc.
 //!     pub const fn name(self) -> &'static str;        // the name
+//!     /// Doc.
+//!     pub const fn index(self) -> usize;              // the position in declaration order
+//!                                                     // (in `ALL`; any method name)
 //!     impl Display("{} {}", to_wire, name);           // write! of these methods' results
 //!     /// Doc.
 //!     #[error("message, found {0}")]
@@ -38,7 +41,11 @@
 //! section needs them.
 //!
 //! Conversions match the declared values, so no bound is written twice: adding a variant to
-//! the table is the whole change.
+//! the table is the whole change. Every number the methods give comes from a `match` on the
+//! variants, never from an `as` cast (rule R5 of `docs/coding-standard.md`): the enum's value
+//! through the `-> u8` method (`to_wire`, `value`, …), its position through the `-> usize` one
+//! (for indexing a table in declaration order), both `const`, and both compiled to the
+//! discriminant itself where that is what they return.
 
 /// Declares a C-like wire enum and its conversions; see the module documentation.
 macro_rules! wire_enum {
@@ -56,6 +63,11 @@ macro_rules! wire_enum {
     (@items $Name:ident $data:tt $(#[$m:meta])* pub const fn $to:ident(self) -> u8;
         $($rest:tt)*) => {
         $crate::wire_enum::wire_enum!(@to $Name $data [$(#[$m])*] $to);
+        $crate::wire_enum::wire_enum!(@items $Name $data $($rest)*);
+    };
+    (@items $Name:ident $data:tt $(#[$m:meta])* pub const fn $ix:ident(self) -> usize;
+        $($rest:tt)*) => {
+        $crate::wire_enum::wire_enum!(@index $Name $data [$(#[$m])*] $ix);
         $crate::wire_enum::wire_enum!(@items $Name $data $($rest)*);
     };
     (@items $Name:ident $data:tt
@@ -114,6 +126,28 @@ macro_rules! wire_enum {
                     $($Name::$V => $($val)?,)+
                 }
             }
+        }
+    };
+    (@index $Name:ident [$($V:ident $(= $val:literal)? $(=> $vname:literal)?;)+]
+        [$(#[$m:meta])*] $ix:ident) => {
+        impl $Name {
+            $(#[$m])*
+            pub const fn $ix(self) -> usize {
+                let v = self;
+                $crate::wire_enum::wire_enum!(@arms v $Name [] [] $($V)+)
+            }
+        }
+    };
+    // The `match` of `@index`, its arms built one variant at a time: each variant's position
+    // is the number of those before it (`$before`), counted as the length of their names.
+    (@arms $v:ident $Name:ident [$($arms:tt)*] [$($before:ident)*] $V:ident $($after:ident)*) => {
+        $crate::wire_enum::wire_enum!(@arms $v $Name
+            [$($arms)* $Name::$V => <[&str]>::len(&[$(stringify!($before)),*]),]
+            [$($before)* $V] $($after)*)
+    };
+    (@arms $v:ident $Name:ident [$($arms:tt)*] [$($before:ident)*]) => {
+        match $v {
+            $($arms)*
         }
     };
     (@from $Name:ident [$($V:ident $(= $val:literal)? $(=> $vname:literal)?;)+]
@@ -233,6 +267,8 @@ mod tests {
         pub const fn from_value(v: u8) -> Option<Self>;
         /// Name.
         pub const fn name(self) -> &'static str;
+        /// Position.
+        pub const fn position(self) -> usize;
         impl Display("{}={}", name, value);
         /// Not a value.
         #[error("not a sparse value: {0}")]
@@ -257,6 +293,8 @@ mod tests {
         pub const fn to_wire(self) -> u8;
         /// From a value.
         pub const fn from_wire(b: u8) -> Option<Self>;
+        /// Position.
+        pub const fn index(self) -> usize;
     }
 
     #[test]
@@ -269,12 +307,15 @@ mod tests {
         }
         let accepted = (0..=255u8).filter(|&v| Sparse::from_value(v).is_some());
         assert!(accepted.eq([2, 5, 9]));
+        assert_eq!(Sparse::ALL.map(Sparse::position), [0, 1, 2]);
         assert_eq!(Sparse::try_from(3), Err(SparseError(3)));
         assert_eq!(shown(SparseError(3)), "not a sparse value: 3");
         assert_eq!(shown(Sparse::Five), "five=5");
 
         assert_eq!((Letters::X as u8, Letters::Y as u8), (0, 1));
         assert_eq!(Letters::ALL.map(Letters::to_wire), [b'x', b'y']);
+        assert_eq!(Letters::ALL.map(Letters::index), [0, 1]);
+        const { assert!(Letters::Y.index() == 1) };
         let accepted = (0..=255u8).filter(|&v| Letters::from_wire(v).is_some());
         assert!(accepted.eq([b'x', b'y']));
     }
