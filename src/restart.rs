@@ -18,66 +18,65 @@
 //! assert!(Boot::from_wire(0x21).differs(Boot::from_wire(0x22))); // restarted in between
 //! ```
 
-/// Why a node last started: the three bits heartbeat byte 59 and the ST\[5\] restart event
-/// carry. The ESP32's reset reasons map onto them in the firmware (`firmware/support`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
-#[repr(u8)]
-pub enum ResetCause {
-    /// Not reported: a paper-era robot, or a board started by a host that does not say.
-    #[default]
-    Unreported = 0,
-    /// The supply came up (first power, or the operator cycled it).
-    PowerOn = 1,
-    /// The brown-out detector reset the chip (the battery sagged under load).
-    BrownOut = 2,
-    /// Software asked for it (the operator's restart command, an update).
-    Software = 3,
-    /// The firmware panicked (the panic handler resets the chip).
-    Panic = 4,
-    /// A watchdog (the RTC or a timer group's) was not fed in time.
-    Watchdog = 5,
-    /// The reset pin (EN) was pulled.
-    External = 6,
-    /// Any other cause the chip reports (deep-sleep wake, JTAG, a CPU lock-up).
-    Other = 7,
+use crate::wire_enum::wire_enum;
+
+wire_enum! {
+    /// Why a node last started: the three bits heartbeat byte 59 and the ST\[5\] restart event
+    /// carry. The ESP32's reset reasons map onto them in the firmware (`firmware/support`).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+    pub enum ResetCause: u8 {
+        /// Not reported: a paper-era robot, or a board started by a host that does not say.
+        #[default]
+        Unreported = 0 => "unreported",
+        /// The supply came up (first power, or the operator cycled it).
+        PowerOn = 1 => "power_on",
+        /// The brown-out detector reset the chip (the battery sagged under load).
+        BrownOut = 2 => "brown_out",
+        /// Software asked for it (the operator's restart command, an update).
+        Software = 3 => "software",
+        /// The firmware panicked (the panic handler resets the chip).
+        Panic = 4 => "panic",
+        /// A watchdog (the RTC or a timer group's) was not fed in time.
+        Watchdog = 5 => "watchdog",
+        /// The reset pin (EN) was pulled.
+        External = 6 => "external",
+        /// Any other cause the chip reports (deep-sleep wake, JTAG, a CPU lock-up).
+        Other = 7 => "other",
+    }
+
+    /// Every cause, in wire order.
+    const ALL;
+    /// The cause's three bits, 0..=7.
+    pub const fn bits(self) -> u8;
+    /// The cause of these three bits, if they are 0..=7.
+    pub const fn from_three_bits(b: u8) -> Option<Self>;
+    /// The cause's name, as logs, JSON and `spec/` use it.
+    pub const fn name(self) -> &'static str;
 }
 
 impl ResetCause {
-    /// Every cause, in wire order.
-    pub const ALL: [ResetCause; 8] = [
-        ResetCause::Unreported,
-        ResetCause::PowerOn,
-        ResetCause::BrownOut,
-        ResetCause::Software,
-        ResetCause::Panic,
-        ResetCause::Watchdog,
-        ResetCause::External,
-        ResetCause::Other,
-    ];
-
     /// The names logs, JSON and `spec/` use, in wire order.
     pub const NAMES: [&'static str; 8] = [
-        "unreported",
-        "power_on",
-        "brown_out",
-        "software",
-        "panic",
-        "watchdog",
-        "external",
-        "other",
+        ResetCause::ALL[0].name(),
+        ResetCause::ALL[1].name(),
+        ResetCause::ALL[2].name(),
+        ResetCause::ALL[3].name(),
+        ResetCause::ALL[4].name(),
+        ResetCause::ALL[5].name(),
+        ResetCause::ALL[6].name(),
+        ResetCause::ALL[7].name(),
     ];
-
-    /// The cause's name.
-    pub const fn name(self) -> &'static str {
-        Self::NAMES[self as usize]
-    }
 
     /// The cause of three bits (the top bits of `bits & 7` are ignored: every value is one).
     pub const fn from_bits(bits: u8) -> ResetCause {
-        Self::ALL[(bits & 7) as usize]
+        match Self::from_three_bits(bits & 7) {
+            Some(c) => c,
+            // Never: every value of three bits is a cause.
+            None => ResetCause::Other,
+        }
     }
 
     /// Whether the chip lost its RTC memory too (a power cycle or a brown-out): what a node
@@ -118,7 +117,7 @@ impl Boot {
 
     /// The byte: cause in bits 7..5, count modulo 32 in bits 4..0.
     pub const fn to_wire(self) -> u8 {
-        ((self.cause as u8) << 5) | (self.count & 0x1f)
+        (self.cause.bits() << 5) | (self.count & 0x1f)
     }
 
     /// Every byte is a start: three bits of cause, five of count.
@@ -133,7 +132,8 @@ impl Boot {
     pub const fn after(cause: ResetCause, boots: u16) -> Boot {
         Boot {
             cause,
-            count: (boots & 0x1f) as u8,
+            // The low five bits: a u8 holds them.
+            count: boots.to_le_bytes()[0] & 0x1f,
         }
     }
 

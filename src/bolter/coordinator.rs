@@ -291,7 +291,8 @@ impl Coordinator {
                     self.status = Status::Failed(Fault::BoltingFailure);
                     return;
                 }
-                self.attempt += 1;
+                // Below the clamped maximum (just above), so this never saturates.
+                self.attempt = self.attempt.saturating_add(1);
                 BolterStep::Descend
             }
             _ => BolterStep::Done,
@@ -303,7 +304,10 @@ impl Coordinator {
         // This pair is done: next pair of an "all four" job, or the end.
         match (
             self.job.map(|j| j.fasteners),
-            BolterPair::from_number(self.pair.number() + 1),
+            self.pair
+                .number()
+                .checked_add(1)
+                .and_then(BolterPair::from_number),
         ) {
             (Some(Fasteners::All), Some(p)) => self.begin_pair(p, now),
             _ => self.status = Status::Done,

@@ -128,16 +128,19 @@ impl MuxLines {
     /// The paper lists the combinations of "A0-A1 (low-low, low-high, high-low, high-high)";
     /// pairs 1–4 take them in that order, so (A0, A1) is pair n − 1 in binary, A0 the high bit.
     pub const fn for_pair(p: BolterPair) -> MuxLines {
-        let n = p.number() - 1;
-        MuxLines {
-            a0: n & 0b10 != 0,
-            a1: n & 0b01 != 0,
-        }
+        let (a0, a1) = match p {
+            BolterPair::P1 => (false, false),
+            BolterPair::P2 => (false, true),
+            BolterPair::P3 => (true, false),
+            BolterPair::P4 => (true, true),
+        };
+        MuxLines { a0, a1 }
     }
 
     /// Wire byte: bit 0 = A0, bit 1 = A1.
     pub const fn to_wire(self) -> u8 {
-        self.a0 as u8 | (self.a1 as u8) << 1
+        // `if`, not `u8::from(bool)`: that is not `const`.
+        (if self.a0 { 0b01 } else { 0 }) | (if self.a1 { 0b10 } else { 0 })
     }
 
     /// Lines from the wire byte; other bits must be zero.

@@ -15,8 +15,11 @@ macro_rules! bit_field {
             pub struct $name($int), min 0, max $max, $quantity;
         }
 
-        // `masked` relies on the maximum being all ones.
-        const _: () = assert!(($max as u32) & ($max as u32 + 1) == 0);
+        // `masked` relies on the maximum being all ones: its ones are all at the bottom.
+        const _: () = {
+            let max: $int = $max;
+            assert!(max.trailing_ones() == max.count_ones());
+        };
 
         impl $name {
             /// The largest value the field's bits carry.
@@ -31,7 +34,7 @@ macro_rules! bit_field {
 
         impl From<$name> for u32 {
             fn from(v: $name) -> u32 {
-                v.0 as u32
+                u32::from(v.0)
             }
         }
     };

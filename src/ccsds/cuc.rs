@@ -72,22 +72,38 @@ impl Cuc {
     /// unit; seconds beyond 2³² − 1 wrap (after 136 years).
     pub const fn from_millis(ms: u64) -> Cuc {
         let frac = ms % 1000;
+        // frac < 1000: neither operation comes near saturating.
+        let fine = frac.saturating_mul(65536).saturating_add(500) / 1000;
+        let [s0, s1, s2, s3, ..] = (ms / 1000).to_le_bytes();
+        // At most (999 · 65536 + 500) / 1000 = 65470: never reaches the next second, and its
+        // two low octets are all of it.
+        let [f0, f1, ..] = fine.to_le_bytes();
         Cuc {
-            coarse: (ms / 1000) as u32,
-            // At most (999 · 65536 + 500) / 1000 = 65470: never reaches the next second.
-            fine: ((frac * 65536 + 500) / 1000) as u16,
+            // The seconds' low 32 bits: they wrap, as documented above.
+            coarse: u32::from_le_bytes([s0, s1, s2, s3]),
+            fine: u16::from_le_bytes([f0, f1]),
         }
     }
 
     /// The time of board A's clock reading `t` (restarts at 0 when the `u32` clock wraps).
     pub const fn from_instant(t: crate::units::Instant) -> Cuc {
-        Cuc::from_millis(t.millis() as u64)
+        let [m0, m1, m2, m3] = t.millis().to_le_bytes();
+        // The u32 widened (`u64::from` is not `const`).
+        Cuc::from_millis(u64::from_le_bytes([m0, m1, m2, m3, 0, 0, 0, 0]))
     }
 
     /// Milliseconds since the epoch, the fraction rounded to the nearest millisecond (a fine
     /// value of 65503 or more rounds up into the next second).
     pub const fn to_millis(self) -> u64 {
-        self.coarse as u64 * 1000 + ((self.fine as u64 * 1000 + 32768) >> 16)
+        let [c0, c1, c2, c3] = self.coarse.to_le_bytes();
+        let [f0, f1] = self.fine.to_le_bytes();
+        // Both widened (`u64::from` is not `const`); below 2³² · 1000 + 1000 < 2⁴², so no
+        // operation comes near saturating.
+        let coarse = u64::from_le_bytes([c0, c1, c2, c3, 0, 0, 0, 0]);
+        let fine = u64::from_le_bytes([f0, f1, 0, 0, 0, 0, 0, 0]);
+        coarse
+            .saturating_mul(1000)
+            .saturating_add(fine.saturating_mul(1000).saturating_add(32768) >> 16)
     }
 
     /// The six octets.

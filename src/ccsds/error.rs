@@ -135,7 +135,18 @@ impl PacketError {
 
     /// The failed check's name (`spec/ccsds/bad-inputs.toml`, CLI output).
     pub const fn name(&self) -> &'static str {
-        Self::NAMES[self.position()]
+        // Constant indices, checked by the compiler; the order is `position`'s.
+        match self {
+            PacketError::Truncated { .. } => Self::NAMES[0],
+            PacketError::Version { .. } => Self::NAMES[1],
+            PacketError::PacketType { .. } => Self::NAMES[2],
+            PacketError::SecondaryHeaderFlag { .. } => Self::NAMES[3],
+            PacketError::SequenceFlags { .. } => Self::NAMES[4],
+            PacketError::Length { .. } => Self::NAMES[5],
+            PacketError::PusVersion { .. } => Self::NAMES[6],
+            PacketError::Checksum { .. } => Self::NAMES[7],
+            PacketError::Apid { .. } => Self::NAMES[8],
+        }
     }
 
     /// The failed check's place in the check order (0 = first).

@@ -138,13 +138,13 @@ fn check_primary(primary: &PrimaryHeader, kind: PacketType, len: usize) -> Resul
 /// Octets of a packet with fixed header `H` and `data_len` octets of user data, or the error
 /// if that is more than a packet holds.
 pub(crate) fn packet_len<H: FixedHeader>(data_len: usize) -> Result<usize, EmitError> {
-    if data_len > H::MAX_DATA_LEN {
-        return Err(EmitError::DataTooLong {
+    match H::MIN_PACKET_LEN.checked_add(data_len) {
+        Some(n) if data_len <= H::MAX_DATA_LEN => Ok(n),
+        _ => Err(EmitError::DataTooLong {
             max: H::MAX_DATA_LEN,
             found: data_len,
-        });
+        }),
     }
-    Ok(H::MIN_PACKET_LEN + data_len)
 }
 
 /// Writes `header`, `data` and the packet error control into the front of `out`; the length.

@@ -24,6 +24,7 @@
 //! ```
 
 use super::bit_field::bit_field;
+use crate::wire_enum::wire_enum;
 use core::fmt;
 use zerocopy::byteorder::big_endian::U16;
 use zerocopy::{FromBytes, Immutable, IntoBytes, KnownLayout, Unaligned};
@@ -64,16 +65,21 @@ pub mod field {
     pub const DATA_LENGTH: Range<usize> = span!(PrimaryLayout, data_length, U16);
 }
 
-/// Telemetry (0) or telecommand (1): bit 3 of the header.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
-pub enum PacketType {
-    /// Telemetry: robot → ground.
-    Tm = 0,
-    /// Telecommand: ground → robot.
-    Tc = 1,
+wire_enum! {
+    /// Telemetry (0) or telecommand (1): bit 3 of the header.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+    #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+    #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+    pub enum PacketType: u8 {
+        /// Telemetry: robot → ground.
+        Tm = 0,
+        /// Telecommand: ground → robot.
+        Tc = 1,
+    }
+
+    /// The type's bit: 0 or 1.
+    pub const fn bit(self) -> u8;
 }
 
 impl PacketType {
@@ -111,7 +117,8 @@ bit_field! {
 impl SeqCount {
     /// The next count, wrapping from 16383 to 0 as CCSDS 133.0-B-2 §4.1.3.4.2.3 says.
     pub const fn wrapping_next(self) -> SeqCount {
-        SeqCount((self.0 + 1) & 0x3fff)
+        // Modulo 2¹⁴, the standard's count: the wrap is meant.
+        SeqCount(self.0.wrapping_add(1) & 0x3fff)
     }
 }
 
@@ -151,8 +158,15 @@ impl PrimaryHeader {
             apid: apid.get(),
             seq_flags: UNSEGMENTED,
             seq_count: seq_count.get(),
-            data_length: total_len.saturating_sub(PRIMARY_LEN + 1) as u16,
+            data_length: data_length_of(total_len),
         }
+    }
+
+    /// The packet's total length in octets as the data length field says:
+    /// `data_length + 7` (the field counts the data field's octets minus one).
+    pub fn total_len(&self) -> usize {
+        // At most 65,542: never saturates.
+        usize::from(self.data_length).saturating_add(PRIMARY_LEN + 1)
     }
 
     /// Decodes the first six octets of `bytes`; `None` if there are fewer.
@@ -160,12 +174,6 @@ impl PrimaryHeader {
     pub fn read(bytes: &[u8]) -> Option<PrimaryHeader> {
         let (l, _) = PrimaryLayout::ref_from_prefix(bytes).ok()?;
         Some(PrimaryHeader::from(l))
-    }
-
-    /// The packet's total length in octets as the data length field says:
-    /// `data_length + 7` (the field counts the data field's octets minus one).
-    pub const fn total_len(&self) -> usize {
-        self.data_length as usize + PRIMARY_LEN + 1
     }
 
     /// The six octets (fields wider than their bits are masked).
@@ -182,17 +190,26 @@ impl PrimaryHeader {
     }
 }
 
+/// The data length field of a packet of `total_len` octets: its low 16 bits, `total_len`
+/// lying in `7..=65542` (the packet builders check that; `From` and `TryFrom` are not `const`).
+const fn data_length_of(total_len: usize) -> u16 {
+    let [lo, hi, ..] = total_len.saturating_sub(PRIMARY_LEN + 1).to_le_bytes();
+    u16::from_le_bytes([lo, hi])
+}
+
 impl From<&PrimaryLayout> for PrimaryHeader {
     #[inline]
     fn from(l: &PrimaryLayout) -> PrimaryHeader {
         let id = l.packet_id.get();
         let seq = l.sequence.get();
+        let [id_hi, _] = id.to_be_bytes();
+        let [seq_hi, _] = seq.to_be_bytes();
         PrimaryHeader {
-            version: (id >> 13) as u8,
-            packet_type: PacketType::from_bit((id >> 12) as u8),
+            version: id_hi >> 5,
+            packet_type: PacketType::from_bit(id_hi >> 4),
             secondary_header: id & 0x0800 != 0,
             apid: id & 0x07ff,
-            seq_flags: (seq >> 14) as u8,
+            seq_flags: seq_hi >> 6,
             seq_count: seq & 0x3fff,
             data_length: l.data_length.get(),
         }
@@ -201,11 +218,11 @@ impl From<&PrimaryLayout> for PrimaryHeader {
 
 impl From<&PrimaryHeader> for PrimaryLayout {
     fn from(h: &PrimaryHeader) -> PrimaryLayout {
-        let id = ((h.version as u16 & 0b111) << 13)
-            | ((h.packet_type as u16) << 12)
-            | ((h.secondary_header as u16) << 11)
+        let id = ((u16::from(h.version) & 0b111) << 13)
+            | (u16::from(h.packet_type.bit()) << 12)
+            | (u16::from(h.secondary_header) << 11)
             | (h.apid & 0x07ff);
-        let seq = ((h.seq_flags as u16 & 0b11) << 14) | (h.seq_count & 0x3fff);
+        let seq = ((u16::from(h.seq_flags) & 0b11) << 14) | (h.seq_count & 0x3fff);
         PrimaryLayout {
             packet_id: U16::new(id),
             sequence: U16::new(seq),

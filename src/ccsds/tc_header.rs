@@ -82,10 +82,18 @@ impl AckFlags {
 
     /// The nibble.
     pub const fn bits(self) -> u8 {
-        self.acceptance as u8
-            | (self.start as u8) << 1
-            | (self.progress as u8) << 2
-            | (self.completion as u8) << 3
+        // `if`, not `u8::from(bool)`: that is not `const`.
+        const fn bit(set: bool, value: u8) -> u8 {
+            if set {
+                value
+            } else {
+                0
+            }
+        }
+        bit(self.acceptance, 0b0001)
+            | bit(self.start, 0b0010)
+            | bit(self.progress, 0b0100)
+            | bit(self.completion, 0b1000)
     }
 }
 

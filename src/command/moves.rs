@@ -18,7 +18,7 @@ impl Reconfiguration {
     pub const fn new(initial: State, target: State) -> Result<Self, ReconfigurationError> {
         if !target.is_matched() {
             Err(ReconfigurationError::TargetNotMatched { target })
-        } else if initial as u8 == target as u8 {
+        } else if initial.to_wire() == target.to_wire() {
             Err(ReconfigurationError::SameState { state: target })
         } else {
             Ok(Reconfiguration { initial, target })
@@ -109,7 +109,7 @@ impl PrimitiveMove {
     /// Board A runs the command only then.
     pub const fn is_move_from(self, from: State) -> bool {
         match crate::pose::map::primitive(from, self.target) {
-            Some(p) => p as u8 == self.primitive as u8,
+            Some(p) => p.number() == self.primitive.number(),
             None => false,
         }
     }
@@ -130,7 +130,7 @@ impl PrimitiveMove {
     pub const fn turns_without_hip_from(self, from: State) -> bool {
         match crate::pose::geometry::single_move(from, self.target) {
             Some((_, p)) => {
-                p as u8 == self.primitive as u8
+                p.number() == self.primitive.number()
                     && crate::pose::geometry::turns_without_hip(from, self.target)
             }
             None => false,

@@ -234,12 +234,13 @@ impl Faults {
 
     /// The two fault bytes, heartbeat byte 60 first.
     pub const fn to_wire(self) -> [u8; 2] {
-        [self.0 as u8, (self.0 >> 8) as u8]
+        let [lo, hi, _, _] = self.0.to_le_bytes();
+        [lo, hi]
     }
 
     /// Fault set from the two fault bytes; reserved bits are refused.
     pub const fn from_wire(b: [u8; 2]) -> Result<Faults, ReservedFaultBits> {
-        let raw = b[0] as u32 | (b[1] as u32) << 8;
+        let raw = u32::from_le_bytes([b[0], b[1], 0, 0]);
         let reserved = raw & !Self::DEFINED;
         if reserved != 0 {
             Err(ReservedFaultBits { reserved })

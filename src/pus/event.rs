@@ -34,15 +34,14 @@ use crate::faults::{Fault, Faults};
 use crate::link::sdls::SdlsRefusal;
 
 /// The place of `not-reserved` among [`SdlsRefusal::NAMES`].
-const NOT_RESERVED: usize = 6;
-const _: () = assert!(matches!(
-    SdlsRefusal::NAMES[NOT_RESERVED].as_bytes(),
-    b"not-reserved"
-));
+const NOT_RESERVED: u8 = 6;
+const _: () =
+    assert!(NOT_RESERVED == 6 && matches!(SdlsRefusal::NAMES[6].as_bytes(), b"not-reserved"));
 use crate::mode::Mode;
 use crate::restart::Boot;
 use crate::safety::policy::fault_action;
 use crate::wire::heartbeat::HeartbeatRepr;
+use crate::wire_enum::wire_enum;
 
 /// Why TM(5,x) source data is not an event of ours (checked in this order).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -91,18 +90,23 @@ pub enum EventError {
     },
 }
 
-/// How a bolting attempt ended.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum AttemptResult {
-    /// The pair is done (locked, or unlocked for an unbolt).
-    Done = 0,
-    /// This attempt failed; the next one runs.
-    Failed = 1,
-    /// The third attempt failed: bolting failure.
-    GaveUp = 2,
-    /// Ended by a Stop, a mode change or another fault before it could finish.
-    Interrupted = 3,
+wire_enum! {
+    /// How a bolting attempt ended.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+    pub enum AttemptResult: u8 {
+        /// The pair is done (locked, or unlocked for an unbolt).
+        Done = 0,
+        /// This attempt failed; the next one runs.
+        Failed = 1,
+        /// The third attempt failed: bolting failure.
+        GaveUp = 2,
+        /// Ended by a Stop, a mode change or another fault before it could finish.
+        Interrupted = 3,
+    }
+
+    /// The auxiliary byte of the event: 0..=3.
+    pub const fn to_wire(self) -> u8;
 }
 
 /// One event report.
@@ -182,13 +186,14 @@ impl Event {
     /// The event definition ID.
     pub const fn id(&self) -> u16 {
         match self {
-            Event::Fault { fault, .. } => 0x0100 + fault.bit() as u16,
+            // 0x0100 + the bit, which is below 256: the ID's low octet.
+            Event::Fault { fault, .. } => u16::from_be_bytes([0x01, fault.bit()]),
             Event::ModeChanged { .. } => 1,
             Event::Attempt { .. } => 2,
             Event::Cleared(_) => 3,
             Event::Restarted(_) => 4,
             Event::LinkStopped { .. } => 5,
-            Event::Security { reason, .. } => 0x0200 + *reason as u16,
+            Event::Security { reason, .. } => u16::from_be_bytes([0x02, *reason]),
         }
     }
 
@@ -213,7 +218,7 @@ impl Event {
             // Informative: a frame refused as not reserved verified (its MAC is good), so it is
             // the ground's own, beyond the durable floor after a restart or a long loss (the
             // next reservation lets its retransmission in): never an attack.
-            Event::Security { reason, .. } if *reason as usize == NOT_RESERVED => 1,
+            Event::Security { reason, .. } if *reason == NOT_RESERVED => 1,
             // Medium: other refused frames are an attack or a fault of the link or the
             // ground's keys, and nothing of them executed. A restart stopped what the robot
             // was doing.
@@ -232,7 +237,7 @@ impl Event {
                 pair,
                 attempt,
                 result,
-            } => [pair.number(), *attempt, *result as u8, 0],
+            } => [pair.number(), *attempt, result.to_wire(), 0],
             Event::Cleared(f) => f.bits().to_be_bytes(),
             Event::Restarted(b) => [b.to_wire(), 0, 0, 0],
             Event::LinkStopped { board, reason } => [*board, *reason, 0, 0],
@@ -290,6 +295,7 @@ impl Event {
     fn decode(id: u16, b: &[u8; EVENT_LEN]) -> Result<Event, EventError> {
         let field = |field, found: u32| EventError::Field { id, field, found };
         let mode = |name, x: u8| Mode::from_wire(x).ok_or(field(name, u32::from(x)));
+        let [_, low] = id.to_be_bytes();
         Ok(match id {
             1 => Event::ModeChanged {
                 from: mode("from", b[2])?,
@@ -319,13 +325,14 @@ impl Event {
                     .ok_or(EventError::UnknownId(id))?,
                 mode: mode("mode", b[2])?,
             },
-            0x0200..=0x02FF if usize::from(id - 0x0200) < SdlsRefusal::NAMES.len() => {
+            // The reason is the ID's low octet (the ID is 0x0200 + it).
+            0x0200..=0x02FF if usize::from(low) < SdlsRefusal::NAMES.len() => {
                 let refused = u16::from_be_bytes([b[2], b[3]]);
                 if refused == 0 {
                     return Err(field("refused", 0));
                 }
                 Event::Security {
-                    reason: (id - 0x0200) as u8,
+                    reason: low,
                     refused,
                     spi: u16::from_be_bytes([b[4], b[5]]),
                 }

@@ -261,7 +261,8 @@ fn state(f: FunctionId, argument: &'static str, b: u8) -> Result<State, Function
 const fn power_target(t: PowerTarget) -> u8 {
     match t {
         PowerTarget::All => 0,
-        PowerTarget::Module(m) => m as u8 + 1,
+        // At most 7 (seven modules): never saturates.
+        PowerTarget::Module(m) => m.index().saturating_add(1),
     }
 }
 
@@ -274,12 +275,17 @@ pub fn decode(data: &[u8]) -> Result<Command, FunctionError> {
     if a.len() != f.args_len() {
         return Err(FunctionError::Length {
             function: id,
-            expected: 1 + f.args_len(),
+            // At most 5: never saturates.
+            expected: f.args_len().saturating_add(1),
             found: data.len(),
         });
     }
     let b = |i: usize| a.get(i).copied().unwrap_or(0);
-    let w = |i: usize| u16::from_be_bytes([b(i), b(i + 1)]);
+    let w = |i: usize| {
+        a.get(i..)
+            .and_then(<[u8]>::first_chunk::<2>)
+            .map_or(0, |&s| u16::from_be_bytes(s))
+    };
     Ok(match f {
         FunctionId::Arm => Command::Arm {
             side: side(f, b(0))?,
@@ -336,7 +342,7 @@ fn hip(f: FunctionId, kind: u8, angle: u16) -> Result<HipTarget, FunctionError> 
 fn bolter(f: FunctionId, op: u8, pair: u8) -> Result<BolterCommand, FunctionError> {
     let op = arg(f, "operation", op.into(), 0, BOLTER_OPS)?;
     let pair = arg(f, "pair", pair.into(), 0, if op == 2 { 0 } else { 4 })?;
-    let fasteners = match BolterPair::from_number(pair as u8) {
+    let fasteners = match u8::try_from(pair).ok().and_then(BolterPair::from_number) {
         Some(p) => Fasteners::Pair(p),
         None => Fasteners::All,
     };
@@ -349,9 +355,13 @@ fn bolter(f: FunctionId, op: u8, pair: u8) -> Result<BolterCommand, FunctionErro
 
 /// A power function: `target` 0 for every module, else module `target - 1`; `on` 0 or 1.
 fn power(f: FunctionId, target: u8, on: u8) -> Result<Command, FunctionError> {
-    let t = arg(f, "target", target.into(), 0, Module::ALL.len() as u16)?;
+    let modules = u16::try_from(Module::ALL.len()).unwrap_or(u16::MAX); // 7
+    let t = arg(f, "target", target.into(), 0, modules)?;
     let on = arg(f, "on", on.into(), 0, 1)? == 1;
-    let target = match t.checked_sub(1).and_then(|i| Module::ALL.get(i as usize)) {
+    let target = match t
+        .checked_sub(1)
+        .and_then(|i| Module::ALL.get(usize::from(i)))
+    {
         Some(&m) => PowerTarget::Module(m),
         None => PowerTarget::All,
     };
@@ -372,7 +382,7 @@ pub fn encode(c: &Command, out: &mut [u8]) -> Result<usize, FunctionError> {
         Command::Arm { side, target } | Command::Gripper { side, target } => {
             let (k, p) = servo(target);
             let [hi, lo] = p.to_be_bytes();
-            [(*side == Side::B) as u8, k, hi, lo]
+            [u8::from(*side == Side::B), k, hi, lo]
         }
         Command::Hip(h) => {
             let (k, v) = match h {
@@ -397,12 +407,13 @@ pub fn encode(c: &Command, out: &mut [u8]) -> Result<usize, FunctionError> {
             }
         }
         Command::Primitive(m) => [m.primitive().number(), m.target().to_wire(), 0, 0],
-        Command::Power { target, on } => [power_target(*target), *on as u8, 0, 0],
+        Command::Power { target, on } => [power_target(*target), u8::from(*on), 0, 0],
         Command::Reconfigure(r) => [r.initial().to_wire(), r.target().to_wire(), 0, 0],
         Command::Mode(m) => [m.to_wire(), 0, 0, 0],
         _ => [0; 4],
     };
-    let n = 1 + f.args_len();
+    // At most 5: never saturates.
+    let n = f.args_len().saturating_add(1);
     for (d, s) in a.iter_mut().skip(1).zip(args.iter()) {
         *d = *s;
     }

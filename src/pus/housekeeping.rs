@@ -108,25 +108,33 @@ macro_rules! side_rows {
     };
 }
 
-/// `head`, then side A's readings, then side B's, then `tail`: the report's order.
+/// `head`, then side A's readings, then side B's, then `tail`: the report's order (`N` is
+/// their sum, checked where [`FIELDS`] is built). Slice patterns, not indices: a `const fn`
+/// has no iterators.
 const fn with_sides<const H: usize, const T: usize, const N: usize>(
     head: [Field; H],
     tail: [Field; T],
 ) -> [Field; N] {
     let (a, b): ([Field; 7], [Field; 7]) = (side_rows!("a", "A"), side_rows!("b", "B"));
     let mut out = [head[0]; N];
-    let mut i = 0;
-    while i < N {
-        out[i] = if i < H {
-            head[i]
-        } else if i < H + 7 {
-            a[i - H]
-        } else if i < H + 14 {
-            b[i - H - 7]
-        } else {
-            tail[i - H - 14]
-        };
-        i += 1;
+    let mut dst: &mut [Field] = &mut out;
+    let parts: [&[Field]; 4] = [&head, &a, &b, &tail];
+    let mut parts: &[&[Field]] = &parts;
+    while let [part, more_parts @ ..] = parts {
+        let mut src: &[Field] = part;
+        while let [s, more @ ..] = src {
+            // Moved out, so that its rest can take its place.
+            let whole = dst;
+            dst = match whole {
+                [d, rest @ ..] => {
+                    *d = *s;
+                    rest
+                }
+                [] => &mut [],
+            };
+            src = more;
+        }
+        parts = more_parts;
     }
     out
 }
@@ -136,6 +144,7 @@ pub const N_FIELDS: usize = 34;
 
 /// The parameters after the structure ID, in order.
 pub const FIELDS: [Field; N_FIELDS] = with_sides(HEAD, TAIL);
+const _: () = assert!(N_FIELDS == HEAD.len() + 14 + TAIL.len());
 
 /// The parameters after the two sides' readings: added after the first layout, at the end, so
 /// that every earlier parameter keeps its offset.
@@ -207,10 +216,10 @@ const HEAD: [Field; 19] = [
 /// Source data length of TM(3,25): structure ID and every parameter.
 pub const REPORT_LEN: usize = {
     let mut n = 1;
-    let mut i = 0;
-    while i < FIELDS.len() {
-        n += FIELDS[i].len;
-        i += 1;
+    let mut rest: &[Field] = &FIELDS;
+    while let [f, more @ ..] = rest {
+        n += f.len;
+        rest = more;
     }
     n
 };
@@ -246,16 +255,11 @@ pub enum HousekeepingError {
     },
 }
 
-const fn electrical(e: &Electrical) -> [u32; 7] {
+fn electrical(e: &Electrical) -> [u32; 7] {
     [
-        e.v_bat as u32,
-        e.i_bat as u32,
-        e.i_loc as u32,
-        e.i_grip as u32,
-        e.i_3v3 as u32,
-        e.v_reg as u32,
-        e.i_bo as u32,
+        e.v_bat, e.i_bat, e.i_loc, e.i_grip, e.i_3v3, e.v_reg, e.i_bo,
     ]
+    .map(u32::from)
 }
 
 /// The parameter values of a heartbeat, in [`FIELDS`] order.
@@ -297,15 +301,23 @@ pub fn values(hb: &HeartbeatRepr) -> [u32; N_FIELDS] {
 
 /// Writes TM(3,25)'s source data for `hb`.
 pub fn emit(hb: &HeartbeatRepr, out: &mut [u8; REPORT_LEN]) {
-    out[0] = ROBOT_SID;
-    let mut at = 1;
+    let Some((sid, mut rest)) = out.split_first_mut() else {
+        return; // never: the report is not empty
+    };
+    *sid = ROBOT_SID;
     for (field, v) in FIELDS.iter().zip(values(hb)) {
         let bytes = v.to_be_bytes();
-        let src = bytes.get(4 - field.len..).unwrap_or(&[]);
-        if let Some(dst) = out.get_mut(at..at + field.len) {
-            dst.copy_from_slice(src);
-        }
-        at += field.len;
+        // A field's octets are the value's last `len` (1, 2 or 4).
+        let src = bytes
+            .len()
+            .checked_sub(field.len)
+            .and_then(|from| bytes.get(from..))
+            .unwrap_or(&[]);
+        let Some((dst, more)) = core::mem::take(&mut rest).split_at_mut_checked(field.len) else {
+            return; // never: the fields fill the report
+        };
+        dst.copy_from_slice(src);
+        rest = more;
     }
 }
 
@@ -362,29 +374,37 @@ impl Values {
     /// The values of `data`, whose length is checked.
     fn read(data: &[u8]) -> Values {
         let mut v = [0u32; N_FIELDS];
-        let mut at = 1;
+        let mut rest = data.get(1..).unwrap_or(&[]);
         for (field, slot) in FIELDS.iter().zip(v.iter_mut()) {
-            for b in data.get(at..at + field.len).unwrap_or(&[]) {
+            // Short data (never: its length is checked) leaves the rest 0.
+            let (octets, more) = rest.split_at_checked(field.len).unwrap_or((&[], &[]));
+            for b in octets {
                 *slot = *slot << 8 | u32::from(*b);
             }
-            at += field.len;
+            rest = more;
         }
         Values(v)
     }
 
     fn bad(&self, i: usize) -> HousekeepingError {
         HousekeepingError::Parameter {
-            name: FIELDS[i % FIELDS.len()].name,
-            value: self.0[i % self.0.len()],
+            name: FIELDS.get(i).map_or("?", |f| f.name),
+            value: self.raw(i),
         }
     }
 
+    /// Value `i`; the callers' `i` are constants below [`N_FIELDS`], so the fallback (a
+    /// value no field accepts) never shows.
+    fn raw(&self, i: usize) -> u32 {
+        self.0.get(i).copied().unwrap_or(u32::MAX)
+    }
+
     fn byte(&self, i: usize) -> Result<u8, HousekeepingError> {
-        u8::try_from(self.0[i]).map_err(|_| self.bad(i))
+        u8::try_from(self.raw(i)).map_err(|_| self.bad(i))
     }
 
     fn word(&self, i: usize) -> Result<u16, HousekeepingError> {
-        u16::try_from(self.0[i]).map_err(|_| self.bad(i))
+        u16::try_from(self.raw(i)).map_err(|_| self.bad(i))
     }
 
     /// 0 for none, else what `from` makes of the byte (refused when it makes nothing).
@@ -416,8 +436,8 @@ impl Values {
     }
 
     fn faults(&self, i: usize) -> Result<Faults, HousekeepingError> {
-        let [_, _, hi, lo] = self.0[i].to_be_bytes();
-        if self.0[i] > 0xFFFF {
+        let [_, _, hi, lo] = self.raw(i).to_be_bytes();
+        if self.raw(i) > 0xFFFF {
             return Err(self.bad(i));
         }
         Faults::from_wire([lo, hi]).map_err(|_| self.bad(i))
@@ -425,14 +445,16 @@ impl Values {
 
     /// The seven readings from `k` on, in [`Electrical`]'s order.
     fn electrical(&self, k: usize) -> Result<Electrical, HousekeepingError> {
+        // `k` is 19 or 26: never saturates.
+        let w = |j: usize| self.word(k.saturating_add(j));
         Ok(Electrical {
-            v_bat: self.word(k)?,
-            i_bat: self.word(k + 1)?,
-            i_loc: self.word(k + 2)?,
-            i_grip: self.word(k + 3)?,
-            i_3v3: self.word(k + 4)?,
-            v_reg: self.word(k + 5)?,
-            i_bo: self.word(k + 6)?,
+            v_bat: w(0)?,
+            i_bat: w(1)?,
+            i_loc: w(2)?,
+            i_grip: w(3)?,
+            i_3v3: w(4)?,
+            v_reg: w(5)?,
+            i_bo: w(6)?,
         })
     }
 }

@@ -96,16 +96,20 @@ pub fn read_tc<'a>(bytes: &'a [u8], apids: &[u16]) -> Result<(TcRepr<'a>, Reques
 
 /// The APID of robot 1 is `ROBOT_APID_BASE + 1`.
 pub const ROBOT_APID_BASE: u16 = 0x100;
+// The board number is the APID's low octet (below).
+const _: () = assert!(ROBOT_APID_BASE & 0xff == 0);
 
 /// The APID of robot `n`'s packets, telecommands and telemetry: `0x100 + n`.
 pub const fn robot_apid(n: BoardNumber) -> u16 {
-    ROBOT_APID_BASE + n.get() as u16
+    ROBOT_APID_BASE | u16::from_be_bytes([0, n.get()])
 }
 
 /// The robot an APID belongs to; none for any other APID.
 pub const fn robot_of_apid(apid: u16) -> Option<BoardNumber> {
     if apid > ROBOT_APID_BASE && apid <= ROBOT_APID_BASE + 255 {
-        match BoardNumber::new((apid - ROBOT_APID_BASE) as u8) {
+        // Within the base's block of 256: the number is the low octet.
+        let [_, n] = apid.to_be_bytes();
+        match BoardNumber::new(n) {
             Ok(n) => Some(n),
             Err(_) => None,
         }

@@ -88,7 +88,7 @@ impl Failure {
     /// Board A refused with refusal code `r`.
     pub const fn refusal(r: u8) -> Failure {
         Failure {
-            code: r as u16,
+            code: u16::from_be_bytes([0, r]),
             data: 0,
         }
     }
@@ -101,7 +101,8 @@ impl Failure {
     /// Fault `f` was raised while the command ran; `latched` is the fault map.
     pub const fn fault(f: Fault, latched: Faults) -> Failure {
         Failure {
-            code: 0x0100 + f.bit() as u16,
+            // 0x0100 + the bit, which is below 256: the code's low octet.
+            code: u16::from_be_bytes([0x01, f.bit()]),
             data: latched.bits(),
         }
     }
@@ -216,8 +217,9 @@ impl Report {
         };
         let expected = if failed { FAILURE_LEN } else { SUCCESS_LEN };
         let w = |i: usize| {
-            data.get(i..i + 2)
-                .map_or(0, |s| u16::from_be_bytes([s[0], s[1]]))
+            data.get(i..)
+                .and_then(<[u8]>::first_chunk::<2>)
+                .map_or(0, |&s| u16::from_be_bytes(s))
         };
         if data.len() != expected {
             return Err(VerificationError::Length {

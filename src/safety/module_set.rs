@@ -14,7 +14,7 @@ impl ModuleSet {
     pub const ALL: ModuleSet = ModuleSet(0x7f);
     /// What Safed mode may power: the hip and both arms (Table 7: "hold hip/arms position only").
     pub const HIP_AND_ARMS: ModuleSet =
-        ModuleSet(1 << Module::Hip as u8 | 1 << Module::ArmA as u8 | 1 << Module::ArmB as u8);
+        ModuleSet(1 << Module::Hip.index() | 1 << Module::ArmA.index() | 1 << Module::ArmB.index());
 
     /// The set plus `m`.
     pub const fn with(self, m: Module) -> ModuleSet {

@@ -64,19 +64,34 @@ pub fn crc16(bytes: &[u8]) -> u16 {
 #[inline(never)]
 fn update(mut crc: u16, bytes: &[u8]) -> u16 {
     let t = CRC.table();
-    let blocks = bytes.chunks_exact(16);
-    let tail = blocks.remainder();
+    let (blocks, tail) = bytes.as_chunks::<16>();
     for block in blocks {
         // The fourteen lookups that do not depend on the register first, so that they run
         // ahead; the register's two last, the only ones on the path from block to block.
         let mut r = 0;
-        for (k, &x) in block.iter().rev().take(14).enumerate() {
-            r ^= t[k][x as usize];
+        for (lane, &x) in t.iter().zip(block.iter().rev().take(14)) {
+            r ^= at(lane, x);
         }
-        let (x0, x1) = (block[0] ^ (crc >> 8) as u8, block[1] ^ crc as u8);
-        crc = r ^ t[14][x1 as usize] ^ t[15][x0 as usize];
+        let [hi, lo] = crc.to_be_bytes();
+        let (x0, x1) = (block[0] ^ hi, block[1] ^ lo);
+        crc = r ^ at(&t[14], x1) ^ at(&t[15], x0);
     }
     remainder(crc, tail)
+}
+
+/// Entry `x` of a table: every octet indexes one of its 256 entries, so the fallback never
+/// shows and the compiler drops the check.
+#[inline(always)]
+fn at(table: &[u16; 256], x: u8) -> u16 {
+    table.get(usize::from(x)).copied().unwrap_or(0)
+}
+
+/// Table `k` of the sixteen, `k` taken modulo 16 (the callers' `k` are below 16, and the
+/// modulo lets the compiler drop the check).
+#[cfg(not(feature = "small-crc-table"))]
+#[inline(always)]
+fn lane(t: &[[u16; 256]; LANES], k: usize) -> &[u16; 256] {
+    t.get(k & 15).unwrap_or(&t[0])
 }
 
 /// The register after the 0–15 octets `tail`, from register `crc`, in one step (module docs,
@@ -87,34 +102,37 @@ fn update(mut crc: u16, bytes: &[u8]) -> u16 {
 fn remainder(crc: u16, tail: &[u8]) -> u16 {
     let t = CRC.table();
     let n = tail.len();
-    let mut r = match n {
-        0 => return crc,
-        1 => return (crc << 8) ^ t[0][(tail[0] ^ (crc >> 8) as u8) as usize],
+    let [hi, lo] = crc.to_be_bytes();
+    let mut r = match tail {
+        [] => return crc,
+        [x] => return (crc << 8) ^ at(&t[0], x ^ hi),
         // The tables are linear in their index, so the register's share is two lookups of
-        // its own, and the octets' shares do not wait for it.
-        _ => t[(n - 1) & 15][(crc >> 8) as usize] ^ t[(n - 2) & 15][crc as u8 as usize],
+        // its own, and the octets' shares do not wait for it. Two octets or more: neither
+        // subtraction saturates.
+        _ => at(lane(t, n.saturating_sub(1)), hi) ^ at(lane(t, n.saturating_sub(2)), lo),
     };
     // The octets in pieces of 8, 4, 2 and 1, each piece unrolled; `k` octets are left, so
-    // the next octet's table is `k - 1`.
+    // the next octet's table is `k - 1`. A piece was split off `k` octets, so no subtraction
+    // saturates.
     let mut rest = tail;
     let mut k = n;
     if let Some((p, more)) = rest.split_first_chunk::<8>() {
-        k -= 8;
-        r ^= piece(&t[k..], p);
+        k = k.saturating_sub(8);
+        r ^= piece(t.get(k..).unwrap_or_default(), p);
         rest = more;
     }
     if let Some((p, more)) = rest.split_first_chunk::<4>() {
-        k -= 4;
-        r ^= piece(&t[k..], p);
+        k = k.saturating_sub(4);
+        r ^= piece(t.get(k..).unwrap_or_default(), p);
         rest = more;
     }
     if let Some((p, more)) = rest.split_first_chunk::<2>() {
-        k -= 2;
-        r ^= piece(&t[k..], p);
+        k = k.saturating_sub(2);
+        r ^= piece(t.get(k..).unwrap_or_default(), p);
         rest = more;
     }
     if let [x] = rest {
-        r ^= t[0][*x as usize];
+        r ^= at(&t[0], *x);
     }
     r
 }
@@ -128,8 +146,8 @@ fn piece<const N: usize>(lanes: &[[u16; 256]], p: &[u8; N]) -> u16 {
         return 0; // never: a piece and the octets after it are fewer than 16
     };
     let mut r = 0;
-    for (i, &x) in p.iter().enumerate() {
-        r ^= lanes[N - 1 - i][x as usize];
+    for (lane, &x) in lanes.iter().rev().zip(p) {
+        r ^= at(lane, x);
     }
     r
 }
@@ -140,7 +158,8 @@ fn piece<const N: usize>(lanes: &[[u16; 256]], p: &[u8; N]) -> u16 {
 fn update(mut crc: u16, bytes: &[u8]) -> u16 {
     let t = &CRC.table()[0];
     for &x in bytes {
-        crc = (crc << 8) ^ t[(x ^ (crc >> 8) as u8) as usize];
+        let [hi, _] = crc.to_be_bytes();
+        crc = (crc << 8) ^ at(t, x ^ hi);
     }
     crc
 }

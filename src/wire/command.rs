@@ -16,7 +16,7 @@
 //! ```
 
 use super::layout::{span, FieldSpec, Unit};
-use super::opcode::{seq_slot, Slot, PARAM_LEN, PARAM_OFFSET};
+use super::opcode::{get_u16, put_u16, seq_slot, Slot, PARAM_LEN, PARAM_OFFSET};
 use super::{check_inline, field_err, seal, Packet, PacketKind, WireError};
 use crate::command::Command;
 use crate::units::BoardNumber;
@@ -199,12 +199,18 @@ impl CommandRepr {
                 0,
             )
         })?;
-        let mut params = [0u8; PARAM_LEN];
-        params.copy_from_slice(&bytes[PARAM_OFFSET..PARAM_OFFSET + PARAM_LEN]);
-        let at = seq_slot(p.command).offset();
-        let seq = u16::from_le_bytes([params[at], params[at + 1]]);
-        params[at] = 0;
-        params[at + 1] = 0;
+        // Never short: `check_inline` checked the length.
+        let Some(&params) = bytes.get(PARAM_OFFSET..).and_then(<[u8]>::first_chunk) else {
+            return Err(WireError::Length {
+                kind: PacketKind::Command,
+                expected: COMMAND_LEN,
+                found: bytes.len(),
+            });
+        };
+        let mut params: [u8; PARAM_LEN] = params;
+        let slot = seq_slot(p.command);
+        let seq = get_u16(&params, slot);
+        put_u16(&mut params, slot, 0);
         let command = super::opcode::decode(p.command, params)?;
         Ok(CommandRepr {
             board,
@@ -216,8 +222,7 @@ impl CommandRepr {
     /// Writes the packet, header and checksum included.
     pub fn emit(&self, out: &mut [u8; COMMAND_LEN]) {
         let (id, mut params) = super::opcode::encode(&self.command);
-        let at = seq_slot(id).offset();
-        params[at..at + 2].copy_from_slice(&self.seq.to_le_bytes());
+        put_u16(&mut params, seq_slot(id), self.seq);
         out[field::BOARD.start] = self.board.get();
         out[field::COMMAND.start] = id;
         out[PARAM_OFFSET..PARAM_OFFSET + PARAM_LEN].copy_from_slice(&params);

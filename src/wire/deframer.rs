@@ -50,7 +50,8 @@ impl Frame {
 
     /// The packet's bytes, header to checksum.
     pub fn as_bytes(&self) -> &[u8] {
-        &self.bytes[..self.kind.len()]
+        // A packet's length is at most `MAX_PACKET_LEN`: the fallback never shows.
+        self.bytes.get(..self.kind.len()).unwrap_or_default()
     }
 }
 
@@ -132,7 +133,8 @@ impl<const N: usize> Deframer<N> {
 
     /// Free buffer space: how many bytes the next [`push`](Self::push) takes at most.
     pub const fn free(&self) -> usize {
-        N - self.len
+        // `len <= N` always: never saturates.
+        N.saturating_sub(self.len)
     }
 
     /// Bytes buffered and not yet resolved into packets or discards.
@@ -153,21 +155,28 @@ impl<const N: usize> Deframer<N> {
     /// Copies as much of `data` as fits and returns how many bytes were taken. Call
     /// [`poll`](Self::poll) until it returns `None` to make room; nothing is dropped here.
     pub fn push(&mut self, data: &[u8]) -> usize {
-        let n = data.len().min(N - self.len);
-        self.buf[self.len..self.len + n].copy_from_slice(&data[..n]);
-        self.len += n;
+        let free = self.buf.get_mut(self.len..).unwrap_or_default();
+        let n = data.len().min(free.len());
+        if let (Some(dst), Some(src)) = (free.get_mut(..n), data.get(..n)) {
+            dst.copy_from_slice(src);
+        }
+        // At most `N`: never saturates.
+        self.len = self.len.saturating_add(n);
         n
     }
 
     fn drop_front(&mut self, n: usize) {
         self.buf.copy_within(n..self.len, 0);
-        self.len -= n;
+        // `n <= len` (the callers drop what they scanned): never saturates.
+        self.len = self.len.saturating_sub(n);
     }
 
     fn discard(&mut self, n: usize) {
         self.drop_front(n);
-        self.pending_discard += n;
-        self.discarded_total += n as u64;
+        // Counters that stop at their maximum (the pending count is at most `N` anyway).
+        self.pending_discard = self.pending_discard.saturating_add(n);
+        let n = u64::try_from(n).unwrap_or(u64::MAX);
+        self.discarded_total = self.discarded_total.saturating_add(n);
     }
 
     /// The next event, or `None` when more bytes are needed.
@@ -198,12 +207,18 @@ impl<const N: usize> Deframer<N> {
             if self.len < need {
                 return None;
             }
-            let (body, crc) = self.buf[..need].split_at(need - CHECKSUM_LEN);
-            if checksum::packet_crc(kind, body) == u16::from_le_bytes([crc[0], crc[1]]) {
+            // `need <= len <= N` just above, and a packet is longer than its checksum: neither
+            // `?` returns.
+            let frame = self.buf.get(..need)?;
+            let (body, crc) = frame.split_last_chunk::<CHECKSUM_LEN>()?;
+            if checksum::packet_crc(kind, body) == u16::from_le_bytes(*crc) {
                 let mut bytes = [0u8; MAX_PACKET_LEN];
-                bytes[..need].copy_from_slice(&self.buf[..need]);
+                if let Some(dst) = bytes.get_mut(..need) {
+                    dst.copy_from_slice(frame);
+                }
                 self.drop_front(need);
-                self.frames_total += 1;
+                // A counter that stops at its maximum.
+                self.frames_total = self.frames_total.saturating_add(1);
                 return Some(Deframed::Frame(Frame { kind, bytes }));
             }
             // A false header: drop its first byte only and look again.
@@ -228,7 +243,8 @@ impl<const N: usize> Deframer<N> {
     pub fn feed(&mut self, mut data: &[u8], mut sink: impl FnMut(Deframed)) {
         loop {
             let n = self.push(data);
-            data = &data[n..];
+            // `n <= data.len()`: the fallback never shows.
+            data = data.get(n..).unwrap_or_default();
             while let Some(e) = self.poll() {
                 sink(e);
             }

@@ -210,7 +210,7 @@ impl Default for HeartbeatRepr {
 
 fn angle(kind: PacketKind, name: &'static str, at: usize, v: U16) -> Result<HipAngle, WireError> {
     HipAngle::new(v.get())
-        .map_err(|_| field_err(kind, at, name, "0..=35999 (0.01 deg)", v.get() as u32))
+        .map_err(|_| field_err(kind, at, name, "0..=35999 (0.01 deg)", u32::from(v.get())))
 }
 
 /// Index of the first byte of layout field `$f`.
@@ -366,7 +366,7 @@ impl HeartbeatRepr {
             electrical_a: ElectricalLayout::from(&self.electrical_a),
             electrical_b: ElectricalLayout::from(&self.electrical_b),
             target_state: self.target_state.map_or(0, State::to_wire),
-            command_complete: self.command_complete as u8,
+            command_complete: u8::from(self.command_complete),
             active_bolter: self.active_bolter.map_or(0, BolterPair::number),
             bolter_attempt: self.bolter_attempt.get(),
             last_seq: U16::new(self.last_seq),

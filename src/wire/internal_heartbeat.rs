@@ -237,21 +237,21 @@ impl InternalHeartbeatRepr {
             bolter_seq: a.seq,
             bolter_pair: a.pair.map_or(0, BolterPair::number),
             bolter_direction: a.direction.map_or(0, BolterDirection::to_wire),
-            bolter_threshold: a.threshold_reached as u8,
-            bolter_locked: a.locked as u8,
-            bolter_timed_out: a.timed_out as u8,
-            bolter_at_home: a.at_home as u8,
+            bolter_threshold: u8::from(a.threshold_reached),
+            bolter_locked: u8::from(a.locked),
+            bolter_timed_out: u8::from(a.timed_out),
+            bolter_at_home: u8::from(a.at_home),
             bolter_mux: a.mux.to_wire(),
             command_received: self.command_received,
             g_sign: self.gravity.map_or(0, |g| g.sign.to_wire()),
             g_axis: self.gravity.map_or(0, |g| g.axis.to_wire()),
-            arm_over_idle: self.arm_over_idle as u8,
-            gripper_over_idle: self.gripper_over_idle as u8,
-            bolter_over_idle: self.bolter_over_idle as u8,
-            arm_overcurrent: self.arm_overcurrent as u8,
-            gripper_overcurrent: self.gripper_overcurrent as u8,
-            bolter_overcurrent: self.bolter_overcurrent as u8,
-            arm_contracted: self.arm_contracted as u8,
+            arm_over_idle: u8::from(self.arm_over_idle),
+            gripper_over_idle: u8::from(self.gripper_over_idle),
+            bolter_over_idle: u8::from(self.bolter_over_idle),
+            arm_overcurrent: u8::from(self.arm_overcurrent),
+            gripper_overcurrent: u8::from(self.gripper_overcurrent),
+            bolter_overcurrent: u8::from(self.bolter_overcurrent),
+            arm_contracted: u8::from(self.arm_contracted),
             checksum: U16::ZERO,
         };
         out.copy_from_slice(p.as_bytes());
@@ -299,7 +299,7 @@ fn bolter_aux(p: &InternalHeartbeatPacket) -> Result<BolterAux, WireError> {
             at!(bolter_mux),
             "bolter_aux.mux",
             "bits 0 (A0) and 1 (A1) only",
-            p.bolter_mux as u32,
+            u32::from(p.bolter_mux),
         )
     })?;
     Ok(BolterAux {
@@ -334,7 +334,7 @@ fn gravity(p: &InternalHeartbeatPacket) -> Result<Option<Gravity>, WireError> {
                     at!(g_sign),
                     "gravity.sign",
                     "'+' or '-' (or 0 with axis 0)",
-                    s as u32,
+                    u32::from(s),
                 )
             })?;
             let axis = Axis::from_wire(a).ok_or_else(|| {
@@ -343,7 +343,7 @@ fn gravity(p: &InternalHeartbeatPacket) -> Result<Option<Gravity>, WireError> {
                     at!(g_axis),
                     "gravity.axis",
                     "'X', 'Y' or 'Z' (or 0 with sign 0)",
-                    a as u32,
+                    u32::from(a),
                 )
             })?;
             Some(Gravity { axis, sign })

@@ -52,10 +52,20 @@ impl From<&Electrical> for ElectricalLayout {
     }
 }
 
+/// `offset..offset + size`: the byte range of a field of `size` octets at `offset`. The sum is
+/// at most the layout's size (a field lies inside its struct), so the `None` arm, an empty
+/// range, is never taken; the callers are `const` items, evaluated as the crate builds.
+pub(crate) const fn span_of(offset: usize, size: usize) -> core::ops::Range<usize> {
+    match offset.checked_add(size) {
+        Some(end) => offset..end,
+        None => offset..offset,
+    }
+}
+
 /// Byte range of field `$f` (of type `$ft`) in layout `$t`.
 macro_rules! span {
     ($t:ty, $($f:ident).+, $ft:ty) => {
-        core::mem::offset_of!($t, $($f).+)..core::mem::offset_of!($t, $($f).+) + core::mem::size_of::<$ft>()
+        $crate::wire::layout::span_of(core::mem::offset_of!($t, $($f).+), core::mem::size_of::<$ft>())
     };
 }
 pub(crate) use span;

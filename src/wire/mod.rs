@@ -291,8 +291,18 @@ pub(crate) fn check_inline<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
             found: bytes.len(),
         });
     }
-    let (body, crc) = bytes.split_at(expected - CHECKSUM_LEN);
-    let found = [bytes[0], bytes[1], bytes[2], bytes[3]];
+    // Never short after the length check (every packet is longer than its header and
+    // checksum); refused as its length were it so.
+    let split = bytes
+        .first_chunk::<HEADER_LEN>()
+        .zip(bytes.split_last_chunk::<CHECKSUM_LEN>());
+    let Some((&found, (body, crc))) = split else {
+        return Err(WireError::Length {
+            kind,
+            expected,
+            found: bytes.len(),
+        });
+    };
     if found != kind.header() {
         return Err(WireError::Header {
             kind,
@@ -300,7 +310,7 @@ pub(crate) fn check_inline<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
             found,
         });
     }
-    let carried = u16::from_le_bytes([crc[0], crc[1]]);
+    let carried = u16::from_le_bytes(*crc);
     let computed = checksum::checked_packet_crc(kind, body);
     if carried != computed {
         return Err(WireError::Checksum {
@@ -318,10 +328,13 @@ pub(crate) fn check_inline<P: Packet>(bytes: &[u8]) -> Result<&P, WireError> {
 
 /// Writes header and checksum around a body already written into `out`.
 pub(crate) fn seal(kind: PacketKind, out: &mut [u8]) {
-    let n = out.len();
-    out[..HEADER_LEN].copy_from_slice(&kind.header());
-    let crc = checksum::crc16(&out[..n - CHECKSUM_LEN]);
-    out[n - CHECKSUM_LEN..].copy_from_slice(&crc.to_le_bytes());
+    // `out` is a whole packet (the callers' arrays), so neither `if let` fails.
+    if let Some(header) = out.first_chunk_mut::<HEADER_LEN>() {
+        *header = kind.header();
+    }
+    if let Some((body, crc)) = out.split_last_chunk_mut::<CHECKSUM_LEN>() {
+        *crc = checksum::crc16(body).to_le_bytes();
+    }
 }
 
 /// A field check failure, for the parsers.
@@ -350,7 +363,7 @@ pub(crate) fn pulse(
     v: zerocopy::little_endian::U16,
 ) -> Result<crate::units::PulseWidth, WireError> {
     crate::units::PulseWidth::new(v.get())
-        .map_err(|_| field_err(kind, at, name, "500..=2500 us", v.get() as u32))
+        .map_err(|_| field_err(kind, at, name, "500..=2500 us", u32::from(v.get())))
 }
 
 /// An optional byte field: `None` for 0 (the field is empty), else the value `from_wire`
@@ -367,7 +380,7 @@ pub(crate) fn optional<T>(
         0 => Ok(None),
         v => from_wire(v)
             .map(Some)
-            .ok_or_else(|| field_err(kind, index, field, expected, v as u32)),
+            .ok_or_else(|| field_err(kind, index, field, expected, u32::from(v))),
     }
 }
 
@@ -380,7 +393,7 @@ pub(crate) fn get_bool(
     match b {
         0 => Ok(false),
         1 => Ok(true),
-        _ => Err(field_err(kind, index, field, "0 or 1", b as u32)),
+        _ => Err(field_err(kind, index, field, "0 or 1", u32::from(b))),
     }
 }
 

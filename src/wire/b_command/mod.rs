@@ -154,7 +154,7 @@ impl BCommandRepr {
                 at!(flags),
                 "flags",
                 "bits 0..=4 only",
-                p.flags as u32,
+                u32::from(p.flags),
             ));
         }
         let bolter = match (p.bolter_pair, p.bolter_direction, p.bolter_step) {
@@ -166,7 +166,7 @@ impl BCommandRepr {
                         at!(bolter_pair),
                         "bolter.pair",
                         "1..=4 (or bytes 10-12 all 0)",
-                        pair as u32,
+                        u32::from(pair),
                     )
                 })?,
                 direction: BolterDirection::from_wire(dir).ok_or_else(|| {
@@ -175,11 +175,17 @@ impl BCommandRepr {
                         at!(bolter_direction),
                         "bolter.direction",
                         "1 (bolt) or 2 (unbolt)",
-                        dir as u32,
+                        u32::from(dir),
                     )
                 })?,
                 step: BolterStep::from_wire(step).ok_or_else(|| {
-                    field_err(KIND, at!(bolter_step), "bolter.step", "1..=8", step as u32)
+                    field_err(
+                        KIND,
+                        at!(bolter_step),
+                        "bolter.step",
+                        "1..=8",
+                        u32::from(step),
+                    )
                 })?,
             }),
         };

@@ -81,6 +81,15 @@ impl Slot {
         }
     }
 
+    /// The packet index of the slot's low byte (6, 8 or 10).
+    pub const fn index(self) -> usize {
+        match self {
+            Slot::Hip => PARAM_OFFSET,
+            Slot::ArmA => PARAM_OFFSET + 2,
+            Slot::ArmB => PARAM_OFFSET + 4,
+        }
+    }
+
     /// Slot carrying a servo target for `side`'s arm or gripper.
     pub const fn for_side(side: Side) -> Slot {
         match side {
@@ -125,7 +134,7 @@ pub enum CommandError {
         found: u8,
     },
     /// A pulse width outside the servo range.
-    #[error("bytes {index}-{}: pulse width must be {}..={} us, found {found}", index + 1, PulseWidth::MIN_US, PulseWidth::MAX_US)]
+    #[error("bytes {index}-{}: pulse width must be {}..={} us, found {found}", index.saturating_add(1), PulseWidth::MIN_US, PulseWidth::MAX_US)]
     PulseWidth {
         /// Packet index of the low byte.
         index: usize,
@@ -134,7 +143,7 @@ pub enum CommandError {
     },
     /// An arm or gripper position outside the module's travel (`Travel::ARM`, `Travel::GRIPPER`;
     /// spec/control/servos.toml): it would drive the servo against its end stop.
-    #[error("bytes {index}-{}: {} target must be within its travel {min}..={max} us, found {found}", index + 1, kind.name())]
+    #[error("bytes {index}-{}: {} target must be within its travel {min}..={max} us, found {found}", index.saturating_add(1), kind.name())]
     OutOfTravel {
         /// Packet index of the low byte.
         index: usize,
@@ -148,7 +157,7 @@ pub enum CommandError {
         max: u16,
     },
     /// A hip angle at or above 360°.
-    #[error("bytes {index}-{}: hip angle must be < 36000 (0.01 deg), found {found}", index + 1)]
+    #[error("bytes {index}-{}: hip angle must be < 36000 (0.01 deg), found {found}", index.saturating_add(1))]
     HipAngle {
         /// Packet index of the low byte.
         index: usize,
@@ -190,17 +199,32 @@ impl CommandError {
     }
 }
 
-fn get_u16(p: &[u8; PARAM_LEN], slot: Slot) -> u16 {
-    let o = slot.offset();
-    u16::from_le_bytes([p[o], p[o + 1]])
+/// The little-endian word in `slot`.
+pub(crate) fn get_u16(p: &[u8; PARAM_LEN], slot: Slot) -> u16 {
+    let [h0, h1, a0, a1, b0, b1] = *p;
+    u16::from_le_bytes(match slot {
+        Slot::Hip => [h0, h1],
+        Slot::ArmA => [a0, a1],
+        Slot::ArmB => [b0, b1],
+    })
 }
 
-fn put_u16(p: &mut [u8; PARAM_LEN], slot: Slot, v: u16) {
-    let o = slot.offset();
-    let b = v.to_le_bytes();
-    p[o] = b[0];
-    p[o + 1] = b[1];
+/// Writes `v` into `slot`, little-endian.
+pub(crate) fn put_u16(p: &mut [u8; PARAM_LEN], slot: Slot, v: u16) {
+    let [h0, h1, a0, a1, b0, b1] = p;
+    let (lo, hi) = match slot {
+        Slot::Hip => (h0, h1),
+        Slot::ArmA => (a0, a1),
+        Slot::ArmB => (b0, b1),
+    };
+    [*lo, *hi] = v.to_le_bytes();
 }
+
+/// The parameter byte of a reconfiguration's and a primitive's target state (packet byte 8),
+/// and of a reconfiguration's initial state (byte 9): slot `ArmA`'s two.
+const TARGET_STATE: usize = 2;
+const INITIAL_STATE: usize = 3;
+const _: () = assert!(TARGET_STATE == Slot::ArmA.offset());
 
 /// Which of the six parameter bytes a command uses, as a mask over them read as one
 /// little-endian word ([`params_word`]): byte `i` is bits `8 * i..8 * i + 8`.
@@ -211,12 +235,24 @@ const NONE: Used = 0;
 
 /// The two bytes of `slot`.
 const fn slot_bytes(slot: Slot) -> Used {
-    0xffff << (8 * slot.offset())
+    match slot {
+        Slot::Hip => byte(0) | byte(1),
+        Slot::ArmA => byte(2) | byte(3),
+        Slot::ArmB => byte(4) | byte(5),
+    }
 }
 
-/// Parameter byte `i` alone.
+/// Parameter byte `i` alone (none for an `i` beyond the six).
 const fn byte(i: usize) -> Used {
-    0xff << (8 * i)
+    match i {
+        0 => 0xff,
+        1 => 0xff << 8,
+        2 => 0xff << 16,
+        3 => 0xff << 24,
+        4 => 0xff << 32,
+        5 => 0xff << 40,
+        _ => NONE,
+    }
 }
 
 /// The six parameter bytes as one word, byte `i` in bits `8 * i..8 * i + 8`.
@@ -237,11 +273,17 @@ fn unused_zero(id: u8, p: &[u8; PARAM_LEN], used: Used) -> Result<(), CommandErr
         return Ok(());
     }
     // `used` covers whole bytes, so the lowest stray byte is the packet's byte as it is.
-    let i = stray.trailing_zeros() as usize / 8;
+    let (i, found) = stray
+        .to_le_bytes()
+        .into_iter()
+        .enumerate()
+        .find(|&(_, b)| b != 0)
+        .unwrap_or_default(); // never: `stray` is not 0
     Err(CommandError::UnusedNotZero {
         id,
-        index: PARAM_OFFSET + i,
-        found: (stray >> (8 * i)) as u8,
+        // i < 6: never saturates.
+        index: PARAM_OFFSET.saturating_add(i),
+        found,
     })
 }
 
@@ -256,10 +298,14 @@ const PRIMITIVE_LAST: u8 = PRIMITIVE + 8;
 const POWER_LAST: u8 = POWER_OFF + 7;
 const _: () = assert!(GRIPPER == ARM + 8 && POWER_OFF == POWER_ON + 8);
 
+// The decoders below take `id - base` only for an `id` that `decode`'s match has placed in
+// `base`'s block, so no `saturating_sub` of theirs saturates; the encoder adds to a base an
+// offset below 8, and no opcode comes near 255, so no `saturating_add` saturates either.
+
 /// Arm and gripper opcodes (`ARM..=SERVO_LAST`): per module two blocks of four (side A,
 /// side B), each contract, extend, position and one unassigned.
 const fn is_servo(id: u8) -> bool {
-    (id - ARM) % 4 != 3
+    id.saturating_sub(ARM) % 4 != 3
 }
 
 /// An arm or gripper command; a position uses its side's parameter slot.
@@ -268,12 +314,12 @@ fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandE
     let base = if id < GRIPPER { ARM } else { GRIPPER };
     let side = side_of(id, base);
     let slot = Slot::for_side(side);
-    let (target, used) = match (id - base) % 4 {
+    let (target, used) = match id.saturating_sub(base) % 4 {
         0 => (ServoTarget::Contract, NONE),
         1 => (ServoTarget::Extend, NONE),
         _ => {
             let raw = get_u16(p, slot);
-            let index = PARAM_OFFSET + slot.offset();
+            let index = slot.index();
             let pw =
                 PulseWidth::new(raw).map_err(|_| CommandError::PulseWidth { index, found: raw })?;
             let (kind, travel) = if base == ARM {
@@ -305,7 +351,7 @@ fn decode_servo(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandE
 /// A hip command: the four presets, or an angle in the hip slot.
 #[inline(always)] // one caller, `decode`
 fn decode_hip(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandError> {
-    Ok(match id - HIP {
+    Ok(match id.saturating_sub(HIP) {
         0 => (Command::Hip(HipTarget::Home), NONE),
         1 => (Command::Hip(HipTarget::Straight), NONE),
         2 => (Command::Hip(HipTarget::RightAngleCw), NONE),
@@ -325,7 +371,7 @@ fn decode_hip(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandErr
 #[inline]
 fn decode_bolter(id: u8) -> BolterCommand {
     let base = if id < UNBOLT { BOLT } else { UNBOLT };
-    let which = match BolterPair::from_number(id - base + 1) {
+    let which = match BolterPair::from_number(id.saturating_sub(base).saturating_add(1)) {
         Some(n) => Fasteners::Pair(n),
         None => Fasteners::All,
     };
@@ -336,11 +382,14 @@ fn decode_bolter(id: u8) -> BolterCommand {
     }
 }
 
-/// The state in parameter byte `i`: missing when 0, invalid when no Table 5 letter.
+/// The state in parameter byte `I`: missing when 0, invalid when no Table 5 letter.
 #[inline]
-fn state_at(p: &[u8; PARAM_LEN], i: usize) -> Result<State, CommandError> {
-    let index = PARAM_OFFSET + i;
-    match p[i] {
+fn state_at<const I: usize>(p: &[u8; PARAM_LEN]) -> Result<State, CommandError> {
+    let index = const { PARAM_OFFSET + I };
+    let Some(&b) = p.get(I) else {
+        return Err(CommandError::MissingState { index }); // never: I is 2 or 3
+    };
+    match b {
         0 => Err(CommandError::MissingState { index }),
         b => State::from_wire(b).ok_or(CommandError::State { index, found: b }),
     }
@@ -350,9 +399,8 @@ fn state_at(p: &[u8; PARAM_LEN], i: usize) -> Result<State, CommandError> {
 /// (Table 2's "final state / init state").
 #[inline(always)] // one caller, `decode`
 fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandError> {
-    let at = Slot::ArmA.offset();
-    let target = state_at(p, at)?;
-    let initial = state_at(p, at + 1)?;
+    let target = state_at::<TARGET_STATE>(p)?;
+    let initial = state_at::<INITIAL_STATE>(p)?;
     Ok((
         Command::Reconfigure(Reconfiguration::new(initial, target)?),
         slot_bytes(Slot::ArmA),
@@ -365,14 +413,13 @@ fn decode_reconfigure(p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandErr
 /// of the map from there (spec/decisions.toml: primitive-final-state).
 #[inline(always)] // one caller, `decode`
 fn decode_primitive(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), CommandError> {
-    let Some(primitive) = Primitive::from_number(id - PRIMITIVE) else {
+    let Some(primitive) = Primitive::from_number(id.saturating_sub(PRIMITIVE)) else {
         return Err(CommandError::UnknownId { id });
     };
-    let at = Slot::ArmA.offset();
-    let target = state_at(p, at)?;
+    let target = state_at::<TARGET_STATE>(p)?;
     Ok((
         Command::Primitive(PrimitiveMove::new(primitive, target)?),
-        byte(at),
+        byte(TARGET_STATE),
     ))
 }
 
@@ -380,7 +427,7 @@ fn decode_primitive(id: u8, p: &[u8; PARAM_LEN]) -> Result<(Command, Used), Comm
 #[inline]
 fn decode_power(id: u8) -> Command {
     let on = id < POWER_OFF;
-    let i = (id - POWER_ON) % 8;
+    let i = id.saturating_sub(POWER_ON) % 8;
     let target = match Module::from_index(i) {
         Some(m) => PowerTarget::Module(m),
         None => PowerTarget::All,
@@ -389,7 +436,7 @@ fn decode_power(id: u8) -> Command {
 }
 
 fn side_of(id: u8, base: u8) -> Side {
-    if id - base >= 4 {
+    if id.saturating_sub(base) >= 4 {
         Side::B
     } else {
         Side::A
@@ -401,14 +448,15 @@ pub fn encode(c: &Command) -> (u8, [u8; PARAM_LEN]) {
     let mut p = [0u8; PARAM_LEN];
     let servo = |base: u8, side: Side, target: ServoTarget, p: &mut [u8; PARAM_LEN]| {
         let side_off = if side == Side::B { 4 } else { 0 };
-        match target {
-            ServoTarget::Contract => base + side_off,
-            ServoTarget::Extend => base + side_off + 1,
+        let k = match target {
+            ServoTarget::Contract => 0,
+            ServoTarget::Extend => 1,
             ServoTarget::Position(pw) => {
                 put_u16(p, Slot::for_side(side), pw.micros());
-                base + side_off + 2
+                2
             }
-        }
+        };
+        base.saturating_add(side_off | k)
     };
     let id = match *c {
         Command::Heartbeat => HEARTBEAT,
@@ -416,7 +464,7 @@ pub fn encode(c: &Command) -> (u8, [u8; PARAM_LEN]) {
         Command::Reset => RESET,
         Command::SystemFault => SYSTEM_FAULT,
         Command::ClearFaults => CLEAR_FAULTS,
-        Command::Mode(m) => MODE + m.to_wire() - 1,
+        Command::Mode(m) => (MODE - 1).saturating_add(m.to_wire()),
         Command::Arm { side, target } => servo(ARM, side, target, &mut p),
         Command::Gripper { side, target } => servo(GRIPPER, side, target, &mut p),
         Command::Hip(h) => match h {
@@ -430,26 +478,26 @@ pub fn encode(c: &Command) -> (u8, [u8; PARAM_LEN]) {
             }
         },
         Command::Bolter(b) => match b {
-            BolterCommand::Bolt(Fasteners::Pair(n)) => BOLT + n.number() - 1,
+            BolterCommand::Bolt(Fasteners::Pair(n)) => (BOLT - 1).saturating_add(n.number()),
             BolterCommand::Bolt(Fasteners::All) => BOLT + 4,
-            BolterCommand::Unbolt(Fasteners::Pair(n)) => UNBOLT + n.number() - 1,
+            BolterCommand::Unbolt(Fasteners::Pair(n)) => (UNBOLT - 1).saturating_add(n.number()),
             BolterCommand::Unbolt(Fasteners::All) => UNBOLT + 4,
             BolterCommand::Down => BOLTERS_DOWN,
         },
         Command::Primitive(m) => {
-            p[Slot::ArmA.offset()] = m.target().to_wire();
-            PRIMITIVE + m.primitive().number()
+            p[TARGET_STATE] = m.target().to_wire();
+            PRIMITIVE.saturating_add(m.primitive().number())
         }
         Command::Reconfigure(r) => {
-            p[Slot::ArmA.offset()] = r.target().to_wire();
-            p[Slot::ArmA.offset() + 1] = r.initial().to_wire();
+            p[TARGET_STATE] = r.target().to_wire();
+            p[INITIAL_STATE] = r.initial().to_wire();
             RECONFIGURE
         }
         Command::Power { target, on } => {
             let base = if on { POWER_ON } else { POWER_OFF };
             match target {
-                PowerTarget::Module(m) => base + m.index(),
-                PowerTarget::All => base + 7,
+                PowerTarget::Module(m) => base.saturating_add(m.index()),
+                PowerTarget::All => base.saturating_add(7),
             }
         }
     };
@@ -472,7 +520,7 @@ pub fn decode(id: u8, p: [u8; PARAM_LEN]) -> Result<Command, CommandError> {
         RESET => (Command::Reset, NONE),
         SYSTEM_FAULT => (Command::SystemFault, NONE),
         CLEAR_FAULTS => (Command::ClearFaults, NONE),
-        MODE..=MODE_LAST => match Mode::from_wire(id - MODE + 1) {
+        MODE..=MODE_LAST => match Mode::from_wire(id.saturating_sub(MODE - 1)) {
             Some(m) => (Command::Mode(m), NONE),
             None => return Err(CommandError::UnknownId { id }),
         },
