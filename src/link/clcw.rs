@@ -88,7 +88,7 @@ impl FarmBCounter {
 
     /// The next count, wrapping from 3 to 0 (the counter is its two low bits).
     pub const fn wrapping_next(self) -> FarmBCounter {
-        FarmBCounter((self.0 + 1) & 3)
+        FarmBCounter(self.0.wrapping_add(1) & 3)
     }
 }
 
@@ -234,24 +234,25 @@ impl Clcw {
     /// [`Clcw::parse`] does after the length.
     pub fn from_word(w: u32) -> Result<Clcw, ClcwError> {
         use field::*;
-        let bits = |shift: u32, width: u32| ((w >> shift) & ((1 << width) - 1)) as u8;
+        // The field's mask is written out (0b1, 0b11, …): its width is the mask's ones.
+        let bits = |shift: u32, mask: u8| super::low::u8_of_u32(w >> shift) & mask;
         let flag = |shift: u32| (w >> shift) & 1 == 1;
-        if bits(TYPE, 1) != CONTROL_WORD_TYPE {
+        if bits(TYPE, 0b1) != CONTROL_WORD_TYPE {
             return Err(ClcwError::ControlWordType {
                 expected: CONTROL_WORD_TYPE,
-                found: bits(TYPE, 1),
+                found: bits(TYPE, 0b1),
             });
         }
-        if bits(VERSION, 2) != CLCW_VERSION {
+        if bits(VERSION, 0b11) != CLCW_VERSION {
             return Err(ClcwError::Version {
                 expected: CLCW_VERSION,
-                found: bits(VERSION, 2),
+                found: bits(VERSION, 0b11),
             });
         }
-        if bits(COP, 2) != COP_1 {
+        if bits(COP, 0b11) != COP_1 {
             return Err(ClcwError::CopInEffect {
                 expected: COP_1,
-                found: bits(COP, 2),
+                found: bits(COP, 0b11),
             });
         }
         if w & SPARE_MASK != 0 {
@@ -260,34 +261,34 @@ impl Clcw {
             });
         }
         Ok(Clcw {
-            status: StatusField(bits(STATUS, 3)),
-            vcid: ClcwVcid(bits(VCID, 6)),
+            status: StatusField(bits(STATUS, 0b111)),
+            vcid: ClcwVcid(bits(VCID, 0x3f)),
             no_rf_available: flag(NO_RF),
             no_bit_lock: flag(NO_BIT_LOCK),
             lockout: flag(LOCKOUT),
             wait: flag(WAIT),
             retransmit: flag(RETRANSMIT),
-            farm_b_counter: FarmBCounter(bits(FARM_B, 2)),
-            report_value: w as u8,
+            farm_b_counter: FarmBCounter(bits(FARM_B, 0b11)),
+            report_value: super::low::u8_of_u32(w),
         })
     }
 
     /// The 32-bit word, the fixed fields written as 232.0-B-4 §4.2.1 says.
     pub fn to_word(&self) -> u32 {
         use field::*;
-        let flag = |b: bool, shift: u32| (b as u32) << shift;
-        ((CONTROL_WORD_TYPE as u32) << TYPE)
-            | ((CLCW_VERSION as u32) << VERSION)
-            | ((self.status.get() as u32 & 0b111) << STATUS)
-            | ((COP_1 as u32) << COP)
-            | ((self.vcid.get() as u32 & 0x3f) << VCID)
+        let flag = |b: bool, shift: u32| u32::from(b) << shift;
+        (u32::from(CONTROL_WORD_TYPE) << TYPE)
+            | (u32::from(CLCW_VERSION) << VERSION)
+            | (u32::from(self.status.get() & 0b111) << STATUS)
+            | (u32::from(COP_1) << COP)
+            | (u32::from(self.vcid.get() & 0x3f) << VCID)
             | flag(self.no_rf_available, NO_RF)
             | flag(self.no_bit_lock, NO_BIT_LOCK)
             | flag(self.lockout, LOCKOUT)
             | flag(self.wait, WAIT)
             | flag(self.retransmit, RETRANSMIT)
-            | ((self.farm_b_counter.get() as u32 & 0b11) << FARM_B)
-            | self.report_value as u32
+            | (u32::from(self.farm_b_counter.get() & 0b11) << FARM_B)
+            | u32::from(self.report_value)
     }
 
     /// The four octets, high first.

@@ -184,7 +184,7 @@ impl<const N: usize> Extractor<N> {
             }
             let gap = count.wrapping_sub(last).wrapping_sub(1);
             if gap != 0 {
-                c.lost_frames = c.lost_frames.wrapping_add(gap as u32);
+                c.lost_frames = c.lost_frames.wrapping_add(u32::from(gap));
                 self.abandon();
             }
         }
@@ -196,7 +196,7 @@ impl<const N: usize> Extractor<N> {
                 return;
             }
             FirstHeaderPointer::NoPacketStart => None,
-            FirstHeaderPointer::Packet(p) => Some((p as usize).min(data.len())),
+            FirstHeaderPointer::Packet(p) => Some(usize::from(p).min(data.len())),
         };
         if matches!(self.state, State::Header) && self.buf.is_empty() {
             // Between packets: the next one starts at octet 0 of this data field.
@@ -243,21 +243,24 @@ impl<const N: usize> Extractor<N> {
     /// by the next packet's header, without, the feeding stops there (the octets before a
     /// first header pointer belong to one packet). Returns the octets used.
     fn feed(&mut self, bytes: &[u8], starts: bool, on_packet: &mut impl FnMut(&[u8])) -> usize {
-        let mut at = 0;
+        // `at` stays within `bytes` (each step takes at most what is left), and a body's `got`
+        // stays below its `total` (a packet is its 6 header octets and at least one more):
+        // the saturating forms below never saturate.
+        let mut at = 0usize;
         while at < bytes.len() {
             let rest = bytes.get(at..).unwrap_or(&[]);
             match self.state {
                 State::Sync => break,
-                State::Header => at += self.feed_header(rest),
+                State::Header => at = at.saturating_add(self.feed_header(rest)),
                 State::Body { total, got, kind } => {
-                    let take = (total - got).min(rest.len());
+                    let take = total.saturating_sub(got).min(rest.len());
                     if kind == Kind::Keep {
                         for &b in rest.get(..take).unwrap_or(&[]) {
                             let _ = self.buf.push(b);
                         }
                     }
-                    at += take;
-                    let got = got + take;
+                    at = at.saturating_add(take);
+                    let got = got.saturating_add(take);
                     if got < total {
                         self.state = State::Body { total, got, kind };
                         continue;
@@ -277,7 +280,8 @@ impl<const N: usize> Extractor<N> {
     /// length and what becomes of it (kept, idle, or too long for the buffer: counted, and
     /// skipped). Returns the octets used.
     fn feed_header(&mut self, bytes: &[u8]) -> usize {
-        let take = (PRIMARY_LEN - self.buf.len()).min(bytes.len());
+        // The buffer holds less than a header while one is collected.
+        let take = PRIMARY_LEN.saturating_sub(self.buf.len()).min(bytes.len());
         for &b in bytes.get(..take).unwrap_or(&[]) {
             let _ = self.buf.push(b);
         }

@@ -172,7 +172,7 @@ impl<P: Clone, const K: usize> Fop<P, K> {
     /// FOP-1 in Initial (S6), V(S) = NN(R) = 0, the window clamped to the sent queue's
     /// capacity.
     pub fn new(config: FopConfig) -> Fop<P, K> {
-        let cap = if K > 255 { 255 } else { K as u8 };
+        let cap = u8::try_from(K).unwrap_or(u8::MAX);
         Fop {
             state: FopState::Initial,
             config: FopConfig {

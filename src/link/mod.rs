@@ -32,6 +32,30 @@ pub mod tc_frame;
 pub mod tm_frame;
 pub mod tm_framer;
 
+/// A word's low bits as a narrower integer, what `as` would keep, taken through the word's
+/// octets (the standard's R5: no `as`). The fields of the headers are masked or shifted
+/// first, so that nothing above is dropped; where the word is wider on purpose (the CLCW's
+/// report value is its last octet) that is the point.
+pub(crate) mod low {
+    /// The low octet of a 16-bit word.
+    pub(crate) const fn u8_of_u16(w: u16) -> u8 {
+        let [_, low] = w.to_be_bytes();
+        low
+    }
+
+    /// The low octet of a 32-bit word.
+    pub(crate) const fn u8_of_u32(w: u32) -> u8 {
+        let [.., low] = w.to_be_bytes();
+        low
+    }
+
+    /// The low octet of a `usize` (whatever its width).
+    pub(crate) const fn u8_of_usize(w: usize) -> u8 {
+        let [.., low] = w.to_be_bytes();
+        low
+    }
+}
+
 /// Which service a TC transfer frame asks for: its bypass and control command flags
 /// (232.0-B-4 §4.1.2.3). The fourth combination (bypass clear, control command set) is not a
 /// frame type, and [`tc_frame`] refuses it by name.

@@ -135,7 +135,9 @@ ranged! {
 impl SpacecraftId {
     /// The spacecraft ID of board `board`'s robot: `0x100 + n` (`spec/ccsds/link.toml`).
     pub const fn of_board(board: BoardNumber) -> SpacecraftId {
-        SpacecraftId(SPACECRAFT_ID_BASE + board.get() as u16)
+        // A board number is at most 255 (its octet widened through from_be_bytes, which a
+        // const fn may call): the sum stays below 0x200.
+        SpacecraftId(SPACECRAFT_ID_BASE.saturating_add(u16::from_be_bytes([0, board.get()])))
     }
 
     /// The 10 bits of `v` (the others dropped): for decoding, where the bits hold no more.
@@ -217,7 +219,7 @@ impl TcFrameConfig<'_> {
     /// The shortest frame: the primary header, one data field octet (232.0-B-4 §4.1.3.1: the
     /// data field holds at least one; Unlock is one), and the FECF.
     pub const fn min_frame_len(&self) -> usize {
-        TC_PRIMARY_HEADER_LEN + 1 + self.fecf_len()
+        (TC_PRIMARY_HEADER_LEN + 1).saturating_add(self.fecf_len())
     }
 
     fn vc(&self, vcid: u8) -> Option<&VcConfig> {

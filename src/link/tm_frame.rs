@@ -138,8 +138,7 @@ impl TmFrameParams {
         ocf: bool,
         fecf: bool,
     ) -> Option<TmFrameParams> {
-        let overhead =
-            PRIMARY_HEADER_LEN + if ocf { OCF_LEN } else { 0 } + if fecf { FECF_LEN } else { 0 };
+        let overhead = overhead(ocf, fecf);
         if spacecraft_id > MAX_SPACECRAFT_ID
             || vcid > MAX_VCID
             || frame_len <= overhead
@@ -160,8 +159,8 @@ impl TmFrameParams {
     /// The same channel with a security header of `header` octets and a trailer of
     /// `trailer` around the packet zone (SDLS, 355.0-B-2 §4.1: `crate::link::sdls` gives the
     /// lengths). `None` when no packet octet would be left.
-    pub const fn with_security(self, header: u8, trailer: u8) -> Option<TmFrameParams> {
-        if self.data_len() <= header as usize + trailer as usize {
+    pub fn with_security(self, header: u8, trailer: u8) -> Option<TmFrameParams> {
+        if self.data_len() <= usize::from(header).saturating_add(usize::from(trailer)) {
             return None;
         }
         Some(TmFrameParams {
@@ -171,14 +170,14 @@ impl TmFrameParams {
     }
 
     /// Octets of the security header and trailer ((0, 0) without SDLS).
-    pub const fn security(&self) -> (usize, usize) {
-        (self.security.0 as usize, self.security.1 as usize)
+    pub fn security(&self) -> (usize, usize) {
+        (usize::from(self.security.0), usize::from(self.security.1))
     }
 
     /// Where the packet zone starts: after the primary header and the security header. The
     /// first header pointer counts from here (as YAMCS reads it).
-    pub const fn data_start(&self) -> usize {
-        PRIMARY_HEADER_LEN + self.security.0 as usize
+    pub fn data_start(&self) -> usize {
+        PRIMARY_HEADER_LEN.saturating_add(usize::from(self.security.0))
     }
 
     /// The mission's (`spec/ccsds/link.toml` `[tm]`) for spacecraft `spacecraft_id`: 256
@@ -209,17 +208,36 @@ impl TmFrameParams {
     }
     /// Octets of the packet zone: the frame less header, OCF, FECF and SDLS's security header
     /// and MAC (at least 1).
-    pub const fn data_len(&self) -> usize {
+    pub fn data_len(&self) -> usize {
+        // `new` and `with_security` refuse parameters that leave no data octet: no step
+        // saturates.
         self.frame_len
-            - PRIMARY_HEADER_LEN
-            - if self.ocf { OCF_LEN } else { 0 }
-            - if self.fecf { FECF_LEN } else { 0 }
-            - self.security.0 as usize
-            - self.security.1 as usize
+            .saturating_sub(overhead(self.ocf, self.fecf))
+            .saturating_sub(usize::from(self.security.0))
+            .saturating_sub(usize::from(self.security.1))
+    }
+    /// Where the packet zone lies in a frame: `data_start()` and `data_len()` octets on.
+    pub fn data_range(&self) -> core::ops::Range<usize> {
+        let start = self.data_start();
+        // Within the frame (a few hundred octets): the sum cannot saturate.
+        start..start.saturating_add(self.data_len())
     }
     /// Where the OCF starts (if there is one): right after the data field (the MAC's end).
-    pub const fn ocf_start(&self) -> usize {
-        self.data_start() + self.data_len() + self.security.1 as usize
+    pub fn ocf_start(&self) -> usize {
+        // At most the frame's length (the parts of a frame, a few hundred octets).
+        self.data_start()
+            .saturating_add(self.data_len())
+            .saturating_add(usize::from(self.security.1))
+    }
+}
+
+/// The octets of a frame outside its data field and SDLS: primary header, OCF, FECF.
+const fn overhead(ocf: bool, fecf: bool) -> usize {
+    match (ocf, fecf) {
+        (false, false) => PRIMARY_HEADER_LEN,
+        (true, false) => PRIMARY_HEADER_LEN + OCF_LEN,
+        (false, true) => PRIMARY_HEADER_LEN + FECF_LEN,
+        (true, true) => PRIMARY_HEADER_LEN + OCF_LEN + FECF_LEN,
     }
 }
 

@@ -78,8 +78,9 @@ pub const IDLE_PERIOD_MS: u32 = 500;
 
 /// The primary header of an idle packet of `len` octets (7..=65542).
 pub const fn idle_header(len: usize) -> [u8; PRIMARY_LEN] {
-    let data_length = len.saturating_sub(MIN_PACKET_LEN) as u16;
-    let [l0, l1] = data_length.to_be_bytes();
+    // The packet data length field: the low 16 bits (what `as u16` kept), in range for
+    // the lengths this takes.
+    let [.., l0, l1] = len.saturating_sub(MIN_PACKET_LEN).to_be_bytes();
     // Version 0, type TM, no secondary header, APID 0x7FF; unsegmented, count 0.
     [0x07, 0xff, 0xc0, 0x00, l0, l1]
 }
@@ -160,7 +161,8 @@ impl<const N: usize> TmFramer<N> {
 
     /// Octets [`TmFramer::push`] can take now.
     pub fn free(&self) -> usize {
-        N - self.queue.len()
+        // The queue holds at most N octets.
+        N.saturating_sub(self.queue.len())
     }
 
     /// Queues one whole space packet (any APID, PUS or not: its primary header's length field
@@ -190,7 +192,8 @@ impl<const N: usize> TmFramer<N> {
     /// period has elapsed since the last frame (or none has gone yet), so that the CLCW
     /// reaches the ground that often.
     pub fn frame_due(&self, now_ms: u32) -> bool {
-        if self.queue.len() + self.idle_tail >= self.params.data_len() {
+        // Both bounded by the queue's capacity and 6: the sum cannot saturate.
+        if self.queue.len().saturating_add(self.idle_tail) >= self.params.data_len() {
             return true;
         }
         match self.last_frame_ms {
@@ -222,7 +225,7 @@ impl<const N: usize> TmFramer<N> {
         } else {
             FirstHeaderPointer::NoPacketStart
         };
-        if let Some(data) = frame.get_mut(p.data_start()..p.data_start() + p.data_len()) {
+        if let Some(data) = frame.get_mut(p.data_range()) {
             if only_idle {
                 data.fill(IDLE_OCTET);
             } else {
@@ -248,52 +251,57 @@ impl<const N: usize> TmFramer<N> {
     /// Fills `data` from the idle tail, the packet in flight, whole packets and an idle packet,
     /// in that order; `fhp` gets the offset of the first packet start.
     fn fill(&mut self, data: &mut [u8], fhp: &mut FirstHeaderPointer) {
+        // `at` never passes `len`, each `n` is at most what it is taken from, and the idle
+        // tail is shorter than an idle packet: the saturating forms never saturate.
         let len = data.len();
-        let mut at = 0;
+        let mut at = 0usize;
         // 1. The spilled tail of a 7-octet idle packet.
         if self.idle_tail > 0 {
             let idle = idle_packet_7();
-            let from = MIN_PACKET_LEN - self.idle_tail;
+            let from = MIN_PACKET_LEN.saturating_sub(self.idle_tail);
             let n = self.idle_tail.min(len);
-            copy(data, at, idle.get(from..from + n).unwrap_or(&[]));
-            self.idle_tail -= n;
-            at += n;
+            let tail = idle.get(from..).and_then(|t| t.get(..n));
+            copy(data, at, tail.unwrap_or(&[]));
+            self.idle_tail = self.idle_tail.saturating_sub(n);
+            at = at.saturating_add(n);
         }
         // 2. The rest of the packet in flight.
         if at < len && self.in_flight > 0 {
-            let n = self.in_flight.min(len - at);
+            let n = self.in_flight.min(len.saturating_sub(at));
             self.pop_into(data, at, n);
-            self.in_flight -= n;
-            at += n;
+            self.in_flight = self.in_flight.saturating_sub(n);
+            at = at.saturating_add(n);
         }
         // 3. Whole packets, the last one perhaps cut (it continues in the next frame).
         while at < len && !self.queue.is_empty() {
             self.mark(fhp, at);
             let total = self.head_len();
-            let n = total.min(len - at);
+            let n = total.min(len.saturating_sub(at));
             self.pop_into(data, at, n);
-            self.in_flight = total - n;
-            at += n;
+            self.in_flight = total.saturating_sub(n);
+            at = at.saturating_add(n);
         }
         // 4. An idle packet in the rest, spilling over if the rest is shorter than 7 octets.
         if at < len {
             self.mark(fhp, at);
-            let room = len - at;
+            let room = len.saturating_sub(at);
             if room >= MIN_PACKET_LEN {
                 copy(data, at, &idle_header(room));
-                if let Some(rest) = data.get_mut(at + PRIMARY_LEN..) {
+                let body = data.get_mut(at..).and_then(|p| p.get_mut(PRIMARY_LEN..));
+                if let Some(rest) = body {
                     rest.fill(IDLE_OCTET);
                 }
             } else {
                 copy(data, at, idle_packet_7().get(..room).unwrap_or(&[]));
-                self.idle_tail = MIN_PACKET_LEN - room;
+                self.idle_tail = MIN_PACKET_LEN.saturating_sub(room);
             }
         }
     }
 
     fn mark(&self, fhp: &mut FirstHeaderPointer, at: usize) {
-        if *fhp == FirstHeaderPointer::NoPacketStart {
-            *fhp = FirstHeaderPointer::Packet(at as u16);
+        // `at` lies in the data field, under MAX_FRAME_LEN octets: it fits the pointer.
+        if let (FirstHeaderPointer::NoPacketStart, Ok(at)) = (*fhp, u16::try_from(at)) {
+            *fhp = FirstHeaderPointer::Packet(at);
         }
     }
 

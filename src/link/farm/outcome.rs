@@ -48,8 +48,16 @@ impl DiscardReason {
         }
     }
 
+    /// The reason's place in [`DiscardReason::ALL`] (and in the counters).
     const fn index(self) -> usize {
-        self as usize
+        match self {
+            DiscardReason::NoBuffer => 0,
+            DiscardReason::Ahead => 1,
+            DiscardReason::Behind => 2,
+            DiscardReason::LockoutArea => 3,
+            DiscardReason::Locked => 4,
+            DiscardReason::Invalid => 5,
+        }
     }
 }
 
@@ -119,6 +127,19 @@ impl FarmCounters {
             }
             Verdict::Control { .. } => self.control = self.control.wrapping_add(1),
             Verdict::Released => {}
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DiscardReason;
+
+    /// The counters' order is the one `ALL` documents.
+    #[test]
+    fn index_is_the_place_in_all() {
+        for (i, r) in DiscardReason::ALL.iter().enumerate() {
+            assert_eq!(r.index(), i, "{r:?}");
         }
     }
 }

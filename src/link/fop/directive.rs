@@ -154,7 +154,7 @@ impl<P: Clone, const K: usize> Fop<P, K> {
     fn set_parameter(&mut self, d: Directive) -> DirectiveResponse {
         use DirectiveResponse::*;
         match d {
-            Directive::SetWindow(k) if k >= 1 && (k as usize) <= K => self.config.window = k,
+            Directive::SetWindow(k) if k >= 1 && usize::from(k) <= K => self.config.window = k,
             Directive::SetT1(t) => self.config.t1_ms = t,
             Directive::SetTxLimit(n) if n >= 1 => self.config.tx_limit = n,
             Directive::SetTimeoutType(t) => self.config.timeout_type = t,

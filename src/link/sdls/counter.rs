@@ -82,9 +82,14 @@ impl TxCounter {
     /// The reservation to write now, when half a block or less is left (and the counter
     /// space is not spent).
     pub fn due(&self) -> Option<u128> {
-        let left = self.reserved - self.next;
-        (left <= u128::from(self.block / 2) && self.reserved < IV_SPACE)
-            .then(|| (self.reserved + u128::from(self.block)).min(IV_SPACE))
+        // next <= reserved <= IV_SPACE = 2^96 always (boot, persisted and take keep it), so
+        // neither saturating form below saturates in a u128.
+        let left = self.reserved.saturating_sub(self.next);
+        (left <= u128::from(self.block / 2) && self.reserved < IV_SPACE).then(|| {
+            self.reserved
+                .saturating_add(u128::from(self.block))
+                .min(IV_SPACE)
+        })
     }
 
     /// The shell wrote `value` durably: IVs below it may now be used. A value at or below
@@ -109,7 +114,8 @@ impl TxCounter {
             });
         }
         let iv = Iv::wrapping(self.next);
-        self.next += 1;
+        // Below IV_SPACE = 2^96 (checked above): far from u128's bound.
+        self.next = self.next.saturating_add(1);
         Ok(iv)
     }
 }
@@ -206,7 +212,8 @@ impl ReplayWindow {
             });
         }
         self.last = iv;
-        self.ahead -= d;
+        // d <= ahead here (checked above).
+        self.ahead = self.ahead.saturating_sub(d);
         self.demand = self.demand.saturating_sub(d);
         Ok(())
     }
@@ -231,7 +238,12 @@ impl ReplayWindow {
     pub fn due(&self) -> Option<u128> {
         let short = self.ahead <= u128::from(self.block / 2) || self.demand > self.ahead;
         short.then(|| {
-            let ahead = (self.ahead.max(self.demand) + u128::from(self.block)).min(HALF - 1);
+            // Both below 2^96 (distances modulo the IV space): the sum cannot saturate.
+            let ahead = self
+                .ahead
+                .max(self.demand)
+                .saturating_add(u128::from(self.block))
+                .min(HALF - 1);
             self.last.wrapping_add(ahead).get()
         })
     }

@@ -28,15 +28,30 @@ use core::ops::Range;
 pub const TC_MAX_DATA: usize =
     MAX_FRAME_LEN - TC_PRIMARY_HEADER_LEN - SEGMENT_HEADER_LEN - OVERHEAD - FECF_LEN;
 
+/// A TM channel's parameters with room for SDLS: the security header before the packet zone,
+/// the MAC after it ([`TmFrameParams::with_security`]); `None` when no packet octet would be
+/// left.
+pub fn secured_tm_params(params: TmFrameParams) -> Option<TmFrameParams> {
+    // 14 and 16 octets: both conversions hold.
+    let header = u8::try_from(HEADER_LEN).ok()?;
+    let mac = u8::try_from(MAC_LEN).ok()?;
+    params.with_security(header, mac)
+}
+
 /// Writes the FECF over the rest of the frame.
 fn refresh_fecf(frame: &mut [u8]) {
-    let n = frame.len();
-    if n < FECF_LEN {
-        return;
+    if let Some((body, fecf)) = frame.split_last_chunk_mut::<FECF_LEN>() {
+        *fecf = pec(body).to_be_bytes();
     }
-    let crc = pec(frame.get(..n - FECF_LEN).unwrap_or(&[]));
-    if let Some(f) = frame.get_mut(n - FECF_LEN..) {
-        f.copy_from_slice(&crc.to_be_bytes());
+}
+
+/// Where the security header starts in a TC frame: after the primary header, and after the
+/// segment header when the frame has one.
+const fn tc_sec_start(segmented: bool) -> usize {
+    if segmented {
+        TC_PRIMARY_HEADER_LEN + SEGMENT_HEADER_LEN
+    } else {
+        TC_PRIMARY_HEADER_LEN
     }
 }
 
@@ -57,10 +72,12 @@ pub fn protect_tc<const N: usize>(
     };
     let mut scratch = [0u8; MAX_FRAME_LEN];
     scratch
-        .get_mut(HEADER_LEN..HEADER_LEN + data.len())
+        .get_mut(HEADER_LEN..)
+        .and_then(|s| s.get_mut(..data.len()))
         .ok_or(too_long)?
         .copy_from_slice(data);
-    let field = scratch.get(..data.len() + OVERHEAD).ok_or(too_long)?;
+    let field_len = data.len().checked_add(OVERHEAD).ok_or(too_long)?;
+    let field = scratch.get(..field_len).ok_or(too_long)?;
     let content = match repr.content {
         TcContent::Ad { .. } => TcContent::Ad {
             map_id,
@@ -74,13 +91,9 @@ pub fn protect_tc<const N: usize>(
     let framed = TcFrameRepr { content, ..*repr };
     let n = framed.emit(out).map_err(|_| too_long)?;
     let frame = out.get_mut(..n).ok_or(too_long)?;
-    let sec_start = TC_PRIMARY_HEADER_LEN
-        + if map_id.is_some() {
-            SEGMENT_HEADER_LEN
-        } else {
-            0
-        };
-    table.protect(spi, frame, sec_start, n - FECF_LEN)?;
+    let sec_start = tc_sec_start(map_id.is_some());
+    // The frame was emitted with its FECF: n is at least FECF_LEN.
+    table.protect(spi, frame, sec_start, n.saturating_sub(FECF_LEN))?;
     refresh_fecf(frame);
     Ok(n)
 }
@@ -94,15 +107,10 @@ pub fn verify_tc<const N: usize>(
 ) -> Result<(Verified, Range<usize>), SdlsRefusal> {
     let bytes = frame.as_bytes();
     let n = bytes.len();
-    let sec_start = TC_PRIMARY_HEADER_LEN
-        + if frame.segment().is_some() {
-            SEGMENT_HEADER_LEN
-        } else {
-            0
-        };
+    let sec_start = tc_sec_start(frame.segment().is_some());
     let mac_end = n.saturating_sub(if frame.fecf().is_some() { FECF_LEN } else { 0 });
     let truncated = SdlsRefusal::Truncated {
-        needed: sec_start + OVERHEAD,
+        needed: sec_start.saturating_add(OVERHEAD),
         found: mac_end,
     };
     let copy = buf.get_mut(..n).ok_or(truncated)?;
@@ -112,7 +120,10 @@ pub fn verify_tc<const N: usize>(
         vcid: frame.vcid().get(),
     };
     let verified = table.verify(copy, sec_start, mac_end, channel)?;
-    Ok((verified, sec_start + HEADER_LEN..mac_end - MAC_LEN))
+    // Verified: the frame holds the security header and the MAC between sec_start and
+    // mac_end, so neither bound saturates.
+    let data = sec_start.saturating_add(HEADER_LEN)..mac_end.saturating_sub(MAC_LEN);
+    Ok((verified, data))
 }
 
 /// A TM frame the framer wrote under `params` (with room for SDLS), protected in place under
@@ -157,8 +168,6 @@ pub fn verify_tm<'b, const N: usize>(
         vcid: parsed.vcid,
     };
     let verified = table.verify(copy, PRIMARY_HEADER_LEN, params.ocf_start(), channel)?;
-    let data = buf
-        .get(params.data_start()..params.data_start() + params.data_len())
-        .unwrap_or(&[]);
+    let data = buf.get(params.data_range()).unwrap_or(&[]);
     Ok((verified, TmFrameRepr { data, ..*parsed }))
 }

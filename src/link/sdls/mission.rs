@@ -19,12 +19,12 @@ use crate::units::BoardNumber;
 
 /// The TC association's SPI of robot `n`: 0x100 + n, its spacecraft ID.
 pub const fn tc_spi(board: BoardNumber) -> u16 {
-    0x100 + board.get() as u16
+    u16::from_be_bytes([0x01, board.get()])
 }
 
 /// The TM association's SPI of robot `n`: 0x200 + n.
 pub const fn tm_spi(board: BoardNumber) -> u16 {
-    0x200 + board.get() as u16
+    u16::from_be_bytes([0x02, board.get()])
 }
 
 /// The server board's anti-replay window for telecommands, W = 2^20: an authentic frame up to

@@ -56,10 +56,9 @@ impl AuthMask {
         {
             to.copy_from_slice(from);
         }
-        AuthMask {
-            bytes,
-            len: n as u8,
-        }
+        // n <= MAX_MASK_LEN = 32: its low octet is all of it.
+        let [.., len] = n.to_be_bytes();
+        AuthMask { bytes, len }
     }
 
     /// The mask's octets.
@@ -172,24 +171,31 @@ impl SecurityAssociation {
     }
 
     /// Where the security header starts and the MAC ends must leave room for both and for
-    /// the mask, which may reach no further than the security header.
-    fn layout(&self, len: usize, sec_start: usize, mac_end: usize) -> Result<(), SdlsError> {
-        let needed = sec_start + OVERHEAD;
+    /// the mask, which may reach no further than the security header. Returns where the
+    /// security header ends and the octets of the text between it and the MAC.
+    fn layout(
+        &self,
+        len: usize,
+        sec_start: usize,
+        mac_end: usize,
+    ) -> Result<(usize, usize), SdlsError> {
+        let bad = SdlsError::Layout {
+            sec_start,
+            mac_end,
+            len,
+        };
+        let needed = sec_start.checked_add(OVERHEAD).ok_or(bad)?;
         if mac_end > len || mac_end < needed {
-            return Err(SdlsError::Layout {
-                sec_start,
-                mac_end,
-                len,
-            });
+            return Err(bad);
         }
+        // sec_start + HEADER_LEN + MAC_LEN = needed <= mac_end: neither form saturates.
+        let header_end = sec_start.saturating_add(HEADER_LEN);
+        let text = mac_end.saturating_sub(header_end).saturating_sub(MAC_LEN);
         let mask = self.mask.as_bytes().len();
-        if mask > sec_start + HEADER_LEN {
-            return Err(SdlsError::MaskTooLong {
-                mask,
-                header_end: sec_start + HEADER_LEN,
-            });
+        if mask > header_end {
+            return Err(SdlsError::MaskTooLong { mask, header_end });
         }
-        Ok(())
+        Ok((header_end, text))
     }
 
     /// Protects `frame` in place: its security header at `sec_start`, its MAC ending at
@@ -201,24 +207,25 @@ impl SecurityAssociation {
         sec_start: usize,
         mac_end: usize,
     ) -> Result<Iv, SdlsError> {
-        self.layout(frame.len(), sec_start, mac_end)?;
+        let (header_end, text) = self.layout(frame.len(), sec_start, mac_end)?;
         let Role::Send(counter) = &mut self.role else {
             return Err(SdlsError::NotSender { spi: self.spi });
         };
         let iv = counter.take()?;
-        let (head, rest) = frame.split_at_mut(sec_start + HEADER_LEN);
-        let sec = head.get_mut(sec_start..).ok_or(SdlsError::Layout {
+        // The layout holds both splits (header_end and the text end within the frame).
+        let bad = SdlsError::Layout {
             sec_start,
             mac_end,
             len: 0,
-        })?;
+        };
+        let (head, rest) = frame.split_at_mut_checked(header_end).ok_or(bad)?;
+        let sec = head.get_mut(sec_start..).ok_or(bad)?;
         let (spi, iv_field) = sec.split_at_mut(SPI_LEN);
         spi.copy_from_slice(&self.spi.to_be_bytes());
         iv_field.copy_from_slice(&iv.to_bytes());
         let mut aad = [0u8; MAX_MASK_LEN];
         let aad = self.mask.aad(head, &mut aad).unwrap_or(&[]);
-        let body = mac_end - sec_start - HEADER_LEN;
-        let (plain, trailer) = rest.split_at_mut(body - MAC_LEN);
+        let (plain, trailer) = rest.split_at_mut_checked(text).ok_or(bad)?;
         let tag = self
             .schedule
             .cipher()
@@ -243,10 +250,11 @@ impl SecurityAssociation {
         channel: Channel,
     ) -> Result<Iv, SdlsRefusal> {
         let malformed = SdlsRefusal::Truncated {
-            needed: sec_start + OVERHEAD,
+            needed: sec_start.saturating_add(OVERHEAD),
             found: mac_end.min(frame.len()),
         };
-        self.layout(frame.len(), sec_start, mac_end)
+        let (header_end, text) = self
+            .layout(frame.len(), sec_start, mac_end)
             .map_err(|_| malformed)?;
         let Role::Receive(window) = &mut self.role else {
             return Err(SdlsRefusal::UnknownSpi { spi: self.spi });
@@ -258,17 +266,17 @@ impl SecurityAssociation {
                 found: channel,
             });
         }
-        let (head, rest) = frame.split_at_mut(sec_start + HEADER_LEN);
+        let (head, rest) = frame.split_at_mut_checked(header_end).ok_or(malformed)?;
         let iv_bytes: [u8; IV_LEN] = head
-            .get(sec_start + SPI_LEN..)
+            .get(sec_start..)
+            .and_then(|s| s.get(SPI_LEN..))
             .and_then(|b| b.try_into().ok())
             .ok_or(malformed)?;
         let iv = Iv::from_bytes(iv_bytes);
         window.check(iv)?;
         let mut aad = [0u8; MAX_MASK_LEN];
         let aad = self.mask.aad(head, &mut aad).ok_or(malformed)?;
-        let body = mac_end - sec_start - HEADER_LEN;
-        let (cipher_text, trailer) = rest.split_at_mut(body - MAC_LEN);
+        let (cipher_text, trailer) = rest.split_at_mut_checked(text).ok_or(malformed)?;
         let tag: [u8; MAC_LEN] = trailer
             .get(..MAC_LEN)
             .and_then(|t| t.try_into().ok())

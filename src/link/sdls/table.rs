@@ -173,11 +173,12 @@ impl<const N: usize> SaTable<N> {
         channel: Channel,
     ) -> Result<Verified, SdlsRefusal> {
         let spi = frame
-            .get(sec_start..sec_start + SPI_LEN)
-            .and_then(|b| <[u8; SPI_LEN]>::try_from(b).ok())
+            .get(sec_start..)
+            .and_then(|b| b.first_chunk::<SPI_LEN>())
+            .copied()
             .map(u16::from_be_bytes)
             .ok_or(SdlsRefusal::Truncated {
-                needed: sec_start + super::OVERHEAD,
+                needed: sec_start.saturating_add(super::OVERHEAD),
                 found: frame.len(),
             })?;
         let sa = self.get_mut(spi).ok_or(SdlsRefusal::UnknownSpi { spi })?;

@@ -35,29 +35,32 @@ impl TcPrimaryHeader {
             bypass: b0 & 0x20 != 0,
             control: b0 & 0x10 != 0,
             spare: (b0 >> 2) & 0b11,
-            spacecraft_id: ((b0 & 0b11) as u16) << 8 | b1 as u16,
+            spacecraft_id: u16::from_be_bytes([b0 & 0b11, b1]),
             vcid: b2 >> 2,
-            frame_length: ((b2 & 0b11) as u16) << 8 | b3 as u16,
+            frame_length: u16::from_be_bytes([b2 & 0b11, b3]),
             seq,
         })
     }
 
     /// The frame's total length in octets as the frame length field says: field + 1.
-    pub const fn total_len(&self) -> usize {
-        self.frame_length as usize + 1
+    pub fn total_len(&self) -> usize {
+        // At most 65,536.
+        usize::from(self.frame_length).saturating_add(1)
     }
 
     /// The five octets (fields wider than their bits are masked).
     pub const fn to_bytes(&self) -> [u8; TC_PRIMARY_HEADER_LEN] {
+        let [scid_hi, scid_lo] = self.spacecraft_id.to_be_bytes();
+        let [len_hi, len_lo] = self.frame_length.to_be_bytes();
         [
             (self.version & 0b11) << 6
-                | (self.bypass as u8) << 5
-                | (self.control as u8) << 4
+                | if self.bypass { 1 << 5 } else { 0 }
+                | if self.control { 1 << 4 } else { 0 }
                 | (self.spare & 0b11) << 2
-                | ((self.spacecraft_id >> 8) & 0b11) as u8,
-            self.spacecraft_id as u8,
-            (self.vcid & 0x3f) << 2 | ((self.frame_length >> 8) & 0b11) as u8,
-            self.frame_length as u8,
+                | scid_hi & 0b11,
+            scid_lo,
+            (self.vcid & 0x3f) << 2 | len_hi & 0b11,
+            len_lo,
             self.seq,
         ]
     }

@@ -124,7 +124,9 @@ impl<'a> TcFrameRepr<'a> {
     /// Octets of the frame, with or without the FECF.
     pub const fn len_with(&self, fecf: bool) -> usize {
         let f = if fecf { FECF_LEN } else { 0 };
-        (TC_PRIMARY_HEADER_LEN + f).saturating_add(self.content.data_field_len())
+        TC_PRIMARY_HEADER_LEN
+            .saturating_add(f)
+            .saturating_add(self.content.data_field_len())
     }
 
     /// Writes the frame, FECF included, into the front of `out`; the number of octets
@@ -139,17 +141,20 @@ impl<'a> TcFrameRepr<'a> {
     /// [`TcFrameRepr::emit`], with or without the FECF (for channels without one).
     pub fn emit_with(&self, fecf: bool, out: &mut [u8]) -> Result<usize, TcEmitError> {
         let len = self.len_with(fecf);
+        let too_long = TcEmitError::FrameTooLong {
+            max: TC_MAX_FRAME_LEN,
+            found: len,
+        };
         if len > TC_MAX_FRAME_LEN {
-            return Err(TcEmitError::FrameTooLong {
-                max: TC_MAX_FRAME_LEN,
-                found: len,
-            });
+            return Err(too_long);
         }
         let too_small = TcEmitError::BufferTooSmall {
             expected: len,
             found: out.len(),
         };
         let frame = out.get_mut(..len).ok_or(too_small)?;
+        // len is at most TC_MAX_FRAME_LEN (1,024, checked above): the conversion holds.
+        let frame_length = u16::try_from(len.saturating_sub(1)).map_err(|_| too_long)?;
         let (bypass, control) = self.kind().flags();
         let header = TcPrimaryHeader {
             version: TC_VERSION,
@@ -158,13 +163,14 @@ impl<'a> TcFrameRepr<'a> {
             spare: 0,
             spacecraft_id: self.spacecraft_id.get(),
             vcid: self.vcid.get(),
-            frame_length: (len - 1) as u16,
+            frame_length,
             seq: self.seq,
         };
         let (head, rest) = frame.split_at_mut(TC_PRIMARY_HEADER_LEN);
         head.copy_from_slice(&header.to_bytes());
         let f = if fecf { FECF_LEN } else { 0 };
-        let field_len = rest.len() - f;
+        // The frame holds the FECF it counted (len_with).
+        let field_len = rest.len().saturating_sub(f);
         let field = rest.get_mut(..field_len).ok_or(too_small)?;
         match self.content {
             TcContent::Ad { map_id, data } | TcContent::Bd { map_id, data } => {

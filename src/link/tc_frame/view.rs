@@ -212,8 +212,8 @@ fn check_header(
         });
     }
     let kind = FrameKind::from_flags(header.bypass, header.control).ok_or(TcFrameError::Flags {
-        bypass: header.bypass as u8,
-        control: header.control as u8,
+        bypass: u8::from(header.bypass),
+        control: u8::from(header.control),
     })?;
     if header.spare != 0 {
         return Err(TcFrameError::Spare {
@@ -304,7 +304,8 @@ impl<'a> Iterator for Packets<'a> {
         let needed = PrimaryHeader::read(rest).map_or(PRIMARY_LEN, |h| h.total_len());
         match rest.get(..needed) {
             Some(packet) if PrimaryHeader::read(rest).is_some() => {
-                self.at += needed;
+                // Within `data`: `packet` was taken from it.
+                self.at = self.at.saturating_add(needed);
                 Some(Ok(packet))
             }
             _ => {

@@ -52,15 +52,16 @@ impl<'a> TmFrameRepr<'a> {
         };
         field(
             "spacecraft ID",
-            MAX_SPACECRAFT_ID as u32,
-            self.spacecraft_id as u32,
+            u32::from(MAX_SPACECRAFT_ID),
+            u32::from(self.spacecraft_id),
         )?;
-        field("VCID", MAX_VCID as u32, self.vcid as u32)?;
+        field("VCID", u32::from(MAX_VCID), u32::from(self.vcid))?;
         if let FirstHeaderPointer::Packet(at) = self.first_header_pointer {
             field(
                 "first header pointer",
-                p.data_len().saturating_sub(1).min(0x7fd) as u32,
-                at as u32,
+                // At most 0x7fd, so the conversion cannot fail.
+                u32::try_from(p.data_len().saturating_sub(1).min(0x7fd)).unwrap_or(0x7fd),
+                u32::from(at),
             )?;
         }
         if self.data.len() != p.data_len() {
@@ -80,7 +81,7 @@ impl<'a> TmFrameRepr<'a> {
             found: out.len(),
         };
         let frame = out.get_mut(..p.frame_len).ok_or(too_small)?;
-        if let Some(d) = frame.get_mut(p.data_start()..p.data_start() + p.data_len()) {
+        if let Some(d) = frame.get_mut(p.data_range()) {
             d.copy_from_slice(self.data);
         }
         self.seal(p, frame);
@@ -91,11 +92,11 @@ impl<'a> TmFrameRepr<'a> {
     /// `p.frame_len` octets; the fields already checked): what [`TmFrameRepr::emit`] and the
     /// framer, which builds the data field in place, share. `self.data` is not read.
     pub(crate) fn seal(&self, p: &TmFrameParams, frame: &mut [u8]) {
-        let id = ((VERSION as u16) << 14)
+        let id = (u16::from(VERSION) << 14)
             | ((self.spacecraft_id & MAX_SPACECRAFT_ID) << 4)
-            | (((self.vcid & MAX_VCID) as u16) << 1)
-            | p.ocf as u16;
-        let status = ((SEGMENT_LENGTH_ID as u16) << 11) | self.first_header_pointer.field();
+            | (u16::from(self.vcid & MAX_VCID) << 1)
+            | u16::from(p.ocf);
+        let status = (u16::from(SEGMENT_LENGTH_ID) << 11) | self.first_header_pointer.field();
         let [i0, i1] = id.to_be_bytes();
         let [s0, s1] = status.to_be_bytes();
         let header = [i0, i1, self.mc_frame_count, self.vc_frame_count, s0, s1];
@@ -103,16 +104,15 @@ impl<'a> TmFrameRepr<'a> {
             h.copy_from_slice(&header);
         }
         if let Some(ocf) = self.ocf {
-            let s = p.ocf_start();
-            if let Some(o) = frame.get_mut(s..s + OCF_LEN) {
-                o.copy_from_slice(&ocf);
+            let at = frame.get_mut(p.ocf_start()..);
+            if let Some(o) = at.and_then(|f| f.first_chunk_mut::<OCF_LEN>()) {
+                *o = ocf;
             }
         }
         if p.fecf {
-            let body_len = p.frame_len - FECF_LEN;
-            let crc = pec(frame.get(..body_len).unwrap_or(&[]));
-            if let Some(f) = frame.get_mut(body_len..p.frame_len) {
-                f.copy_from_slice(&crc.to_be_bytes());
+            let whole = frame.get_mut(..p.frame_len);
+            if let Some((body, f)) = whole.and_then(|w| w.split_last_chunk_mut::<FECF_LEN>()) {
+                *f = pec(body).to_be_bytes();
             }
         }
     }

@@ -7,6 +7,7 @@ use super::{
     VERSION,
 };
 use crate::ccsds::pec;
+use crate::link::low::u8_of_u16;
 
 /// A frame whose every [`TmFrameError`] check has passed, over its octets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,7 +49,7 @@ impl<'a> TmFrame<'a> {
     }
     /// VCID (the parameters').
     pub fn vcid(&self) -> u8 {
-        ((self.id() >> 1) & 0x7) as u8
+        u8_of_u16((self.id() >> 1) & 0x7)
     }
     /// Master channel frame count.
     pub fn mc_frame_count(&self) -> u8 {
@@ -67,19 +68,17 @@ impl<'a> TmFrame<'a> {
     }
     /// The data field.
     pub fn data(&self) -> &'a [u8] {
-        self.bytes
-            .get(self.params.data_start()..self.params.data_start() + self.params.data_len())
-            .unwrap_or(&[])
+        self.bytes.get(self.params.data_range()).unwrap_or(&[])
     }
     /// The OCF, when the channel carries one.
     pub fn ocf(&self) -> Option<[u8; OCF_LEN]> {
         if !self.params.ocf {
             return None;
         }
-        let s = self.params.ocf_start();
         self.bytes
-            .get(s..s + OCF_LEN)
-            .and_then(|o| <[u8; OCF_LEN]>::try_from(o).ok())
+            .get(self.params.ocf_start()..)
+            .and_then(|o| o.first_chunk::<OCF_LEN>())
+            .copied()
     }
     /// The frame's fields.
     pub fn repr(&self) -> TmFrameRepr<'a> {
@@ -107,7 +106,7 @@ fn check_fixed(bytes: &[u8], p: &TmFrameParams) -> Result<(u16, u16), TmFrameErr
         });
     }
     let id = u16::from_be_bytes([octet(bytes, 0), octet(bytes, 1)]);
-    let version = (id >> 14) as u8;
+    let version = u8_of_u16(id >> 14);
     if version != VERSION {
         return Err(TmFrameError::Version {
             expected: VERSION,
@@ -153,7 +152,7 @@ fn check_address(id: u16, p: &TmFrameParams) -> Result<(), TmFrameError> {
             found: spacecraft_id,
         });
     }
-    let vcid = ((id >> 1) & 0x7) as u8;
+    let vcid = u8_of_u16((id >> 1) & 0x7);
     if vcid != p.vcid {
         return Err(TmFrameError::Vcid {
             expected: p.vcid,
@@ -174,7 +173,7 @@ fn check_status(status: u16, p: &TmFrameParams) -> Result<(), TmFrameError> {
     if status & 0x2000 != 0 {
         return Err(TmFrameError::PacketOrderFlag);
     }
-    let segment = ((status >> 11) & 0b11) as u8;
+    let segment = u8_of_u16((status >> 11) & 0b11);
     if segment != SEGMENT_LENGTH_ID {
         return Err(TmFrameError::SegmentLengthId {
             expected: SEGMENT_LENGTH_ID,
@@ -182,7 +181,7 @@ fn check_status(status: u16, p: &TmFrameParams) -> Result<(), TmFrameError> {
         });
     }
     let fhp = status & 0x7ff;
-    if fhp as usize >= p.data_len() && fhp != FHP_NO_PACKET_START && fhp != FHP_ONLY_IDLE_DATA {
+    if usize::from(fhp) >= p.data_len() && fhp != FHP_NO_PACKET_START && fhp != FHP_ONLY_IDLE_DATA {
         return Err(TmFrameError::FirstHeaderPointer {
             data_len: p.data_len(),
             found: fhp,

@@ -115,22 +115,28 @@ impl Efficiency {
     /// Adds an attempt's result, forgetting the oldest beyond the window.
     pub fn push(&mut self, ok: bool) {
         let mask = (1u128 << Self::WINDOW) - 1;
-        self.bits = ((self.bits << 1) | ok as u128) & mask;
-        self.len = (self.len + 1).min(Self::WINDOW);
+        self.bits = ((self.bits << 1) | u128::from(ok)) & mask;
+        self.len = self.len.saturating_add(1).min(Self::WINDOW);
     }
 
     /// Successful attempts and attempts in the window.
     pub const fn counts(&self) -> (u8, u8) {
-        (self.bits.count_ones() as u8, self.len)
+        // At most WINDOW = 100 ones (the mask): the count fits its low octet.
+        (
+            crate::link::low::u8_of_u32(self.bits.count_ones()),
+            self.len,
+        )
     }
 
     /// Successful attempts as a whole percentage of the window; none before the first.
     pub const fn percent(&self) -> Option<u8> {
         let (ok, n) = self.counts();
-        if n == 0 {
-            None
-        } else {
-            Some(((ok as u32 * 100 + n as u32 / 2) / n as u32) as u8)
+        // Widened through from_be_bytes (a const fn may not call From): ok <= n <= 100, so
+        // the sum is at most 10,050 and the quotient at most 100, and n = 0 gives None.
+        let (ok, n) = (u16::from_be_bytes([0, ok]), u16::from_be_bytes([0, n]));
+        match ok.saturating_mul(100).saturating_add(n / 2).checked_div(n) {
+            Some(p) => Some(crate::link::low::u8_of_u16(p)),
+            None => None,
         }
     }
 }
@@ -327,7 +333,8 @@ impl Uplink {
                 });
                 return t;
             }
-            o.attempts += 1;
+            // Below max_attempts (checked above).
+            o.attempts = o.attempts.saturating_add(1);
             o.open_since = Some(Instant::from_millis(now));
             self.last_send = Some(Instant::from_millis(now));
             t.send = Some(CommandRepr {

@@ -134,6 +134,7 @@ pub struct OutboxFull {
 /// an extractor of `N` octets.
 #[derive(Debug, Clone)]
 pub struct GroundLink<const K: usize, const Q: usize, const N: usize> {
+    board: BoardNumber,
     spacecraft_id: SpacecraftId,
     fop: Fop<Packet, K>,
     outbox: Deque<Packet, Q>,
@@ -157,6 +158,7 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
     pub fn with(board: BoardNumber, fop: FopConfig) -> Self {
         let spacecraft_id = SpacecraftId::of_board(board);
         GroundLink {
+            board,
             spacecraft_id,
             fop: Fop::new(fop),
             outbox: Deque::new(),
@@ -173,15 +175,11 @@ impl<const K: usize, const Q: usize, const N: usize> GroundLink<K, Q, N> {
     /// `tm_key` (a frame that does not verify gives neither packets nor CLCW); `stored`, the
     /// durable counters: the TC reservation and the TM floor.
     pub fn secure(&mut self, tc_key: Key256, tm_key: Key256, stored: (Option<u128>, Option<u128>)) {
-        let board =
-            BoardNumber::new((self.spacecraft_id.get() - tc_frame::SPACECRAFT_ID_BASE) as u8)
-                .unwrap_or(BoardNumber::ONE);
+        let board = self.board;
         let mut table = SaTable::new();
         let _ = table.add(sdls::mission::tc_sender(board, tc_key, stored.0));
         let _ = table.add(sdls::mission::tm_receiver(board, tm_key, stored.1));
-        self.tm = self
-            .tm
-            .and_then(|p| p.with_security(sdls::HEADER_LEN as u8, sdls::MAC_LEN as u8));
+        self.tm = self.tm.and_then(secured::secured_tm_params);
         self.sdls = Some(table);
     }
 

@@ -50,6 +50,7 @@ use crate::ccsds::tc::TC_MIN_LEN;
 use crate::command::Command;
 use crate::faults::Faults;
 use crate::link::fop::FopConfig;
+use crate::link::low;
 use crate::mode::Mode;
 use crate::node::exactly_once::uplink::{Done, Efficiency, Outcome};
 use crate::pus::function;
@@ -115,7 +116,8 @@ impl Config {
     /// assert_eq!((c.timeout_ms, c.max_attempts), (1000, 30)); // 10 × 3 s
     /// ```
     pub fn under_cop1(self, fop: &FopConfig) -> Config {
-        let horizon = u64::from(fop.tx_limit) * u64::from(fop.t1_ms);
+        // Two 32-bit values at most: their product fits a u64 (no saturation).
+        let horizon = u64::from(fop.tx_limit).saturating_mul(u64::from(fop.t1_ms));
         let needed = horizon.div_ceil(u64::from(self.timeout_ms.max(1)));
         let max_attempts = u8::try_from(needed)
             .unwrap_or(u8::MAX)
@@ -275,10 +277,11 @@ impl TcLink {
         match f.code {
             c if (0x0100..0x0100 + 16).contains(&c) => MotionEnd::Interrupted {
                 mode,
-                faults: Faults::from_wire([f.data as u8, (f.data >> 8) as u8]).unwrap_or(faults),
+                faults: Faults::from_wire([low::u8_of_u32(f.data), low::u8_of_u32(f.data >> 8)])
+                    .unwrap_or(faults),
             },
             ABANDONED => MotionEnd::Interrupted {
-                mode: Mode::from_wire(f.data as u8).unwrap_or(mode),
+                mode: Mode::from_wire(low::u8_of_u32(f.data)).unwrap_or(mode),
                 faults,
             },
             _ => MotionEnd::Unacknowledged,

@@ -161,7 +161,9 @@ impl<const N: usize> Server<N> {
                 Some((b, Some(p))) => Some((i, b, p)),
                 _ => None,
             })?;
-        self.cursor = if i + 1 < N { i + 1 } else { 0 };
+        // i is a slot's index, below N: the sum cannot saturate.
+        let next = i.saturating_add(1);
+        self.cursor = if next < N { next } else { 0 };
         Some((b, p))
     }
 

@@ -115,6 +115,8 @@ pub struct PlanKept {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PlanRunner<L = Uplink> {
     up: L,
+    /// The current step's index: at most the plan's length, so stepping on by
+    /// `saturating_add(1)` never saturates.
     next: usize,
     /// The number of the current step's command, once submitted.
     step_seq: Option<u16>,
@@ -271,7 +273,7 @@ impl<L: Link> PlanRunner<L> {
         let step = self.next;
         self.phase = match e {
             MotionEnd::Completed if !self.held && !mode_step => {
-                self.next += 1;
+                self.next = self.next.saturating_add(1);
                 Phase::Ready
             }
             MotionEnd::Completed => Phase::Settling {
@@ -339,7 +341,7 @@ impl<L: Link> PlanRunner<L> {
                     > 0
                     || until == now =>
             {
-                self.next += 1;
+                self.next = self.next.saturating_add(1);
                 self.phase = Phase::Ready;
                 return true;
             }
@@ -350,7 +352,7 @@ impl<L: Link> PlanRunner<L> {
                 mode_step: false,
                 ..
             } if !L::POLLS && !self.held => {
-                self.next += 1;
+                self.next = self.next.saturating_add(1);
                 self.phase = Phase::Ready;
                 return true;
             }
@@ -429,7 +431,7 @@ impl<L: Link> PlanRunner<L> {
     /// settling, any other is done.
     fn accepted(&mut self, c: Command) {
         if settles_after(&c) {
-            let need = matches!(c.kind(), CommandKind::Bolter) as u16;
+            let need = u16::from(matches!(c.kind(), CommandKind::Bolter));
             let mode_step = matches!(c.kind(), CommandKind::Mode);
             self.phase = Phase::Settling {
                 polls: 0,
@@ -440,7 +442,7 @@ impl<L: Link> PlanRunner<L> {
                 ended: !L::POLLS && mode_step,
             };
         } else {
-            self.next += 1;
+            self.next = self.next.saturating_add(1);
             self.phase = Phase::Ready;
         }
     }
@@ -464,7 +466,7 @@ impl<L: Link> PlanRunner<L> {
                 faults: h.faults,
             });
         } else if !self.held && polls >= need && hb.is_some_and(settled) {
-            self.next += 1;
+            self.next = self.next.saturating_add(1);
             self.phase = Phase::Ready;
         } else {
             self.phase = Phase::Settling {

@@ -56,7 +56,7 @@ impl PlanRunner<TcLink> {
             && !self.held
             && settled(&hb)
         {
-            self.next += 1;
+            self.next = self.next.saturating_add(1);
             self.phase = Phase::Ready;
         }
         t.end = self.end();

@@ -12,7 +12,7 @@
 
 use super::{FrameGateway, RobotLink};
 use crate::node::server::gateway::Job;
-use crate::node::server::store::queue::{job_entry, queue_key, QUEUE_SLOTS};
+use crate::node::server::store::queue::{job_entry, queue_key, ring_after, QUEUE_SLOTS, SLOTS};
 use crate::node::server::store::{kept_entries, Entry};
 use crate::units::BoardNumber;
 use heapless::Vec;
@@ -32,23 +32,23 @@ impl<const N: usize> RobotLink<N> {
         }
         for j in queue {
             if !self.ring.contains(&Some(j.key())) {
-                let s = usize::from(self.ring_next) % QUEUE_SLOTS;
-                if let Some(slot) = self.ring.get_mut(s) {
+                let s = self.ring_next % SLOTS;
+                if let Some(slot) = self.ring.get_mut(usize::from(s)) {
                     *slot = Some(j.key());
                 }
-                self.ring_next = ((s + 1) % QUEUE_SLOTS) as u8;
+                self.ring_next = ring_after(s);
             }
         }
     }
 
     /// What slot `s` should hold: its telecommand, or empty when none, or when it is the head
     /// about to leave for board A (`wants_out`).
-    fn slot_due(&self, s: usize, queue: &[Job], wants_out: Option<(u16, u16)>) -> Entry {
-        let key = self.ring.get(s).copied().flatten();
+    fn slot_due(&self, s: u8, queue: &[Job], wants_out: Option<(u16, u16)>) -> Entry {
+        let key = self.ring.get(usize::from(s)).copied().flatten();
         let job = key
             .filter(|k| Some(*k) != wants_out)
             .and_then(|k| queue.iter().find(|j| j.key() == k));
-        job_entry(self.board, s as u8, job)
+        job_entry(self.board, s, job)
     }
 
     /// The gating entries of this link that differ from what the shell confirmed: the
@@ -60,11 +60,11 @@ impl<const N: usize> RobotLink<N> {
         wants_out: Option<(u16, u16)>,
         out: &mut impl FnMut(Entry),
     ) {
-        for s in 0..QUEUE_SLOTS {
-            let written = self.ring_written.get(s).copied().flatten();
+        for s in 0..SLOTS {
+            let written = self.ring_written.get(usize::from(s)).copied().flatten();
             // A slot that holds nothing and was never written is not due: skip encoding its
             // empty entry (most slots, most calls; issue 40).
-            if written.is_none() && self.ring.get(s).copied().flatten().is_none() {
+            if written.is_none() && self.ring.get(usize::from(s)).copied().flatten().is_none() {
                 continue;
             }
             let e = self.slot_due(s, queue, wants_out);
@@ -187,19 +187,19 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
         let l = self
             .links
             .iter_mut()
-            .find(|l| (0..QUEUE_SLOTS as u8).any(|s| queue_key(l.board, s) == e.key))?;
+            .find(|l| (0..SLOTS).any(|s| queue_key(l.board, s) == e.key))?;
         let board = l.board;
-        let s = (0..QUEUE_SLOTS).find(|&s| queue_key(board, s as u8) == e.key)?;
+        let s = (0..SLOTS).find(|&s| queue_key(board, s) == e.key)?;
         let queue = self.gateway.queued(board);
         let wants_out = self.gateway.wants_out(board);
         if l.slot_due(s, queue, wants_out) != *e {
             return Some(false);
         }
-        let fresh = l.ring_written.get(s).copied().flatten() != Some(*e);
-        if let Some(w) = l.ring_written.get_mut(s) {
+        let fresh = l.ring_written.get(usize::from(s)).copied().flatten() != Some(*e);
+        if let Some(w) = l.ring_written.get_mut(usize::from(s)) {
             *w = Some(*e);
         }
-        let head = l.ring.get(s).copied().flatten();
+        let head = l.ring.get(usize::from(s)).copied().flatten();
         if let (Some(k), Some(out)) = (head, wants_out)
             && k == out
             && e.aux == 0
@@ -226,14 +226,14 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
             return false;
         };
         for (slot, job) in queue {
-            let s = usize::from(*slot) % QUEUE_SLOTS;
-            if let Some(r) = l.ring.get_mut(s) {
+            let s = *slot % SLOTS;
+            if let Some(r) = l.ring.get_mut(usize::from(s)) {
                 *r = Some(job.key());
             }
-            if let Some(w) = l.ring_written.get_mut(s) {
-                *w = Some(job_entry(board, s as u8, Some(job)));
+            if let Some(w) = l.ring_written.get_mut(usize::from(s)) {
+                *w = Some(job_entry(board, s, Some(job)));
             }
-            l.ring_next = ((s + 1) % QUEUE_SLOTS) as u8;
+            l.ring_next = ring_after(s);
         }
         all
     }

@@ -34,10 +34,7 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
             .iter_mut()
             .find(|l| l.board == board)
             .ok_or(SecureError::NotServed { board: n })?;
-        let params = link
-            .framer
-            .params()
-            .with_security(sdls::HEADER_LEN as u8, sdls::MAC_LEN as u8)
+        let params = sdls::frames::secured_tm_params(*link.framer.params())
             .ok_or(SecureError::Layout { board: n })?;
         let mut table = SaTable::new();
         let tc = sdls::mission::tc_receiver(board, tc_key, stored.tc);
@@ -115,10 +112,12 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     pub(super) fn security_reports(&mut self, now: u32) {
         let mut due: Vec<(u16, Event), 16> = Vec::new();
         for l in self.links.iter_mut() {
-            for (reason, a) in l.alarms.iter_mut().enumerate() {
+            // One alarm per refusal reason, far fewer than 256: the zip ends before the
+            // reason's count could pass u8::MAX.
+            for (a, reason) in l.alarms.iter_mut().zip(0u8..) {
                 if a.ready(now) {
                     let e = Event::Security {
-                        reason: reason as u8,
+                        reason,
                         refused: a.pending,
                         spi: a.spi,
                     };

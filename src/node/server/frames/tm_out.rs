@@ -49,7 +49,7 @@ impl<const R: usize, const Q: usize, const K: usize, const N: usize> FrameGatewa
     pub fn next_deadline(&self, now: u32) -> Option<u32> {
         let wait = |t: u32| {
             let d = t.wrapping_sub(now);
-            if d > i32::MAX as u32 {
+            if d > i32::MAX.unsigned_abs() {
                 0
             } else {
                 d

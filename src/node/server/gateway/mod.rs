@@ -120,11 +120,12 @@ impl TmOut {
     }
 
     /// The index of its message type among the robot's counters.
-    const fn type_index(&self) -> usize {
+    fn type_index(&self) -> usize {
+        // The subservices' ranges keep both sums in 0..=12.
         match (self.service, self.subservice) {
-            (1, s) if s <= 8 => s as usize - 1,
+            (1, s @ 1..=8) => usize::from(s).saturating_sub(1),
             (3, _) => 8,
-            (5, s) if s >= 1 && s <= 4 => 8 + s as usize,
+            (5, s @ 1..=4) => usize::from(s).saturating_add(8),
             (17, _) => 13,
             _ => 15,
         }
@@ -299,7 +300,7 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
     pub fn next_deadline(&self, now: u32) -> Option<u32> {
         let wait = |t: u32| {
             let d = t.wrapping_sub(now);
-            if d > i32::MAX as u32 {
+            if d > i32::MAX.unsigned_abs() {
                 0
             } else {
                 d
@@ -328,7 +329,8 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
         self.robots
             .iter()
             .find(|r| r.board == board)
-            .map(|r| Q - r.queue.len())
+            // A queue holds at most Q.
+            .map(|r| Q.saturating_sub(r.queue.len()))
     }
 
     /// The latest heartbeat of robot `board`.

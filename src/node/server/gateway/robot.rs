@@ -98,6 +98,12 @@ const fn newer14(a: u16, b: u16) -> bool {
     d != 0 && d < 0x2000
 }
 
+/// The queue's capacity, the data of a `QUEUE_FULL` failure (a queue of a few entries: it
+/// fits a u32).
+fn queue_capacity<const Q: usize>() -> u32 {
+    u32::try_from(Q).unwrap_or(u32::MAX)
+}
+
 impl<const Q: usize, const K: usize> Robot<Q, K> {
     /// A telecommand through the key log: a copy is answered from it (its latest report
     /// again; a reused key with another request is refused), a new one is logged (the
@@ -268,7 +274,7 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
             Err(_) => {
                 let f = Failure {
                     code: QUEUE_FULL,
-                    data: Q as u32,
+                    data: queue_capacity::<Q>(),
                 };
                 let rep = report(Stage::Acceptance, job.request, Some(f));
                 self.remember(key, rep);
@@ -333,7 +339,7 @@ impl<const Q: usize, const K: usize> Robot<Q, K> {
                         // More motions at once than the queue holds: say so, never lose one.
                         let f = Failure {
                             code: QUEUE_FULL,
-                            data: Q as u32,
+                            data: queue_capacity::<Q>(),
                         };
                         self.report(out, &job, report(Stage::Completion, req, Some(f)));
                     }

@@ -197,13 +197,13 @@ pub fn parse(part: &[u8]) -> Result<KeySet, KeysError> {
     if head[10..12] != [0, 0] {
         return Err(KeysError::Reserved { at: 10 });
     }
-    let body = signed_len(n);
+    let end = signed_len(n).saturating_add(4);
     let truncated = KeysError::Truncated {
-        needed: body + 4,
+        needed: end,
         found: part.len(),
     };
     let (signed, crc) = part
-        .get(..body + 4)
+        .get(..end)
         .and_then(<[u8]>::split_last_chunk::<4>)
         .ok_or(truncated)?;
     let found = u32::from_be_bytes(*crc);
@@ -226,7 +226,7 @@ fn read_entries(signed: &[u8], truncated: KeysError) -> Result<KeySet, KeysError
         let spi = u16::from_be_bytes([e[0], e[1]]);
         if e[2..4] != [0, 0] {
             return Err(KeysError::Reserved {
-                at: HEADER_LEN + i * ENTRY_LEN + 2,
+                at: signed_len(i).saturating_add(2),
             });
         }
         if set.get(spi).is_some() {
@@ -243,7 +243,8 @@ fn read_entries(signed: &[u8], truncated: KeysError) -> Result<KeySet, KeysError
 
 /// The octets the CRC covers for `n` keys: the header and the entries.
 const fn signed_len(n: usize) -> usize {
-    HEADER_LEN + n * ENTRY_LEN
+    // n is at most MAX_KEYS (the callers check it first): neither step saturates.
+    HEADER_LEN.saturating_add(n.saturating_mul(ENTRY_LEN))
 }
 
 /// Writes `keys` in the partition's layout at the start of `out` (the caller erases the rest
@@ -258,12 +259,12 @@ pub fn emit(keys: &[(u16, &Key256)], out: &mut [u8]) -> Result<usize, KeysError>
     if keys.is_empty() || keys.len() > MAX_KEYS {
         return Err(count);
     }
-    let body = signed_len(keys.len());
+    let end = signed_len(keys.len()).saturating_add(4);
     let room = KeysError::Room {
-        needed: body + 4,
+        needed: end,
         found: out.len(),
     };
-    if out.len() < body + 4 {
+    if out.len() < end {
         return Err(room);
     }
     for (i, (spi, key)) in keys.iter().enumerate() {
@@ -274,7 +275,7 @@ pub fn emit(keys: &[(u16, &Key256)], out: &mut [u8]) -> Result<usize, KeysError>
         }
     }
     let (signed, crc) = out
-        .get_mut(..body + 4)
+        .get_mut(..end)
         .and_then(<[u8]>::split_last_chunk_mut::<4>)
         .ok_or(room)?;
     let (head, rest) = signed.split_first_chunk_mut::<HEADER_LEN>().ok_or(room)?;
@@ -289,5 +290,5 @@ pub fn emit(keys: &[(u16, &Key256)], out: &mut [u8]) -> Result<usize, KeysError>
         e[4..].copy_from_slice(key.octets());
     }
     *crc = CRC32.checksum(signed).to_be_bytes();
-    Ok(body + 4)
+    Ok(end)
 }

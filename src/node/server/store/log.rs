@@ -98,7 +98,10 @@ pub fn decode(r: &[u8; RECORD_LEN]) -> Record {
             aux: r[1],
             value,
         }),
-        TAG_SECTOR if r[1] == 0 && key == 0 && value >> 32 == 0 => Record::Header(value as u32),
+        // A header's generation is a u32: a value beyond one is no header.
+        TAG_SECTOR if r[1] == 0 && key == 0 => {
+            u32::try_from(value).map_or(Record::Invalid, Record::Header)
+        }
         _ => Record::Invalid,
     }
 }
@@ -140,14 +143,15 @@ pub enum ImageError {
 /// erased), written over the whole of `out` (its length: two sectors).
 pub fn image(entries: &[Entry], sector: usize, out: &mut [u8]) -> Result<(), ImageError> {
     let min = 2 * RECORD_LEN;
-    if sector < min || out.len() != 2 * sector {
+    if sector < min || sector.checked_mul(2) != Some(out.len()) {
         return Err(ImageError::Size {
             sector,
             min,
             found: out.len(),
         });
     }
-    let fit = sector / RECORD_LEN - 1;
+    // At least 2 records' room (checked above): the subtraction cannot saturate.
+    let fit = (sector / RECORD_LEN).saturating_sub(1);
     if entries.len() > fit {
         return Err(ImageError::TooMany {
             entries: entries.len(),

@@ -49,6 +49,7 @@ pub mod log;
 pub mod queue;
 
 use super::gateway::{Kept, KEPT_SOURCES};
+use crate::link::low;
 use crate::link::sdls::key::{Fingerprint, WeakKey};
 use crate::link::sdls::{mission, Key256};
 use crate::units::BoardNumber;
@@ -88,17 +89,20 @@ pub const fn fingerprint_key(spi: u16) -> u16 {
 
 /// The key of robot `board`'s FARM-1 progress on a secured link.
 pub const fn progress_key(board: BoardNumber) -> u16 {
-    0x2000 + board.get() as u16
+    u16::from_be_bytes([0x20, board.get()])
 }
 
 /// The key of robot `board`'s FARM-1 progress on a link without SDLS.
 pub const fn clear_progress_key(board: BoardNumber) -> u16 {
-    0x2100 + board.get() as u16
+    u16::from_be_bytes([0x21, board.get()])
 }
 
 /// The key of robot `board`'s kept telecommand key in `slot` (0..[`KEPT_SOURCES`]).
 pub const fn kept_key(board: BoardNumber, slot: u8) -> u16 {
-    0x3000 + 4 * board.get() as u16 + (slot & 3) as u16
+    // 0x3000 + 4 × board + slot: the three parts' bits do not overlap (the board's end at
+    // bit 9), so or-ing them adds them. Widened through from_be_bytes (a const fn may not
+    // call From).
+    0x3000 | (u16::from_be_bytes([0, board.get()]) << 2) | u16::from_be_bytes([0, slot & 3])
 }
 
 /// Where FARM-1 and the TC window stood after the last accepted frame: the server board
@@ -151,7 +155,8 @@ pub fn kept_entries(board: BoardNumber, kept: &Kept) -> [Entry; KEPT_SOURCES] {
             None => (0, 0),
         };
         Entry {
-            key: kept_key(board, slot as u8),
+            // slot < KEPT_SOURCES = 4: its low octet is all of it.
+            key: kept_key(board, low::u8_of_usize(slot)),
             aux,
             value,
         }
@@ -162,11 +167,12 @@ pub fn kept_entries(board: BoardNumber, kept: &Kept) -> [Entry; KEPT_SOURCES] {
 pub fn kept_load(board: BoardNumber, lookup: &impl Fn(u16) -> Option<(u8, u128)>) -> Option<Kept> {
     let mut kept = Kept::new();
     let mut any = false;
-    for slot in 0..KEPT_SOURCES as u8 {
+    for slot in (0u8..).take(KEPT_SOURCES) {
         if let Some((aux, value)) = lookup(kept_key(board, slot)) {
             any = true;
             if aux == 1 {
-                let _ = kept.push(((value >> 16) as u16, value as u16));
+                let [.., s0, s1, c0, c1] = value.to_be_bytes();
+                let _ = kept.push((u16::from_be_bytes([s0, s1]), u16::from_be_bytes([c0, c1])));
             }
         }
     }
@@ -222,7 +228,8 @@ impl Stopped {
 
     /// The code of ST\[5\]'s `link_stopped` ([`crate::pus::event::LINK_STOPPED_REASONS`]).
     pub const fn code(&self) -> u8 {
-        self.position() as u8
+        // A place among four names: its low octet is all of it.
+        low::u8_of_usize(self.position())
     }
 
     /// The reason's place in [`Stopped::NAMES`].
@@ -423,9 +430,10 @@ pub fn provision(
 /// key this layout knows): reported, never used.
 pub fn foreign(served: &[BoardNumber], key: u16) -> bool {
     let robot = match key {
-        0x0100..=0x02FF | 0x1100..=0x12FF | 0x2000..=0x21FF => Some((key & 0xFF) as u8),
-        0x3000..=0x33FF => Some(((key - 0x3000) / 4) as u8),
-        0x4000..=0x4FFF => Some(((key - 0x4000) / 16) as u8),
+        // Each range's robot number fits an octet: the conversions hold.
+        0x0100..=0x02FF | 0x1100..=0x12FF | 0x2000..=0x21FF => u8::try_from(key & 0xFF).ok(),
+        0x3000..=0x33FF => u8::try_from(key.saturating_sub(0x3000) / 4).ok(),
+        0x4000..=0x4FFF => u8::try_from(key.saturating_sub(0x4000) / 16).ok(),
         _ => None,
     };
     !robot.is_some_and(|r| served.iter().any(|b| b.get() == r))

@@ -46,9 +46,29 @@ use heapless::Vec;
 /// Slots of a robot's ring: more than a queue holds (the gateway's queue is at most 15).
 pub const QUEUE_SLOTS: usize = 16;
 
+/// [`QUEUE_SLOTS`] as a slot's number: its low octet, which is all of it (checked below).
+pub const SLOTS: u8 = {
+    let [.., low] = QUEUE_SLOTS.to_be_bytes();
+    low
+};
+const _: () = assert!(QUEUE_SLOTS <= 0xFF);
+
+/// The ring's slot after slot `s` (slots count modulo [`QUEUE_SLOTS`]).
+pub const fn ring_after(s: u8) -> u8 {
+    // s % SLOTS is below SLOTS: the sum cannot saturate.
+    (s % SLOTS).saturating_add(1) % SLOTS
+}
+
 /// The key of robot `board`'s queue slot `slot`.
 pub const fn queue_key(board: BoardNumber, slot: u8) -> u16 {
-    0x4000 + QUEUE_SLOTS as u16 * board.get() as u16 + (slot as u16 % QUEUE_SLOTS as u16)
+    // Widened through from_be_bytes (a const fn may not call From); the key is at most
+    // 0x4000 + 16 × 255 + 15 = 0x4FFF: no step saturates.
+    let slots = u16::from_be_bytes([0, SLOTS]);
+    let board = u16::from_be_bytes([0, board.get()]);
+    let slot = u16::from_be_bytes([0, slot % SLOTS]);
+    0x4000u16
+        .saturating_add(slots.saturating_mul(board))
+        .saturating_add(slot)
 }
 
 /// Slot `slot` of robot `board`'s ring holding `job` (`None`: empty).
@@ -103,15 +123,16 @@ pub fn queue_load(
     board: BoardNumber,
     lookup: &impl Fn(u16) -> Option<(u8, u128)>,
 ) -> Vec<(u8, Job), QUEUE_SLOTS> {
-    let n = QUEUE_SLOTS as u8;
     let queued = |s: u8| lookup(queue_key(board, s)).filter(|(aux, _)| *aux == 1);
+    // The slot before `s` in the ring.
+    let before = |s: u8| s.checked_sub(1).unwrap_or(SLOTS - 1);
     let mut out = Vec::new();
-    let Some(start) = (0..n).find(|&s| queued(s).is_some() && queued((s + n - 1) % n).is_none())
+    let Some(start) = (0..SLOTS).find(|&s| queued(s).is_some() && queued(before(s)).is_none())
     else {
         return out;
     };
-    for i in 0..n {
-        let s = (start + i) % n;
+    // The ring from `start` round: its two halves.
+    for s in (start..SLOTS).chain(0..start) {
         let Some(job) = queued(s).and_then(|(_, v)| job_of(board, v)) else {
             break;
         };
