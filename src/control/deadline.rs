@@ -26,6 +26,7 @@
 //! ```
 
 use super::interp::Rate;
+use crate::units::widen::to_u32;
 use crate::units::{HipAngle, PulseWidth};
 
 /// The margins added to a motion's nominal time.
@@ -54,8 +55,8 @@ impl Default for Config {
 /// The time the interpolator takes from `from` to `to`: one `rate.step_us` per
 /// `rate.period_ms`, the last step partial (as [`super::interp::Interpolator`] moves).
 pub const fn servo_ms(from: PulseWidth, to: PulseWidth, rate: Rate) -> u32 {
-    let d = from.micros().abs_diff(to.micros()) as u32;
-    let step = if rate.step_us == 0 { 1 } else { rate.step_us } as u32;
+    let d = to_u32(from.micros().abs_diff(to.micros()).to_le_bytes());
+    let step = to_u32(if rate.step_us == 0 { 1 } else { rate.step_us }.to_le_bytes());
     let periods = d.div_ceil(step);
     periods.saturating_mul(if rate.period_ms == 0 {
         1
@@ -67,9 +68,10 @@ pub const fn servo_ms(from: PulseWidth, to: PulseWidth, rate: Rate) -> u32 {
 /// The time the hip takes from `from` to `to` the short way round at `speed` (0.01°/s, the hip
 /// controller's velocity-mode speed; at least 1).
 pub const fn hip_ms(from: HipAngle, to: HipAngle, speed: i32) -> u32 {
-    let d = from.distance(to) as u32;
-    let speed = if speed < 1 { 1 } else { speed as u32 };
-    (d * 1000).div_ceil(speed)
+    let d = to_u32(from.distance(to).to_le_bytes());
+    let speed = if speed < 1 { 1 } else { speed.unsigned_abs() };
+    // `d` ≤ 18000: the product stays far below the saturation.
+    d.saturating_mul(1000).div_ceil(speed)
 }
 
 /// A motion's budget from the slowest servo's nominal time and the hip's (0 where that kind of

@@ -23,6 +23,7 @@
 //! assert!(out.micros() > 1500);
 //! ```
 
+use crate::units::widen::to_u32;
 use crate::units::Instant;
 use crate::units::{HipAngle, PulseWidth};
 
@@ -91,17 +92,24 @@ pub struct HipController {
 
 /// Signed shortest difference `to − from`, in (−18000, 18000].
 pub const fn angle_error(from: HipAngle, to: HipAngle) -> i32 {
-    let d = to.centidegrees() as i32 - from.centidegrees() as i32;
+    // Both angles are in 0..36000 (their type's range): `d` is in (−36000, 36000) and the
+    // results below in (−18000, 18000], far from saturating.
+    let d = centidegrees(to).saturating_sub(centidegrees(from));
     if d > 18000 {
-        d - 36000
+        d.saturating_sub(36000)
     } else if d <= -18000 {
-        d + 36000
+        d.saturating_add(36000)
     } else {
         d
     }
 }
 
-const STOP_US: i32 = 1500;
+/// The angle as a signed number of centidegrees, for differences.
+const fn centidegrees(a: HipAngle) -> i32 {
+    to_u32(a.centidegrees().to_le_bytes()).cast_signed()
+}
+
+const STOP_US: u16 = 1500;
 
 impl HipController {
     /// At rest, no history.
@@ -131,11 +139,18 @@ impl HipController {
         let mut dt_ms = 0u32;
         if let Some((t0, a0)) = self.last {
             dt_ms = Instant::from_millis(now).since(t0).millis().min(1000);
-            if dt_ms > 0 {
-                // |raw| ≤ 18000 × 1000: no overflow; the estimate stays within the same bound.
-                let raw = (angle_error(a0, measured) as i64 * 1000 / dt_ms as i64) as i32;
+            // In 1..=1000 here, so `checked_div` never fails, and `raw` is exact in i32:
+            // |raw| ≤ 18000 × 1000. The estimate stays within the same bound, so neither
+            // saturating operation below ever saturates.
+            if let Ok(dt @ 1..) = i32::try_from(dt_ms) {
+                let raw = angle_error(a0, measured)
+                    .saturating_mul(1000)
+                    .checked_div(dt)
+                    .unwrap_or(0);
                 let shift = self.cfg.smoothing_shift.min(8);
-                self.velocity += (raw - self.velocity) >> shift;
+                self.velocity = self
+                    .velocity
+                    .saturating_add(raw.saturating_sub(self.velocity) >> shift);
             }
         }
         self.last = Some((Instant::from_millis(now), measured));
@@ -167,7 +182,8 @@ impl HipController {
                     c.speed.saturating_neg()
                 };
                 let ff = if c.servo_gain > 0 {
-                    v_ref / c.servo_gain
+                    // A positive divisor: `checked_div` never fails.
+                    v_ref.checked_div(c.servo_gain).unwrap_or(0)
                 } else {
                     0
                 };
@@ -180,24 +196,32 @@ impl HipController {
             }
             Mode::Position => (e, c.kp_position_q8, c.ki_position_q8, 0),
         };
-        let p = (err as i64 * kp as i64) >> 8;
-        let unsat = (ff as i64)
+        // Exact: the product of two i32 is below 2⁶² in magnitude.
+        let p = i64::from(err).wrapping_mul(i64::from(kp)) >> 8;
+        let unsat = i64::from(ff)
             .saturating_add(p)
-            .saturating_add(self.integral_q8 as i64 >> 8);
-        let out = unsat.clamp(-(max as i64), max as i64) as i32;
+            .saturating_add(i64::from(self.integral_q8) >> 8);
+        let max = i64::from(max);
+        let out = unsat.clamp(max.saturating_neg(), max);
         // Anti-windup: integrate only when not saturated, or when the error pulls back inward.
-        let saturated = unsat != out as i64;
+        let saturated = unsat != out;
         if !saturated || (unsat > 0) != (err > 0) {
-            let di = (err as i64)
-                .saturating_mul(ki as i64)
-                .saturating_mul(dt_ms as i64)
+            let di = i64::from(err)
+                .saturating_mul(i64::from(ki))
+                .saturating_mul(i64::from(dt_ms))
                 / 1000;
-            let lim = (max as i64) << 8;
-            self.integral_q8 = (self.integral_q8 as i64)
-                .saturating_add(di)
-                .clamp(-lim, lim) as i32;
+            let lim = max << 8;
+            // Clamped to ±256,000 (max ≤ 1000): an i32, so the fallback never applies.
+            self.integral_q8 = i32::try_from(
+                i64::from(self.integral_q8)
+                    .saturating_add(di)
+                    .clamp(lim.saturating_neg(), lim),
+            )
+            .unwrap_or(0);
         }
-        PulseWidth::saturating((STOP_US + out) as u16)
+        // |out| ≤ 1000: an i16, so the fallback never applies.
+        let out = i16::try_from(out).unwrap_or(0);
+        PulseWidth::saturating(STOP_US.saturating_add_signed(out))
     }
 
     /// A tick without an angle reading: the stop pulse, and the controller starts afresh
@@ -215,6 +239,6 @@ impl HipController {
     /// ```
     pub fn blind(&mut self) -> PulseWidth {
         *self = HipController::new(self.cfg);
-        PulseWidth::saturating(STOP_US as u16)
+        PulseWidth::saturating(STOP_US)
     }
 }

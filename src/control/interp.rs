@@ -4,6 +4,8 @@
 
 /// The servos' travel is command vocabulary (what a target means); re-exported at its old path.
 pub use crate::command::{OutOfTravel, Travel};
+use core::num::NonZeroU32;
+
 use crate::units::Instant;
 use crate::units::PulseWidth;
 
@@ -59,21 +61,24 @@ impl Interpolator {
     /// Advances to time `t` (ms, wrapping): one step per whole period elapsed, stopping on the
     /// target. Returns the pulse to send.
     pub fn tick(&mut self, t: u32) -> PulseWidth {
-        let period = self.rate.period_ms.max(1);
+        // A zero period counts as 1 ms; as a `NonZeroU32` its division cannot panic.
+        let period = NonZeroU32::new(self.rate.period_ms).unwrap_or(NonZeroU32::MIN);
         let t = Instant::from_millis(t);
         self.banked_ms = self.banked_ms.saturating_add(t.since(self.last).millis());
         self.last = t;
         let periods = self.banked_ms / period;
         self.banked_ms %= period;
-        let max_move = (periods as u64).saturating_mul(self.rate.step_us.max(1) as u64);
-        let (now, target) = (self.now.micros() as u64, self.target.micros() as u64);
+        let max_move = u64::from(periods).saturating_mul(u64::from(self.rate.step_us.max(1)));
+        let (now, target) = (self.now.micros(), self.target.micros());
+        let gap = now.abs_diff(target);
+        // At most `gap`, so `next` lies between `now` and `target`, both in range.
+        let step = u16::try_from(max_move.min(u64::from(gap))).unwrap_or(gap);
         let next = if target >= now {
-            now + max_move.min(target - now)
+            now.saturating_add(step)
         } else {
-            now - max_move.min(now - target)
+            now.saturating_sub(step)
         };
-        // `next` lies between `now` and `target`, both in range.
-        self.now = PulseWidth::saturating(next as u16);
+        self.now = PulseWidth::saturating(next);
         self.now
     }
 

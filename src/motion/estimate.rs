@@ -154,12 +154,17 @@ pub struct Readings {
     pub hip: HipAngle,
 }
 
+/// Dot product of the model's unit vectors (components in −1..=1, the result too): the
+/// saturating operations never saturate.
 fn dot(a: Vec3, b: Vec3) -> i8 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    a.into_iter()
+        .zip(b)
+        .fold(0, |sum, (x, y)| sum.saturating_add(x.saturating_mul(y)))
 }
 
+/// `−v`, of a model vector (components in −1..=1).
 fn neg(v: Vec3) -> Vec3 {
-    [-v[0], -v[1], -v[2]]
+    v.map(i8::saturating_neg)
 }
 
 /// Gravity as a board whose frame is (x = `arm`, z = `hip_axis`) reads it.
@@ -199,14 +204,14 @@ fn hip_options(s: State) -> impl Iterator<Item = (Vec3, u16)> {
     let c = cross(a, b);
     let in_line = c == [0, 0, 0];
     let mut out = [([0i8; 3], 0u16); 4];
-    let mut n = 0;
+    let n;
     if in_line {
-        for h in ALL_DIRS {
-            if dot(h, a) == 0 && n < 4 {
-                out[n] = (h, 18000);
-                n += 1;
-            }
-        }
+        let across = ALL_DIRS.into_iter().filter(|&h| dot(h, a) == 0);
+        n = out
+            .iter_mut()
+            .zip(across)
+            .map(|(slot, h)| *slot = (h, 18000))
+            .count();
     } else {
         out[0] = (c, 9000);
         out[1] = (neg(c), 27000);

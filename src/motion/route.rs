@@ -13,8 +13,10 @@
 //! assert_eq!(route::lookup(State::A, State::B).len(), 3);
 //! ```
 
-use crate::pose::map::MAP;
+use crate::pose::map::primitive;
 use crate::pose::{Primitive, State};
+use crate::units::slice;
+use crate::units::widen::{to_u16, to_usize};
 
 /// Longest shortest plan between any two states.
 pub const MAX_LEN: usize = 3;
@@ -38,17 +40,22 @@ impl Route {
     /// The primitives in order.
     pub fn primitives(&self) -> &[Primitive] {
         // `len` never exceeds MAX_LEN; `get` keeps even a broken invariant from panicking.
-        self.prims.get(..self.len as usize).unwrap_or(&[])
+        self.prims.get(..usize::from(self.len)).unwrap_or(&[])
     }
 
     /// The state after each primitive (the last one is the target).
-    pub fn states(&self) -> &[State] {
-        self.states.get(..self.len as usize).unwrap_or(&[])
+    pub const fn states(&self) -> &[State] {
+        // `len` never exceeds MAX_LEN; `split_at_checked` keeps even a broken invariant from
+        // panicking (const, where `get` cannot be called).
+        match self.states.split_at_checked(self.len()) {
+            Some((used, _)) => used,
+            None => &[],
+        }
     }
 
     /// Number of primitives (0 when from = to).
     pub const fn len(&self) -> usize {
-        self.len as usize
+        to_usize(self.len.to_le_bytes())
     }
 
     /// True for the empty plan (from = to).
@@ -73,30 +80,35 @@ impl core::hash::Hash for Route {
     }
 }
 
-/// Depth-limited search in Table 5 order: the first plan of exactly `depth` primitives.
+/// Depth-limited search in Table 5 order: the first plan of exactly `depth` primitives. The
+/// plan holds at most [`MAX_LEN`] primitives (a longer one is not tried: `get_mut` refuses the
+/// slot), so its length never saturates.
 const fn dfs(at: State, to: State, depth: usize, mut acc: Route) -> Option<Route> {
-    if depth == 0 {
+    let Some(deeper) = depth.checked_sub(1) else {
         return if at.index() == to.index() {
             Some(acc)
         } else {
             None
         };
-    }
-    let mut j = 0;
-    while j < 15 {
-        if let (Some(p), Some(next)) = (MAP[at.index()][j], State::from_index(j)) {
-            let k = acc.len as usize;
-            if k < MAX_LEN {
-                acc.prims[k] = p;
-                acc.states[k] = next;
-                acc.len += 1;
-                if let Some(found) = dfs(next, to, depth - 1, acc) {
-                    return Some(found);
-                }
-                acc.len -= 1;
+    };
+    let k = acc.len();
+    let mut rest: &[State] = &State::ALL;
+    while let [next, tail @ ..] = rest {
+        if let Some(p) = primitive(at, *next)
+            && let (Some(prim), Some(state)) = (
+                slice::get_mut(&mut acc.prims, k),
+                slice::get_mut(&mut acc.states, k),
+            )
+        {
+            *prim = p;
+            *state = *next;
+            acc.len = acc.len.saturating_add(1);
+            if let Some(found) = dfs(*next, to, deeper, acc) {
+                return Some(found);
             }
+            acc.len = acc.len.saturating_sub(1);
         }
-        j += 1;
+        rest = tail;
     }
     None
 }
@@ -109,33 +121,44 @@ pub const fn search(from: State, to: State) -> Route {
         if let Some(p) = dfs(from, to, depth, Route::EMPTY) {
             return p;
         }
-        depth += 1;
+        // Stops at MAX_LEN + 1: never saturates.
+        depth = depth.saturating_add(1);
     }
     Route::EMPTY
 }
 
+/// Packed: bits 0–1 the length, then 4 bits per visited state's Table 5 index (a primitive
+/// number alone would not do: from a two-face state the same primitive reaches two different
+/// states). Three states end at bit 13: no shift loses a bit.
+const fn pack(p: &Route) -> u16 {
+    let mut v = to_u16(p.len.to_le_bytes());
+    let mut shift: u32 = 2;
+    let mut rest = p.states();
+    while let [s, tail @ ..] = rest {
+        // A Table 5 index is below 15: four bits.
+        let index = to_u16(s.to_wire().saturating_sub(b'a').to_le_bytes());
+        v |= index << shift;
+        shift = shift.saturating_add(4);
+        rest = tail;
+    }
+    v
+}
+
+/// Runs at compile time only (for [`TABLE`]).
 const fn build() -> [[u16; 15]; 15] {
     let mut t = [[0u16; 15]; 15];
-    let mut i = 0;
-    while i < 15 {
-        let mut j = 0;
-        while j < 15 {
-            if let (Some(f), Some(to)) = (State::from_index(i), State::from_index(j)) {
-                let p = search(f, to);
-                // Packed: bits 0–1 length, then 4 bits per visited state's Table 5 index (a
-                // primitive number alone would not do: from a two-face state the same primitive
-                // reaches two different states).
-                let mut v = p.len as u16;
-                let mut k = 0;
-                while k < p.len as usize {
-                    v |= (p.states[k].index() as u16) << (2 + 4 * k);
-                    k += 1;
-                }
-                t[i][j] = v;
-            }
-            j += 1;
+    let mut rows: &mut [[u16; 15]] = &mut t;
+    let mut froms: &[State] = &State::ALL;
+    while let ([row, rows_tail @ ..], [f, froms_tail @ ..]) = (rows, froms) {
+        let mut cells: &mut [u16] = row;
+        let mut tos: &[State] = &State::ALL;
+        while let ([cell, cells_tail @ ..], [to, tos_tail @ ..]) = (cells, tos) {
+            *cell = pack(&search(*f, *to));
+            cells = cells_tail;
+            tos = tos_tail;
         }
-        i += 1;
+        rows = rows_tail;
+        froms = froms_tail;
     }
     t
 }
@@ -148,21 +171,30 @@ pub const TABLE_BYTES: usize = core::mem::size_of::<[[u16; 15]; 15]>();
 
 /// The plan from `from` to `to`, from the precomputed table: O(1).
 pub fn lookup(from: State, to: State) -> Route {
-    let v = TABLE[from.index()][to.index()];
+    // A state's index is below 15: the row and the cell are always there.
+    let v = TABLE
+        .get(from.index())
+        .and_then(|row| row.get(to.index()))
+        .copied()
+        .unwrap_or(0);
     let mut plan = Route::EMPTY;
     let mut at = from;
-    for k in 0..(v & 0b11) as usize {
-        let next = match State::from_index(((v >> (2 + 4 * k)) & 0xf) as usize) {
+    let mut bits = v >> 2;
+    let slots = plan.prims.iter_mut().zip(plan.states.iter_mut());
+    for (prim, state) in slots.take(usize::from(v & 0b11)) {
+        let next = match State::from_index(usize::from(bits & 0xf)) {
             Some(s) => s,
             None => break,
         };
-        let p = match MAP[at.index()][next.index()] {
+        bits >>= 4;
+        let p = match primitive(at, next) {
             Some(p) => p,
             None => break,
         };
-        plan.prims[k] = p;
-        plan.states[k] = next;
-        plan.len += 1;
+        *prim = p;
+        *state = next;
+        // At most MAX_LEN slots: never saturates.
+        plan.len = plan.len.saturating_add(1);
         at = next;
     }
     plan

@@ -65,7 +65,7 @@ impl Runner {
     }
 
     fn begin_next(&mut self, now: u32) {
-        match self.plan.states().get(self.next as usize) {
+        match self.plan.states().get(usize::from(self.next)) {
             None => {
                 self.seq = None;
                 self.status = RunStatus::Complete;
@@ -96,7 +96,8 @@ impl Runner {
             Status::Failed(f) => self.status = RunStatus::Failed(f),
             Status::Done => {
                 self.current = seq.target_state();
-                self.next += 1;
+                // At most the plan's length (≤ 3): never saturates.
+                self.next = self.next.saturating_add(1);
                 self.begin_next(now);
             }
         }

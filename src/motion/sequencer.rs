@@ -247,7 +247,7 @@ impl Sequencer {
     /// The current step while running.
     pub fn current_step(&self) -> Option<Step> {
         match self.status {
-            Status::Running => self.steps.get(self.at as usize).copied(),
+            Status::Running => self.steps.get(usize::from(self.at)).copied(),
             _ => None,
         }
     }
@@ -260,7 +260,7 @@ impl Sequencer {
     /// Sets the targets of the current step.
     fn issue(&mut self) {
         let s = self.side;
-        match self.steps.get(self.at as usize) {
+        match self.steps.get(usize::from(self.at)) {
             Some(Step::Release) => self.targets.gripper[s] = ServoTarget::Contract,
             Some(Step::Move) => {
                 if self.to.is_matched() {
@@ -300,7 +300,7 @@ impl Sequencer {
         self.waited_ms = self.waited_ms.saturating_add(t.since(self.last).millis());
         self.last = t;
         let s = self.side;
-        let step = match self.steps.get(self.at as usize) {
+        let step = match self.steps.get(usize::from(self.at)) {
             Some(st) => *st,
             None => {
                 self.status = Status::Done;
@@ -320,7 +320,8 @@ impl Sequencer {
             Step::Confirm => (fb.arm_switch.all(), self.cfg.confirm_ms),
         };
         if done {
-            self.at += 1;
+            // Below `n_steps` (≤ 4) before: never saturates.
+            self.at = self.at.saturating_add(1);
             self.waited_ms = 0;
             if self.at >= self.n_steps {
                 self.status = Status::Done;

@@ -40,24 +40,28 @@ const fn axis_index(a: Axis) -> usize {
     }
 }
 
-const AXES: [Axis; 3] = [Axis::X, Axis::Y, Axis::Z];
-
 /// Unit vector `sign · axis`.
 pub const fn unit(axis: Axis, sign: Sign) -> Vec3 {
-    let mut v = [0i8; 3];
-    v[axis_index(axis)] = match sign {
+    let s = match sign {
         Sign::Positive => 1,
         Sign::Negative => -1,
     };
-    v
+    match axis {
+        Axis::X => [s, 0, 0],
+        Axis::Y => [0, s, 0],
+        Axis::Z => [0, 0, s],
+    }
 }
 
-/// Cross product.
+/// Cross product. The model's vectors are unit vectors and their cross products, components
+/// in −1..=1: the saturating operations never saturate.
 pub const fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    let [a0, a1, a2] = a;
+    let [b0, b1, b2] = b;
     [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
+        a1.saturating_mul(b2).saturating_sub(a2.saturating_mul(b1)),
+        a2.saturating_mul(b0).saturating_sub(a0.saturating_mul(b2)),
+        a0.saturating_mul(b1).saturating_sub(a1.saturating_mul(b0)),
     ]
 }
 
@@ -85,11 +89,16 @@ pub const fn faces(s: State) -> (Face, Face) {
         State::M => (pos(Axis::X), pos(Axis::X)),
         State::N => (pos(Axis::Y), pos(Axis::Y)),
         State::O => (pos(Axis::Z), pos(Axis::Z)),
-        _ => {
-            // d..l in Table 5 order: A's axis major, B's axis minor.
-            let i = s.index() - State::D.index();
-            (neg(AXES[i / 3]), pos(AXES[i % 3]))
-        }
+        // d..l in Table 5 order: A's axis major, B's axis minor.
+        State::D => (neg(Axis::X), pos(Axis::X)),
+        State::E => (neg(Axis::X), pos(Axis::Y)),
+        State::F => (neg(Axis::X), pos(Axis::Z)),
+        State::G => (neg(Axis::Y), pos(Axis::X)),
+        State::H => (neg(Axis::Y), pos(Axis::Y)),
+        State::I => (neg(Axis::Y), pos(Axis::Z)),
+        State::J => (neg(Axis::Z), pos(Axis::X)),
+        State::K => (neg(Axis::Z), pos(Axis::Y)),
+        State::L => (neg(Axis::Z), pos(Axis::Z)),
     }
 }
 
@@ -109,7 +118,11 @@ pub const fn arm_direction(s: State, side: Side) -> Vec3 {
 }
 
 const fn same(x: Face, y: Face) -> bool {
-    axis_index(x.axis) == axis_index(y.axis) && x.sign as u8 == y.sign as u8
+    axis_index(x.axis) == axis_index(y.axis)
+        && matches!(
+            (x.sign, y.sign),
+            (Sign::Positive, Sign::Positive) | (Sign::Negative, Sign::Negative)
+        )
 }
 
 /// The single-primitive move from `from` to `to`, if one exists: exactly one side moves
@@ -156,7 +169,8 @@ pub const fn single_move(from: State, to: State) -> Option<(Side, Primitive)> {
         }
     } else {
         // CCW when old × new points along a positive axis (right-hand rule).
-        let ccw = c[0] + c[1] + c[2] > 0;
+        let [c0, c1, c2] = c;
+        let ccw = c0.saturating_add(c1).saturating_add(c2) > 0;
         match (fwd, ccw) {
             (true, false) => Primitive::FwdTurnCw,
             (true, true) => Primitive::FwdTurnCcw,
@@ -199,4 +213,52 @@ pub fn model_moves() -> impl Iterator<Item = (State, State, Side, Primitive)> {
             .into_iter()
             .filter_map(move |t| single_move(f, t).map(|(side, p)| (f, t, side, p)))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A face as Table 5 names it: `Xneg`, `Ypos`, ...
+    fn named(f: Face) -> &'static str {
+        match (f.axis, f.sign) {
+            (Axis::X, Sign::Negative) => "Xneg",
+            (Axis::Y, Sign::Negative) => "Yneg",
+            (Axis::Z, Sign::Negative) => "Zneg",
+            (Axis::X, Sign::Positive) => "Xpos",
+            (Axis::Y, Sign::Positive) => "Ypos",
+            (Axis::Z, Sign::Positive) => "Zpos",
+        }
+    }
+
+    #[test]
+    fn faces_follow_the_table_5_names() {
+        for s in State::ALL {
+            let (a, b) = faces(s);
+            let mut words = s.name().split(' ');
+            let first = words.next().unwrap();
+            let second = words.next().unwrap();
+            if second == "match" {
+                assert_eq!((named(a), named(b)), (first, first), "{s}");
+            } else {
+                assert_eq!((named(a), named(b)), (first, second), "{s}");
+            }
+        }
+    }
+
+    #[test]
+    fn unit_and_cross_follow_the_right_hand_rule() {
+        let (x, y, z) = (
+            unit(Axis::X, Sign::Positive),
+            unit(Axis::Y, Sign::Positive),
+            unit(Axis::Z, Sign::Positive),
+        );
+        assert_eq!((x, y, z), ([1, 0, 0], [0, 1, 0], [0, 0, 1]));
+        assert_eq!(unit(Axis::Y, Sign::Negative), [0, -1, 0]);
+        assert_eq!(cross(x, y), z);
+        assert_eq!(cross(y, z), x);
+        assert_eq!(cross(z, x), y);
+        assert_eq!(cross(y, x), [0, 0, -1]);
+        assert_eq!(cross(x, x), [0, 0, 0]);
+    }
 }

@@ -15,31 +15,44 @@
 
 use super::geometry::{robot_move, single_move};
 use super::{Primitive, State};
+use crate::units::slice;
 
 const N: usize = 15;
 
 /// The grid of [`robot_move`] (`robot`) or of the model's [`single_move`].
+/// Runs at compile time only (for [`MAP`] and the model's grid); the loop counters stop at
+/// `N`, far below saturation.
 const fn build(robot: bool) -> [[Option<Primitive>; N]; N] {
     let mut m = [[None; N]; N];
     let mut i = 0;
-    while i < N {
+    while let (Some(row), Some(from)) = (slice::get_mut(&mut m, i), State::from_index(i)) {
         let mut j = 0;
-        while j < N {
-            if let (Some(from), Some(to)) = (State::from_index(i), State::from_index(j)) {
-                let mv = if robot {
-                    robot_move(from, to)
-                } else {
-                    single_move(from, to)
-                };
-                if let Some((_, p)) = mv {
-                    m[i][j] = Some(p);
-                }
+        while let (Some(cell), Some(to)) = (slice::get_mut(row, j), State::from_index(j)) {
+            let mv = if robot {
+                robot_move(from, to)
+            } else {
+                single_move(from, to)
+            };
+            if let Some((_, p)) = mv {
+                *cell = Some(p);
             }
-            j += 1;
+            j = j.saturating_add(1);
         }
-        i += 1;
+        i = i.saturating_add(1);
     }
     m
+}
+
+/// The cell of `grid` in row `from`, column `to` (both always in range: a state's index is
+/// below 15).
+const fn cell(grid: &[[Option<Primitive>; N]; N], from: State, to: State) -> Option<Primitive> {
+    match slice::get(grid, from.index()) {
+        Some(row) => match slice::get(row, to.index()) {
+            Some(p) => *p,
+            None => None,
+        },
+        None => None,
+    }
 }
 
 /// Figure 9: the primitive that takes row state to column state, if the robot can make the
@@ -52,7 +65,7 @@ const MODEL: [[Option<Primitive>; N]; N] = build(false);
 
 /// The primitive for a single-primitive reconfiguration from `from` to `to`.
 pub const fn primitive(from: State, to: State) -> Option<Primitive> {
-    MAP[from.index()][to.index()]
+    cell(&MAP, from, to)
 }
 
 /// Every single-primitive move, as (from, to, primitive), rows and columns in Table 5 order.
@@ -81,14 +94,14 @@ pub fn targets(from: State, p: Primitive) -> impl Iterator<Item = State> {
 /// naming one of the 12 turns without a hip rotation is well formed, and board A refuses it by
 /// that name when the robot is where the move starts (`Refusal::TurnWithoutHip`).
 pub const fn reaches(p: Primitive, to: State) -> bool {
-    let mut i = 0;
-    while i < N {
-        if let Some(q) = MODEL[i][to.index()]
-            && q as u8 == p as u8
+    let mut rest: &[State] = &State::ALL;
+    while let [from, tail @ ..] = rest {
+        if let Some(q) = cell(&MODEL, *from, to)
+            && q.number() == p.number()
         {
             return true;
         }
-        i += 1;
+        rest = tail;
     }
     false
 }

@@ -1,5 +1,7 @@
 //! The 15 allowed configurations of Table 5.
 
+use crate::units::slice;
+use crate::units::widen::to_u32;
 use crate::wire_enum::wire_enum;
 
 /// Shape of a configuration (Section 6).
@@ -69,25 +71,24 @@ impl State {
 
     /// State at Table 5 index `i`.
     pub const fn from_index(i: usize) -> Option<State> {
-        if i < Self::ALL.len() {
-            Some(Self::ALL[i])
-        } else {
-            None
+        match slice::get(&Self::ALL, i) {
+            Some(s) => Some(*s),
+            None => None,
         }
     }
 
     /// Table 5 letter.
     pub const fn letter(self) -> char {
-        self.to_wire() as char
+        // Every u8 is a char (U+0000..=U+00FF): the fallback never applies.
+        match char::from_u32(to_u32(self.to_wire().to_le_bytes())) {
+            Some(c) => c,
+            None => char::REPLACEMENT_CHARACTER,
+        }
     }
 
     /// State with Table 5 letter `c` (lowercase).
-    pub const fn from_letter(c: char) -> Option<State> {
-        if c.is_ascii() {
-            State::from_wire(c as u8)
-        } else {
-            None
-        }
+    pub fn from_letter(c: char) -> Option<State> {
+        u8::try_from(c).ok().and_then(State::from_wire)
     }
 
     /// Matched, stretch or turn.

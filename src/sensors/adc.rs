@@ -11,6 +11,7 @@
 //! assert_eq!(scale(&s, Channel::VBat, 2730), 10_000); // 10.0 V, the low-battery threshold
 //! ```
 
+use crate::units::widen::to_u32;
 use crate::units::Electrical;
 
 /// ADS7828 input channels, in channel order.
@@ -70,24 +71,46 @@ impl Default for Scaling {
 /// Largest 12-bit code.
 pub const CODE_MAX: u16 = 4095;
 
+/// [`CODE_MAX`] as the divisor of the scaling.
+const CODE_MAX_U32: u32 = to_u32(CODE_MAX.to_le_bytes());
+
 /// Scales a 12-bit code (codes above 4095 are clamped) to the channel's unit, rounding to
 /// nearest.
-pub const fn scale(s: &Scaling, ch: Channel, code: u16) -> u16 {
-    let c = if code > CODE_MAX { CODE_MAX } else { code } as u32;
-    let fs = s.full_scale[ch as usize] as u32;
-    ((c * fs + CODE_MAX as u32 / 2) / CODE_MAX as u32) as u16
+pub fn scale(s: &Scaling, ch: Channel, code: u16) -> u16 {
+    let c = u32::from(code.min(CODE_MAX));
+    let fs = u32::from(s.of(ch));
+    // Exact: at most 4095 × 65535 + 2047 < 2³²; the quotient is at most `fs`, a u16.
+    let q = c.wrapping_mul(fs).wrapping_add(CODE_MAX_U32 / 2) / CODE_MAX_U32;
+    u16::try_from(q).unwrap_or(u16::MAX)
+}
+
+impl Scaling {
+    /// The full-scale value of channel `ch`.
+    pub const fn of(&self, ch: Channel) -> u16 {
+        let [v_bat, i_bat, i_loc, i_grip, i_3v3, v_reg, i_bo, spare] = self.full_scale;
+        match ch {
+            Channel::VBat => v_bat,
+            Channel::IBat => i_bat,
+            Channel::ILoc => i_loc,
+            Channel::IGrip => i_grip,
+            Channel::I3v3 => i_3v3,
+            Channel::VReg => v_reg,
+            Channel::IBo => i_bo,
+            Channel::Spare => spare,
+        }
+    }
 }
 
 /// One side's readings from the eight (filtered) codes.
 pub fn electrical(s: &Scaling, codes: [u16; 8]) -> Electrical {
-    let v = |ch: Channel| scale(s, ch, codes[ch as usize]);
+    let [v_bat, i_bat, i_loc, i_grip, i_3v3, v_reg, i_bo, _spare] = codes;
     Electrical {
-        v_bat: v(Channel::VBat),
-        i_bat: v(Channel::IBat),
-        i_loc: v(Channel::ILoc),
-        i_grip: v(Channel::IGrip),
-        i_3v3: v(Channel::I3v3),
-        v_reg: v(Channel::VReg),
-        i_bo: v(Channel::IBo),
+        v_bat: scale(s, Channel::VBat, v_bat),
+        i_bat: scale(s, Channel::IBat, i_bat),
+        i_loc: scale(s, Channel::ILoc, i_loc),
+        i_grip: scale(s, Channel::IGrip, i_grip),
+        i_3v3: scale(s, Channel::I3v3, i_3v3),
+        v_reg: scale(s, Channel::VReg, v_reg),
+        i_bo: scale(s, Channel::IBo, i_bo),
     }
 }

@@ -7,15 +7,27 @@
 //! assert_eq!(hip_angle(0, 1024).centidegrees(), 27000); // the zero offset wraps
 //! ```
 
+use crate::units::widen::to_u32;
 use crate::units::HipAngle;
 
 /// Counts per turn of the 12-bit encoder.
 pub const COUNTS: u32 = 4096;
 
+/// A turn in centidegrees, as the u32 of the arithmetic.
+const TURN: u32 = to_u32(HipAngle::TURN.to_le_bytes());
+
 /// Hip angle of raw reading `raw` (low 12 bits used) with `zero` the raw reading at 0°,
 /// rounded to the nearest 0.01°.
 pub fn hip_angle(raw: u16, zero: u16) -> HipAngle {
-    let counts = (raw as u32 + COUNTS - (zero as u32 % COUNTS)) % COUNTS;
-    let cdeg = (counts * HipAngle::TURN as u32 + COUNTS / 2) / COUNTS;
-    HipAngle::new((cdeg % HipAngle::TURN as u32) as u16).unwrap_or(HipAngle::ZERO)
+    // Exact in u32: at most 65535 + 4096 before the first `%`, and 4095 × 36000 + 2048 before
+    // the division; the angle is then below 36000, a u16.
+    let counts = u32::from(raw)
+        .wrapping_add(COUNTS)
+        .wrapping_sub(u32::from(zero) % COUNTS)
+        % COUNTS;
+    let cdeg = counts.wrapping_mul(TURN).wrapping_add(COUNTS / 2) / COUNTS;
+    u16::try_from(cdeg % TURN)
+        .ok()
+        .and_then(|c| HipAngle::new(c).ok())
+        .unwrap_or(HipAngle::ZERO)
 }

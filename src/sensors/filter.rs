@@ -21,11 +21,12 @@ impl<const N: usize> Default for MovingAverage<N> {
     }
 }
 
+/// The longest window whose sum of u16 samples fits a u32: ⌊(2³² − 1) / (2¹⁶ − 1)⌋ (the
+/// tests check the figure).
+const MAX_WINDOW: usize = 65_537;
+
 impl<const N: usize> MovingAverage<N> {
-    const FITS: () = assert!(
-        N >= 1 && (N as u64) * (u16::MAX as u64) <= u32::MAX as u64,
-        "window too large for a u32 sum"
-    );
+    const FITS: () = assert!(N >= 1 && N <= MAX_WINDOW, "window too large for a u32 sum");
 
     /// An empty filter.
     pub const fn new() -> Self {
@@ -51,7 +52,8 @@ impl<const N: usize> MovingAverage<N> {
             *slot = sample;
         }
         if !full {
-            self.count += 1;
+            // Below N here (not full): never saturates.
+            self.count = self.count.saturating_add(1);
         }
         self.next = wrap_next::<N>(self.next);
     }
@@ -73,13 +75,33 @@ impl<const N: usize> MovingAverage<N> {
     }
 }
 
-/// The slot after `i` in a window of `N`, back to 0 after the last.
+/// The slot after `i` in a window of `N`, back to 0 after the last. The increment wraps, at
+/// no cost: `i` < N, and even `usize::MAX` would wrap to slot 0, a slot.
 const fn wrap_next<const N: usize>(i: usize) -> usize {
-    if i + 1 < N {
-        i + 1
+    let next = i.wrapping_add(1);
+    if next < N {
+        next
     } else {
         0
     }
+}
+
+/// `N` as the divisor of a full window's mean; a constant, so that its division compiles to a
+/// multiplication (N ≤ [`MAX_WINDOW`] by `FITS`, so the conversion is exact).
+fn full<const N: usize>() -> u32 {
+    u32::try_from(N).unwrap_or(u32::MAX)
+}
+
+/// `sum / n`, the mean of `n` u16 samples summing to `sum`, as the u16 it always is (a mean
+/// never exceeds its largest sample); `n` is never 0 (the callers match 0 first), which would
+/// give 0.
+fn mean_u16(sum: u32, n: u32) -> u16 {
+    u16::try_from(sum.checked_div(n).unwrap_or(0)).unwrap_or(u16::MAX)
+}
+
+/// A partial window's count `c` (< N ≤ [`MAX_WINDOW`]) as a divisor: exact.
+fn partial(c: usize) -> u32 {
+    u32::try_from(c).unwrap_or(u32::MAX)
 }
 
 /// `sum / count` rounded down, or `None` when `count` is 0; the divisor is the constant `N`
@@ -87,9 +109,8 @@ const fn wrap_next<const N: usize>(i: usize) -> usize {
 fn mean_of<const N: usize>(sum: u32, count: usize) -> Option<u16> {
     match count {
         0 => None,
-        c if c == N => Some((sum / N as u32) as u16),
-        // `c` < N ≤ 65537 (FITS), so the cast is exact; the mean of u16 samples fits a u16.
-        c => Some((sum / c as u32) as u16),
+        c if c == N => Some(mean_u16(sum, full::<N>())),
+        c => Some(mean_u16(sum, partial(c))),
     }
 }
 
@@ -139,7 +160,8 @@ impl<const N: usize, const K: usize> Averages<N, K> {
             }
         }
         if !full {
-            self.count += 1;
+            // Below N here (not full): never saturates.
+            self.count = self.count.saturating_add(1);
         }
         self.next = wrap_next::<N>(self.next);
     }
@@ -159,9 +181,11 @@ impl<const N: usize, const K: usize> Averages<N, K> {
     pub fn means_or(&self, empty: [u16; K]) -> [u16; K] {
         match self.count {
             0 => empty,
-            c if c == N => self.sum.map(|s| (s / N as u32) as u16),
-            // `c` < N ≤ 65537 (FITS): the cast is exact, the mean of u16 samples a u16.
-            c => self.sum.map(|s| (s / c as u32) as u16),
+            c if c == N => self.sum.map(|s| mean_u16(s, full::<N>())),
+            c => {
+                let c = partial(c);
+                self.sum.map(|s| mean_u16(s, c))
+            }
         }
     }
 
@@ -179,6 +203,13 @@ impl<const N: usize, const K: usize> Averages<N, K> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn max_window_is_the_largest_that_fits() {
+        let max = u64::try_from(MAX_WINDOW).unwrap();
+        assert!(max * u64::from(u16::MAX) <= u64::from(u32::MAX));
+        assert!((max + 1) * u64::from(u16::MAX) > u64::from(u32::MAX));
+    }
 
     /// Per channel, [`Averages`] gives what a [`MovingAverage`] gives, before and after the
     /// window fills and across its wrap, with the extreme samples.

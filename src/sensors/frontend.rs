@@ -75,7 +75,7 @@ impl Default for Config {
             scaling: Scaling::default(),
             encoder_zero: 0,
             hip_encoder: true,
-            loss_ticks: WINDOW as u16,
+            loss_ticks: u16::try_from(WINDOW).unwrap_or(u16::MAX),
         }
     }
 }
@@ -156,12 +156,12 @@ struct Silence {
 
 /// Offsets an i16 into u16 order-preservingly (−32768 → 0).
 const fn unsign(a: i16) -> u16 {
-    (a as u16) ^ 0x8000
+    a.cast_unsigned() ^ 0x8000
 }
 
 /// Inverse of [`unsign`].
 const fn resign(u: u16) -> i16 {
-    (u ^ 0x8000) as i16
+    (u ^ 0x8000).cast_signed()
 }
 
 /// One more tick of silence, or none when the device answered.

@@ -12,16 +12,15 @@ use crate::units::{Axis, Gravity, Sign};
 /// The axis with the largest |acceleration| and its sign; `None` when all three are zero.
 /// Ties go to the earlier axis (X, then Y, then Z) so the answer is deterministic.
 pub fn gravity(accel: [i16; 3]) -> Option<Gravity> {
-    let mut best: Option<(usize, u16)> = None;
-    for (i, &a) in accel.iter().enumerate() {
+    let mut best: Option<(Axis, i16, u16)> = None;
+    for (axis, a) in Axis::ALL.into_iter().zip(accel) {
         let m = a.unsigned_abs();
-        if m > 0 && best.is_none_or(|(_, b)| m > b) {
-            best = Some((i, m));
+        if m > 0 && best.is_none_or(|(_, _, b)| m > b) {
+            best = Some((axis, a, m));
         }
     }
-    let (i, _) = best?;
-    let axis = Axis::ALL[i];
-    let sign = if accel[i] > 0 {
+    let (axis, a, _) = best?;
+    let sign = if a > 0 {
         Sign::Positive
     } else {
         Sign::Negative

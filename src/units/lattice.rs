@@ -39,15 +39,22 @@ impl Module {
 
     /// Index 0..7 in [`Module::ALL`].
     pub const fn index(self) -> u8 {
-        self as u8
+        match self {
+            Module::Hip => 0,
+            Module::ArmA => 1,
+            Module::ArmB => 2,
+            Module::GripperA => 3,
+            Module::GripperB => 4,
+            Module::BolterA => 5,
+            Module::BolterB => 6,
+        }
     }
 
     /// Module with index `i`, if any.
     pub const fn from_index(i: u8) -> Option<Module> {
-        if (i as usize) < Self::ALL.len() {
-            Some(Self::ALL[i as usize])
-        } else {
-            None
+        match super::slice::get(&Self::ALL, super::widen::to_usize(i.to_le_bytes())) {
+            Some(m) => Some(*m),
+            None => None,
         }
     }
 
@@ -143,4 +150,20 @@ pub struct Gravity {
     pub axis: Axis,
     /// Sign of gravity along it.
     pub sign: Sign,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn module_index_is_the_position_in_all() {
+        for (i, m) in Module::ALL.iter().enumerate() {
+            assert_eq!(usize::from(m.index()), i);
+            assert_eq!(m.index(), *m as u8);
+            assert_eq!(Module::from_index(m.index()), Some(*m));
+        }
+        assert_eq!(Module::from_index(7), None);
+        assert_eq!(Module::from_index(u8::MAX), None);
+    }
 }

@@ -20,7 +20,9 @@ mod number;
 pub(crate) mod range;
 mod servo;
 mod side;
+pub(crate) mod slice;
 mod time;
+pub mod widen;
 
 pub use board::BoardNumber;
 pub use electrical::{Electrical, Milliamps, Millivolts};

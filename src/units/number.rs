@@ -68,10 +68,10 @@ impl<'de> serde::Deserialize<'de> for Number {
                 f.write_str("an integer")
             }
             fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Number, E> {
-                Ok(Number(v as i128))
+                Ok(Number(i128::from(v)))
             }
             fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Number, E> {
-                Ok(Number(v as i128))
+                Ok(Number(i128::from(v)))
             }
             fn visit_i128<E: serde::de::Error>(self, v: i128) -> Result<Number, E> {
                 Ok(Number(v))
@@ -81,6 +81,15 @@ impl<'de> serde::Deserialize<'de> for Number {
             }
             // JSON readers hand integers beyond u64 over as floats: a whole float is taken
             // as the integer it is (saturating beyond ±1.7e38), a fraction is refused.
+            #[cfg_attr(
+                not(test),
+                expect(
+                    clippy::as_conversions,
+                    reason = "f64 to i128 and back, no From: `as` saturates (NaN to 0, but \
+                              only finite values get here), and the round trip tells a whole \
+                              number from a fraction"
+                )
+            )]
             fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Number, E> {
                 if v.is_finite() && v == (v as i128) as f64 {
                     Ok(Number(v as i128))
@@ -103,7 +112,7 @@ pub(crate) mod de {
             #[$doc]
             pub(crate) fn $name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$t, D::Error> {
                 <Number as serde::Deserialize>::deserialize(d)?
-                    .narrow($quantity, (<$t>::MIN as i128, <$t>::MAX as i128), Some)
+                    .narrow($quantity, (i128::from(<$t>::MIN), i128::from(<$t>::MAX)), Some)
                     .map_err(serde::de::Error::custom)
             }
         )*};

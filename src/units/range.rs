@@ -42,14 +42,20 @@ macro_rules! ranged {
         impl $name {
             #[doc = concat!("`v` as a ", $quantity, ", refused outside `", stringify!($min), "..=", stringify!($max), "`.")]
             pub const fn new(v: $int) -> Result<$name, $crate::units::RangeError> {
-                if $crate::units::range::within(v as u32, $min as u32, $max as u32) {
+                let (min, max): ($int, $int) = ($min, $max);
+                let (found, min, max) = (
+                    $crate::units::widen::to_u32(v.to_le_bytes()),
+                    $crate::units::widen::to_u32(min.to_le_bytes()),
+                    $crate::units::widen::to_u32(max.to_le_bytes()),
+                );
+                if $crate::units::range::within(found, min, max) {
                     Ok($name(v))
                 } else {
                     Err($crate::units::RangeError {
                         quantity: $quantity,
-                        min: $min as u32,
-                        max: $max as u32,
-                        found: v as u32,
+                        min,
+                        max,
+                        found,
                     })
                 }
             }
@@ -79,7 +85,10 @@ macro_rules! ranged {
             fn try_from(
                 n: $crate::units::Number,
             ) -> Result<$name, $crate::units::NumberRangeError> {
-                n.narrow($quantity, ($min as i128, $max as i128), |v: $int| $name::new(v).ok())
+                let (min, max): ($int, $int) = ($min, $max);
+                n.narrow($quantity, (i128::from(min), i128::from(max)), |v: $int| {
+                    $name::new(v).ok()
+                })
             }
         }
 

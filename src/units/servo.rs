@@ -76,7 +76,8 @@ impl HipAngle {
     pub const fn distance(self, other: HipAngle) -> u16 {
         let d = self.0.abs_diff(other.0);
         if d > Self::TURN / 2 {
-            Self::TURN - d
+            // Both angles are below TURN, so `d` is too: the subtraction never saturates.
+            Self::TURN.saturating_sub(d)
         } else {
             d
         }

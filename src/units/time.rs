@@ -20,6 +20,9 @@ pub struct Instant(u32);
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Duration(u32);
 
+/// Half the clock's wrap, 2³¹ − 1 ms: a later moment is at most this far ahead.
+const HALF_WRAP: u32 = i32::MAX.unsigned_abs();
+
 impl Instant {
     /// The clock's zero.
     pub const ZERO: Instant = Instant(0);
@@ -49,14 +52,14 @@ impl Instant {
     /// assert!(t(5).reached(t(u32::MAX - 5))); // across the wrap
     /// ```
     pub const fn reached(self, deadline: Instant) -> bool {
-        self.0.wrapping_sub(deadline.0) <= i32::MAX as u32
+        self.0.wrapping_sub(deadline.0) <= HALF_WRAP
     }
 
     /// Time from `earlier` to `self` on the wrapping clock; zero if `self` is earlier (a
     /// difference of more than half the wrap is read as the clock having gone backwards).
     pub const fn since(self, earlier: Instant) -> Duration {
         let d = self.0.wrapping_sub(earlier.0);
-        if d > i32::MAX as u32 {
+        if d > HALF_WRAP {
             Duration(0)
         } else {
             Duration(d)
