@@ -92,13 +92,14 @@ pub struct HipController {
 
 /// Signed shortest difference `to − from`, in (−18000, 18000].
 pub const fn angle_error(from: HipAngle, to: HipAngle) -> i32 {
-    // Both angles are in 0..36000 (their type's range): `d` is in (−36000, 36000) and the
-    // results below in (−18000, 18000], far from saturating.
-    let d = centidegrees(to).saturating_sub(centidegrees(from));
+    // Exact, so the wrapping operations (which cost nothing on the board's control tick)
+    // never wrap: both angles are in 0..36000 (their type's range), `d` in (−36000, 36000) and
+    // the results in (−18000, 18000].
+    let d = centidegrees(to).wrapping_sub(centidegrees(from));
     if d > 18000 {
-        d.saturating_sub(36000)
+        d.wrapping_sub(36000)
     } else if d <= -18000 {
-        d.saturating_add(36000)
+        d.wrapping_add(36000)
     } else {
         d
     }
@@ -140,17 +141,17 @@ impl HipController {
         if let Some((t0, a0)) = self.last {
             dt_ms = Instant::from_millis(now).since(t0).millis().min(1000);
             // In 1..=1000 here, so `checked_div` never fails, and `raw` is exact in i32:
-            // |raw| ≤ 18000 × 1000. The estimate stays within the same bound, so neither
-            // saturating operation below ever saturates.
+            // |raw| ≤ 18000 × 1000. The estimate stays within the same bound, so the update's
+            // wrapping operations (free on the control tick) are exact.
             if let Ok(dt @ 1..) = i32::try_from(dt_ms) {
                 let raw = angle_error(a0, measured)
-                    .saturating_mul(1000)
+                    .wrapping_mul(1000)
                     .checked_div(dt)
                     .unwrap_or(0);
                 let shift = self.cfg.smoothing_shift.min(8);
                 self.velocity = self
                     .velocity
-                    .saturating_add(raw.saturating_sub(self.velocity) >> shift);
+                    .wrapping_add(raw.wrapping_sub(self.velocity) >> shift);
             }
         }
         self.last = Some((Instant::from_millis(now), measured));
@@ -202,7 +203,8 @@ impl HipController {
             .saturating_add(p)
             .saturating_add(i64::from(self.integral_q8) >> 8);
         let max = i64::from(max);
-        let out = unsat.clamp(max.saturating_neg(), max);
+        // 0..=1000: the negation is exact.
+        let out = unsat.clamp(max.wrapping_neg(), max);
         // Anti-windup: integrate only when not saturated, or when the error pulls back inward.
         let saturated = unsat != out;
         if !saturated || (unsat > 0) != (err > 0) {
@@ -215,13 +217,14 @@ impl HipController {
             self.integral_q8 = i32::try_from(
                 i64::from(self.integral_q8)
                     .saturating_add(di)
-                    .clamp(lim.saturating_neg(), lim),
+                    .clamp(lim.wrapping_neg(), lim),
             )
             .unwrap_or(0);
         }
-        // |out| ≤ 1000: an i16, so the fallback never applies.
+        // |out| ≤ 1000: an i16, so the fallback never applies, and the pulse is in 500..=2500
+        // (exact: the wrapping addition never wraps).
         let out = i16::try_from(out).unwrap_or(0);
-        PulseWidth::saturating(STOP_US.saturating_add_signed(out))
+        PulseWidth::saturating(STOP_US.wrapping_add_signed(out))
     }
 
     /// A tick without an angle reading: the stop pulse, and the controller starts afresh

@@ -71,12 +71,13 @@ impl Interpolator {
         let max_move = u64::from(periods).saturating_mul(u64::from(self.rate.step_us.max(1)));
         let (now, target) = (self.now.micros(), self.target.micros());
         let gap = now.abs_diff(target);
-        // At most `gap`, so `next` lies between `now` and `target`, both in range.
+        // At most `gap`, so `next` lies between `now` and `target`, both in range: the
+        // wrapping operations (free on the control tick) are exact.
         let step = u16::try_from(max_move.min(u64::from(gap))).unwrap_or(gap);
         let next = if target >= now {
-            now.saturating_add(step)
+            now.wrapping_add(step)
         } else {
-            now.saturating_sub(step)
+            now.wrapping_sub(step)
         };
         self.now = PulseWidth::saturating(next);
         self.now

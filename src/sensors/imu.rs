@@ -13,7 +13,7 @@ use crate::units::{Axis, Gravity, Sign};
 /// Ties go to the earlier axis (X, then Y, then Z) so the answer is deterministic.
 pub fn gravity(accel: [i16; 3]) -> Option<Gravity> {
     let mut best: Option<(Axis, i16, u16)> = None;
-    for (axis, a) in Axis::ALL.into_iter().zip(accel) {
+    for (&axis, &a) in Axis::ALL.iter().zip(accel.iter()) {
         let m = a.unsigned_abs();
         if m > 0 && best.is_none_or(|(_, _, b)| m > b) {
             best = Some((axis, a, m));
