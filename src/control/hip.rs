@@ -208,23 +208,29 @@ impl HipController {
         // Anti-windup: integrate only when not saturated, or when the error pulls back inward.
         let saturated = unsat != out;
         if !saturated || (unsat > 0) != (err > 0) {
-            let di = i64::from(err)
-                .saturating_mul(i64::from(ki))
-                .saturating_mul(i64::from(dt_ms))
-                / 1000;
-            let lim = max << 8;
-            // Clamped to ±256,000 (max ≤ 1000): an i32, so the fallback never applies.
-            self.integral_q8 = i32::try_from(
-                i64::from(self.integral_q8)
-                    .saturating_add(di)
-                    .clamp(lim.wrapping_neg(), lim),
-            )
-            .unwrap_or(0);
+            self.integrate(err, ki, dt_ms, max);
         }
         // |out| ≤ 1000: an i16, so the fallback never applies, and the pulse is in 500..=2500
         // (exact: the wrapping addition never wraps).
         let out = i16::try_from(out).unwrap_or(0);
         PulseWidth::saturating(STOP_US.wrapping_add_signed(out))
+    }
+
+    /// Adds `err × ki` over `dt_ms` to the integral, clamped to the output's range `max`
+    /// (0..=1000 µs) in Q8.
+    fn integrate(&mut self, err: i32, ki: i32, dt_ms: u32, max: i64) {
+        let di = i64::from(err)
+            .saturating_mul(i64::from(ki))
+            .saturating_mul(i64::from(dt_ms))
+            / 1000;
+        let lim = max << 8;
+        // Clamped to ±256,000: an i32, so the fallback never applies.
+        self.integral_q8 = i32::try_from(
+            i64::from(self.integral_q8)
+                .saturating_add(di)
+                .clamp(lim.wrapping_neg(), lim),
+        )
+        .unwrap_or(0);
     }
 
     /// A tick without an angle reading: the stop pulse, and the controller starts afresh
