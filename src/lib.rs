@@ -52,9 +52,10 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
-// No panics on any input: outside the tests, no unwrap, expect, panic! or unreachable!, and
-// every exception to a lint says why (clippy denies them in CI, for the host and for RV32). The
-// rules and what enforces each: docs/coding-standard.md; the exceptions: docs/evidence/lint-record.md.
+// No panics on any input: outside the tests, no unwrap, expect, panic! or unreachable!, no
+// indexing or slicing the compiler cannot check, no unchecked arithmetic, no `as`; every
+// exception to a lint says why (clippy denies them in CI, for the host and for RV32). The rules
+// and what enforces each: docs/coding-standard.md; the exceptions: docs/evidence/lint-record.md.
 #![cfg_attr(
     not(test),
     deny(
@@ -65,6 +66,9 @@
         clippy::todo,
         clippy::unimplemented,
         clippy::unreachable,
+        clippy::indexing_slicing,
+        clippy::arithmetic_side_effects,
+        clippy::as_conversions,
         clippy::allow_attributes_without_reason
     )
 )]

@@ -57,17 +57,14 @@ wire_enum! {
     pub const fn from_wire(b: u8) -> Option<Self>;
     /// Table 5 descriptive name.
     pub const fn name(self) -> &'static str;
+    /// Index 0..15 in Table 5 order.
+    pub const fn index(self) -> usize;
     impl Display("{} ({})", letter, name);
 }
 
 impl State {
     /// The six matched (final) states.
     pub const MATCHED: [State; 6] = [State::A, State::B, State::C, State::M, State::N, State::O];
-
-    /// Index 0..15 in Table 5 order.
-    pub const fn index(self) -> usize {
-        self as usize
-    }
 
     /// State at Table 5 index `i`.
     pub const fn from_index(i: usize) -> Option<State> {
