@@ -154,17 +154,21 @@ pub struct Readings {
     pub hip: HipAngle,
 }
 
-/// Dot product of the model's unit vectors (components in −1..=1, the result too): the
-/// saturating operations never saturate.
+/// Dot product of the model's vectors (unit vectors and their cross products, components in
+/// −1..=1): each product is in −1..=1 and the sum in −3..=3, so the wrapping operations (free on
+/// board A's tick, which estimates every state; coding standard R4, "exact") never wrap.
 fn dot(a: Vec3, b: Vec3) -> i8 {
-    a.into_iter()
-        .zip(b)
-        .fold(0, |sum, (x, y)| sum.saturating_add(x.saturating_mul(y)))
+    let [a0, a1, a2] = a;
+    let [b0, b1, b2] = b;
+    a0.wrapping_mul(b0)
+        .wrapping_add(a1.wrapping_mul(b1))
+        .wrapping_add(a2.wrapping_mul(b2))
 }
 
-/// `−v`, of a model vector (components in −1..=1).
+/// `−v`, of a model vector (components in −1..=1: the negation is exact).
 fn neg(v: Vec3) -> Vec3 {
-    v.map(i8::saturating_neg)
+    let [x, y, z] = v;
+    [x.wrapping_neg(), y.wrapping_neg(), z.wrapping_neg()]
 }
 
 /// Gravity as a board whose frame is (x = `arm`, z = `hip_axis`) reads it.

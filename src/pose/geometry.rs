@@ -54,14 +54,15 @@ pub const fn unit(axis: Axis, sign: Sign) -> Vec3 {
 }
 
 /// Cross product. The model's vectors are unit vectors and their cross products, components
-/// in −1..=1: the saturating operations never saturate.
+/// in −1..=1: each component here is in −2..=2, so the wrapping operations (free on board A's
+/// tick; coding standard R4, "exact") never wrap.
 pub const fn cross(a: Vec3, b: Vec3) -> Vec3 {
     let [a0, a1, a2] = a;
     let [b0, b1, b2] = b;
     [
-        a1.saturating_mul(b2).saturating_sub(a2.saturating_mul(b1)),
-        a2.saturating_mul(b0).saturating_sub(a0.saturating_mul(b2)),
-        a0.saturating_mul(b1).saturating_sub(a1.saturating_mul(b0)),
+        a1.wrapping_mul(b2).wrapping_sub(a2.wrapping_mul(b1)),
+        a2.wrapping_mul(b0).wrapping_sub(a0.wrapping_mul(b2)),
+        a0.wrapping_mul(b1).wrapping_sub(a1.wrapping_mul(b0)),
     ]
 }
 
@@ -170,7 +171,8 @@ pub const fn single_move(from: State, to: State) -> Option<(Side, Primitive)> {
     } else {
         // CCW when old × new points along a positive axis (right-hand rule).
         let [c0, c1, c2] = c;
-        let ccw = c0.saturating_add(c1).saturating_add(c2) > 0;
+        // Components in −2..=2: the sum is exact.
+        let ccw = c0.wrapping_add(c1).wrapping_add(c2) > 0;
         match (fwd, ccw) {
             (true, false) => Primitive::FwdTurnCw,
             (true, true) => Primitive::FwdTurnCcw,
