@@ -17,6 +17,7 @@ mod link_spec;
 mod pics;
 mod sdls;
 mod sdls_spec;
+mod shared_link;
 mod store;
 mod tc_frame;
 mod tm_frame;

@@ -39,7 +39,10 @@ fn statements() -> Vec<Statement> {
     let mut out: Vec<Statement> = files
         .iter()
         .map(|p| {
-            let rel = format!("spec/ccsds/pics/{}", p.file_name().unwrap().to_string_lossy());
+            let rel = format!(
+                "spec/ccsds/pics/{}",
+                p.file_name().unwrap().to_string_lossy()
+            );
             read(&rel, "book")
         })
         .collect();
@@ -50,7 +53,10 @@ fn statements() -> Vec<Statement> {
 /// A statement file: `head` names its header table (`book` or `standard`).
 fn read(rel: &str, head: &str) -> Statement {
     let t: toml::Table = toml::from_str(&repo(rel)).unwrap_or_else(|e| panic!("{rel}: {e}"));
-    let header = t[head].as_table().unwrap_or_else(|| panic!("{rel}: no [{head}]")).clone();
+    let header = t[head]
+        .as_table()
+        .unwrap_or_else(|| panic!("{rel}: no [{head}]"))
+        .clone();
     let items = t["item"]
         .as_array()
         .unwrap_or_else(|| panic!("{rel}: no [[item]]"))
@@ -58,7 +64,12 @@ fn read(rel: &str, head: &str) -> Statement {
         .map(|i| i.as_table().expect("an item is a table").clone())
         .collect();
     let id = header["id"].as_str().expect("an id").to_string();
-    Statement { path: rel.to_string(), id, header, items }
+    Statement {
+        path: rel.to_string(),
+        id,
+        header,
+        items,
+    }
 }
 
 /// A string field of an item, or "".
@@ -90,7 +101,11 @@ fn every_item_is_complete_and_its_code_exists() {
     for s in statements() {
         let book = s.path.starts_with("spec/ccsds/pics/");
         if book {
-            let stem = Path::new(&s.path).file_stem().unwrap().to_string_lossy().to_string();
+            let stem = Path::new(&s.path)
+                .file_stem()
+                .unwrap()
+                .to_string_lossy()
+                .to_string();
             assert_eq!(s.id, stem, "{}: the book id is the file's name", s.path);
             for k in ["title", "annex", "source"] {
                 assert!(!field(&s.header, k).is_empty(), "{}: [book] {k}", s.path);
@@ -101,7 +116,10 @@ fn every_item_is_complete_and_its_code_exists() {
                 "{}: numbering {numbering:?}",
                 s.path
             );
-            let count = s.header.get("items_in_book").or_else(|| s.header.get("items_in_source"));
+            let count = s
+                .header
+                .get("items_in_book")
+                .or_else(|| s.header.get("items_in_source"));
             if let Some(n) = count.and_then(|v| v.as_integer()) {
                 assert_eq!(s.items.len() as i64, n, "{}: the item count", s.path);
             }
@@ -110,9 +128,15 @@ fn every_item_is_complete_and_its_code_exists() {
         for item in &s.items {
             let id = field(item, "id");
             let at = format!("{} {id}", s.path);
-            assert!(!id.is_empty() && seen.insert(id.to_string()), "{at}: an id, once");
+            assert!(
+                !id.is_empty() && seen.insert(id.to_string()),
+                "{at}: an id, once"
+            );
             assert!(!field(item, "clause").is_empty(), "{at}: clause");
-            assert!(item.get("checked").is_some_and(|v| v.is_bool()), "{at}: checked");
+            assert!(
+                item.get("checked").is_some_and(|v| v.is_bool()),
+                "{at}: checked"
+            );
             if book {
                 assert!(!field(item, "feature").is_empty(), "{at}: feature");
                 assert!(status_ok(field(item, "status")), "{at}: status");
@@ -149,7 +173,11 @@ fn citations() -> BTreeMap<String, Vec<String>> {
         let mut files = Vec::new();
         rust_files(&root().join(dir), &mut files);
         for f in files {
-            let rel = f.strip_prefix(root()).unwrap().to_string_lossy().replace('\\', "/");
+            let rel = f
+                .strip_prefix(root())
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
             let text = std::fs::read_to_string(&f).unwrap();
             for (ids, test) in annotations(&text, dir == "src") {
                 for id in ids {
@@ -163,7 +191,9 @@ fn citations() -> BTreeMap<String, Vec<String>> {
 
 /// The `.rs` files under `dir`, sorted.
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(rd) = std::fs::read_dir(dir) else { return };
+    let Ok(rd) = std::fs::read_dir(dir) else {
+        return;
+    };
     let mut entries: Vec<PathBuf> = rd.map(|e| e.unwrap().path()).collect();
     entries.sort();
     for p in entries {
@@ -183,7 +213,10 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 fn annotations(text: &str, src: bool) -> Vec<(Vec<String>, String)> {
     let lines: Vec<&str> = text.lines().collect();
     let start = if src {
-        match lines.iter().position(|l| l.trim_start().starts_with("#[cfg(test)]")) {
+        match lines
+            .iter()
+            .position(|l| l.trim_start().starts_with("#[cfg(test)]"))
+        {
             Some(i) => i,
             None => return Vec::new(),
         }
@@ -197,7 +230,10 @@ fn annotations(text: &str, src: bool) -> Vec<(Vec<String>, String)> {
         let comment = t.starts_with("//") || t.is_empty();
         if let Some(rest) = t.strip_prefix("//").map(str::trim_start) {
             if let Some(list) = rest.strip_prefix("req:") {
-                let ids = list.split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty());
+                let ids = list
+                    .split(',')
+                    .map(|s| s.trim().to_string())
+                    .filter(|s| !s.is_empty());
                 let target = if in_header {
                     "(module)".to_string()
                 } else {
@@ -221,8 +257,10 @@ fn next_fn(lines: &[&str]) -> Option<String> {
         if before.is_some_and(|c| !c.is_whitespace()) {
             return None;
         }
-        let name: String =
-            l[i + 3..].chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+        let name: String = l[i + 3..]
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
         (!name.is_empty()).then_some(name)
     })
 }
@@ -239,19 +277,31 @@ fn every_supported_item_is_cited_by_a_test_and_every_citation_exists() {
             let id = req_id(&s, item);
             if field(item, "supported") == "Y" && !cites.contains_key(&id) {
                 let flagged = item.get("tests_missing").and_then(|v| v.as_bool()) == Some(true);
-                missing.push(format!("{id}{}", if flagged { " (tests_missing)" } else { "" }));
+                missing.push(format!(
+                    "{id}{}",
+                    if flagged { " (tests_missing)" } else { "" }
+                ));
             }
             known.insert(id);
         }
     }
-    assert!(missing.is_empty(), "supported, but no test says `// req:` for:\n{}", missing.join("\n"));
-    let ours = |id: &str| id.starts_with("PUS/") || books.iter().any(|b| id.starts_with(b.as_str()));
+    assert!(
+        missing.is_empty(),
+        "supported, but no test says `// req:` for:\n{}",
+        missing.join("\n")
+    );
+    let ours =
+        |id: &str| id.starts_with("PUS/") || books.iter().any(|b| id.starts_with(b.as_str()));
     let unknown: Vec<String> = cites
         .iter()
         .filter(|(id, _)| ours(id) && !known.contains(*id))
         .map(|(id, at)| format!("{id} ({})", at.join("; ")))
         .collect();
-    assert!(unknown.is_empty(), "cited, but in no statement:\n{}", unknown.join("\n"));
+    assert!(
+        unknown.is_empty(),
+        "cited, but in no statement:\n{}",
+        unknown.join("\n")
+    );
 }
 
 /// A table cell: no pipe or newline breaks the row.
@@ -259,27 +309,58 @@ fn cell(s: &str) -> String {
     s.replace('|', "\\|").replace('\n', " ")
 }
 
-/// The counts line of a page: items by status, and by support.
-fn counts(s: &Statement) -> String {
-    let mut by_status: BTreeMap<String, usize> = BTreeMap::new();
+/// The counts of a page: items by status (by direction for the PUS tailoring), by support,
+/// and the support of each status.
+fn counts(s: &Statement, book: bool) -> String {
+    let class = |item: &toml::Table| -> String {
+        let k = if book {
+            field(item, "status")
+        } else {
+            field(item, "direction")
+        };
+        let k = if book && k.starts_with('C') { "C" } else { k };
+        if k.is_empty() {
+            "service or capability".to_string()
+        } else {
+            k.to_string()
+        }
+    };
+    let mut by_class: BTreeMap<String, BTreeMap<String, usize>> = BTreeMap::new();
     let mut by_support: BTreeMap<String, usize> = BTreeMap::new();
     for item in &s.items {
-        let st = field(item, "status");
-        let st = if st.starts_with('C') { "C" } else { st };
-        let st = if st.is_empty() { "-" } else { st };
-        *by_status.entry(st.to_string()).or_default() += 1;
-        *by_support.entry(field(item, "supported").to_string()).or_default() += 1;
+        let sup = field(item, "supported").to_string();
+        *by_class
+            .entry(class(item))
+            .or_default()
+            .entry(sup.clone())
+            .or_default() += 1;
+        *by_support.entry(sup).or_default() += 1;
     }
     let list = |m: &BTreeMap<String, usize>| {
-        m.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")
+        m.iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
     };
-    let checked = s.items.iter().filter(|i| i["checked"].as_bool() == Some(true)).count();
-    format!(
-        "{} items. Status: {}. Supported: {}. Checked against the book's text: {checked}.\n",
+    let checked = s
+        .items
+        .iter()
+        .filter(|i| i["checked"].as_bool() == Some(true))
+        .count();
+    let mut out = format!(
+        "{} items; supported: {}; checked against the {}'s text: {checked}.\n\n",
         s.items.len(),
-        list(&by_status),
-        list(&by_support)
-    )
+        list(&by_support),
+        if book { "book" } else { "standard" }
+    );
+    out += &format!(
+        "| {} | items | supported |\n|---|---|---|\n",
+        if book { "status" } else { "direction" }
+    );
+    for (k, m) in &by_class {
+        out += &format!("| {k} | {} | {} |\n", m.values().sum::<usize>(), list(m));
+    }
+    out
 }
 
 /// The review page of one statement.
@@ -288,7 +369,11 @@ fn page(s: &Statement, cites: &BTreeMap<String, Vec<String>>) -> String {
     let mut out = format!(
         "# {} {}\n\n<!-- generated by tests/ccsds/pics.rs from {}; regenerate: \
          MMIC_REGENERATE=1 cargo test --test ccsds pics -->\n\n",
-        if book { "PICS of CCSDS" } else { "PUS-C tailoring," },
+        if book {
+            "PICS of CCSDS"
+        } else {
+            "PUS-C tailoring,"
+        },
         s.id,
         s.path
     );
@@ -297,19 +382,35 @@ fn page(s: &Statement, cites: &BTreeMap<String, Vec<String>>) -> String {
     if book {
         out += &format!("Numbering: {}.", field(&s.header, "numbering"));
         if let Some(n) = s.header.get("note").and_then(|v| v.as_str()) {
-            out += &format!(" {n}.");
+            out += &format!(" {}.", n.trim_end_matches('.'));
         }
         out += "\n\n";
     }
-    out += &counts(s);
-    out += "\n| item | clause | feature | status | value | supported | code or why | tests citing it |\n";
+    out += &counts(s, book);
+    out += &format!(
+        "\n| item | clause | feature | {} |",
+        if book { "status" } else { "direction" }
+    );
+    out += " value | supported | code or why | tests citing it |\n";
     out += "|---|---|---|---|---|---|---|---|\n";
     for item in &s.items {
         let id = req_id(s, item);
-        let feature = if book { field(item, "feature") } else { field(item, "name") };
-        let status = if book { field(item, "status") } else { field(item, "direction") };
+        let feature = if book {
+            field(item, "feature")
+        } else {
+            field(item, "name")
+        };
+        let status = if book {
+            field(item, "status")
+        } else {
+            field(item, "direction")
+        };
         let code_or_why = if field(item, "supported") == "Y" {
-            code(item).iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", ")
+            code(item)
+                .iter()
+                .map(|c| format!("`{c}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
         } else {
             cell(field(item, "why"))
         };
@@ -360,8 +461,17 @@ fn the_annotation_reader_takes_the_next_fn_and_skips_src_outside_tests() {
     let text = "//! doc\n// req: A/1\nuse x;\n// req: A/2, PUS/ST[8].1\n#[test]\nfn one() {}\n";
     let got = annotations(text, false);
     assert_eq!(got[0], (vec!["A/1".to_string()], "(module)".to_string()));
-    assert_eq!(got[1], (vec!["A/2".to_string(), "PUS/ST[8].1".to_string()], "one".to_string()));
-    assert!(annotations(text, true).is_empty(), "src/ without #[cfg(test)]");
+    assert_eq!(
+        got[1],
+        (
+            vec!["A/2".to_string(), "PUS/ST[8].1".to_string()],
+            "one".to_string()
+        )
+    );
+    assert!(
+        annotations(text, true).is_empty(),
+        "src/ without #[cfg(test)]"
+    );
     let src = "fn shipped() {}\n// req: A/3\n#[cfg(test)]\nmod tests {\n    // req: A/4\n    #[test]\n    fn two() {}\n}\n";
     let got = annotations(src, true);
     assert_eq!(got, vec![(vec!["A/4".to_string()], "two".to_string())]);
