@@ -228,19 +228,18 @@ fn annotations(text: &str, src: bool) -> Vec<(Vec<String>, String)> {
     for (i, line) in lines.iter().enumerate().skip(start) {
         let t = line.trim_start();
         let comment = t.starts_with("//") || t.is_empty();
-        if let Some(rest) = t.strip_prefix("//").map(str::trim_start) {
-            if let Some(list) = rest.strip_prefix("req:") {
-                let ids = list
-                    .split(',')
-                    .map(|s| s.trim().to_string())
-                    .filter(|s| !s.is_empty());
-                let target = if in_header {
-                    "(module)".to_string()
-                } else {
-                    next_fn(&lines[i + 1..]).unwrap_or_else(|| "(none)".to_string())
-                };
-                out.push((ids.collect(), target));
-            }
+        let req = t.strip_prefix("//").map(str::trim_start);
+        if let Some(list) = req.and_then(|rest| rest.strip_prefix("req:")) {
+            let ids = list
+                .split(',')
+                .map(|s| s.trim().to_string())
+                .filter(|s| !s.is_empty());
+            let target = if in_header {
+                "(module)".to_string()
+            } else {
+                next_fn(&lines[i + 1..]).unwrap_or_else(|| "(none)".to_string())
+            };
+            out.push((ids.collect(), target));
         }
         if !comment {
             in_header = false;

@@ -290,7 +290,12 @@ fn review_pages_are_fresh() {
     let on_disk = std::fs::read_dir(&dir)
         .unwrap()
         .filter(|e| {
-            let name = e.as_ref().unwrap().file_name().to_string_lossy().into_owned();
+            let name = e
+                .as_ref()
+                .unwrap()
+                .file_name()
+                .to_string_lossy()
+                .into_owned();
             !(name.starts_with("pics-") || name == "pus-tailoring.md")
         })
         .count();
