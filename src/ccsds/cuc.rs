@@ -175,6 +175,7 @@ mod tests {
         assert_eq!(Cuc::from_millis((1u64 << 32) * 1000 + 5).coarse, 0);
     }
 
+    // req: PUS/tm-time-cuc
     #[test]
     fn p_field_is_agency_epoch_4_coarse_2_fine() {
         assert_eq!(P_FIELD, 0x2e);

@@ -235,6 +235,7 @@ impl From<&PrimaryHeader> for PrimaryLayout {
 mod tests {
     use super::*;
 
+    // req: 133.0-B-2/SPP-3, 133.0-B-2/SPP-15
     #[test]
     fn every_field_lands_on_its_bits() {
         // All ones in each field in turn, against the bit positions of 133.0-B-2 §4.1.3.

@@ -157,6 +157,7 @@ impl From<&TcSecondaryHeader> for TcSecondaryLayout {
 mod tests {
     use super::*;
 
+    // req: PUS/tc-ack-flags
     #[test]
     fn ack_flags_take_the_standards_bit_order() {
         for bits in 0..16u8 {

@@ -303,6 +303,7 @@ mod tests {
 
     /// Each field all ones in turn, by hand against the bit table of 232.0-B-4 §4.2.1 (bit 0
     /// the most significant of octet 0): the fixed part alone is `0x01 0x00 0x00 0x00`.
+    // req: 232.1-B-2/CLCW-1
     #[test]
     fn every_field_lands_on_its_bits() {
         let z = Clcw::default();
@@ -369,6 +370,7 @@ mod tests {
     /// Every fixed bit's value (type, version, COP, the three spare bits: 2^8 combinations)
     /// under a few variable parts: refused by the first check in order that fails, accepted
     /// only with all of them right.
+    // req: 232.1-B-2/CLCW-2
     #[test]
     fn each_fixed_bit_is_checked_in_order() {
         for fixed in 0u32..256 {

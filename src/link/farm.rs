@@ -267,6 +267,7 @@ mod tests {
         assert_eq!(FarmWindow::new(1), Err(FarmWindowError { found: 1 }));
     }
 
+    // req: 232.1-B-2/FARM-9
     #[test]
     fn wait_then_release_then_the_same_frame_is_taken() {
         let mut f = Farm::new(FarmWindow::MISSION);
@@ -286,6 +287,7 @@ mod tests {
         assert_eq!(f.counters().discarded(DiscardReason::NoBuffer), 1);
     }
 
+    // req: 232.1-B-2/FARM-5
     #[test]
     fn lockout_from_wait_keeps_the_wait_flag_until_release_or_unlock() {
         let mut f = Farm::new(FarmWindow::MISSION);

@@ -382,6 +382,7 @@ mod tests {
         }
     }
 
+    // req: 232.1-B-2/FOP-2, 232.1-B-2/FOP-4
     #[test]
     fn window_full_holds_the_fdu_until_an_acknowledgement() {
         let mut f = active(small());
@@ -409,6 +410,7 @@ mod tests {
         assert_eq!((f.nnr(), f.vs(), f.sent_len()), (2, 4, 2));
     }
 
+    // req: 232.1-B-2/FOP-7
     #[test]
     fn retransmit_flag_resends_everything_outstanding() {
         let mut f = active(small());
@@ -434,6 +436,7 @@ mod tests {
         assert_eq!(f.timer_deadline(), None);
     }
 
+    // req: 232.1-B-2/FOP-5, 232.1-B-2/FOP-6, 232.1-B-2/FOP-11
     #[test]
     fn timer_expiry_retransmits_until_the_limit_then_alerts() {
         let mut f = active(small());
@@ -460,6 +463,7 @@ mod tests {
         assert_eq!(f.state(), FopState::Initial);
     }
 
+    // req: 232.1-B-2/FOP-6, 232.1-B-2/FOP-9
     #[test]
     fn timeout_type_1_suspends_and_resume_takes_up() {
         let mut f = active(FopConfig {
@@ -490,6 +494,7 @@ mod tests {
         assert_eq!(f.sent_len(), 0);
     }
 
+    // req: 232.1-B-2/FOP-8, 232.1-B-2/FOP-11
     #[test]
     fn lockout_alerts_and_unlock_recovers() {
         let mut f = active(small());
@@ -540,6 +545,7 @@ mod tests {
         assert_eq!(f.state(), FopState::Active);
     }
 
+    // req: 232.1-B-2/FOP-8, 232.1-B-2/FOP-9, 232.1-B-2/FOP-11
     #[test]
     fn initiate_with_clcw_and_with_set_vr() {
         let mut f = F::new(small());
@@ -619,6 +625,7 @@ mod tests {
         }
     }
 
+    // req: 232.1-B-2/FOP-1, 232.1-B-2/FOP-3
     #[test]
     fn clcw_events_are_classified_as_table_5_1_says() {
         let mut f = active(FopConfig {

@@ -146,6 +146,7 @@ pub fn tc_frame_verdict(bytes: &[u8]) -> Result<(), TcFrameError> {
     frame.packets().try_for_each(|p| p.map(|_| ()))
 }
 
+// req: 133.0-B-2/SPP-21, 133.0-B-2/SPP-22, 132.0-B-3/TM-8, 132.0-B-3/TM-86
 #[test]
 fn every_bad_input_is_refused_by_name() {
     let t = table();

@@ -203,6 +203,8 @@ fn events() -> Vec<FarmEvent> {
     out
 }
 
+// req: 232.1-B-2/FARM-1, 232.1-B-2/FARM-2, 232.1-B-2/FARM-3, 232.1-B-2/FARM-5, 232.1-B-2/FARM-6
+// req: 232.1-B-2/FARM-7, 232.1-B-2/FARM-8, 232.1-B-2/FARM-9
 #[test]
 #[cfg_attr(
     miri,

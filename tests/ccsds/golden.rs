@@ -35,6 +35,9 @@ fn tc_17_1_are_you_alive() {
     assert_eq!(TcRepr::parse(&bytes, &[APID]), Ok(ping()));
 }
 
+// req: 133.0-B-2/SPP-2, 133.0-B-2/SPP-3, 133.0-B-2/SPP-6, 133.0-B-2/SPP-7, 133.0-B-2/SPP-8
+// req: 133.0-B-2/SPP-13, 133.0-B-2/SPP-14, 133.0-B-2/SPP-15, 133.0-B-2/SPP-16, 133.0-B-2/SPP-17
+// req: 133.0-B-2/SPP-21, 133.0-B-2/SPP-22, 133.0-B-2/SPP-24, PUS/packet-error-control
 #[test]
 fn tc_8_1_with_application_data() {
     let repr = TcRepr {
@@ -92,6 +95,9 @@ fn tm_17_2_i_am_alive() {
     assert_eq!(TmRepr::parse(&bytes, &[APID]), Ok(alive()));
 }
 
+// req: 133.0-B-2/SPP-12, 133.0-B-2/SPP-14, 133.0-B-2/SPP-15, 133.0-B-2/SPP-16, 133.0-B-2/SPP-17
+// req: 133.0-B-2/SPP-19, 133.0-B-2/SPP-24, PUS/ST[3].25, PUS/tm-time-cuc
+// req: PUS/packet-error-control
 #[test]
 fn tm_3_25_with_source_data() {
     let repr = TmRepr {
@@ -116,6 +122,7 @@ fn tm_3_25_with_source_data() {
     assert_eq!(TmRepr::parse(&bytes, &[APID]), Ok(repr));
 }
 
+// req: 133.0-B-2/SPP-15, 133.0-B-2/SPP-16
 #[test]
 fn field_ranges_are_the_standards_offsets() {
     assert_eq!(tc::field::VERSION_ACK, 6..7);
@@ -128,6 +135,7 @@ fn field_ranges_are_the_standards_offsets() {
     assert_eq!(tm::field::SOURCE_DATA_START, 19);
 }
 
+// req: 133.0-B-2/SPP-23
 #[test]
 fn emit_refuses_a_short_buffer_and_oversized_data() {
     let mut small = [0u8; 12];

@@ -112,6 +112,7 @@ proptest! {
     }
 }
 
+// req: 133.0-B-2/SPP-14, 133.0-B-2/SPP-17, 133.0-B-2/SPP-18
 #[test]
 fn the_golden_ping_is_byte_identical_in_spacepackets() {
     let sph = SpHeader::new_for_unseg_tc(u11::new(super::APID), u14::new(7), 0);

@@ -25,6 +25,11 @@ fn boolean(t: &toml::Table, section: &str, key: &str) -> bool {
         .unwrap_or_else(|| panic!("[{section}] {key}"))
 }
 
+// req: 132.0-B-3/TM-58, 132.0-B-3/TM-69, 132.0-B-3/TM-71, 132.0-B-3/TM-73, 132.0-B-3/TM-75
+// req: 132.0-B-3/TM-76, 132.0-B-3/TM-77, 132.0-B-3/TM-79, 132.0-B-3/TM-83, 132.0-B-3/TM-85
+// req: 232.0-B-4/TC-7, 232.0-B-4/TC-37, 232.0-B-4/TC-39, 232.0-B-4/TC-41, 232.0-B-4/TC-43
+// req: 232.0-B-4/TC-44, 232.0-B-4/TC-46, 232.0-B-4/TC-47, 232.1-B-2/FARM-4, 232.1-B-2/FOP-4
+// req: 232.1-B-2/FOP-5, 232.1-B-2/FOP-6
 #[test]
 #[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
 fn the_managed_parameters_are_the_codes() {

@@ -187,6 +187,7 @@ fn receiver(k: Key256, mask: AuthMask, last: u128, ahead: u128) -> SaTable<2> {
 /// mask, its nonce the counter) gives the published ciphertext and tag, and through a
 /// receiving one gives the plaintext back; the same frame with its tag's last bit flipped is
 /// refused and left as it came.
+// req: 355.0-B-2/SDLS-9, 355.0-B-2/SDLS-11, 355.0-B-2/SDLS-13, 355.0-B-2/SDLS-14
 #[test]
 fn nist_vectors_through_security_associations() {
     // Under Miri (minutes per AES-GCM call chain), every fifth vector.
@@ -264,6 +265,7 @@ fn oracle(delta: i128, window: u32, ahead: u128) -> &'static str {
 /// away), for lasts at both ends of the 2^96 space and around 2^95, under several windows
 /// and floors: the window's verdict is the oracle's, an accepted IV becomes `last` with the
 /// floor where it was, a refused one changes nothing.
+// req: 355.0-B-2/SDLS-12
 #[test]
 #[cfg_attr(miri, ignore = "about 400,000 window checks: minutes under Miri")]
 fn replay_window_at_its_edges_and_the_wrap() {
@@ -345,6 +347,7 @@ fn replay_window_at_its_edges_and_the_wrap() {
 /// A sender never uses an IV twice, whatever the order of frames, reservations, confirmed
 /// writes and restarts (the shell's store keeps only what was confirmed): every schedule of
 /// 12 steps over 4 step kinds, for blocks of 1 to 4.
+// req: 355.0-B-2/SDLS-3
 #[test]
 #[cfg_attr(miri, ignore = "4 × 4^12 schedules: hours under Miri")]
 fn sender_never_reuses_an_iv_across_restarts() {
@@ -458,6 +461,7 @@ fn receiver_never_accepts_a_replay_across_restarts() {
 }
 
 /// The refusals the issue lists, each counted under its reason, the frame untouched.
+// req: 355.0-B-2/SDLS-14, 132.0-B-3/TM-99
 #[test]
 fn each_refusal_is_counted_and_changes_nothing() {
     let k = [0x11u8; 32];

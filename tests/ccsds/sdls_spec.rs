@@ -29,6 +29,9 @@ fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
+// req: 132.0-B-3/TM-103, 132.0-B-3/TM-104, 132.0-B-3/TM-105, 132.0-B-3/TM-106, 355.0-B-2/SDLS-1
+// req: 355.0-B-2/SDLS-2, 355.0-B-2/SDLS-3, 355.0-B-2/SDLS-6, 355.0-B-2/SDLS-10
+// req: 355.0-B-2/SDLS-11
 #[test]
 #[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
 fn the_choices_are_the_codes() {

@@ -78,6 +78,9 @@ pub const BD_PING: &str = "2101001400c01842c00700062f1101000012d00ae0";
 pub const BC_UNLOCK: &str = "3101000700004bfd";
 pub const BC_SET_VR_5: &str = "310100090082000525b3";
 
+// req: 232.0-B-4/TC-4, 232.0-B-4/TC-7, 232.0-B-4/TC-19, 232.0-B-4/TC-20, 232.0-B-4/TC-21
+// req: 232.0-B-4/TC-22, 232.0-B-4/TC-23, 232.0-B-4/TC-38, 232.0-B-4/TC-42, 232.0-B-4/TC-45
+// req: 232.0-B-4/TC-46, 232.0-B-4/TC-47
 #[test]
 fn golden_frames_are_the_standards_bits() {
     let p = tc_bytes(&ping());
@@ -144,6 +147,8 @@ fn golden_frames_are_the_standards_bits() {
     assert_eq!(unlock.packets().count(), 0);
 }
 
+// req: 232.0-B-4/TC-37, 232.0-B-4/TC-38, 232.0-B-4/TC-39, 232.0-B-4/TC-41, 232.0-B-4/TC-43
+// req: 232.0-B-4/TC-44, 232.0-B-4/TC-47, 232.0-B-4/TC-48
 #[test]
 fn constants_are_the_standards_and_the_missions() {
     assert_eq!(
@@ -288,6 +293,7 @@ fn emit_refuses_what_does_not_fit() {
 
 /// One refused frame per check, each one defect away from a golden frame (the length field
 /// and FECF rewritten, so that each reaches its own check), with the exact error.
+// req: 232.0-B-4/TC-32, 232.0-B-4/TC-33
 #[test]
 fn every_check_refuses_with_its_numbers() {
     let cfg = config();
@@ -424,6 +430,7 @@ fn every_check_refuses_with_its_numbers() {
     );
 }
 
+// req: 232.0-B-4/TC-1, 232.0-B-4/TC-5, 232.0-B-4/TC-24, 232.0-B-4/TC-30
 #[test]
 fn the_packets_of_a_data_field() {
     let p = tc_bytes(&ping());

@@ -50,6 +50,11 @@ pub fn reference_frame() -> Vec<u8> {
     out
 }
 
+// req: 132.0-B-3/TM-4, 132.0-B-3/TM-5, 132.0-B-3/TM-7, 132.0-B-3/TM-19, 132.0-B-3/TM-20
+// req: 132.0-B-3/TM-50, 132.0-B-3/TM-51, 132.0-B-3/TM-53, 132.0-B-3/TM-54, 132.0-B-3/TM-55
+// req: 132.0-B-3/TM-61, 132.0-B-3/TM-69, 132.0-B-3/TM-70, 132.0-B-3/TM-73, 132.0-B-3/TM-74
+// req: 132.0-B-3/TM-75, 132.0-B-3/TM-77, 132.0-B-3/TM-79, 132.0-B-3/TM-80, 132.0-B-3/TM-81
+// req: 132.0-B-3/TM-82, 132.0-B-3/TM-83, 132.0-B-3/TM-85
 #[test]
 #[allow(clippy::unusual_byte_groupings)] // grouped as the header's fields
 fn reference_frame_bit_by_bit() {
@@ -74,6 +79,7 @@ fn reference_frame_bit_by_bit() {
     assert_eq!((r.mc_frame_count, r.vc_frame_count), (0x12, 0x34));
 }
 
+// req: 132.0-B-3/TM-53, 132.0-B-3/TM-56
 #[test]
 fn continuation_and_idle_frames_bit_by_bit() {
     // No packet starts: FHP 0x7FF, 000 11 111 1111 1111 = 0x1fff; counts 0xff / 0x00.
@@ -110,6 +116,7 @@ fn continuation_and_idle_frames_bit_by_bit() {
     assert_eq!(TmFrameRepr::parse(&f, &params()), Ok(repr));
 }
 
+// req: 132.0-B-3/TM-41, 132.0-B-3/TM-51
 #[test]
 fn the_view_reads_every_field() {
     let f = reference_frame();
@@ -270,6 +277,7 @@ fn reseal(mut bytes: Vec<u8>) -> Vec<u8> {
     bytes
 }
 
+// req: 132.0-B-3/TM-63, 132.0-B-3/TM-64, 132.0-B-3/TM-67
 #[test]
 fn every_check_refuses_with_its_numbers() {
     let good = reference_frame();

@@ -198,6 +198,9 @@ pub fn check(p: &TmFrameParams, r: &Run, lost: &[bool]) {
     );
 }
 
+// req: 133.0-B-2/SPP-1, 133.0-B-2/SPP-10, 133.0-B-2/SPP-11, 133.0-B-2/SPP-20, 133.0-B-2/SPP-26
+// req: 132.0-B-3/TM-1, 132.0-B-3/TM-6, 132.0-B-3/TM-34, 132.0-B-3/TM-35, 132.0-B-3/TM-56
+// req: 132.0-B-3/TM-57, 132.0-B-3/TM-59, 132.0-B-3/TM-62
 #[test]
 #[cfg_attr(
     miri,
@@ -232,6 +235,7 @@ fn every_length_at_every_offset() {
     assert_eq!(runs, 244 * 502);
 }
 
+// req: 132.0-B-3/TM-63, 132.0-B-3/TM-88
 #[test]
 fn a_lost_frame_drops_only_the_packets_it_touches() {
     // Every single lost frame of a run with packets of several lengths around the data field's.
@@ -271,6 +275,7 @@ fn only_idle_frames_between_bursts_and_the_count_wrap() {
     assert!(c.idle_frames > 50, "{c:?}");
 }
 
+// req: 132.0-B-3/TM-87
 #[test]
 fn too_long_packets_are_skipped_and_counted() {
     let p = params();
@@ -311,6 +316,7 @@ fn the_framer_refuses_what_it_cannot_take() {
     assert_eq!(f.waiting(), 60);
 }
 
+// req: 132.0-B-3/TM-40, 132.0-B-3/TM-57
 #[test]
 fn frames_are_due_when_full_or_after_the_idle_period() {
     let p = params();
@@ -360,6 +366,8 @@ fn steps() -> impl Strategy<Value = Vec<Step>> {
 proptest! {
     #![proptest_config(crate::common::prop::config(2000))]
 
+    // req: 133.0-B-2/SPP-1, 133.0-B-2/SPP-10, 133.0-B-2/SPP-11, 133.0-B-2/SPP-25
+    // req: 132.0-B-3/TM-62
     #[test]
     fn any_packets_come_out_identical_and_in_order(s in steps()) {
         let p = params();

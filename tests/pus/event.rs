@@ -50,6 +50,7 @@ fn events() -> Vec<Event> {
     v
 }
 
+// req: PUS/ST[5].1, PUS/ST[5].2, PUS/ST[5].3, PUS/ST[5].4
 #[test]
 fn every_event_round_trips_in_its_severity_only() {
     let cleared = (1..=Faults::DEFINED).map(|bits| {

@@ -295,6 +295,9 @@ fn run_secure(
     }
 }
 
+// req: 232.0-B-4/TC-1, 232.0-B-4/TC-6, 232.0-B-4/TC-13, 232.0-B-4/TC-14, 232.0-B-4/TC-26
+// req: 232.0-B-4/TC-27, 232.0-B-4/TC-28, 232.0-B-4/TC-34, 132.0-B-3/TM-41, 132.0-B-3/TM-65
+// req: 232.1-B-2/FARM-10
 #[test]
 fn a_clean_link_delivers_every_telecommand_once_in_order() {
     let r = run(12, 1, 0.0, 0.0, 0.0, 20_000);
@@ -326,6 +329,7 @@ fn a_clean_link_delivers_every_telecommand_once_in_order() {
     );
 }
 
+// req: 232.1-B-2/FARM-3, 232.1-B-2/FOP-7
 #[test]
 fn a_lossy_duplicating_reordering_link_still_delivers_once_in_order() {
     // 20 % of frames lost each way, 10 % duplicated, 10 % overtaken: many seeds. The ground
@@ -379,6 +383,7 @@ fn a_lossy_duplicating_reordering_link_still_delivers_once_in_order() {
     println!("40 runs: {lost} frames lost, {retransmissions} retransmissions, {alerts} alerts");
 }
 
+// req: 232.1-B-2/FARM-5, 232.1-B-2/FARM-9
 #[test]
 fn a_full_queue_holds_frames_back_with_wait_and_loses_none() {
     // Board A never answers: the gateway's queue (4) fills, FARM-1 goes to Wait, and FOP-1
@@ -433,6 +438,10 @@ fn a_full_queue_holds_frames_back_with_wait_and_loses_none() {
 /// still given to board A exactly once per request, every attack is refused by SDLS (none
 /// reaches FARM-1 or the PUS layer), and the ground's retransmissions, each under a fresh IV,
 /// get through.
+// req: 232.0-B-4/TC-49, 132.0-B-3/TM-89, 132.0-B-3/TM-90, 132.0-B-3/TM-91, 132.0-B-3/TM-92
+// req: 132.0-B-3/TM-93, 132.0-B-3/TM-94, 132.0-B-3/TM-95, 132.0-B-3/TM-96, 132.0-B-3/TM-97
+// req: 132.0-B-3/TM-100, 132.0-B-3/TM-101, 132.0-B-3/TM-102, 355.0-B-2/SDLS-1
+// req: 355.0-B-2/SDLS-13, 355.0-B-2/SDLS-14
 #[test]
 #[cfg_attr(miri, ignore = "AES under Miri: minutes per seed")]
 fn sdls_under_attack_delivers_once_and_refuses_every_forgery() {
@@ -551,6 +560,7 @@ fn sdls_counters_survive_a_restart_of_the_server_board() {
 /// share the TM frames, which moves the downlink's timing by a few ms either way); the
 /// refusals are reported in ST[5] at most once per reason a second, and the reports count
 /// every refused frame.
+// req: 355.0-B-2/SDLS-15
 #[test]
 #[cfg_attr(miri, ignore = "AES under Miri: minutes")]
 fn a_flood_of_bad_frames_does_not_delay_good_ones() {

@@ -77,6 +77,7 @@ fn every_command() -> Vec<Command> {
     all
 }
 
+// req: PUS/ST[8].1
 #[test]
 fn every_command_is_a_function_and_back() {
     let all = every_command();

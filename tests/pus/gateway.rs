@@ -93,6 +93,7 @@ fn telecommands_wait_for_board_as_first_heartbeat() {
     assert_eq!(c.command, r);
 }
 
+// req: PUS/ST[1].7, PUS/ST[8].1
 #[test]
 fn a_motion_completes_when_board_a_says_so() {
     let mut g = gateway();
@@ -120,6 +121,7 @@ fn a_motion_completes_when_board_a_says_so() {
     );
 }
 
+// req: PUS/ST[1].8
 #[test]
 fn a_fault_or_a_mode_change_fails_a_running_motion() {
     for (faults, mode, code) in [
@@ -148,6 +150,7 @@ fn a_fault_or_a_mode_change_fails_a_running_motion() {
     }
 }
 
+// req: PUS/ST[1].4
 #[test]
 fn a_refusal_is_a_start_failure_with_the_refusal_code() {
     let mut g = gateway();
@@ -200,6 +203,7 @@ fn a_copy_runs_once_and_gets_its_latest_report_again() {
     assert_eq!(reports(&out), [(Stage::Acceptance, Some(0x0308), 1)]);
 }
 
+// req: PUS/ST[1].2
 #[test]
 fn a_full_queue_refuses_at_acceptance() {
     let mut g = gateway();
@@ -215,6 +219,7 @@ fn a_full_queue_refuses_at_acceptance() {
     );
 }
 
+// req: PUS/ST[1].1, PUS/ST[1].3, PUS/ST[1].7, PUS/tc-ack-flags
 #[test]
 fn success_reports_only_when_asked_failures_always() {
     let mut g = gateway();
@@ -231,6 +236,7 @@ fn success_reports_only_when_asked_failures_always() {
     assert_eq!(reports(&g.tc(&bad)), [(Stage::Acceptance, Some(0x0301), 1)]);
 }
 
+// req: PUS/ST[3].5, PUS/ST[3].6, PUS/ST[3].25, PUS/ST[3].31
 #[test]
 fn housekeeping_comes_every_interval_and_can_be_switched_off() {
     let mut g = gateway();
@@ -266,6 +272,7 @@ fn housekeeping_comes_every_interval_and_can_be_switched_off() {
     assert!((7_000..10_000).step_by(10).all(|t| hk(&g.tick(t)) == 0));
 }
 
+// req: PUS/ST[17].1, PUS/ST[17].2
 #[test]
 fn are_you_alive_is_answered_once_board_a_answers() {
     let mut g = gateway();
@@ -281,6 +288,7 @@ fn are_you_alive_is_answered_once_board_a_answers() {
     assert_eq!(kinds, [(1, 3), (17, 2), (1, 7)]);
 }
 
+// req: PUS/ST[5].1, PUS/ST[5].2, PUS/ST[5].3, PUS/ST[5].4
 #[test]
 fn events_come_from_what_changed_between_heartbeats() {
     let mut g = gateway();
@@ -312,6 +320,7 @@ fn events_come_from_what_changed_between_heartbeats() {
 /// Packets end to end: a TC(8,1) as bytes in; TM packets out, numbered per APID (sequence
 /// count 0, 1, 2, …) and per message type, stamped with the gateway's clock; a corrupted TC
 /// refused whole (no report: its request ID cannot be trusted).
+// req: 133.0-B-2/SPP-19, PUS/tm-message-type-counter, PUS/tm-time-cuc
 #[test]
 fn packets_in_and_out() {
     use mmic::ccsds::primary::{Apid, SeqCount};

@@ -183,6 +183,9 @@ struct EventRow {
     aux: String,
 }
 
+// req: PUS/ST[1].1, PUS/ST[1].2, PUS/ST[1].3, PUS/ST[1].4, PUS/ST[1].7, PUS/ST[1].8
+// req: PUS/ST[3].5, PUS/ST[3].6, PUS/ST[3].25, PUS/ST[3].31, PUS/ST[5].1, PUS/ST[5].2
+// req: PUS/ST[5].3, PUS/ST[5].4, PUS/ST[8].1, PUS/ST[17].1, PUS/ST[17].2
 #[test]
 fn services_toml_is_what_the_gateway_serves() {
     let spec: Services = load("ccsds/services.toml");

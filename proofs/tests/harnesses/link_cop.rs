@@ -41,6 +41,7 @@ const ALPHABET: [(u8, u8, bool); 17] = [
 ///
 /// Under `cargo test`: exhaustively, every sequence of 5 events of [`ALPHABET`] (17^5); then
 /// sampled sequences of 12 events with any N(S) and V*(R), from any window.
+// req: 232.1-B-2/FARM-3
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(14))]
 fn farm_accepts_each_frame_once_in_order() {
@@ -74,6 +75,7 @@ fn farm_accepts_each_frame_once_in_order() {
 /// Under `cargo test`: exhaustively, every value of octets 0 and 2 (type, version, status,
 /// COP; the flags, FARM-B counter and spare bits) with octets 1 and 3 each 0x00, 0xa5 and
 /// 0xff; then sampled words.
+// req: 232.1-B-2/CLCW-1
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(8))]
 fn clcw_round_trip() {
@@ -107,6 +109,7 @@ fn clcw_round_trip() {
 /// Under `cargo test`: exhaustively, every sequence of 5 inputs of 20 (requests, CLCWs with
 /// and without each flag at several N(R), T1's expiry, the initiate directives, terminate);
 /// then sampled sequences of 12 of any inputs.
+// req: 232.1-B-2/FOP-1, 232.1-B-2/FOP-2, 232.1-B-2/FOP-10
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(14))]
 fn fop_keeps_its_window_and_confirms_in_order() {

@@ -183,6 +183,7 @@ fn tc_frame_parse_matches_oracle() {
 /// the spacecraft ID check on another spacecraft's channel.
 ///
 /// Under `cargo test`: every value of each seed octet, others zero; then sampled seeds and data.
+// req: 232.0-B-4/TC-19, 232.0-B-4/TC-20
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(26))]
 fn tc_frame_round_trip() {

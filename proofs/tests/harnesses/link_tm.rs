@@ -96,6 +96,7 @@ fn tm_frame_parse_matches_oracle() {
 ///
 /// Under `cargo test`: every value of each of the 12 seed octets, the others zero; then
 /// sampled seeds.
+// req: 132.0-B-3/TM-51
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(260))]
 fn tm_frame_round_trip() {
@@ -129,6 +130,7 @@ fn tm_frame_round_trip() {
 ///
 /// Under `cargo test`: every sequence of 4 steps of [`STEPS`] on the 256-octet frame and on a
 /// 40-octet one (data field 28); then sampled frame lengths and sequences of up to 64 steps.
+// req: 132.0-B-3/TM-62
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn tm_extractor_loses_nothing_without_frame_loss() {
@@ -169,6 +171,7 @@ fn tm_extractor_loses_nothing_without_frame_loss() {
 /// Under `cargo test`: every sequence of 3 steps of [`STEPS`] on the 256-octet and the
 /// 40-octet frame, with every single lost frame of the first 8 and every pair of lost frames
 /// among the first 6 (8 + 15 masks); then sampled inputs with random loss masks.
+// req: 132.0-B-3/TM-88
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn tm_extractor_never_splices() {

@@ -55,6 +55,7 @@ fn changed(v: &Changed) -> &'static str {
 /// Under `cargo test`: exhaustively, every octet × every XOR 1..=255 × reseal or not, of an AD
 /// frame with the ping under IV 5 and a BD frame with it under IV 2^96 − 1 (51 octets each);
 /// then sampled inputs (any IV, data of 0..=32 octets).
+// req: 355.0-B-2/SDLS-14
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(42))]
 fn sdls_verify_never_accepts_a_changed_frame() {
@@ -166,6 +167,7 @@ fn window(v: &WindowCase) -> &'static str {
 /// Under `cargo test`: exhaustively, W 1..=4 × 11 lasts (a fresh window; 0, 1, 2, 2^95 − 2,
 /// 2^95 − 1, 2^95, 2^95 + 1, 2^96 − 3, 2^96 − 2, 2^96 − 1) × floor 0..=5 ahead × 17 IVs
 /// (last − 6 ..= last + 6, last ± 2^95, last + 2^95 ± 1); then sampled inputs.
+// req: 355.0-B-2/SDLS-12
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(14))]
 fn sdls_window_matches_oracle() {
@@ -230,6 +232,7 @@ type TxCase = (u128, bool, u8, [u8; OPS]);
 /// write, confirm it, confirm the stored value again, restart losing the write, restart
 /// keeping it) × block 1 and 2 × a new association and one 2 short of 2^96; then sampled
 /// inputs (24 operations, any start, any block 1..=256).
+// req: 355.0-B-2/SDLS-3
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(8))]
 fn sdls_tx_counter_never_reuses() {
