@@ -105,6 +105,20 @@ fn the_map_is_the_models_moves_the_hip_can_make() {
     }
 }
 
+/// Section 6: moves between matched and stretched states use primitives 1-4, moves from or to a
+/// turn state primitives 4-8 (the paper's ranges, which share 4).
+#[test]
+fn straight_moves_use_primitives_1_to_4_and_turns_4_to_8() {
+    let mut seen = [0u32; 2];
+    for (from, to, p) in map::moves() {
+        let turn = from.kind() == StateKind::Turn || to.kind() == StateKind::Turn;
+        let range = if turn { 4..=8 } else { 1..=4 };
+        assert!(range.contains(&p.number()), "{from} -> {to} by {p}");
+        seen[usize::from(turn)] += 1;
+    }
+    assert!(seen[0] > 0 && seen[1] > 0, "{seen:?}");
+}
+
 /// Floyd–Warshall over the moves the joints make ([`robot_moves_oracle`]): the oracle.
 fn all_pairs() -> [[u32; 15]; 15] {
     let inf = 99;

@@ -622,6 +622,21 @@ fn a_single_module_move_is_a_motion_until_its_servo_is_at_its_target() {
     }
 }
 
+/// Section 5: the heartbeat's present arm value is the last interpolated pulse board A sent to
+/// the servo, not a measurement: mid-move it trails the target, pulse by pulse.
+#[test]
+fn the_heartbeats_present_arm_value_is_the_last_pulse_sent() {
+    let mut r = Rig::operational();
+    r.send(arm(Side::A, ServoTarget::Extend));
+    let mut trailing = 0;
+    for _ in 0..300 {
+        let hb = r.tick(Some(Command::Heartbeat)).hb.expect("a heartbeat");
+        assert_eq!(Some(hb.arm_a_now), r.arm_pulse[0]);
+        trailing += u32::from(hb.arm_a_now != hb.arm_a_target);
+    }
+    assert!(trailing > 10, "{trailing} heartbeats mid-move");
+}
+
 /// Table 8's "arm not fully contracted": after a contract arm command, once the arm has
 /// finished its travel, its contraction switch must close within the confirm time
 /// (`motion.confirm_ms`). A switch that stays open raises the fault (and the robot is

@@ -7,6 +7,7 @@ use mmic::mode::Mode;
 use mmic::refusal::Refusal;
 use mmic::safety::detect::Config;
 use mmic::safety::policy::{accepts, fault_action, is_condition, powered, regulator_on};
+use mmic::safety::supervisor::{Input, Supervisor};
 use mmic::safety::ModuleSet;
 use mmic::units::Module;
 use serde::Deserialize;
@@ -89,6 +90,17 @@ fn the_moving_command_kinds_equal_spec() {
         .map(|k| k.name())
         .collect();
     assert_eq!(got, spec().moving, "spec/modes.toml `moving`");
+}
+
+/// Section 7: the robot starts in Standby with nothing powered and the regulator off, and a
+/// first step without any input leaves it there.
+#[test]
+fn the_robot_starts_in_standby_with_nothing_powered() {
+    let mut s = Supervisor::new();
+    assert_eq!(s.mode(), Mode::Standby);
+    let out = s.step(&Input::quiet());
+    assert_eq!(out.mode, Mode::Standby);
+    assert!(out.powered.is_empty() && !out.regulator && out.faults.is_empty());
 }
 
 #[test]
