@@ -48,6 +48,7 @@ fn stopped_mid_turn() -> (Robot, f64) {
 
 /// Defect 1: Table 1's Stop is an emergency stop of the current motion, so the hip holds too
 /// (it used to finish the turn, up to 90° in 9 s). The servos hold where they are.
+// req: T1/stop
 #[test]
 fn stop_holds_the_hip_mid_turn_and_every_servo() {
     let (mut r, at_stop) = stopped_mid_turn();
@@ -67,6 +68,7 @@ fn stop_holds_the_hip_mid_turn_and_every_servo() {
 
 /// Defect 3: Reset resumes the interrupted reconfiguration from the step where it stopped,
 /// and it completes.
+// req: T1/reset
 #[test]
 fn reset_resumes_the_reconfiguration_a_stop_interrupted() {
     let (mut r, _) = stopped_mid_turn();
@@ -194,6 +196,7 @@ fn move_bolters_down_only_descends() {
 /// Defect 8: an arm command board B never acknowledges (the A->B direction dead, B's
 /// heartbeats still arriving) raises internal communication loss, as Table 8 says. Before,
 /// the A->B number only changed with bolter orders, B echoed 0, and the rule never fired.
+// req: P7.19
 #[test]
 fn an_unacknowledged_arm_command_raises_internal_comm_loss() {
     let mut r = operational(State::A);
@@ -220,6 +223,7 @@ fn an_unacknowledged_arm_command_raises_internal_comm_loss() {
 /// not continuously: a robot at rest with a bolter drawing more than its idle limit (but
 /// under the absolute one) is no fault until a reconfiguration is asked for; then the check
 /// fails, the motion does not start and the robot is Safed.
+// req: P7.16
 #[test]
 fn the_idle_check_runs_when_a_reconfiguration_starts_not_while_idle() {
     let mut r = operational(State::A);
@@ -242,6 +246,7 @@ fn the_idle_check_runs_when_a_reconfiguration_starts_not_while_idle() {
 }
 
 /// Defect 9: command complete (heartbeat byte 54) comes after the idle check at the end.
+// req: P7.16
 #[test]
 fn command_complete_follows_the_idle_check_at_the_end() {
     let mut r = operational(State::A);
@@ -260,6 +265,7 @@ fn command_complete_follows_the_idle_check_at_the_end() {
 /// Found in the review (same kind as the defects above): Table 8's "after executing an arm
 /// contraction command, the contraction is not sensed by hardware" holds for either arm, but
 /// board A checked only arm A. Arm B's switch travels in Table 4 byte 44.
+// req: P7.15
 #[test]
 fn an_arm_b_contraction_the_switch_does_not_sense_is_arm_not_contracted() {
     for side in [Side::A, Side::B] {

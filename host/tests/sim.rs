@@ -67,6 +67,7 @@ fn steps(text: &str) -> Vec<mmic_host::sim::SimStep> {
     mmic_host::sim::steps_of(&plan::parse(text).unwrap())
 }
 
+// req: P3.1
 #[test]
 fn the_demo_plan_completes_with_no_fault() {
     let (s, records) = simulate("demo", SimConfig::demo());
@@ -167,6 +168,7 @@ fn thirty_percent_wifi_loss_still_completes_and_runs_nothing_twice() {
     }
 }
 
+// req: P7.19
 #[test]
 fn cutting_board_b_off_gives_internal_comm_loss_and_safed_within_the_timeout() {
     let cut = 6_000;
@@ -236,6 +238,7 @@ fn cutting_board_b_off_gives_internal_comm_loss_and_safed_within_the_timeout() {
         && r["t_ms"].as_u64().unwrap() >= cut as u64)));
 }
 
+// req: P7.13, T8/low_battery
 #[test]
 fn low_battery_during_a_motion_enters_standby_only_after_the_motion_completes() {
     let low = 8_000;
@@ -565,6 +568,7 @@ fn a_bolt_command_completes_on_the_bolter_current() {
     );
 }
 
+// req: P7.9
 #[test]
 fn a_jammed_fastener_ends_in_the_bolting_failure_fault_and_standby() {
     let mut cfg = SimConfig {
@@ -605,6 +609,7 @@ fn a_jammed_fastener_ends_in_the_bolting_failure_fault_and_standby() {
         .all(|(_, aux, _)| aux["locked"] == false));
 }
 
+// req: P7.17, T8/bolter_overcurrent
 #[test]
 fn a_bolter_obstacle_while_bolting_raises_bolter_overcurrent_and_safes_the_robot() {
     // Bolting starts about 3.6 s in; the obstacle meets bolter A on its way down. (At rest the
@@ -884,6 +889,7 @@ fn check_case(c: &Case, s: &Summary, records: &[Value], json: &report::SummaryJs
     wrong
 }
 
+// req: T8/*, P7.7, P7.14, P7.18
 #[test]
 fn every_table8_fault_injected_on_the_demo_reaches_its_table8_mode() {
     let wall = std::time::Instant::now();

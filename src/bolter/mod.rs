@@ -174,6 +174,7 @@ mod tests {
 
     /// The paper's order of the select lines: pairs 1–4 take A0-A1 low-low, low-high,
     /// high-low, high-high; the wire byte has A0 in bit 0 and A1 in bit 1, and refuses others.
+    // req: P2.8, P5.10
     #[test]
     fn mux_lines_per_pair_and_on_the_wire() {
         let want = [(false, false), (false, true), (true, false), (true, true)];

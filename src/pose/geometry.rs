@@ -231,6 +231,7 @@ mod tests {
         }
     }
 
+    // req: P6.2
     #[test]
     fn faces_follow_the_table_5_names() {
         for s in State::ALL {

@@ -144,6 +144,7 @@ mod tests {
         assert_eq!(State::from_letter('p'), None);
     }
 
+    // req: P6.3
     #[test]
     fn kinds_follow_names() {
         for s in State::ALL {

@@ -344,6 +344,7 @@ mod tests {
         assert_eq!(f.push(&raw(1000)).lost, Lost::NONE);
     }
 
+    // req: P4.2
     #[test]
     fn a_side_without_a_hip_encoder_never_loses_it() {
         let cfg = Config {

@@ -180,6 +180,7 @@ fn every_entry_quotes_the_paper_and_every_departure_is_a_decision() {
     }
 }
 
+// req: P2.1, P2.10
 #[test]
 fn the_codes_numbers_equal_the_papers_hardware() {
     let h = hardware();
@@ -229,6 +230,7 @@ fn the_codes_numbers_equal_the_papers_hardware() {
 
 /// Figure 10's counts add up, one per attempt Table 8 allows; the statistics test draws its
 /// rates from them (`bolter_statistics::attempt_histogram_matches_figure_10`).
+// req: P8.1
 #[test]
 fn figure_10_counts_add_up_to_the_pairs_engaged_one_count_per_attempt() {
     let f = figure10();

@@ -59,6 +59,7 @@ fn pair(t: interp::Travel) -> (u16, u16) {
     (t.contracted.micros(), t.extended.micros())
 }
 
+// req: P5.1
 #[test]
 fn servo_defaults_equal_spec() {
     let s = spec();

@@ -21,6 +21,7 @@ fn ups() -> Vec<(Axis, Sign)> {
         .collect()
 }
 
+// req: P2.5
 #[test]
 fn the_true_state_is_always_in_the_estimate() {
     let mut checked = 0;
@@ -129,6 +130,7 @@ fn indistinguishable_classes_are_published() {
     }
 }
 
+// req: P7.10, T8/initial_state_mismatch
 #[test]
 fn initial_state_check() {
     let cfg = Config::default();
@@ -237,6 +239,7 @@ fn the_commanded_arm_pwm_values_decide_matched_or_two_face() {
 /// switches): an arm is reported exactly when it is commanded contracted and its switch is
 /// open, arm A first; an arm commanded extended or between is never reported, whatever its
 /// switch says.
+// req: P7.15, T8/arm_not_contracted
 #[test]
 fn an_arm_is_not_contracted_exactly_when_commanded_contracted_with_its_switch_open() {
     let mut reported = 0;

@@ -30,6 +30,7 @@ fn bfs_len(from: State, to: State) -> usize {
     dist[to.index()]
 }
 
+// req: P6.5
 #[test]
 fn plan_length_table() {
     let mut grid = String::from(

@@ -144,6 +144,7 @@ fn every_move_under_every_signal_interleaving() {
     println!("sequencer: {runs} runs of {depth} ticks (running/done/failed: {outcomes:?})");
 }
 
+// req: P6.4, P6.5
 #[test]
 fn every_reconfiguration_reaches_its_target() {
     let all = Feedback {

@@ -519,6 +519,7 @@ fn a_primitive_accepted_right_after_a_motion_starts_once_the_robot_has_rested() 
 /// Entering Operational sends the hip to the configured home angle (`safety.hip_home`: the
 /// contracted-gripped configuration the hip mismatch check reads against), not to a fixed
 /// 180°: a robot whose home is at 90°, reading 90°, is held there.
+// req: P7.6
 #[test]
 fn entering_operational_sends_the_hip_to_its_configured_home() {
     let home = HipAngle::new(9_000).unwrap();
@@ -624,6 +625,7 @@ fn a_single_module_move_is_a_motion_until_its_servo_is_at_its_target() {
 
 /// Section 5: the heartbeat's present arm value is the last interpolated pulse board A sent to
 /// the servo, not a measurement: mid-move it trails the target, pulse by pulse.
+// req: P5.4
 #[test]
 fn the_heartbeats_present_arm_value_is_the_last_pulse_sent() {
     let mut r = Rig::operational();
@@ -641,6 +643,7 @@ fn the_heartbeats_present_arm_value_is_the_last_pulse_sent() {
 /// finished its travel, its contraction switch must close within the confirm time
 /// (`motion.confirm_ms`). A switch that stays open raises the fault (and the robot is
 /// safed) — not while the arm is still on its way, and not when the switch closes.
+// req: P5.3, P7.15, T8/arm_not_contracted
 #[test]
 fn an_arm_contraction_is_a_fault_when_the_switch_stays_open_past_the_confirm_time() {
     let cfg = board_a::Config::default();
@@ -762,6 +765,7 @@ fn pairs(events: &[Event]) -> Vec<(BolterPair, u8, bool)> {
 /// should: both sides run Figure 8's steps pair after pair, each pair is fastened at the first
 /// attempt (events name them in order), the job ends done with no fault, the robot is in
 /// motion (and refuses other moves) until then and reports command complete after.
+// req: P4.1, P5.9
 #[test]
 fn bolting_all_four_pairs_runs_both_sides_pair_after_pair_to_done() {
     let mut r = Rig::operational();
@@ -806,6 +810,7 @@ fn a_pair_that_does_not_lock_at_first_is_fastened_at_its_second_attempt() {
 /// A fastener that never locks on side A: after the third failed attempt (Table 8: three) the
 /// pair is given up, the job fails with Table 8's (un)bolting failure, and the robot goes to
 /// Standby (fully gripped: cutting power cannot drop it).
+// req: T8/bolting_failure
 #[test]
 fn a_pair_that_never_locks_fails_the_job_after_three_attempts() {
     let mut r = Rig::operational();
@@ -859,6 +864,7 @@ fn moving_the_bolters_down_ends_when_both_touch_or_a_descent_times_out() {
 /// measures it, side B's as board B judged it — raises that module's idle overcurrent fault
 /// once the robot has rested, the robot is safed, and the motion does not start. The same
 /// current, below the operational limits, faults nothing while no reconfiguration starts.
+// req: P7.16
 #[test]
 fn an_idle_overcurrent_at_the_start_keeps_the_primitive_from_starting() {
     let limits = board_a::Config::default().safety.idle;
@@ -905,6 +911,7 @@ fn matched_other_than_a() -> State {
 /// Table 8's initial state mismatch: a reconfiguration whose initial state is not the state
 /// the robot is in is refused with that reason, latches the fault (Standby: the robot is
 /// gripped), and nothing moves; the same reconfiguration from where the robot is, is accepted.
+// req: P7.10, T8/initial_state_mismatch
 #[test]
 fn a_reconfiguration_from_another_state_is_refused_as_an_initial_state_mismatch() {
     let target = matched_other_than_a();
@@ -1059,6 +1066,7 @@ fn a_bolter_switched_off_is_not_driven() {
 
 /// Table 1's hip commands set the hip's target: a preset to its angle, any other angle to
 /// itself, home to the configured home angle.
+// req: T1/hip
 #[test]
 fn a_hip_command_sets_the_angle_it_names() {
     use mmic::command::HipTarget;
@@ -1080,6 +1088,7 @@ fn a_hip_command_sets_the_angle_it_names() {
 /// A reconfiguration over primitives that turn nothing (the rig's hip reads 180° throughout):
 /// from a to a matched state two or more primitives away, run primitive after primitive, it
 /// reaches its target, which the board then tracks, with no fault and command complete.
+// req: P6.5, T1/reconfiguration
 #[test]
 fn a_reconfiguration_runs_its_primitives_to_its_target() {
     use mmic::motion::route;
@@ -1745,6 +1754,7 @@ fn a_timed_out_motion_is_not_timed_again_until_the_modules_rest() {
 /// Section 7: "When switching to 'opmode', actuators are set to go to their home position" —
 /// also when Operational is entered again after Safed held them where they were: arm B, held
 /// half-way out, goes back to contracted, within the module budget and with no fault.
+// req: P7.6
 #[test]
 fn re_entering_operational_sends_the_servos_home_again() {
     let cfg = board_a::Config::default();

@@ -57,6 +57,7 @@ fn hearing(mut hb: InternalHeartbeatRepr, ms: u32) -> BoardA {
 /// Defect 11: board A takes side B's overcurrent verdicts as board B reports them (Table 4
 /// bytes 41–43, B's own limits), instead of recomputing them from B's currents: a flag with
 /// quiet currents is a fault, and high currents B did not flag are not.
+// req: P4.7
 #[test]
 fn board_a_takes_side_b_overcurrent_as_b_judged_it() {
     let a_cfg = board_a::Config::default();

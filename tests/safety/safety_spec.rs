@@ -94,6 +94,7 @@ fn the_moving_command_kinds_equal_spec() {
 
 /// Section 7: the robot starts in Standby with nothing powered and the regulator off, and a
 /// first step without any input leaves it there.
+// req: P7.2, P7.3, T7/entry
 #[test]
 fn the_robot_starts_in_standby_with_nothing_powered() {
     let mut s = Supervisor::new();
@@ -103,6 +104,7 @@ fn the_robot_starts_in_standby_with_nothing_powered() {
     assert!(out.powered.is_empty() && !out.regulator && out.faults.is_empty());
 }
 
+// req: T7/*, P7.1, P7.3, P7.4, P7.5, P7.8
 #[test]
 fn table7_acceptance_and_power_equal_spec() {
     let s = spec();
@@ -135,6 +137,7 @@ fn table7_acceptance_and_power_equal_spec() {
     }
 }
 
+// req: T8/*, P7.7, P7.9, P7.13, P7.14
 #[test]
 fn table8_modes_deferral_and_kinds_equal_spec() {
     let s = spec();
@@ -179,6 +182,7 @@ fn table8_modes_deferral_and_kinds_equal_spec() {
     }
 }
 
+// req: P7.11, P7.17
 #[test]
 fn refusal_codes_and_thresholds_equal_spec() {
     let s = spec();

@@ -103,27 +103,30 @@ fn is_header(line: &str) -> bool {
     t.is_empty() || t.starts_with("#![") || (t.starts_with("//") && !t.starts_with("///"))
 }
 
-/// Whether a line may sit between an annotation and its item: attributes, comments.
-fn is_between(line: &str) -> bool {
-    let t = line.trim();
-    t.starts_with("#[") || t.starts_with("//") || t.starts_with(')') || t.starts_with(']')
+/// How far a line opens brackets: an attribute spans lines until its brackets close.
+fn depth(line: &str) -> i32 {
+    let count = |set: &[char]| line.chars().filter(|c| set.contains(c)).count() as i32;
+    count(&['[', '(']) - count(&[']', ')'])
 }
 
-/// The target of the annotation on line `at`; `None` when it annotates nothing.
+/// The target of the annotation on line `at`; `None` when it annotates nothing. Attributes (of
+/// any number of lines) and comments may sit between the annotation and its item.
 fn target(lines: &[&str], at: usize) -> Option<Target> {
     let header = lines.iter().take(at).all(|l| is_header(l));
     if header && lines.get(at + 1).is_some_and(|l| l.trim().is_empty()) {
         return Some(Target::Module);
     }
-    let mut test = false;
+    let (mut test, mut open) = (false, 0);
     for line in lines.iter().skip(at + 1) {
-        if let Some((kind, name)) = declares(line).filter(|_| !line.trim().starts_with("//")) {
-            return Some(Target::Item { kind, name, test });
+        let t = line.trim();
+        if open > 0 {
+            open += depth(t);
+        } else if t.starts_with("#[") {
+            test |= t.starts_with("#[test]");
+            open = depth(t);
+        } else if !t.starts_with("//") {
+            return declares(t).map(|(kind, name)| Target::Item { kind, name, test });
         }
-        if !is_between(line) {
-            return None;
-        }
-        test |= line.trim().starts_with("#[test]");
     }
     None
 }

@@ -25,6 +25,7 @@ fn each_command_checked(visit: impl FnMut(Command)) -> usize {
     }
 }
 
+// req: T1/*
 #[test]
 fn every_command_round_trips_through_its_encoding() {
     let mut n = 0;
@@ -69,6 +70,7 @@ fn opcodes_are_distinct_per_variant_class() {
     }
 }
 
+// req: P3.13
 #[test]
 fn unused_parameter_bytes_must_be_zero() {
     for_each_variant_class(PulseWidth::CENTER, HipAngle::ZERO, |c| {
@@ -83,6 +85,7 @@ fn unused_parameter_bytes_must_be_zero() {
     });
 }
 
+// req: P6.4
 #[test]
 fn range_errors_name_the_byte() {
     let bad = 2501u16.to_le_bytes();

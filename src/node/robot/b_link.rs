@@ -144,6 +144,7 @@ mod tests {
         step: BolterStep::Descend,
     };
 
+    // req: P4.5
     #[test]
     fn every_new_content_gets_a_new_number_and_zero_is_skipped() {
         let mut link = BLink::new();

@@ -272,6 +272,7 @@ mod tests {
         assert_eq!((got, w.counts().other_kind, w.counts().commands), (1, 1, 1));
     }
 
+    // req: P3.14
     #[test]
     fn stale_heartbeats_are_dropped_and_fresh_ones_sent() {
         let mut w = WifiSession::default();

@@ -217,6 +217,7 @@ mod tests {
         }
     }
 
+    // req: P3.5, P3.6
     #[test]
     fn full_hands_the_packet_back_and_free_slots_are_reused() {
         let mut s: Server<2> = Server::new();
@@ -235,6 +236,7 @@ mod tests {
         assert_eq!(s.pending_count(), 2);
     }
 
+    // req: P3.7
     #[test]
     fn supersession_is_reported_and_visits_alternate() {
         let mut s: Server<4> = Server::new();

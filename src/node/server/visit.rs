@@ -180,6 +180,7 @@ mod tests {
         assert_eq!(v.left_ms(1_000), None);
     }
 
+    // req: P3.8
     #[test]
     fn the_answer_is_the_first_heartbeat_after_garbage_and_other_kinds() {
         let mut v = Visit::new(0, BoardNumber::ONE, stop(1), 200);
@@ -196,6 +197,7 @@ mod tests {
         assert!(v.discarded() > 0);
     }
 
+    // req: P3.6, P3.9
     #[test]
     fn an_unwritten_visit_leaves_its_command_pending() {
         let mut s: Server<2> = Server::new();
