@@ -12,6 +12,7 @@
 //! assert_eq!(BolterStep::from_wire(BolterStep::Rotate.to_wire()), Some(BolterStep::Rotate));
 //! assert_eq!(MuxLines::for_pair(BolterPair::P3), MuxLines { a0: true, a1: false });
 //! ```
+// req: P2.8, P5.9, P5.10, P5.11
 
 use crate::units::ranged;
 use crate::wire_enum::wire_enum;

@@ -24,6 +24,7 @@
 //! assert_eq!(budget_ms(&cfg, 2_400, 0), 2_400 + cfg.servo_margin_ms);
 //! assert_eq!(budget_ms(&cfg, 2_400, 9_000), 9_000 + cfg.hip_margin_ms);
 //! ```
+// req: D:module-motion-deadline, D:motion-timeout
 
 use super::interp::Rate;
 use crate::units::widen::to_u32;

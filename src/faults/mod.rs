@@ -16,6 +16,7 @@
 //! assert_eq!(Faults::from_wire(f.to_wire()), Ok(f));
 //! assert_eq!(f.iter().count(), 2);
 //! ```
+// req: T8/*, P7.7, D:heartbeat-byte-62, D:faults-latched-outside-operational
 
 #[cfg(feature = "serde")]
 mod ser;

@@ -15,6 +15,7 @@
 //! assert_eq!(robot_move(State::G, State::J), None);
 //! assert!(turns_without_hip(State::G, State::J));
 //! ```
+// req: P6.2, D:turn-primitives
 
 use super::{Primitive, State, StateKind};
 use crate::units::{Axis, Side, Sign};

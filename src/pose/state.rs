@@ -1,4 +1,5 @@
 //! The 15 allowed configurations of Table 5.
+// req: T5/*, P6.1, P6.2, P6.3, D:state-letters
 
 use crate::units::slice;
 use crate::units::widen::to_u32;

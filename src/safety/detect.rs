@@ -18,6 +18,7 @@
 //! let mut lb = LowBattery::default();
 //! assert!(!lb.update(&cfg, 0, 12_000, None) && !lb.update(&cfg, 2_000, 12_000, None));
 //! ```
+// req: P2.7, P7.11, P7.15, P7.16, P7.17, P7.18, P7.19
 
 use crate::faults::{Fault, Faults};
 use crate::units::{Electrical, HipAngle, Instant, Milliamps, Millivolts};

@@ -1,4 +1,5 @@
 //! A set of modules, for power switching.
+// req: P7.3, P7.8
 
 use crate::units::Module;
 

@@ -1,6 +1,7 @@
 //! Moving averages with a running sum: O(1) per sample. [`MovingAverage`] is one channel;
 //! [`Averages`] is `K` channels sampled together (a sensor front end's ADC or IMU), sharing
 //! one slot index and count so a tick's samples cost one index update, not one per channel.
+// req: P2.10, D:sensor-filtering
 
 /// Mean of the last `N` samples (fewer before `N` have arrived), rounded down.
 ///

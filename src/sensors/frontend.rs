@@ -44,6 +44,7 @@
 //! }
 //! assert!(f.push(&silent).lost.adc && f.lost().encoder);
 //! ```
+// req: P2.10, D:sensor-loss
 
 use super::adc::{self, Scaling};
 use super::{encoder, imu, Averages};

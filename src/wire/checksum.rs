@@ -30,6 +30,7 @@
 //! let mut body = *b"MICM\x01\x02\x00\x00\x00\x00\x00\x00";
 //! assert_eq!(packet_crc(PacketKind::Command, &body), crc16(&body));
 //! ```
+// req: D:checksum, D:crc-table
 
 use super::{PacketKind, HEADER_LEN};
 

@@ -31,6 +31,7 @@
 //!     other => panic!("{other:?}"),
 //! }
 //! ```
+// req: D:deframing, D:headers
 
 use super::{checksum, PacketKind, CHECKSUM_LEN, HEADER_LEN, MAX_PACKET_LEN};
 

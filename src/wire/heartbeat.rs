@@ -11,6 +11,7 @@
 //! assert_eq!(&acked.to_bytes()[57..60], &[2, 1, 0]); // bytes 57–58 acknowledge command 0x0102
 //! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
+// req: T3/*, P3.16
 
 use super::layout::{fields, ElectricalLayout};
 use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKind, WireError};

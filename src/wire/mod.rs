@@ -14,6 +14,7 @@
 //! bytes[..4].copy_from_slice(&PacketKind::Heartbeat.header());
 //! assert!(matches!(CommandRepr::parse(&bytes), Err(WireError::Header { .. })));
 //! ```
+// req: T2/*, T3/*, T4/*
 
 use core::fmt;
 use zerocopy::{FromBytes, Immutable, KnownLayout, Unaligned};

@@ -25,6 +25,7 @@
 //! wrap-around as long as fewer than 32,768 commands separate a copy from its original.
 //! Board A's log is in RAM: after a reset the first sequenced command is taken whatever its
 //! number (documented in spec/protocol/README.md).
+// req: D:exactly-once-window
 
 use crate::refusal::Refusal;
 

@@ -29,6 +29,7 @@
 //! assert_eq!((done.seq, done.outcome, done.attempts), (seq, Outcome::Accepted, 2));
 //! assert_eq!(up.efficiency().percent(), Some(50));
 //! ```
+// req: P3.10, P3.11, P8.4, P8.5, P7.20, D:ground-uplink
 
 use crate::command::Command;
 use crate::refusal::Refusal;

@@ -34,6 +34,7 @@
 //! let moved = BCommandRepr { arm_target: PulseWidth::MAX, ..snap };
 //! assert_eq!(link.due(60, 50, moved).map(|c| c.seq), Some(2)); // new content: new number
 //! ```
+// req: P4.5, D:a-to-b-sequence-number
 
 use crate::units::Instant;
 use crate::wire::b_command::{BCommandRepr, BolterOrder};

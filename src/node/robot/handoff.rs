@@ -27,6 +27,7 @@
 //! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`, or
 //! `portable-atomic` when another crate already selects portable-atomic's backend (esp-hal on
 //! the C3 selects `unsafe-assume-single-core`, which `critical-section` may not join).
+// req: P2.11, P3.17, P3.18
 
 use heapless::spsc;
 

@@ -48,6 +48,7 @@
 //! assert!(wifi.close());
 //! assert_eq!(wifi.counts().sent, 1);
 //! ```
+// req: P3.14
 
 use crate::wire::command::COMMAND_LEN;
 use crate::wire::deframer::{Deframed, Deframer};

@@ -35,6 +35,7 @@
 //! server.delivered(robot, &packet);
 //! assert_eq!(server.next_visit(), None);
 //! ```
+// req: P3.5, P3.6, P3.7, D:server-pending-slot
 
 use crate::units::BoardNumber;
 use crate::wire::command::{CommandRepr, COMMAND_LEN};

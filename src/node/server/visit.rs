@@ -45,6 +45,7 @@
 //! // Without it, the visit would have ended at its deadline.
 //! assert_eq!(visit.left_ms(300), None);
 //! ```
+// req: P3.7, P3.8, P3.9, D:relay-visit-window
 
 use super::relay::{Packet, Server};
 use crate::units::BoardNumber;

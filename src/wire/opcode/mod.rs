@@ -10,6 +10,7 @@
 //! assert_eq!(id, opcode::HIP + 1);
 //! assert_eq!(opcode::decode(id, params), Ok(Command::Hip(HipTarget::Straight)));
 //! ```
+// req: T1/*, P3.13, D:opcodes
 
 use crate::command::{
     BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
