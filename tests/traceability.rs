@@ -111,7 +111,10 @@ fn every_annotation_cites_known_ids_and_annotates_an_item() {
             }
         }
         if a.ids.is_empty() {
-            bad.push(format!("{}:{}: an annotation citing nothing", a.file, a.line));
+            bad.push(format!(
+                "{}:{}: an annotation citing nothing",
+                a.file, a.line
+            ));
         }
     }
     bad.extend(w.scan.dangling.iter().cloned());
@@ -167,8 +170,11 @@ fn the_scanner_reads_module_item_and_test_annotations() {
          pub fn bare() {{}}\n{c} req: P7.3\n\nlet x = 1;\n"
     );
     let s = scan::scan_text("src/x.rs", &text);
-    let found: Vec<(Vec<String>, Target)> =
-        s.annotations.iter().map(|a| (a.ids.clone(), a.target.clone())).collect();
+    let found: Vec<(Vec<String>, Target)> = s
+        .annotations
+        .iter()
+        .map(|a| (a.ids.clone(), a.target.clone()))
+        .collect();
     let item = |kind: &str, name: &str, test| Target::Item {
         kind: kind.to_string(),
         name: name.to_string(),
@@ -183,8 +189,19 @@ fn the_scanner_reads_module_item_and_test_annotations() {
             (ids(&["P7.2"]), item("struct", "Item", false)),
         ]
     );
-    assert_eq!(s.tests.iter().map(|t| t.name.as_str()).collect::<Vec<_>>(), ["cites", "cites_none"]);
-    assert_eq!(s.public.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(), ["Item", "bare"]);
-    assert_eq!(s.dangling.len(), 1, "the last annotation annotates nothing: {:?}", s.dangling);
+    assert_eq!(
+        s.tests.iter().map(|t| t.name.as_str()).collect::<Vec<_>>(),
+        ["cites", "cites_none"]
+    );
+    assert_eq!(
+        s.public.iter().map(|p| p.name.as_str()).collect::<Vec<_>>(),
+        ["Item", "bare"]
+    );
+    assert_eq!(
+        s.dangling.len(),
+        1,
+        "the last annotation annotates nothing: {:?}",
+        s.dangling
+    );
     assert!(cites("T5/*", "T5/a") && !cites("T5/*", "T6/1") && cites("P7.2", "P7.2"));
 }

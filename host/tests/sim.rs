@@ -99,6 +99,7 @@ fn the_demo_plan_completes_with_no_fault() {
     }
 }
 
+// req: P3.11
 #[test]
 fn thirty_percent_wifi_loss_still_completes_and_runs_nothing_twice() {
     let cfg = SimConfig {
@@ -303,6 +304,7 @@ fn the_demo_plan_parses() {
 
 /// The demo plan's comments give each reconfiguration's number of primitives (issue 39: one
 /// said three where the plan takes two): each is the chosen plan's length.
+// req: P6.5
 #[test]
 fn the_demo_plans_primitive_counts_are_the_plans() {
     use mmic::motion::{route, State};
@@ -348,6 +350,7 @@ fn a_malformed_plan_file_is_refused_with_line_and_column() {
     );
 }
 
+// req: P7.10
 #[test]
 fn a_state_mismatch_on_the_robot_says_what_the_plan_expected_and_what_it_reported() {
     // The library-level run does not trace the plan (`mmic sim` would refuse this file before
@@ -513,6 +516,7 @@ fn the_plant_bolter_currents_straddle_the_library_thresholds() {
     assert!(BOLTER_OBSTACLE_MA > absolute);
 }
 
+// req: T1/bolter, P5.12
 #[test]
 fn a_bolt_command_completes_on_the_bolter_current() {
     let cfg = SimConfig {
@@ -963,6 +967,7 @@ fn every_table8_fault_injected_on_the_demo_reaches_its_table8_mode() {
 /// name; during the motion the contraction into m is not confirmed. The estimate of the state
 /// reads the arms' commanded PWM values, so the ground's belief (a) still holds and is not
 /// reported wrong.
+// req: P7.15
 #[test]
 fn a_dead_arm_switch_is_arm_not_contracted_at_rest_and_during_a_motion() {
     for (at_s, step) in [(20, "bolt all"), (26, "reconfigure a -> m")] {
@@ -1037,6 +1042,7 @@ fn a_dead_arm_switch_is_arm_not_contracted_at_rest_and_during_a_motion() {
     }
 }
 
+// req: T1/stop, T1/reset
 #[test]
 fn stop_during_a_reconfiguration_then_reset_resumes_it_and_the_demo_completes() {
     // Stop in the middle of `reconfigure a -> m` (about 24-36 s), Reset 3 s later: the
@@ -1176,6 +1182,7 @@ fn inject_is_checked_and_summary_json_is_what_mmic_sim_returned() {
 /// The plant locks fasteners with Figure 10's per-attempt rates and starts with a full battery,
 /// both as spec/hardware.toml gives them (the paper's counts, in fastener pairs: decision
 /// figure-10-pairs).
+// req: P8.1, P2.1
 #[test]
 fn the_plant_takes_figure_10_and_the_battery_from_spec_hardware() {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../spec/hardware.toml");

@@ -24,6 +24,7 @@ fn demo_at(latency_ms: u64, jitter_ms: u64) -> Summary {
     engine::run(&cfg).unwrap()
 }
 
+// req: P3.7, D:relay-visit-window
 #[test]
 fn the_server_visits_as_long_as_the_opsui_window_allows() {
     assert_eq!(SimConfig::demo().visit_ms, relay::VISIT_MS);

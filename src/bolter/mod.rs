@@ -214,6 +214,7 @@ mod tests {
         );
     }
 
+    // req: T3/bolter_attempt
     #[cfg(feature = "serde")]
     #[test]
     fn bolter_attempt_from_a_number() {
@@ -226,6 +227,7 @@ mod tests {
     /// A side's executor times a sensed step out past `sensed_ms` and a step that ends at home
     /// past `home_ms` (different here), selects its order's pair on the multiplexer and
     /// reports its direction.
+    // req: P5.10
     #[test]
     fn side_timeouts_mux_and_direction() {
         use super::BolterOrder;
@@ -264,6 +266,7 @@ mod tests {
         }
     }
 
+    // req: T3/bolter_attempt
     #[test]
     fn bolter_attempt_range() {
         for n in 0..=u8::MAX {

@@ -266,6 +266,7 @@ impl FromIterator<Fault> for Faults {
 mod tests {
     use super::*;
 
+    // req: T8/*
     #[test]
     fn every_subset_round_trips_and_reserved_bits_are_refused() {
         // Every subset of the 13 faults; under Miri (.ci/miri), whose interpretation is some

@@ -248,6 +248,7 @@ mod tests {
         }
     }
 
+    // req: P6.2
     #[test]
     fn unit_and_cross_follow_the_right_hand_rule() {
         let (x, y, z) = (

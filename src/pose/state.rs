@@ -127,6 +127,7 @@ impl From<State> for char {
 mod tests {
     use super::*;
 
+    // req: T5/*, D:state-letters
     #[test]
     fn letters_wire_and_index_agree() {
         for (i, s) in State::ALL.iter().enumerate() {

@@ -314,6 +314,7 @@ mod tests {
         assert!(lb.update(&cfg, 5_502, 9_000, None));
     }
 
+    // req: P7.11
     #[test]
     fn clock_going_backwards_counts_as_no_time() {
         let mut d = Debounce::default();

@@ -397,6 +397,7 @@ mod tests {
     /// `parse` takes every field's check at once and leaves the order to `fields`: the two
     /// agree on every packet whose one octet (header and checksum aside) holds any value,
     /// from a sample of valid packets, the checksum made right each time.
+    // req: T3/*
     #[test]
     fn the_fast_path_agrees_with_the_checks_in_order() {
         let samples = [

@@ -402,6 +402,7 @@ pub(crate) fn get_bool(
 mod tests {
     use super::*;
 
+    // req: D:headers
     #[test]
     fn headers_are_far_apart() {
         for a in PacketKind::ALL {

@@ -131,6 +131,7 @@ proptest! {
 /// true start reads 180.01° through the encoder, so the controller turns the other way. Kept as
 /// a fixed case over loads and phases, because proptest's random inputs rarely land within one
 /// encoder count of 180°.
+// req: P5.5
 #[test]
 fn half_turn_within_one_encoder_count_takes_either_short_way() {
     for load in [0.0, 150.0, 300.0] {
@@ -164,6 +165,7 @@ fn turns_at_about_ten_degrees_per_second() {
     assert!((8.0..=12.0).contains(&t), "took {t} s");
 }
 
+// req: P5.8
 #[test]
 fn sweep_reports_the_worst_case() {
     let mut worst_overshoot: f64 = 0.0;

@@ -129,6 +129,7 @@ pub(crate) fn figure10() -> Figure10 {
 /// Every table quotes the paper, word for word, in its `paper` entry: each quoted sentence
 /// (the `[...]` cuts and section notes aside) is in the paper's text, so a number typed here is
 /// the paper's.
+// req: D:firmware-chips
 #[test]
 fn every_entry_quotes_the_paper_and_every_departure_is_a_decision() {
     let raw: toml::Table = toml::from_str(&text("spec/hardware.toml")).unwrap();

@@ -101,6 +101,7 @@ proptest! {
     }
 }
 
+// req: P2.10
 #[test]
 fn moving_average_extremes_and_small_windows() {
     // Every window content of a 3-sample filter over the values {0, 1, 65534, 65535}, every

@@ -40,6 +40,7 @@ pub(crate) fn robot_moves_oracle() -> Vec<(State, State, Primitive)> {
         .collect()
 }
 
+// req: P6.9
 #[test]
 fn sixty_moves_each_with_its_inverse() {
     let moves: Vec<_> = map::moves().collect();
@@ -280,6 +281,7 @@ fn render_ambiguous() -> String {
     s
 }
 
+// req: D:primitive-final-state
 #[test]
 fn ambiguous_primitives_are_published_and_each_is_a_match_or_a_stretch() {
     let text = render_ambiguous();

@@ -289,6 +289,7 @@ fn arm(side: Side, target: ServoTarget) -> Command {
     Command::Arm { side, target }
 }
 
+// req: T1/stop, D:stop-and-reset
 #[test]
 fn stop_mid_motion_freezes_both_arms_and_keeps_the_motion_for_reset() {
     for side in [Side::A, Side::B] {
@@ -327,6 +328,7 @@ fn stop_mid_motion_freezes_both_arms_and_keeps_the_motion_for_reset() {
     }
 }
 
+// req: P7.8
 #[test]
 fn entering_safed_mid_motion_freezes_both_sides_and_drops_the_motion() {
     for side in [Side::A, Side::B] {
@@ -346,6 +348,7 @@ fn entering_safed_mid_motion_freezes_both_sides_and_drops_the_motion() {
     }
 }
 
+// req: T1/stop
 #[test]
 fn stop_and_safed_end_a_bolting_job_on_both_sides() {
     for stopper in [Command::Stop, Command::Mode(Mode::Safed)] {
@@ -371,6 +374,7 @@ fn stop_and_safed_end_a_bolting_job_on_both_sides() {
     }
 }
 
+// req: T1/stop
 #[test]
 fn stop_mid_turn_holds_the_hip_where_it_is_read() {
     let mut r = Rig::operational();
@@ -402,6 +406,7 @@ fn extend_from_a() -> Command {
 /// its end, the robot counts as in motion at every tick (`BoardA::in_motion`) and a command
 /// that moves is refused as busy — also at the ticks where every module has reached one
 /// step's targets and the next step has not yet set its own, when no servo is on its way.
+// req: T1/primitive
 #[test]
 fn a_primitive_is_in_motion_and_refuses_other_moves_at_every_tick_until_it_ends() {
     let mut r = Rig::operational();
@@ -434,6 +439,7 @@ fn a_primitive_is_in_motion_and_refuses_other_moves_at_every_tick_until_it_ends(
 /// the primitive reaches its state the robot stays busy, and command complete (heartbeat byte
 /// 54) stays unset, until it has been still for `idle_settle_ms` (the sensor averages no
 /// longer hold the motion's currents); then the check passes and command complete is set.
+// req: T3/command_complete, D:command-complete, D:idle-check-settling
 #[test]
 fn command_complete_waits_until_the_robot_has_rested_idle_settle_ms_after_the_primitive() {
     let settle = board_a::Config::default().idle_settle_ms;
@@ -570,6 +576,7 @@ fn until_idle(r: &mut Rig) {
 /// until its servo is at the target, as the heartbeat reports it: meanwhile the robot is in
 /// motion, another move is refused as busy, and command complete (byte 54) is unset; then
 /// the motion ends with command complete set (spec/decisions.toml, `command-complete`).
+// req: T1/arm, T1/gripper, P5.1
 #[test]
 fn a_single_module_move_is_a_motion_until_its_servo_is_at_its_target() {
     let cfg = board_a::Config::default();
@@ -792,6 +799,7 @@ fn bolting_all_four_pairs_runs_both_sides_pair_after_pair_to_done() {
 /// A fastener that side B's head cannot lock at first (it turns on it; Rotate times out):
 /// the attempt is abandoned — both bolters go home — and the pair is tried again, fastened at
 /// the second attempt (Figure 10's "twice"); the other pairs are unaffected.
+// req: T3/bolter_attempt, P5.9
 #[test]
 fn a_pair_that_does_not_lock_at_first_is_fastened_at_its_second_attempt() {
     let mut r = Rig::operational();
@@ -833,6 +841,7 @@ fn a_pair_that_never_locks_fails_the_job_after_three_attempts() {
 /// and stop there; the job ends reporting contact, with no fault. When one side finds nothing
 /// to touch, its descent times out: the job still ends (nothing was bolted, so no failure),
 /// reporting no contact.
+// req: T1/bolter, D:bolters-down
 #[test]
 fn moving_the_bolters_down_ends_when_both_touch_or_a_descent_times_out() {
     for b_there in [true, false] {
@@ -1001,6 +1010,7 @@ fn events_name_refused_commands_mode_changes_and_new_faults_once() {
 /// Power Control (Table 1): a module switched off in Operational gets no pulse while the
 /// others are driven — on side A by board A, on side B by board B as the A→B command's power
 /// flags tell it; switched on again, it is driven.
+// req: T1/power_control
 #[test]
 fn a_module_switched_off_is_not_driven_and_the_others_are() {
     use mmic::command::PowerTarget;
@@ -1047,6 +1057,7 @@ fn a_module_switched_off_is_not_driven_and_the_others_are() {
 
 /// Power Control of a bolter: with bolter A switched off, a bolting job leaves side A's motor
 /// unpowered (idle) while side B's descends.
+// req: T1/power_control
 #[test]
 fn a_bolter_switched_off_is_not_driven() {
     use mmic::command::PowerTarget;
@@ -1159,6 +1170,7 @@ fn straight_target() -> State {
 /// command refused with arm_not_contracted — not an initial state mismatch and Standby, which
 /// would tell the operator that their belief of where the robot is was wrong. At rest, before
 /// the reconfiguration, nothing checks the switch.
+// req: T8/arm_not_contracted, D:initial-state-sensors
 #[test]
 fn a_dead_arm_switch_at_rest_is_arm_not_contracted_when_a_reconfiguration_arrives() {
     let target = straight_target();
@@ -1196,6 +1208,7 @@ fn a_dead_arm_switch_at_rest_is_arm_not_contracted_when_a_reconfiguration_arrive
 /// The same dead switch during the reconfiguration (as before issue 39): the motion's last
 /// contraction is not confirmed, Table 8's arm not fully contracted, Safed, the target never
 /// reached; no initial state mismatch.
+// req: T8/arm_not_contracted, P7.15
 #[test]
 fn a_switch_that_dies_during_a_reconfiguration_is_arm_not_contracted() {
     let target = straight_target();
@@ -1230,6 +1243,7 @@ fn a_switch_that_dies_during_a_reconfiguration_is_arm_not_contracted() {
 /// With every switch working, a reconfiguration from any state but the one the robot is in
 /// (a, tracked, arms commanded contracted) is an initial state mismatch: refused by that name,
 /// Standby (the robot is gripped), nothing else latched.
+// req: P7.10, T8/initial_state_mismatch
 #[test]
 fn a_wrong_initial_state_with_working_switches_is_an_initial_state_mismatch_from_every_state() {
     let mut n = 0;
@@ -1256,6 +1270,7 @@ fn a_wrong_initial_state_with_working_switches_is_an_initial_state_mismatch_from
 /// and also with the switch stuck closed, which a check reading the switches took for a
 /// contracted arm (and accepted the command). Not arm not fully contracted: the arm is not
 /// commanded contracted.
+// req: P7.10
 #[test]
 fn an_arm_commanded_extended_is_in_no_matched_state_whatever_its_switch_says() {
     let target = straight_target();

@@ -217,6 +217,7 @@ fn every_command_class_in_every_starting_mode_runs_once_and_is_acknowledged() {
 /// judge again (duplicate, stale) the command bytes 57–58 name. So whenever the answered
 /// packet is sequenced, byte 62 is the outcome of the number in bytes 57–58, whatever
 /// unsequenced commands came in between.
+// req: T3/refusal, D:heartbeat-byte-62
 #[test]
 fn byte_62_reports_the_command_the_heartbeat_reports_on() {
     let arm = Command::Arm {
@@ -256,6 +257,7 @@ fn byte_62_reports_the_command_the_heartbeat_reports_on() {
     assert_eq!(answer(&mut a, arm, 10), (11, None));
 }
 
+// req: T2/board, T2/checksum
 #[test]
 fn packets_for_others_or_broken_get_no_answer_and_malformed_ones_a_refusal() {
     let mut a = BoardA::new(board_a::Config::default());

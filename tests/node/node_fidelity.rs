@@ -14,6 +14,7 @@ use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
 
 /// Defect 10: board B starts with its servos at home, as board A does (it used to start at
 /// 1500 µs, so entering Operational drove B's arm and gripper to mid-travel first).
+// req: D:b-starts-at-home
 #[test]
 fn board_b_starts_at_home_like_board_a() {
     let a_cfg = board_a::Config::default();

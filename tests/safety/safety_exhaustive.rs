@@ -373,6 +373,7 @@ fn fault_classes() -> Vec<Faults> {
 /// what the supervisor branches on (mode, enabled modules, deferred Standby pending, a motion
 /// kept by Stop); the latched fault set rides along as data: no branch reads it (it is only
 /// output, widened by each step's faults and narrowed by ClearFaults).
+// req: T7/*, P7.7
 #[test]
 fn every_reachable_supervisor_state_satisfies_the_properties() {
     use std::collections::{HashSet, VecDeque};

@@ -269,6 +269,7 @@ proptest! {
     }
 }
 
+// req: P7.8
 #[test]
 fn oracle_module_names_match_spec() {
     let names: Vec<String> = Module::ALL.iter().map(|m| module_name(*m)).collect();

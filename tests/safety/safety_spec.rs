@@ -82,6 +82,7 @@ fn module_name(m: Module) -> &'static str {
     }
 }
 
+// req: P7.4
 #[test]
 fn the_moving_command_kinds_equal_spec() {
     let got: Vec<&str> = CommandKind::ALL
@@ -253,6 +254,7 @@ fn assert_introduces(decisions: &BTreeMap<String, String>, id: &str, what: &str)
 /// the decision that added it: the code takes every kind Table 7 lets a mode take (Operational:
 /// every Table 1 kind), and each kind taken beyond that has an entry in [accepts_decisions]
 /// whose decision names it. No entry is left over.
+// req: T7/commands, D:commands-in-every-mode
 #[test]
 fn acceptance_beyond_table7_is_a_recorded_decision() {
     let s = spec();
@@ -296,6 +298,7 @@ fn acceptance_beyond_table7_is_a_recorded_decision() {
 }
 
 /// None of the refusal codes is the paper's: each names the decision that introduced it.
+// req: D:heartbeat-byte-62
 #[test]
 fn every_refusal_code_names_the_decision_that_introduced_it() {
     let s = spec();

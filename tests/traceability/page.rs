@@ -15,7 +15,11 @@ fn list(items: &BTreeSet<String>) -> String {
     if items.is_empty() {
         return "—".to_string();
     }
-    items.iter().map(|i| format!("`{i}`")).collect::<Vec<_>>().join(", ")
+    items
+        .iter()
+        .map(|i| format!("`{i}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// The groups of the counts table, in order: the paper's statements, its table rows, then each
@@ -45,7 +49,11 @@ fn counts(page: &mut String, reqs: &[Req], by_req: &Citations) {
     }
     let mut total = [0; 5];
     for (name, g) in &groups {
-        let _ = writeln!(page, "| {name} | {} | {} | {} | {} | {} |", g[0], g[1], g[2], g[3], g[4]);
+        let _ = writeln!(
+            page,
+            "| {name} | {} | {} | {} | {} | {} |",
+            g[0], g[1], g[2], g[3], g[4]
+        );
         total.iter_mut().zip(g).for_each(|(t, n)| *t += n);
     }
     let [a, b, c, d, e] = total;
@@ -67,7 +75,15 @@ fn matrix(page: &mut String, reqs: &[Req], by_req: &Citations) {
         }
         let status = match (r.status, &r.why) {
             (Status::Implemented, _) => "implemented".to_string(),
-            (s, why) => format!("{}: {}", if s == Status::Informative { "informative" } else { "not implemented" }, why.as_deref().unwrap_or("")),
+            (s, why) => format!(
+                "{}: {}",
+                if s == Status::Informative {
+                    "informative"
+                } else {
+                    "not implemented"
+                },
+                why.as_deref().unwrap_or("")
+            ),
         };
         let (code, tests) = by_req.get(&r.id).cloned().unwrap_or_default();
         let _ = writeln!(
@@ -76,7 +92,10 @@ fn matrix(page: &mut String, reqs: &[Req], by_req: &Citations) {
             r.id,
             cell(&r.text),
             cell(&status),
-            r.spec.as_deref().map(|s| format!("`{s}`")).unwrap_or_else(|| "—".to_string()),
+            r.spec
+                .as_deref()
+                .map(|s| format!("`{s}`"))
+                .unwrap_or_else(|| "—".to_string()),
             list(&code),
             list(&tests)
         );
@@ -85,34 +104,48 @@ fn matrix(page: &mut String, reqs: &[Req], by_req: &Citations) {
 
 /// The tests citing no requirement, by file; then the public items of `src/` tracing nowhere.
 fn reverse(page: &mut String, scan: &Scan) {
-    let citing: BTreeSet<(String, String)> = scan
-        .annotations
-        .iter()
-        .filter_map(|a| match &a.target {
-            Target::Item { name, test: true, .. } => Some((a.file.clone(), name.clone())),
-            _ => None,
-        })
-        .collect();
+    // Per test, (file, name): whether it cites a requirement, or only decisions (`D:`).
+    let mut citing: BTreeMap<(String, String), bool> = BTreeMap::new();
+    for a in &scan.annotations {
+        if let Target::Item {
+            name, test: true, ..
+        } = &a.target
+        {
+            let req = a.ids.iter().any(|id| !id.starts_with("D:"));
+            *citing.entry((a.file.clone(), name.clone())).or_default() |= req;
+        }
+    }
     let mut by_file: BTreeMap<&str, (usize, Vec<&str>)> = BTreeMap::new();
     for t in &scan.tests {
         let entry = by_file.entry(&t.file).or_default();
         entry.0 += 1;
-        if !citing.contains(&(t.file.clone(), t.name.clone())) {
+        if !citing
+            .get(&(t.file.clone(), t.name.clone()))
+            .copied()
+            .unwrap_or(false)
+        {
             entry.1.push(&t.name);
         }
     }
     let none: usize = by_file.values().map(|(_, v)| v.len()).sum();
+    let decisions_only = citing.values().filter(|r| !**r).count();
     let _ = write!(
         page,
         "\n## Tests citing no requirement\n\n{none} of {} tests (`#[test]` functions in src/, \
-         tests/, proofs/, host/) cite no requirement: checks of the project's own design (its \
-         decisions, the CCSDS layer, the tools) or not yet annotated.\n\n\
+         tests/, proofs/, host/) cite no requirement ({decisions_only} of them cite decisions \
+         only): checks of the project's own design (its decisions, the CCSDS layer, the tools) \
+         or not yet annotated.\n\n\
          | file | tests | citing none | those tests |\n|---|---|---|---|\n",
         scan.tests.len()
     );
     for (file, (all, names)) in by_file.iter().filter(|(_, (_, v))| !v.is_empty()) {
         let names: Vec<String> = names.iter().map(|n| format!("`{n}`")).collect();
-        let _ = writeln!(page, "| `{file}` | {all} | {} | {} |", names.len(), names.join(", "));
+        let _ = writeln!(
+            page,
+            "| `{file}` | {all} | {} | {} |",
+            names.len(),
+            names.join(", ")
+        );
     }
     let bare: Vec<_> = scan.public.iter().filter(|p| !scan.traces(p)).collect();
     let _ = write!(
@@ -125,7 +158,10 @@ fn reverse(page: &mut String, scan: &Scan) {
     );
     let mut by_file: BTreeMap<&str, Vec<String>> = BTreeMap::new();
     for p in bare {
-        by_file.entry(&p.file).or_default().push(format!("`{}`", p.name));
+        by_file
+            .entry(&p.file)
+            .or_default()
+            .push(format!("`{}`", p.name));
     }
     if !by_file.is_empty() {
         page.push_str("| file | items |\n|---|---|\n");

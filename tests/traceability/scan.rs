@@ -10,7 +10,11 @@ pub enum Target {
     /// The whole file's module (a `// req:` line among the header comments, then a blank line).
     Module,
     /// The item declared right below it; `test` when an attribute between is `#[test]`.
-    Item { kind: String, name: String, test: bool },
+    Item {
+        kind: String,
+        name: String,
+        test: bool,
+    },
 }
 
 #[derive(Debug)]
@@ -42,7 +46,9 @@ pub struct Scan {
 impl Scan {
     /// Whether a public item of `src/` cites, or sits in a module that cites, anything.
     pub fn traces(&self, item: &Named) -> bool {
-        self.item_cited.iter().any(|(f, n)| *f == item.file && *n == item.name)
+        self.item_cited
+            .iter()
+            .any(|(f, n)| *f == item.file && *n == item.name)
             || self
                 .annotations
                 .iter()
@@ -65,7 +71,16 @@ fn module_covers(module: &str, file: &str) -> bool {
 }
 
 const KINDS: &[&str] = &[
-    "fn", "struct", "enum", "mod", "const", "static", "trait", "type", "union", "impl",
+    "fn",
+    "struct",
+    "enum",
+    "mod",
+    "const",
+    "static",
+    "trait",
+    "type",
+    "union",
+    "impl",
     "macro_rules",
 ];
 
@@ -80,7 +95,9 @@ pub fn declares(line: &str) -> Option<(String, String)> {
         .filter(|w| !w.is_empty())
         .collect();
     words.windows(2).find_map(|w| match w {
-        [kind, name] if KINDS.contains(kind) && !KINDS.contains(name) && !QUALIFIERS.contains(name) => {
+        [kind, name]
+            if KINDS.contains(kind) && !KINDS.contains(name) && !QUALIFIERS.contains(name) =>
+        {
             Some((kind.to_string(), name.to_string()))
         }
         _ => None,
@@ -88,7 +105,11 @@ pub fn declares(line: &str) -> Option<(String, String)> {
 }
 
 fn annotation_ids(line: &str) -> Option<Vec<String>> {
-    let rest = line.trim_start().strip_prefix("//")?.trim_start().strip_prefix("req:")?;
+    let rest = line
+        .trim_start()
+        .strip_prefix("//")?
+        .trim_start()
+        .strip_prefix("req:")?;
     Some(
         rest.split(',')
             .map(str::trim)
@@ -149,26 +170,36 @@ pub fn scan_text(file: &str, text: &str) -> Scan {
                         target,
                     });
                 }
-                None => scan.dangling.push(format!("{file}:{}: annotates no item", i + 1)),
+                None => scan
+                    .dangling
+                    .push(format!("{file}:{}: annotates no item", i + 1)),
             }
         }
         if line.trim().starts_with("#[test]") {
             let name = lines.iter().skip(i + 1).take(12).find_map(|l| declares(l));
             if let Some((_, name)) = name {
-                scan.tests.push(Named { file: file.to_string(), name });
+                scan.tests.push(Named {
+                    file: file.to_string(),
+                    name,
+                });
             }
         }
-        if file.starts_with("src/") && line.starts_with("pub ") && !line.starts_with("pub use") {
-            if let Some((_, name)) = declares(line).filter(|(k, _)| k != "mod") {
-                scan.public.push(Named { file: file.to_string(), name });
-            }
+        let public =
+            file.starts_with("src/") && line.starts_with("pub ") && !line.starts_with("pub use");
+        if let Some((_, name)) = declares(line).filter(|(k, _)| public && k != "mod") {
+            scan.public.push(Named {
+                file: file.to_string(),
+                name,
+            });
         }
     }
     scan
 }
 
 fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
     for entry in entries.flatten() {
         let path = entry.path();
         let name = entry.file_name();
@@ -189,7 +220,11 @@ pub fn scan_tree(root: &Path, dirs: &[&str]) -> Scan {
     files.sort();
     let mut all = Scan::default();
     for path in files {
-        let rel = path.strip_prefix(root).expect("under the root").to_string_lossy().replace('\\', "/");
+        let rel = path
+            .strip_prefix(root)
+            .expect("under the root")
+            .to_string_lossy()
+            .replace('\\', "/");
         let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{rel}: {e}"));
         let s = scan_text(&rel, &text);
         all.annotations.extend(s.annotations);

@@ -77,7 +77,9 @@ fn str_of<'a>(t: &'a toml::Table, key: &str) -> &'a str {
 /// The items of one proforma or tailoring file as requirements (every item; `supported = "Y"`
 /// ones are implemented, the others not), their IDs prefixed by `prefix`.
 fn supported_items(path: &Path, source: &str, prefix: &str) -> Vec<Req> {
-    let Some(value) = parse::<Value>(path) else { return Vec::new() };
+    let Some(value) = parse::<Value>(path) else {
+        return Vec::new();
+    };
     let mut tables = Vec::new();
     id_tables(&value, &mut tables);
     tables
@@ -86,12 +88,24 @@ fn supported_items(path: &Path, source: &str, prefix: &str) -> Vec<Req> {
             let id = str_of(t, "id");
             let supported = str_of(t, "supported");
             Req {
-                id: if id.starts_with(prefix) { id.to_string() } else { format!("{prefix}{id}") },
+                id: if id.starts_with(prefix) {
+                    id.to_string()
+                } else {
+                    format!("{prefix}{id}")
+                },
                 section: 0,
                 kind: "item".to_string(),
                 text: str_of(t, "feature").to_string() + str_of(t, "what"),
-                spec: Some(path.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default()),
-                status: if supported == "Y" { Status::Implemented } else { Status::NotImplemented },
+                spec: Some(
+                    path.file_name()
+                        .map(|n| n.to_string_lossy().to_string())
+                        .unwrap_or_default(),
+                ),
+                status: if supported == "Y" {
+                    Status::Implemented
+                } else {
+                    Status::NotImplemented
+                },
                 why: Some(format!("supported = \"{supported}\"")).filter(|_| supported != "Y"),
                 source: source.to_string(),
             }
@@ -104,15 +118,31 @@ pub fn requirements(root: &Path) -> Vec<Req> {
     let mut reqs = Vec::new();
     for path in toml_files(&root.join("spec/requirements")) {
         let file: ReqFile = parse(&path).expect("listed");
-        let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
-        reqs.extend(file.req.into_iter().map(|r| Req { source: stem.clone(), ..r }));
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
+        reqs.extend(file.req.into_iter().map(|r| Req {
+            source: stem.clone(),
+            ..r
+        }));
     }
     for path in toml_files(&root.join("spec/ccsds/pics")) {
         let value: Value = parse(&path).expect("listed");
-        let stem = path.file_stem().map(|s| s.to_string_lossy().to_string()).unwrap_or_default();
-        let book = value.get("book").and_then(|b| b.get("id")).and_then(Value::as_str);
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_string())
+            .unwrap_or_default();
+        let book = value
+            .get("book")
+            .and_then(|b| b.get("id"))
+            .and_then(Value::as_str);
         let book = book.unwrap_or(&stem).to_string();
-        reqs.extend(supported_items(&path, &format!("PICS {book}"), &format!("{book}/")));
+        reqs.extend(supported_items(
+            &path,
+            &format!("PICS {book}"),
+            &format!("{book}/"),
+        ));
     }
     let tailoring = root.join("spec/ccsds/pus-tailoring.toml");
     reqs.extend(supported_items(&tailoring, "PUS tailoring", "PUS/"));
@@ -130,7 +160,10 @@ pub fn other_known_ids(root: &Path) -> Vec<String> {
         id: String,
     }
     let d: Decisions = parse(&root.join("spec/decisions.toml")).expect("spec/decisions.toml");
-    d.decision.into_iter().map(|d| format!("D:{}", d.id)).collect()
+    d.decision
+        .into_iter()
+        .map(|d| format!("D:{}", d.id))
+        .collect()
 }
 
 /// Unique IDs, statuses with their reason, the paper's IDs in their form.
@@ -151,7 +184,10 @@ pub fn check_requirements(reqs: &[Req]) -> Vec<String> {
                 _ => false,
             };
             if !form || r.text.is_empty() {
-                problems.push(format!("{}: kind `{}`, section {}, text or ID form wrong", r.id, r.kind, r.section));
+                problems.push(format!(
+                    "{}: kind `{}`, section {}, text or ID form wrong",
+                    r.id, r.kind, r.section
+                ));
             }
         }
     }
@@ -160,7 +196,11 @@ pub fn check_requirements(reqs: &[Req]) -> Vec<String> {
 
 fn keys(path: &Path, array: &str, key: &str, keep: impl Fn(&Value) -> bool) -> BTreeSet<String> {
     let value: Value = parse(path).unwrap_or_else(|| panic!("{}", path.display()));
-    let rows = value.get(array).and_then(Value::as_array).cloned().unwrap_or_default();
+    let rows = value
+        .get(array)
+        .and_then(Value::as_array)
+        .cloned()
+        .unwrap_or_default();
     rows.iter()
         .filter(|r| keep(r))
         .filter_map(|r| match r.get(key)? {
@@ -174,17 +214,56 @@ fn keys(path: &Path, array: &str, key: &str, keep: impl Fn(&Value) -> bool) -> B
 pub fn table_rows(root: &Path) -> BTreeMap<u32, BTreeSet<String>> {
     let spec = root.join("spec");
     let all = |_: &Value| true;
-    let paper_fault = |r: &Value| !r.get("table8").and_then(Value::as_str).unwrap_or("none").starts_with("none");
+    let paper_fault = |r: &Value| {
+        !r.get("table8")
+            .and_then(Value::as_str)
+            .unwrap_or("none")
+            .starts_with("none")
+    };
     let modes: Value = parse(&spec.join("modes.toml")).expect("spec/modes.toml");
-    let table7 = modes.get("table7").and_then(Value::as_table).expect("[table7]");
+    let table7 = modes
+        .get("table7")
+        .and_then(Value::as_table)
+        .expect("[table7]");
     BTreeMap::from([
         (1, keys(&spec.join("commands.toml"), "table1", "kind", all)),
-        (2, keys(&spec.join("packets/command.toml"), "field", "name", all)),
-        (3, keys(&spec.join("packets/heartbeat.toml"), "field", "name", all)),
-        (4, keys(&spec.join("packets/internal-heartbeat.toml"), "field", "name", all)),
-        (5, keys(&spec.join("motion/states.toml"), "state", "letter", all)),
-        (6, keys(&spec.join("motion/primitives.toml"), "primitive", "number", all)),
-        (7, table7.keys().filter(|k| *k != "columns").cloned().collect()),
-        (8, keys(&spec.join("faults.toml"), "fault", "name", paper_fault)),
+        (
+            2,
+            keys(&spec.join("packets/command.toml"), "field", "name", all),
+        ),
+        (
+            3,
+            keys(&spec.join("packets/heartbeat.toml"), "field", "name", all),
+        ),
+        (
+            4,
+            keys(
+                &spec.join("packets/internal-heartbeat.toml"),
+                "field",
+                "name",
+                all,
+            ),
+        ),
+        (
+            5,
+            keys(&spec.join("motion/states.toml"), "state", "letter", all),
+        ),
+        (
+            6,
+            keys(
+                &spec.join("motion/primitives.toml"),
+                "primitive",
+                "number",
+                all,
+            ),
+        ),
+        (
+            7,
+            table7.keys().filter(|k| *k != "columns").cloned().collect(),
+        ),
+        (
+            8,
+            keys(&spec.join("faults.toml"), "fault", "name", paper_fault),
+        ),
     ])
 }

@@ -41,6 +41,7 @@ fn assert_crc(bytes: &[u8]) {
     assert_eq!(crc16_bitwise(&bytes[..n - 2]), carried, "vector checksum");
 }
 
+// req: D:checksum
 #[test]
 fn bitwise_crc_matches_the_catalogue_check_value() {
     // CRC-16/CCITT-FALSE ("CRC-16/IBM-3740" in the CRC catalogue): check = 0x29B1.
@@ -169,6 +170,7 @@ const COMMAND_RECONFIGURE_SEQUENCED: [u8; COMMAND_LEN] = [
     0xb4, 0x70, // 12-13 CRC-16 0x70b4
 ];
 
+// req: D:command-sequence-number
 #[test]
 fn golden_command_sequenced() {
     let arm = CommandRepr {
@@ -391,6 +393,7 @@ const B_COMMAND: [u8; B_COMMAND_LEN] = [
     0xe4, 0x53, // 13-14 CRC-16 0x53e4
 ];
 
+// req: D:b-command
 #[test]
 fn golden_b_command() {
     let repr = BCommandRepr {

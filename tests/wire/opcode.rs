@@ -38,6 +38,7 @@ fn every_command_round_trips_through_its_encoding() {
     assert_eq!(expected, if cfg!(miri) { 61 } else { 40_595 });
 }
 
+// req: D:command-sequence-number
 #[test]
 fn no_command_uses_its_sequence_slot() {
     // The exactly-once sequence number may take `seq_slot(id)`: exhaustive over all commands.
@@ -51,6 +52,7 @@ fn no_command_uses_its_sequence_slot() {
     assert_eq!(n, expected);
 }
 
+// req: T1/*, D:opcodes
 #[test]
 fn opcodes_are_distinct_per_variant_class() {
     let mut seen = [false; 256];
@@ -129,6 +131,7 @@ fn range_errors_name_the_byte() {
     );
 }
 
+// req: D:primitive-final-state
 #[test]
 fn a_primitive_names_its_final_state_in_byte_8() {
     // 7 (backTurnCW): e -> a and e -> d; both commandable, each its own bytes.
@@ -170,6 +173,7 @@ fn a_primitive_names_its_final_state_in_byte_8() {
     );
 }
 
+// req: P6.9
 #[test]
 fn every_move_of_the_model_is_one_primitive_command() {
     // 72 moves of the model, 60 commands: a command is (primitive, final state); the

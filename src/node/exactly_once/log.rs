@@ -93,6 +93,7 @@ impl CommandLog {
 mod tests {
     use super::*;
 
+    // req: D:exactly-once-window
     #[test]
     fn serial_arithmetic_at_the_wrap() {
         assert!(newer(0, 0xffff) && newer(1, 0xffff) && !newer(0xffff, 0));
@@ -117,6 +118,7 @@ mod tests {
         }
     }
 
+    // req: D:exactly-once-window
     #[test]
     fn duplicates_report_the_recorded_outcome() {
         let mut log = CommandLog::new();

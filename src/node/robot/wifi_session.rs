@@ -242,6 +242,7 @@ mod tests {
         .to_bytes()
     }
 
+    // req: P3.14
     #[test]
     fn a_new_connection_forgets_the_last_ones_cut_packet() {
         let mut w = WifiSession::default();
@@ -259,6 +260,7 @@ mod tests {
         assert_eq!(w.counts().connections, 2);
     }
 
+    // req: P3.14
     #[test]
     fn bytes_without_a_connection_and_other_kinds_are_not_commands() {
         let mut w = WifiSession::default();
@@ -294,6 +296,7 @@ mod tests {
         assert_eq!((c.sent, c.unconnected), (1, 3));
     }
 
+    // req: P3.14
     #[test]
     fn idleness_counts_from_the_last_bytes_and_wraps() {
         let mut w = WifiSession::new(WifiConfig { idle_ms: 100 });

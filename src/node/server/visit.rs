@@ -171,6 +171,7 @@ mod tests {
         .to_bytes()
     }
 
+    // req: D:relay-visit-window
     #[test]
     fn the_deadline_counts_from_the_start_and_wraps() {
         let v = Visit::new(u32::MAX - 50, BoardNumber::ONE, stop(1), 100);

@@ -472,6 +472,7 @@ mod tests {
         Ok(())
     }
 
+    // req: P3.13
     #[test]
     fn unused_bytes_are_refused_as_byte_by_byte() {
         // Every mask a decoder returns, over every combination of four values per byte
