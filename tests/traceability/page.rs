@@ -37,9 +37,16 @@ fn counts(page: &mut String, reqs: &[Req], by_req: &Citations) {
         "## Counts\n\n| source | requirements | implemented | implemented and cited by ≥1 test | \
          not implemented | informative |\n|---|---|---|---|---|---|\n",
     );
-    let mut groups: BTreeMap<String, [usize; 5]> = BTreeMap::new();
+    // In the order the sources come: the paper first.
+    let mut groups: Vec<(String, [usize; 5])> = Vec::new();
     for r in reqs {
-        let g = groups.entry(group(r)).or_default();
+        let name = group(r);
+        if groups.last().is_none_or(|(last, _)| *last != name) {
+            groups.push((name, [0; 5]));
+        }
+        let Some((_, g)) = groups.last_mut() else {
+            continue;
+        };
         let tested = by_req.get(&r.id).is_some_and(|(_, t)| !t.is_empty());
         g[0] += 1;
         g[1] += usize::from(r.status == Status::Implemented);

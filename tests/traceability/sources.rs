@@ -82,6 +82,12 @@ fn supported_items(path: &Path, source: &str, prefix: &str) -> Vec<Req> {
     };
     let mut tables = Vec::new();
     id_tables(&value, &mut tables);
+    // The file as the page names it, from the repository's root.
+    let shown = path.to_string_lossy().replace('\\', "/");
+    let spec = format!(
+        "spec/{}",
+        shown.rsplit_once("/spec/").map_or("", |(_, p)| p)
+    );
     tables
         .iter()
         .map(|t| {
@@ -95,18 +101,15 @@ fn supported_items(path: &Path, source: &str, prefix: &str) -> Vec<Req> {
                 },
                 section: 0,
                 kind: "item".to_string(),
-                text: str_of(t, "feature").to_string() + str_of(t, "what"),
-                spec: Some(
-                    path.file_name()
-                        .map(|n| n.to_string_lossy().to_string())
-                        .unwrap_or_default(),
-                ),
+                text: [str_of(t, "feature"), str_of(t, "name")].concat(),
+                spec: Some(spec.clone()),
                 status: if supported == "Y" {
                     Status::Implemented
                 } else {
                     Status::NotImplemented
                 },
-                why: Some(format!("supported = \"{supported}\"")).filter(|_| supported != "Y"),
+                why: Some(format!("supported = {supported}: {}", str_of(t, "why")))
+                    .filter(|_| supported != "Y"),
                 source: source.to_string(),
             }
         })
