@@ -5,6 +5,7 @@
 //! assert_eq!(Mode::from_wire(Mode::Safed.to_wire()), Some(Mode::Safed));
 //! assert_eq!(Mode::default(), Mode::Standby); // the startup mode
 //! ```
+// req: P7.1, T7/*, D:mode-codes
 
 use crate::wire_enum::wire_enum;
 

@@ -6,6 +6,7 @@
 //! assert_eq!(Refusal::from_wire(Refusal::NotAllowedInMode.to_wire()), Some(Refusal::NotAllowedInMode));
 //! assert_eq!(Refusal::from_wire(0), None); // 0 = the command was accepted
 //! ```
+// req: D:heartbeat-byte-62, D:commands-in-every-mode
 
 use crate::wire_enum::wire_enum;
 

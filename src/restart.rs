@@ -17,6 +17,7 @@
 //! assert_eq!(Boot::from_wire(0), Boot::UNREPORTED);
 //! assert!(Boot::from_wire(0x21).differs(Boot::from_wire(0x22))); // restarted in between
 //! ```
+// req: D:restart-board-a, D:restart-board-b, D:restart-server, D:restart-ground
 
 use crate::wire_enum::wire_enum;
 

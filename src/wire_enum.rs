@@ -46,6 +46,7 @@
 //! through the `-> u8` method (`to_wire`, `value`, …), its position through the `-> usize` one
 //! (for indexing a table in declaration order), both `const`, and both compiled to the
 //! discriminant itself where that is what they return.
+// req: D:mode-codes, D:state-letters, D:zero-is-none
 
 /// Declares a C-like wire enum and its conversions; see the module documentation.
 macro_rules! wire_enum {

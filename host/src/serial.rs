@@ -152,6 +152,7 @@ pub fn read(port: &mut dyn std::io::Read, buf: &mut [u8]) -> Read {
 mod tests {
     use super::*;
 
+    // req: P3.3, D:opsui-serial-line
     #[test]
     fn the_spec_gives_the_decided_line() {
         let s = LineSettings::spec().unwrap();
@@ -159,6 +160,7 @@ mod tests {
         assert!(s.builder("/dev/null").is_ok());
     }
 
+    // req: D:opsui-serial-line
     #[test]
     fn a_setting_serialport_cannot_take_is_named() {
         let mut s = LineSettings::spec().unwrap();

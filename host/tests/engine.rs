@@ -102,6 +102,7 @@ fn records_of<'a>(s: &'a mmic_host::sim::Summary, ty: &'a str) -> impl Iterator<
         .filter(move |r| r["kind"] == "event" && r["event"]["type"] == ty)
 }
 
+// req: D:exactly-once-window
 #[test]
 fn duplicated_and_reordered_wifi_packets_are_answered_never_run_twice() {
     let mut cfg = rough(Protocol::Legacy, 11);

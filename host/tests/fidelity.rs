@@ -48,6 +48,7 @@ fn stopped_mid_turn() -> (Robot, f64) {
 
 /// Defect 1: Table 1's Stop is an emergency stop of the current motion, so the hip holds too
 /// (it used to finish the turn, up to 90° in 9 s). The servos hold where they are.
+// req: T1/stop
 #[test]
 fn stop_holds_the_hip_mid_turn_and_every_servo() {
     let (mut r, at_stop) = stopped_mid_turn();
@@ -67,6 +68,7 @@ fn stop_holds_the_hip_mid_turn_and_every_servo() {
 
 /// Defect 3: Reset resumes the interrupted reconfiguration from the step where it stopped,
 /// and it completes.
+// req: T1/reset
 #[test]
 fn reset_resumes_the_reconfiguration_a_stop_interrupted() {
     let (mut r, _) = stopped_mid_turn();
@@ -92,6 +94,7 @@ fn reset_resumes_the_reconfiguration_a_stop_interrupted() {
 }
 
 /// Defect 3: Reset with nothing to resume, or after the mode changed, is refused by name.
+// req: T1/reset, D:stop-and-reset
 #[test]
 fn reset_is_refused_with_nothing_to_resume() {
     let mut r = operational(State::A);
@@ -109,6 +112,7 @@ fn reset_is_refused_with_nothing_to_resume() {
 }
 
 /// Defect 1: entering Safed mid-turn holds the hip as well (Table 7: hold hip/arms position).
+// req: P7.8
 #[test]
 fn safed_mid_turn_holds_the_hip() {
     let mut r = operational(State::A);
@@ -127,6 +131,7 @@ fn safed_mid_turn_holds_the_hip() {
 /// Defect 4: what Safed accepts runs on both sides: arm B extends in Safed (board A used to
 /// keep B's stop flag set in Safed, so B held). A Stop in Safed with nothing moving does not
 /// lock the arm commands out; one that interrupts an arm move is resumed by Reset in Safed.
+// req: T7/commands, P7.8
 #[test]
 fn safed_arm_commands_run_on_side_b_and_stop_reset_work_there() {
     let mut r = operational(State::A);
@@ -159,6 +164,7 @@ fn safed_arm_commands_run_on_side_b_and_stop_reset_work_there() {
 
 /// Defect 2: "move bolters down" descends both bolters and stops there: nothing engages or
 /// rotates (it used to run a whole bolt of pair 1).
+// req: T1/bolter, D:bolters-down
 #[test]
 fn move_bolters_down_only_descends() {
     let mut r = operational(State::A);
@@ -194,6 +200,7 @@ fn move_bolters_down_only_descends() {
 /// Defect 8: an arm command board B never acknowledges (the A->B direction dead, B's
 /// heartbeats still arriving) raises internal communication loss, as Table 8 says. Before,
 /// the A->B number only changed with bolter orders, B echoed 0, and the rule never fired.
+// req: P7.19
 #[test]
 fn an_unacknowledged_arm_command_raises_internal_comm_loss() {
     let mut r = operational(State::A);
@@ -220,6 +227,7 @@ fn an_unacknowledged_arm_command_raises_internal_comm_loss() {
 /// not continuously: a robot at rest with a bolter drawing more than its idle limit (but
 /// under the absolute one) is no fault until a reconfiguration is asked for; then the check
 /// fails, the motion does not start and the robot is Safed.
+// req: P7.16
 #[test]
 fn the_idle_check_runs_when_a_reconfiguration_starts_not_while_idle() {
     let mut r = operational(State::A);
@@ -242,6 +250,7 @@ fn the_idle_check_runs_when_a_reconfiguration_starts_not_while_idle() {
 }
 
 /// Defect 9: command complete (heartbeat byte 54) comes after the idle check at the end.
+// req: P7.16
 #[test]
 fn command_complete_follows_the_idle_check_at_the_end() {
     let mut r = operational(State::A);
@@ -260,6 +269,7 @@ fn command_complete_follows_the_idle_check_at_the_end() {
 /// Found in the review (same kind as the defects above): Table 8's "after executing an arm
 /// contraction command, the contraction is not sensed by hardware" holds for either arm, but
 /// board A checked only arm A. Arm B's switch travels in Table 4 byte 44.
+// req: P7.15
 #[test]
 fn an_arm_b_contraction_the_switch_does_not_sense_is_arm_not_contracted() {
     for side in [Side::A, Side::B] {
@@ -288,6 +298,7 @@ fn an_arm_b_contraction_the_switch_does_not_sense_is_arm_not_contracted() {
 /// Side A's ADC silent mid-turn: the averages stand for one window (50 ticks, 500 ms), then
 /// the project's sensor loss takes the robot to Safed and the hip holds. No low battery or
 /// overcurrent is judged from the stale averages.
+// req: D:sensor-loss
 #[test]
 fn a_silent_adc_a_is_sensor_loss_after_one_window_then_safed() {
     let mut r = operational(State::A);
@@ -318,6 +329,7 @@ fn a_silent_adc_a_is_sensor_loss_after_one_window_then_safed() {
 
 /// The hip encoder silent mid-turn: the hip gets the stop pulse from the first tick without a
 /// reading (it is not steered from a guessed angle), then sensor loss, Safed.
+// req: D:sensor-loss
 #[test]
 fn a_silent_hip_encoder_stops_the_hip_at_once_then_sensor_loss() {
     let mut r = operational(State::A);
@@ -343,6 +355,7 @@ fn a_silent_hip_encoder_stops_the_hip_at_once_then_sensor_loss() {
 
 /// Side B's ADC silent: Table 4 has no byte for it, so board B holds and falls silent, and
 /// board A raises internal comm loss (Safed).
+// req: P7.19, D:sensor-loss
 #[test]
 fn a_silent_adc_b_silences_board_b_and_is_internal_comm_loss() {
     let mut r = operational(State::A);
@@ -358,6 +371,7 @@ fn a_silent_adc_b_silences_board_b_and_is_internal_comm_loss() {
 
 /// An ADC that never answers from power-up: sensor loss at once; its empty averages (0 V)
 /// are not judged, so no low battery is raised however long it lasts.
+// req: D:sensor-loss
 #[test]
 fn an_adc_silent_from_power_up_is_sensor_loss_never_low_battery() {
     let plant = PlantConfig {

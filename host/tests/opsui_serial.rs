@@ -254,6 +254,7 @@ pub(crate) fn the_demo_runs_over_a_serial_line_every_command_once() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+// req: D:opsui-serial-line
 #[test]
 fn a_device_that_cannot_be_opened_is_exit_5() {
     let out = std::env::temp_dir().join(format!("mmic-opsui-open-{}", std::process::id()));
@@ -277,6 +278,7 @@ fn a_device_that_cannot_be_opened_is_exit_5() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+// req: D:opsui-line-lost
 #[test]
 fn the_line_lost_mid_run_is_exit_6_with_the_open_command() {
     let (mut master, slave) = pair();
@@ -308,6 +310,7 @@ fn the_line_lost_mid_run_is_exit_6_with_the_open_command() {
     assert!(out.contains("line lost at"), "{out}");
 }
 
+// req: D:opsui-serial-line
 #[test]
 fn options_without_meaning_on_the_opsui_line_are_refused() {
     for extra in [

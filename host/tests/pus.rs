@@ -658,6 +658,7 @@ fn a_fault_over_pus_fails_its_tc_and_is_reported_as_an_event() {
     );
 }
 
+// req: P7.18, T8/hip_mismatch
 #[test]
 fn hip_mismatch_at_power_up_over_pus_refuses_the_next_step() {
     let mut cfg = SimConfig {

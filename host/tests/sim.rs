@@ -67,6 +67,7 @@ fn steps(text: &str) -> Vec<mmic_host::sim::SimStep> {
     mmic_host::sim::steps_of(&plan::parse(text).unwrap())
 }
 
+// req: P3.1
 #[test]
 fn the_demo_plan_completes_with_no_fault() {
     let (s, records) = simulate("demo", SimConfig::demo());
@@ -98,6 +99,7 @@ fn the_demo_plan_completes_with_no_fault() {
     }
 }
 
+// req: P3.11
 #[test]
 fn thirty_percent_wifi_loss_still_completes_and_runs_nothing_twice() {
     let cfg = SimConfig {
@@ -167,6 +169,7 @@ fn thirty_percent_wifi_loss_still_completes_and_runs_nothing_twice() {
     }
 }
 
+// req: P7.19
 #[test]
 fn cutting_board_b_off_gives_internal_comm_loss_and_safed_within_the_timeout() {
     let cut = 6_000;
@@ -236,6 +239,7 @@ fn cutting_board_b_off_gives_internal_comm_loss_and_safed_within_the_timeout() {
         && r["t_ms"].as_u64().unwrap() >= cut as u64)));
 }
 
+// req: P7.13, T8/low_battery
 #[test]
 fn low_battery_during_a_motion_enters_standby_only_after_the_motion_completes() {
     let low = 8_000;
@@ -300,6 +304,7 @@ fn the_demo_plan_parses() {
 
 /// The demo plan's comments give each reconfiguration's number of primitives (issue 39: one
 /// said three where the plan takes two): each is the chosen plan's length.
+// req: P6.5
 #[test]
 fn the_demo_plans_primitive_counts_are_the_plans() {
     use mmic::motion::{route, State};
@@ -345,6 +350,7 @@ fn a_malformed_plan_file_is_refused_with_line_and_column() {
     );
 }
 
+// req: P7.10
 #[test]
 fn a_state_mismatch_on_the_robot_says_what_the_plan_expected_and_what_it_reported() {
     // The library-level run does not trace the plan (`mmic sim` would refuse this file before
@@ -510,6 +516,7 @@ fn the_plant_bolter_currents_straddle_the_library_thresholds() {
     assert!(BOLTER_OBSTACLE_MA > absolute);
 }
 
+// req: T1/bolter, P5.12
 #[test]
 fn a_bolt_command_completes_on_the_bolter_current() {
     let cfg = SimConfig {
@@ -565,6 +572,7 @@ fn a_bolt_command_completes_on_the_bolter_current() {
     );
 }
 
+// req: P7.9
 #[test]
 fn a_jammed_fastener_ends_in_the_bolting_failure_fault_and_standby() {
     let mut cfg = SimConfig {
@@ -605,6 +613,7 @@ fn a_jammed_fastener_ends_in_the_bolting_failure_fault_and_standby() {
         .all(|(_, aux, _)| aux["locked"] == false));
 }
 
+// req: P7.17, T8/bolter_overcurrent
 #[test]
 fn a_bolter_obstacle_while_bolting_raises_bolter_overcurrent_and_safes_the_robot() {
     // Bolting starts about 3.6 s in; the obstacle meets bolter A on its way down. (At rest the
@@ -884,6 +893,7 @@ fn check_case(c: &Case, s: &Summary, records: &[Value], json: &report::SummaryJs
     wrong
 }
 
+// req: T8/*, P7.7, P7.14, P7.18
 #[test]
 fn every_table8_fault_injected_on_the_demo_reaches_its_table8_mode() {
     let wall = std::time::Instant::now();
@@ -957,6 +967,7 @@ fn every_table8_fault_injected_on_the_demo_reaches_its_table8_mode() {
 /// name; during the motion the contraction into m is not confirmed. The estimate of the state
 /// reads the arms' commanded PWM values, so the ground's belief (a) still holds and is not
 /// reported wrong.
+// req: P7.15
 #[test]
 fn a_dead_arm_switch_is_arm_not_contracted_at_rest_and_during_a_motion() {
     for (at_s, step) in [(20, "bolt all"), (26, "reconfigure a -> m")] {
@@ -1031,6 +1042,7 @@ fn a_dead_arm_switch_is_arm_not_contracted_at_rest_and_during_a_motion() {
     }
 }
 
+// req: T1/stop, T1/reset
 #[test]
 fn stop_during_a_reconfiguration_then_reset_resumes_it_and_the_demo_completes() {
     // Stop in the middle of `reconfigure a -> m` (about 24-36 s), Reset 3 s later: the
@@ -1170,6 +1182,7 @@ fn inject_is_checked_and_summary_json_is_what_mmic_sim_returned() {
 /// The plant locks fasteners with Figure 10's per-attempt rates and starts with a full battery,
 /// both as spec/hardware.toml gives them (the paper's counts, in fastener pairs: decision
 /// figure-10-pairs).
+// req: P8.1, P2.1
 #[test]
 fn the_plant_takes_figure_10_and_the_battery_from_spec_hardware() {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../spec/hardware.toml");

@@ -24,6 +24,7 @@ fn demo_at(latency_ms: u64, jitter_ms: u64) -> Summary {
     engine::run(&cfg).unwrap()
 }
 
+// req: P3.7, D:relay-visit-window
 #[test]
 fn the_server_visits_as_long_as_the_opsui_window_allows() {
     assert_eq!(SimConfig::demo().visit_ms, relay::VISIT_MS);
@@ -35,6 +36,7 @@ fn the_server_visits_as_long_as_the_opsui_window_allows() {
 
 /// Round trips as the opsUI measures them (command written to heartbeat read) from 250 ms to
 /// 650 ms: every attempt answered, the demo completes.
+// req: P8.3, P8.4
 #[test]
 fn every_attempt_is_answered_at_round_trips_from_250_to_650_ms() {
     let mut longest = Vec::new();
@@ -59,6 +61,7 @@ fn every_attempt_is_answered_at_round_trips_from_250_to_650_ms() {
 
 /// A WiFi round trip above 0.7 s: no heartbeat reaches the opsUI in time, and it counts every
 /// attempt failed, resends until its limit and reports the command unacknowledged.
+// req: P3.10, P8.4
 #[test]
 fn above_the_window_every_attempt_fails_as_section_8_counts_it() {
     for latency_ms in [360, 500] {
@@ -79,6 +82,7 @@ fn above_the_window_every_attempt_fails_as_section_8_counts_it() {
 /// Figure 11's analogue is the opsUI's own count: with jitter that sends some answers past
 /// 0.7 s, the efficiency after each attempt equals the share of answered attempts among the
 /// last 100 in the log, and both kinds of attempt occur.
+// req: P8.5
 #[test]
 fn the_efficiency_curve_is_the_moving_window_of_the_logged_attempts() {
     let s = demo_at(250, 220);

@@ -59,6 +59,7 @@ const CHECKS: [Check; 9] = [
 ];
 /// Every check in `CHECKS` (or those `MMIC_WALL_CLOCK` names) side by side; fails naming every
 /// check that failed, after all have ended.
+// req: P3.1, P3.3
 #[test]
 fn the_wall_clock_tests_side_by_side() {
     let only = std::env::var("MMIC_WALL_CLOCK").unwrap_or_default();

@@ -3,6 +3,7 @@
 //! step that ends at home and times out fails the job at once, at any attempt: the next
 //! attempt would start from a home the bolter did not reach (Table 8 names only the three
 //! attempts; spec/decisions.toml, `bolting-failure-at-home`).
+// req: P5.9, P5.13, T8/bolting_failure
 
 use super::side::{ended, SideConfig};
 use super::{

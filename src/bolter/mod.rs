@@ -12,6 +12,7 @@
 //! assert_eq!(BolterStep::from_wire(BolterStep::Rotate.to_wire()), Some(BolterStep::Rotate));
 //! assert_eq!(MuxLines::for_pair(BolterPair::P3), MuxLines { a0: true, a1: false });
 //! ```
+// req: P2.8, P5.9, P5.10, P5.11
 
 use crate::units::ranged;
 use crate::wire_enum::wire_enum;
@@ -174,6 +175,7 @@ mod tests {
 
     /// The paper's order of the select lines: pairs 1–4 take A0-A1 low-low, low-high,
     /// high-low, high-high; the wire byte has A0 in bit 0 and A1 in bit 1, and refuses others.
+    // req: P2.8, P5.10
     #[test]
     fn mux_lines_per_pair_and_on_the_wire() {
         let want = [(false, false), (false, true), (true, false), (true, true)];
@@ -212,6 +214,7 @@ mod tests {
         );
     }
 
+    // req: T3/bolter_attempt
     #[cfg(feature = "serde")]
     #[test]
     fn bolter_attempt_from_a_number() {
@@ -224,6 +227,7 @@ mod tests {
     /// A side's executor times a sensed step out past `sensed_ms` and a step that ends at home
     /// past `home_ms` (different here), selects its order's pair on the multiplexer and
     /// reports its direction.
+    // req: P5.10
     #[test]
     fn side_timeouts_mux_and_direction() {
         use super::BolterOrder;
@@ -262,6 +266,7 @@ mod tests {
         }
     }
 
+    // req: T3/bolter_attempt
     #[test]
     fn bolter_attempt_range() {
         for n in 0..=u8::MAX {

@@ -1,5 +1,6 @@
 //! What is asked of the bolters: by a command, which fasteners ([`Fasteners`]); by board A of
 //! side B, one step of one pair ([`BolterOrder`], carried in the A→B command's bolter bytes).
+// req: D:b-command
 
 use super::{BolterDirection, BolterPair, BolterStep};
 

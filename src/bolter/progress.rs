@@ -1,5 +1,6 @@
 //! What side B reports of its bolter to board A (the internal heartbeat's auxiliary bytes): the
 //! progress board A's coordinator waits on before it orders the next step.
+// req: P5.9, T3/active_bolter, T3/bolter_attempt
 
 use super::{BolterDirection, BolterPair, BolterStep, MuxLines};
 

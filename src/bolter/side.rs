@@ -1,6 +1,7 @@
 //! One side's bolter: executes the step it was last ordered, decides the end of a
 //! current-sensed step from the measured bolter current I_bo against the step's threshold,
 //! latches it, and times out the steps that never end.
+// req: P5.11, P5.12, P5.13, P5.14, D:bolter-current-thresholds
 
 use super::{BolterAux, BolterDirection, BolterOrder, BolterStep, MuxLines};
 use crate::units::{Instant, Milliamps};

@@ -35,6 +35,7 @@
 //! through [`crate::pus::PusError`], which wraps [`PacketError`] (the services stand above
 //! the packets, so the error that joins both is theirs). `spec/ccsds/bad-inputs.toml` holds one refused packet per check, which
 //! `tests/ccsds/bad_inputs.rs` walks through the parsers.
+// req: D:ccsds-own-layer, D:ccsds-time, D:ccsds-check-order, D:ccsds-ack-flags
 
 mod bit_field;
 pub mod cuc;

@@ -2,6 +2,7 @@
 //! carries its parameters too.
 //!
 //! [`Command`]: super::Command
+// req: T1/*
 
 use crate::wire_enum::wire_enum;
 

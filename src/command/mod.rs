@@ -32,6 +32,7 @@
 //! assert_eq!(encode(&p), (0x57, [0, 0, b'd', 0, 0, 0]));
 //! assert!(decode(0x57, [0; 6]).is_err()); // no final state: refused
 //! ```
+// req: T1/*
 
 use crate::mode::Mode;
 use crate::pose::{Primitive, State};

@@ -1,6 +1,7 @@
 //! The two commands that name states: a primitive with the final state it must end in, and a
 //! reconfiguration between two states. Both are checked against the map of Figure 9 when they
 //! are built, so a `Command` holding one can always be run from some state.
+// req: P7.4, D:commands-in-every-mode
 
 use crate::pose::{Primitive, State};
 

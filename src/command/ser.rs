@@ -1,6 +1,7 @@
 //! The serde impls of the command set (feature `serde`) that a derive cannot give: servo
 //! targets checked against their travel, and the state-naming commands checked against the
 //! map, so that JSON is refused exactly where the packet's bytes are.
+// req: D:opcodes
 
 use super::{PrimitiveMove, Reconfiguration, ServoTarget, Travel};
 use crate::pose::{Primitive, State};

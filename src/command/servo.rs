@@ -1,6 +1,7 @@
 //! Where an arm, a gripper or the hip is told to go, and the travel that gives "contract" and
 //! "extend" a pulse width. The travel is here, beside the targets, because a command is only
 //! valid within it: decoding and JSON refuse a position outside it.
+// req: D:servo-travel, D:hip-presets
 
 use crate::units::{HipAngle, PulseWidth};
 

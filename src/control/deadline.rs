@@ -24,6 +24,7 @@
 //! assert_eq!(budget_ms(&cfg, 2_400, 0), 2_400 + cfg.servo_margin_ms);
 //! assert_eq!(budget_ms(&cfg, 2_400, 9_000), 9_000 + cfg.hip_margin_ms);
 //! ```
+// req: D:module-motion-deadline, D:motion-timeout
 
 use super::interp::Rate;
 use crate::units::widen::to_u32;
@@ -95,6 +96,7 @@ pub const fn budget_ms(cfg: &Config, servos_ms: u32, hip_ms: u32) -> u32 {
 mod tests {
     use super::*;
 
+    // req: D:module-motion-deadline
     #[test]
     fn servo_time_rounds_the_last_partial_step_up_and_never_divides_by_zero() {
         let us = |v| PulseWidth::new(v).unwrap();
@@ -115,6 +117,7 @@ mod tests {
         assert_eq!(servo_ms(us(500), us(2500), slow), u32::MAX);
     }
 
+    // req: D:module-motion-deadline
     #[test]
     fn hip_time_goes_the_short_way_and_survives_any_speed() {
         let a = HipAngle::wrapping;
@@ -127,6 +130,7 @@ mod tests {
         assert_eq!(hip_ms(a(0), a(18000), i32::MAX), 1);
     }
 
+    // req: D:module-motion-deadline
     #[test]
     fn the_budget_is_the_slower_kind_with_its_margin() {
         let c = Config::default();

@@ -22,6 +22,7 @@
 //! assert_eq!(c.mode(), Mode::Velocity); // 90° away: turn at 10°/s
 //! assert!(out.micros() > 1500);
 //! ```
+// req: P5.5, P5.6, P5.7, P5.8, D:hip-position-law, D:hip-velocity-feed-forward
 
 use crate::units::widen::to_u32;
 use crate::units::Instant;

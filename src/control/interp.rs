@@ -1,6 +1,7 @@
 //! Arm and gripper interpolation: open loop, a fixed step per period towards the target,
 //! monotone, ending exactly on the target, never outside the servo range (the type
 //! [`PulseWidth`] cannot leave 500..=2500 µs). The heartbeat's "current PWM" is [`Interpolator::now`].
+// req: P5.1
 
 /// The servos' travel is command vocabulary (what a target means); re-exported at its old path.
 pub use crate::command::{OutOfTravel, Travel};

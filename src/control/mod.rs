@@ -10,6 +10,7 @@
 //! assert_eq!(i.tick(200).micros(), 1050); // never past the target
 //! assert!(i.done());
 //! ```
+// req: P5.1, P5.5
 
 pub mod deadline;
 pub mod hip;

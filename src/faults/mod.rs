@@ -16,6 +16,7 @@
 //! assert_eq!(Faults::from_wire(f.to_wire()), Ok(f));
 //! assert_eq!(f.iter().count(), 2);
 //! ```
+// req: T8/*, P7.7, D:heartbeat-byte-62, D:faults-latched-outside-operational
 
 #[cfg(feature = "serde")]
 mod ser;
@@ -265,6 +266,7 @@ impl FromIterator<Fault> for Faults {
 mod tests {
     use super::*;
 
+    // req: T8/*
     #[test]
     fn every_subset_round_trips_and_reserved_bits_are_refused() {
         // Every subset of the 13 faults; under Miri (.ci/miri), whose interpretation is some

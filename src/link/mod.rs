@@ -22,6 +22,7 @@
 //! The choices the standards leave to a mission (spacecraft IDs, virtual channels, frame
 //! lengths, the FARM window, the idle period) are in `spec/ccsds/link.toml`, each with its
 //! decision.
+// req: D:link-spacecraft-id, D:link-tc-frame, D:link-cop1, D:link-tm-frame
 
 pub mod clcw;
 pub mod extract;

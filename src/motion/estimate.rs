@@ -34,6 +34,7 @@
 //!     assert!(consistent(&cfg, &r).contains(State::E));
 //! }
 //! ```
+// req: P2.5, P7.10, D:initial-state-sensors
 
 use crate::command::Travel;
 use crate::faults::Fault;

@@ -11,6 +11,7 @@
 //! figure9::render(&mut grid).unwrap();
 //! assert!(grid.starts_with("from\\to"));
 //! ```
+// req: P6.9, P6.10
 
 use crate::pose::map::primitive;
 use crate::pose::{Primitive, State};

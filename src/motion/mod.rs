@@ -10,6 +10,7 @@
 //! assert_eq!(State::E.kind(), StateKind::Turn);
 //! assert_eq!(Primitive::from_number(4), Some(Primitive::BackExtend));
 //! ```
+// req: P6.4, P6.5, P6.11
 
 pub mod estimate;
 pub mod figure9;

@@ -12,6 +12,7 @@
 //! assert_eq!(route::search(State::A, State::M), p);
 //! assert_eq!(route::lookup(State::A, State::B).len(), 3);
 //! ```
+// req: P6.11, P6.5
 
 use crate::pose::map::primitive;
 use crate::pose::{Primitive, State};

@@ -14,6 +14,7 @@
 //! assert_eq!(r.current_state(), State::B);
 //! assert!(r.command_complete());
 //! ```
+// req: P6.5, P6.4
 
 use super::route::{lookup, Route};
 use super::sequencer::{Config, Feedback, Sequencer, Status, Targets};

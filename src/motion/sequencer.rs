@@ -29,6 +29,7 @@
 //! while s.status() == Status::Running { t += 10; s.step(t, &all); }
 //! assert_eq!(s.status(), Status::Done);
 //! ```
+// req: P6.5, P6.6
 
 use crate::command::{preset_angle, HipTarget, ServoTarget};
 use crate::faults::Fault;

@@ -15,6 +15,7 @@
 //! assert_eq!(robot_move(State::G, State::J), None);
 //! assert!(turns_without_hip(State::G, State::J));
 //! ```
+// req: P6.2, D:turn-primitives
 
 use super::{Primitive, State, StateKind};
 use crate::units::{Axis, Side, Sign};
@@ -233,6 +234,7 @@ mod tests {
         }
     }
 
+    // req: P6.2
     #[test]
     fn faces_follow_the_table_5_names() {
         for s in State::ALL {
@@ -248,6 +250,7 @@ mod tests {
         }
     }
 
+    // req: P6.2
     #[test]
     fn unit_and_cross_follow_the_right_hand_rule() {
         let (x, y, z) = (

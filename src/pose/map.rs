@@ -12,6 +12,7 @@
 //! assert!(map::targets(State::E, Primitive::BackTurnCw).eq([State::A, State::D]));
 //! assert_eq!(map::ambiguous().count(), 12);
 //! ```
+// req: P6.9, P6.7, D:turn-to-turn-moves
 
 use super::geometry::{robot_move, single_move};
 use super::{Primitive, State};

@@ -15,6 +15,7 @@
 //! assert_eq!(State::E.kind(), StateKind::Turn);
 //! assert_eq!(Primitive::from_number(4), Some(Primitive::BackExtend));
 //! ```
+// req: P6.1, P6.6, P6.9
 
 pub mod geometry;
 pub mod map;

@@ -1,4 +1,5 @@
 //! The 8 motion primitives of Table 6.
+// req: T6/*, P6.6, P6.8, D:fwd-back-reading
 
 use crate::wire_enum::wire_enum;
 

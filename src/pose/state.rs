@@ -1,4 +1,5 @@
 //! The 15 allowed configurations of Table 5.
+// req: T5/*, P6.1, P6.2, P6.3, D:state-letters
 
 use crate::units::slice;
 use crate::units::widen::to_u32;
@@ -126,6 +127,7 @@ impl From<State> for char {
 mod tests {
     use super::*;
 
+    // req: T5/*, D:state-letters
     #[test]
     fn letters_wire_and_index_agree() {
         for (i, s) in State::ALL.iter().enumerate() {
@@ -144,6 +146,7 @@ mod tests {
         assert_eq!(State::from_letter('p'), None);
     }
 
+    // req: P6.3
     #[test]
     fn kinds_follow_names() {
         for s in State::ALL {

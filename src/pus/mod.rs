@@ -21,6 +21,7 @@
 //! assert_eq!(pus::robot_of_apid(0x100), None); // robot 0 does not exist
 //! assert_eq!(pus::robot_of_apid(0x7FF), None); // the idle APID
 //! ```
+// req: D:pus-apid, D:pus-gateway
 
 pub mod event;
 pub mod function;

@@ -18,6 +18,7 @@
 //! let mut lb = LowBattery::default();
 //! assert!(!lb.update(&cfg, 0, 12_000, None) && !lb.update(&cfg, 2_000, 12_000, None));
 //! ```
+// req: P2.7, P7.11, P7.15, P7.16, P7.17, P7.18, P7.19
 
 use crate::faults::{Fault, Faults};
 use crate::units::{Electrical, HipAngle, Instant, Milliamps, Millivolts};
@@ -287,6 +288,7 @@ pub const fn bolting_failure(cfg: &Config, consecutive_failed_attempts: u8) -> b
 mod tests {
     use super::*;
 
+    // req: P2.7, P7.11, T8/low_battery
     #[test]
     fn low_battery_boundaries() {
         let cfg = Config::default();
@@ -312,6 +314,7 @@ mod tests {
         assert!(lb.update(&cfg, 5_502, 9_000, None));
     }
 
+    // req: P7.11
     #[test]
     fn clock_going_backwards_counts_as_no_time() {
         let mut d = Debounce::default();
@@ -329,6 +332,7 @@ mod tests {
         assert_eq!(d.held_ms(), 0);
     }
 
+    // req: P7.19, T8/internal_comm_loss
     #[test]
     fn comm_loss_by_silence_and_by_unacknowledged_resends() {
         let cfg = Config::default();
@@ -367,6 +371,7 @@ mod tests {
         assert!(c.lost(&cfg));
     }
 
+    // req: T8/bolting_failure
     #[test]
     fn bolting_failure_after_the_third_failed_attempt() {
         let cfg = Config::default();
@@ -374,6 +379,7 @@ mod tests {
         assert!(bolting_failure(&cfg, 3) && bolting_failure(&cfg, 4));
     }
 
+    // req: P7.18
     #[test]
     fn hip_distance_is_circular() {
         let a = HipAngle::wrapping; // all test values are below 36000
@@ -384,6 +390,7 @@ mod tests {
         assert!(!hip_at_home(&cfg, a(16999)) && !hip_at_home(&cfg, a(19001)));
     }
 
+    // req: P2.7, P7.17
     #[test]
     fn overcurrent_is_strictly_above_the_limit_on_a_and_as_b_reports_it() {
         let cfg = Config::default();

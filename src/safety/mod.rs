@@ -16,6 +16,7 @@
 //! assert_eq!(policy::powered(Mode::Standby, ModuleSet::ALL), ModuleSet::EMPTY);
 //! assert_eq!(policy::powered(Mode::Safed, ModuleSet::ALL), ModuleSet::HIP_AND_ARMS);
 //! ```
+// req: P7.7, P2.7
 
 pub mod detect;
 mod module_set;

@@ -1,4 +1,5 @@
 //! A set of modules, for power switching.
+// req: P7.3, P7.8
 
 use crate::units::Module;
 
@@ -69,6 +70,7 @@ mod tests {
 
     /// Every set against its members: bits, from_bits (the 8th bit dropped), subset,
     /// intersection, with/without, and the hip-and-arms constant.
+    // req: P7.8
     #[test]
     fn every_set_agrees_with_its_members() {
         let members = |s: ModuleSet| Module::ALL.map(|m| s.contains(m));

@@ -1,4 +1,5 @@
 //! Table 7 (operating modes) and Table 8 (fault → mode) as total functions over finite domains.
+// req: T7/*, T8/*, P7.3, P7.4, P7.5, P7.8, P7.9, P7.14
 
 use super::module_set::ModuleSet;
 use crate::command::CommandKind;

@@ -32,6 +32,7 @@
 //! let out = s.step(&Input { faults: lb, command: Some(Incoming::Command(Command::Mode(Mode::Operational))), ..Input::quiet() });
 //! assert_eq!(out.answer, Some(Answer::Refused(mmic::refusal::Refusal::FaultConditionHolds)));
 //! ```
+// req: P7.2, P7.7, P7.12, P7.13
 
 use super::module_set::ModuleSet;
 use super::policy::{accepts, fault_action, is_condition, powered, regulator_on};

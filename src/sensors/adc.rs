@@ -10,6 +10,7 @@
 //! assert_eq!(scale(&s, Channel::VBat, 4095), 15_000); // full scale, mV
 //! assert_eq!(scale(&s, Channel::VBat, 2730), 10_000); // 10.0 V, the low-battery threshold
 //! ```
+// req: P2.6
 
 use crate::units::widen::to_u32;
 use crate::units::Electrical;

@@ -6,6 +6,7 @@
 //! assert_eq!(hip_angle(2048, 0).centidegrees(), 18000);
 //! assert_eq!(hip_angle(0, 1024).centidegrees(), 27000); // the zero offset wraps
 //! ```
+// req: P2.9
 
 use crate::units::widen::to_u32;
 use crate::units::HipAngle;

@@ -1,6 +1,7 @@
 //! Moving averages with a running sum: O(1) per sample. [`MovingAverage`] is one channel;
 //! [`Averages`] is `K` channels sampled together (a sensor front end's ADC or IMU), sharing
 //! one slot index and count so a tick's samples cost one index update, not one per channel.
+// req: P2.10, D:sensor-filtering
 
 /// Mean of the last `N` samples (fewer before `N` have arrived), rounded down.
 ///
@@ -204,6 +205,7 @@ impl<const N: usize, const K: usize> Averages<N, K> {
 mod tests {
     use super::*;
 
+    // req: P2.10
     #[test]
     fn max_window_is_the_largest_that_fits() {
         let max = u64::try_from(MAX_WINDOW).unwrap();
@@ -213,6 +215,7 @@ mod tests {
 
     /// Per channel, [`Averages`] gives what a [`MovingAverage`] gives, before and after the
     /// window fills and across its wrap, with the extreme samples.
+    // req: P2.10
     #[test]
     fn averages_equal_one_moving_average_per_channel() {
         let mut all = Averages::<5, 3>::new();

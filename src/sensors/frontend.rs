@@ -44,6 +44,7 @@
 //! }
 //! assert!(f.push(&silent).lost.adc && f.lost().encoder);
 //! ```
+// req: P2.10, D:sensor-loss
 
 use super::adc::{self, Scaling};
 use super::{encoder, imu, Averages};
@@ -242,6 +243,7 @@ mod tests {
         }
     }
 
+    // req: P2.10
     #[test]
     fn a_step_reaches_the_output_after_exactly_the_window() {
         let mut f = Frontend::<50>::new(Config::default());
@@ -260,6 +262,7 @@ mod tests {
         }
     }
 
+    // req: P2.5
     #[test]
     fn accelerations_average_with_their_sign() {
         assert_eq!(resign(unsign(-32768)), -32768);
@@ -282,6 +285,7 @@ mod tests {
         assert_eq!(out.map(|g| g.axis), Some(crate::units::Axis::X));
     }
 
+    // req: P2.5
     #[test]
     fn no_imu_sample_no_gravity_and_a_gap_keeps_the_average() {
         let mut f = Frontend::<50>::new(Config::default());
@@ -294,6 +298,7 @@ mod tests {
         assert_eq!(f.push(&r).gravity, before.gravity);
     }
 
+    // req: D:sensor-loss
     #[test]
     fn a_device_is_lost_after_exactly_loss_ticks_silent_ticks_and_found_at_its_next_reading() {
         let cfg = Config {
@@ -344,6 +349,7 @@ mod tests {
         assert_eq!(f.push(&raw(1000)).lost, Lost::NONE);
     }
 
+    // req: P4.2
     #[test]
     fn a_side_without_a_hip_encoder_never_loses_it() {
         let cfg = Config {

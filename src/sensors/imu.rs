@@ -6,6 +6,7 @@
 //! assert_eq!(gravity([120, -16200, 300]), Some(Gravity { axis: Axis::Y, sign: Sign::Negative }));
 //! assert_eq!(gravity([0, 0, 0]), None);
 //! ```
+// req: P2.5, D:gravity-encoding
 
 use crate::units::{Axis, Gravity, Sign};
 

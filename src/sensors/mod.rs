@@ -9,6 +9,7 @@
 //! f.push(200);
 //! assert_eq!(f.mean(), Some(150)); // before the window is full: the mean of what came
 //! ```
+// req: P2.5, P2.6, P2.9, P2.10
 
 pub mod adc;
 pub mod encoder;

@@ -1,4 +1,5 @@
 //! The number that addresses one robot.
+// req: P3.12, D:board-numbering
 
 use super::RangeError;
 #[cfg(feature = "serde")]

@@ -11,6 +11,7 @@
 //!
 //! One file per kind of quantity; each bounded integer is a `ranged!` newtype, so a
 //! value outside its range cannot be built and is refused by name.
+// req: D:hip-unit, D:servo-unit, D:electrical-units
 
 mod board;
 mod electrical;

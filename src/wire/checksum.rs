@@ -30,6 +30,7 @@
 //! let mut body = *b"MICM\x01\x02\x00\x00\x00\x00\x00\x00";
 //! assert_eq!(packet_crc(PacketKind::Command, &body), crc16(&body));
 //! ```
+// req: D:checksum, D:crc-table
 
 use super::{PacketKind, HEADER_LEN};
 
@@ -220,6 +221,7 @@ pub(crate) fn checked_packet_crc(kind: PacketKind, body: &[u8]) -> u16 {
 mod tests {
     use super::*;
 
+    // req: D:checksum
     #[test]
     fn every_length_and_start_equals_the_crc_crate() {
         // Every length 0..=80 (so every remainder after whole 16-octet blocks), from the
@@ -254,6 +256,7 @@ mod tests {
         assert_eq!(crc16(b"123456789"), 0x29b1);
     }
 
+    // req: D:checksum
     #[test]
     fn resuming_after_the_header_equals_the_full_crc() {
         for kind in PacketKind::ALL {

@@ -14,6 +14,7 @@
 //! assert_eq!((bytes[10], bytes[11]), (7, 0));     // exactly-once sequence number
 //! assert_eq!(CommandRepr::parse(&bytes), Ok(repr));
 //! ```
+// req: T2/*, P3.12
 
 use super::layout::{span, FieldSpec, Unit};
 use super::opcode::{get_u16, put_u16, seq_slot, Slot, PARAM_LEN, PARAM_OFFSET};

@@ -31,6 +31,7 @@
 //!     other => panic!("{other:?}"),
 //! }
 //! ```
+// req: D:deframing, D:headers
 
 use super::{checksum, PacketKind, CHECKSUM_LEN, HEADER_LEN, MAX_PACKET_LEN};
 
@@ -278,6 +279,7 @@ mod tests {
         (frames, dropped)
     }
 
+    // req: D:deframing
     #[test]
     fn false_header_does_not_hide_a_following_packet() {
         let pkt = CommandRepr {
@@ -315,6 +317,7 @@ mod tests {
         assert!(matches!(events[1], Deframed::Frame(f) if f.as_bytes() == pkt));
     }
 
+    // req: D:deframing
     #[test]
     fn byte_by_byte_delivery_finds_every_packet() {
         let a = CommandRepr {
@@ -336,6 +339,7 @@ mod tests {
         assert_eq!(dropped, 6);
     }
 
+    // req: D:deframing
     #[test]
     fn trailing_header_prefix_waits_for_more() {
         let mut d = Deframer::<66>::new();

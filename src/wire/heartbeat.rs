@@ -11,6 +11,7 @@
 //! assert_eq!(&acked.to_bytes()[57..60], &[2, 1, 0]); // bytes 57–58 acknowledge command 0x0102
 //! assert_eq!(HeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
+// req: T3/*, P3.16
 
 use super::layout::{fields, ElectricalLayout};
 use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKind, WireError};
@@ -396,6 +397,7 @@ mod tests {
     /// `parse` takes every field's check at once and leaves the order to `fields`: the two
     /// agree on every packet whose one octet (header and checksum aside) holds any value,
     /// from a sample of valid packets, the checksum made right each time.
+    // req: T3/*
     #[test]
     fn the_fast_path_agrees_with_the_checks_in_order() {
         let samples = [

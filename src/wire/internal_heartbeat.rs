@@ -8,6 +8,7 @@
 //! assert_eq!(bytes[35], 42); // Table 4 "command received": the echoed A→B sequence number
 //! assert_eq!(InternalHeartbeatRepr::parse(&bytes), Ok(hb));
 //! ```
+// req: T4/*, P4.7
 
 use super::layout::{fields, ElectricalLayout};
 use super::{check, field_err, get_bool, optional, pulse, seal, Packet, PacketKind, WireError};

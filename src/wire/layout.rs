@@ -1,6 +1,7 @@
 //! Field tables: name, byte range, unit and the paper's label for every field of a packet,
 //! built from the zerocopy layouts so that the layout struct stays the one place a range is
 //! defined. spec/ is checked against these tables, and the review pages are rendered from them.
+// req: D:byte-order
 
 use crate::units::Electrical;
 use core::ops::Range;

@@ -14,6 +14,7 @@
 //! bytes[..4].copy_from_slice(&PacketKind::Heartbeat.header());
 //! assert!(matches!(CommandRepr::parse(&bytes), Err(WireError::Header { .. })));
 //! ```
+// req: T2/*, T3/*, T4/*
 
 use core::fmt;
 use zerocopy::{FromBytes, Immutable, KnownLayout, Unaligned};
@@ -401,6 +402,7 @@ pub(crate) fn get_bool(
 mod tests {
     use super::*;
 
+    // req: D:headers
     #[test]
     fn headers_are_far_apart() {
         for a in PacketKind::ALL {

@@ -162,6 +162,7 @@ fn bolter_defaults_equal_spec() {
     );
 }
 
+// req: P5.11, P5.12
 #[test]
 fn each_sensed_step_ends_at_its_own_threshold_and_not_one_ma_below() {
     let cfg = SideConfig::default();
@@ -220,6 +221,7 @@ fn each_sensed_step_ends_at_its_own_threshold_and_not_one_ma_below() {
     }
 }
 
+// req: P5.11
 #[test]
 fn a_current_spike_outside_a_sensed_step_ends_nothing() {
     let cfg = SideConfig::default();
@@ -282,6 +284,7 @@ proptest! {
     /// For any thresholds, any step and any current: one tick ends a current-sensed step iff
     /// `i_bo >= threshold(step)`, and never ends another (without the home switch). The
     /// current is drawn near the thresholds half of the time.
+    // req: P5.12
     #[test]
     fn the_decision_is_exactly_i_bo_at_least_the_threshold(
         push in any::<u16>(),

@@ -321,11 +321,13 @@ fn check_direction(direction: BolterDirection) {
 }
 
 // One test per direction: libtest runs them side by side (each is some 2.8 M states).
+// req: P5.13, P5.14
 #[test]
 fn handshake_single_pair_bolt() {
     check_direction(BolterDirection::Bolt);
 }
 
+// req: P5.14
 #[test]
 fn handshake_single_pair_unbolt() {
     check_direction(BolterDirection::Unbolt);

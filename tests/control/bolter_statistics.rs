@@ -102,6 +102,7 @@ fn run_pair(cfg: &Config, succeeds: [bool; 3]) -> (u8, Status) {
     panic!("pair never finished");
 }
 
+// req: P8.1
 #[test]
 fn attempt_histogram_matches_figure_10() {
     // Figure 10's counts, from spec/hardware.toml (in fastener pairs: decision figure-10-pairs).
@@ -161,6 +162,7 @@ fn attempt_histogram_matches_figure_10() {
     }
 }
 
+// req: P7.9, T8/bolting_failure
 #[test]
 fn a_failed_pair_takes_an_operational_robot_to_standby() {
     let (attempts, status) = run_pair(&Config::default(), [false; 3]);
@@ -328,6 +330,7 @@ fn success_at_attempt_one_two_and_three() {
     }
 }
 
+// req: P7.9, T8/bolting_failure
 #[test]
 fn bolting_failure_after_the_third_attempt_and_not_before() {
     for direction in [BolterDirection::Bolt, BolterDirection::Unbolt] {
@@ -430,6 +433,7 @@ fn side_b_never_reporting_is_the_motion_timeout_one_tick_past_its_limit() {
     assert_eq!(o.end_ms, limit + 10);
 }
 
+// req: P5.9, P5.10
 #[test]
 fn all_four_runs_pairs_one_to_four_in_order() {
     let o = scripted(

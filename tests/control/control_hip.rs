@@ -115,6 +115,7 @@ fn short_way(start: f64, target: u16) -> f64 {
 
 proptest! {
     #![proptest_config(common::prop::config(200))]
+    // req: P5.5, P5.8
     #[test]
     fn reaches_any_target_without_large_overshoot(start in 0u16..36000, target in 0u16..36000, load in 0.0f64..300.0, phase in 0.0f64..6.3) {
         // 180° at 10°/s takes 18 s; allow 30 s.
@@ -130,6 +131,7 @@ proptest! {
 /// true start reads 180.01° through the encoder, so the controller turns the other way. Kept as
 /// a fixed case over loads and phases, because proptest's random inputs rarely land within one
 /// encoder count of 180°.
+// req: P5.5
 #[test]
 fn half_turn_within_one_encoder_count_takes_either_short_way() {
     for load in [0.0, 150.0, 300.0] {
@@ -154,6 +156,7 @@ fn half_turn_within_one_encoder_count_takes_either_short_way() {
     }
 }
 
+// req: P2.9, P5.6, P5.7
 #[test]
 fn turns_at_about_ten_degrees_per_second() {
     // 90° with no load: velocity mode until 3°, so about 9 s plus the final approach.
@@ -162,6 +165,7 @@ fn turns_at_about_ten_degrees_per_second() {
     assert!((8.0..=12.0).contains(&t), "took {t} s");
 }
 
+// req: P5.8
 #[test]
 fn sweep_reports_the_worst_case() {
     let mut worst_overshoot: f64 = 0.0;
@@ -197,6 +201,7 @@ fn sweep_reports_the_worst_case() {
 
 /// spec/control/hip.md's parameter table is the code's defaults: each row names one parameter
 /// (or two, "a / b") and gives its default first in the value column (likewise "x / y").
+// req: P5.6, P5.7
 #[test]
 fn the_defaults_equal_the_table_of_spec_control_hip_md() {
     let md = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/spec/control/hip.md"))

@@ -129,6 +129,7 @@ pub(crate) fn figure10() -> Figure10 {
 /// Every table quotes the paper, word for word, in its `paper` entry: each quoted sentence
 /// (the `[...]` cuts and section notes aside) is in the paper's text, so a number typed here is
 /// the paper's.
+// req: D:firmware-chips
 #[test]
 fn every_entry_quotes_the_paper_and_every_departure_is_a_decision() {
     let raw: toml::Table = toml::from_str(&text("spec/hardware.toml")).unwrap();
@@ -180,6 +181,7 @@ fn every_entry_quotes_the_paper_and_every_departure_is_a_decision() {
     }
 }
 
+// req: P2.1, P2.10
 #[test]
 fn the_codes_numbers_equal_the_papers_hardware() {
     let h = hardware();
@@ -229,6 +231,7 @@ fn the_codes_numbers_equal_the_papers_hardware() {
 
 /// Figure 10's counts add up, one per attempt Table 8 allows; the statistics test draws its
 /// rates from them (`bolter_statistics::attempt_histogram_matches_figure_10`).
+// req: P8.1
 #[test]
 fn figure_10_counts_add_up_to_the_pairs_engaged_one_count_per_attempt() {
     let f = figure10();

@@ -32,6 +32,7 @@ fn naive_signed(samples: &[i16], n: usize) -> Option<i16> {
 
 proptest! {
     #![proptest_config(common::prop::config(256))]
+    // req: P2.10
     #[test]
     fn frontend_equals_scaling_the_naive_means(
         ticks in prop::collection::vec((
@@ -73,6 +74,7 @@ proptest! {
         }
     }
 
+    // req: P2.10
     #[test]
     fn moving_average_equals_the_naive_mean(samples in prop::collection::vec(any::<u16>(), 0..200)) {
         let mut f = MovingAverage::<50>::new();
@@ -84,6 +86,7 @@ proptest! {
         }
     }
 
+    // req: P2.5
     #[test]
     fn imu_picks_the_largest_axis(a in any::<[i16; 3]>()) {
         match gravity(a) {
@@ -98,6 +101,7 @@ proptest! {
     }
 }
 
+// req: P2.10
 #[test]
 fn moving_average_extremes_and_small_windows() {
     // Every window content of a 3-sample filter over the values {0, 1, 65534, 65535}, every
@@ -118,6 +122,7 @@ fn moving_average_extremes_and_small_windows() {
     assert_eq!(f.mean(), Some(u16::MAX));
 }
 
+// req: P2.6
 #[test]
 fn adc_scaling_is_monotone_exact_at_the_ends_and_rounded() {
     let s = Scaling::default();
@@ -141,6 +146,7 @@ fn adc_scaling_is_monotone_exact_at_the_ends_and_rounded() {
     assert_eq!((e.v_bat, e.i_bat, e.v_reg), (10_000, 10_000, 7_499)); // 3071 × 10000 / 4095 = 7499.4
 }
 
+// req: P2.9
 #[test]
 fn encoder_covers_the_turn() {
     let mut prev = None;
@@ -158,6 +164,7 @@ fn encoder_covers_the_turn() {
     assert_eq!(hip_angle(4095, 0).centidegrees(), 35991);
 }
 
+// req: P2.6, P2.10
 #[test]
 fn adc_scaling_equals_spec() {
     #[derive(serde::Deserialize)]

@@ -59,6 +59,7 @@ fn pair(t: interp::Travel) -> (u16, u16) {
     (t.contracted.micros(), t.extended.micros())
 }
 
+// req: P5.1
 #[test]
 fn servo_defaults_equal_spec() {
     let s = spec();
@@ -90,6 +91,7 @@ fn servo_defaults_equal_spec() {
 
 /// The travel the spec states is the one the command decoder enforces: its ends accepted, one
 /// past each refused with the range in the message.
+// req: D:servo-travel
 #[test]
 fn the_decoder_enforces_the_spec_travel() {
     use mmic::wire::opcode::{decode, CommandError};

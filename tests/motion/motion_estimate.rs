@@ -21,6 +21,7 @@ fn ups() -> Vec<(Axis, Sign)> {
         .collect()
 }
 
+// req: P2.5
 #[test]
 fn the_true_state_is_always_in_the_estimate() {
     let mut checked = 0;
@@ -129,6 +130,7 @@ fn indistinguishable_classes_are_published() {
     }
 }
 
+// req: P7.10, T8/initial_state_mismatch
 #[test]
 fn initial_state_check() {
     let cfg = Config::default();
@@ -158,6 +160,7 @@ fn arm_pairs() -> impl Iterator<Item = PerSide<ArmPwm>> {
 /// contracted end, extended exactly at its extended end, between anywhere else — over every
 /// pulse width there is, for the arms' travel and for a travel whose ends are the other way
 /// round (a servo mounted mirrored).
+// req: P7.10, D:initial-state-sensors
 #[test]
 fn an_arms_pwm_value_is_contracted_or_extended_only_at_the_ends_of_its_travel() {
     let mirrored = Travel {
@@ -200,6 +203,7 @@ fn an_arms_pwm_value_is_contracted_or_extended_only_at_the_ends_of_its_travel() 
 /// one the state has — both contracted in a match, at least one extended and none between
 /// otherwise. So a robot whose commanded arm PWM is extended is in no matched state, and one
 /// commanded contracted on both arms in no two-face state.
+// req: P7.10
 #[test]
 fn the_commanded_arm_pwm_values_decide_matched_or_two_face() {
     let (c, e) = (ArmPwm::Contracted, ArmPwm::Extended);
@@ -237,6 +241,7 @@ fn the_commanded_arm_pwm_values_decide_matched_or_two_face() {
 /// switches): an arm is reported exactly when it is commanded contracted and its switch is
 /// open, arm A first; an arm commanded extended or between is never reported, whatever its
 /// switch says.
+// req: P7.15, T8/arm_not_contracted
 #[test]
 fn an_arm_is_not_contracted_exactly_when_commanded_contracted_with_its_switch_open() {
     let mut reported = 0;
@@ -269,6 +274,7 @@ fn an_arm_is_not_contracted_exactly_when_commanded_contracted_with_its_switch_op
 /// commanded contracted is arm not fully contracted whatever the initial state says (never a
 /// mismatch); with working switches the check is the mismatch check alone, and the true
 /// state always passes it.
+// req: T8/arm_not_contracted, T8/initial_state_mismatch
 #[test]
 fn a_dead_switch_is_arm_not_contracted_and_a_wrong_belief_a_mismatch() {
     let mut counts = [0u32; 3];

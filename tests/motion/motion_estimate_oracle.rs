@@ -124,6 +124,7 @@ const DIRS: [V; 6] = [
     [0, 0, -1],
 ];
 
+// req: P2.5
 #[test]
 fn true_state_in_estimate_under_an_independent_simulation_for_all_24_orientations() {
     let rots = rotations();

@@ -40,6 +40,7 @@ pub(crate) fn robot_moves_oracle() -> Vec<(State, State, Primitive)> {
         .collect()
 }
 
+// req: P6.9
 #[test]
 fn sixty_moves_each_with_its_inverse() {
     let moves: Vec<_> = map::moves().collect();
@@ -67,6 +68,7 @@ fn sixty_moves_each_with_its_inverse() {
 /// Table 6's caption: the turns "include a rotation of the hip". The model's 72 moves include
 /// 12 turns between two right-angle states (e↔f, e↔k, f↔i, g↔i, g↔j, j↔k), in which the moving
 /// arm would turn about the holding arm; the map is exactly the model's moves the joints make.
+// req: P6.9
 #[test]
 fn the_map_is_the_models_moves_the_hip_can_make() {
     use mmic::motion::geometry::{model_moves, turns_without_hip};
@@ -103,6 +105,21 @@ fn the_map_is_the_models_moves_the_hip_can_make() {
             assert!(f.kind() != StateKind::Turn || t.kind() != StateKind::Turn);
         }
     }
+}
+
+/// Section 6: moves between matched and stretched states use primitives 1-4, moves from or to a
+/// turn state primitives 4-8 (the paper's ranges, which share 4).
+// req: P6.7
+#[test]
+fn straight_moves_use_primitives_1_to_4_and_turns_4_to_8() {
+    let mut seen = [0u32; 2];
+    for (from, to, p) in map::moves() {
+        let turn = from.kind() == StateKind::Turn || to.kind() == StateKind::Turn;
+        let range = if turn { 4..=8 } else { 1..=4 };
+        assert!(range.contains(&p.number()), "{from} -> {to} by {p}");
+        seen[usize::from(turn)] += 1;
+    }
+    assert!(seen[0] > 0 && seen[1] > 0, "{seen:?}");
 }
 
 /// Floyd–Warshall over the moves the joints make ([`robot_moves_oracle`]): the oracle.
@@ -150,6 +167,7 @@ fn all_shortest(f: State, t: State, len: u32) -> Vec<Vec<State>> {
     out
 }
 
+// req: P6.10, P6.11, P6.4
 #[test]
 fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
     let d = all_pairs();
@@ -220,6 +238,7 @@ fn plans_are_valid_shortest_tie_broken_and_table_equals_search() {
     assert_eq!(route::TABLE_BYTES, 450);
 }
 
+// req: P6.9, P6.10
 #[test]
 fn rendered_grid_is_current_in_spec() {
     let mut grid = String::new();
@@ -262,6 +281,7 @@ fn render_ambiguous() -> String {
     s
 }
 
+// req: D:primitive-final-state
 #[test]
 fn ambiguous_primitives_are_published_and_each_is_a_match_or_a_stretch() {
     let text = render_ambiguous();
@@ -317,6 +337,7 @@ fn ambiguous_primitives_are_published_and_each_is_a_match_or_a_stretch() {
 /// to the same 72 moves: (a) the side that moves (the model), (b) the direction of travel, fwd
 /// when the moving gripper's displacement points towards A's end (along A's arm in the initial
 /// state). The numbers below are the decision's evidence.
+// req: P6.8
 #[test]
 fn fwd_back_readings_compared_on_every_move() {
     use mmic::motion::geometry::{arm_direction, faces, unit};

@@ -30,6 +30,7 @@ fn bfs_len(from: State, to: State) -> usize {
     dist[to.index()]
 }
 
+// req: P6.5
 #[test]
 fn plan_length_table() {
     let mut grid = String::from(
@@ -91,6 +92,7 @@ fn plan_length_table() {
 
 /// spec/motion/plans.txt: every chosen plan, one line per ordered pair of distinct states, for
 /// review against Figure 9 and for diffs when the map changes.
+// req: P6.11
 #[test]
 fn plan_list_is_current_in_spec() {
     let mut text = String::from(

@@ -58,6 +58,7 @@ fn expected_fault(step: Step) -> Fault {
     }
 }
 
+// req: P6.6
 #[test]
 fn every_move_under_every_signal_interleaving() {
     let cfg = Config::default();
@@ -144,6 +145,7 @@ fn every_move_under_every_signal_interleaving() {
     println!("sequencer: {runs} runs of {depth} ticks (running/done/failed: {outcomes:?})");
 }
 
+// req: P6.4, P6.5
 #[test]
 fn every_reconfiguration_reaches_its_target() {
     let all = Feedback {
@@ -181,6 +183,7 @@ fn every_reconfiguration_reaches_its_target() {
     }
 }
 
+// req: P6.5
 #[test]
 fn a_failed_primitive_stops_the_reconfiguration() {
     let mut r = Runner::start(Config::default(), State::A, State::M, Targets::home(), 0);
@@ -267,6 +270,7 @@ fn every_pose_reached_is_accepted_by_the_estimator() {
 
 /// The model's 12 turns between two right-angle states need a joint the robot does not have:
 /// the sequencer refuses each, the hip has no goal for it, and no chosen plan uses one.
+// req: D:turn-to-turn-moves
 #[test]
 fn turns_without_the_hip_are_no_primitive() {
     use mmic::motion::geometry::{model_moves, turns_without_hip};

@@ -61,6 +61,7 @@ struct PrimitiveRow {
     name: String,
 }
 
+// req: T5/*, P6.1
 #[test]
 fn table5_as_transcribed_is_the_codes_states() {
     let t: States = toml::from_str(&text("spec/motion/states.toml")).unwrap();
@@ -96,6 +97,7 @@ fn table5_as_transcribed_is_the_codes_states() {
     }
 }
 
+// req: T6/*, P6.6
 #[test]
 fn table6_as_transcribed_is_the_codes_primitives() {
     let t: Primitives = toml::from_str(&text("spec/motion/primitives.toml")).unwrap();
@@ -203,6 +205,7 @@ fn sentence(pairs: usize, what: &str, h: [usize; 3]) -> String {
 /// has none such; from any state to a matched target (what a reconfiguration command may ask)
 /// it has. The counts are computed here, and spec/motion/reconfigurations.toml, the decision
 /// and spec/motion/model.md must state exactly these.
+// req: P6.9
 #[test]
 fn single_primitive_reconfigurations_are_counted_as_spec_says() {
     let r: Reconfigurations = toml::from_str(&text("spec/motion/reconfigurations.toml")).unwrap();

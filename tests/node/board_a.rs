@@ -289,6 +289,7 @@ fn arm(side: Side, target: ServoTarget) -> Command {
     Command::Arm { side, target }
 }
 
+// req: T1/stop, D:stop-and-reset
 #[test]
 fn stop_mid_motion_freezes_both_arms_and_keeps_the_motion_for_reset() {
     for side in [Side::A, Side::B] {
@@ -327,6 +328,7 @@ fn stop_mid_motion_freezes_both_arms_and_keeps_the_motion_for_reset() {
     }
 }
 
+// req: P7.8
 #[test]
 fn entering_safed_mid_motion_freezes_both_sides_and_drops_the_motion() {
     for side in [Side::A, Side::B] {
@@ -346,6 +348,7 @@ fn entering_safed_mid_motion_freezes_both_sides_and_drops_the_motion() {
     }
 }
 
+// req: T1/stop
 #[test]
 fn stop_and_safed_end_a_bolting_job_on_both_sides() {
     for stopper in [Command::Stop, Command::Mode(Mode::Safed)] {
@@ -371,6 +374,7 @@ fn stop_and_safed_end_a_bolting_job_on_both_sides() {
     }
 }
 
+// req: T1/stop
 #[test]
 fn stop_mid_turn_holds_the_hip_where_it_is_read() {
     let mut r = Rig::operational();
@@ -402,6 +406,7 @@ fn extend_from_a() -> Command {
 /// its end, the robot counts as in motion at every tick (`BoardA::in_motion`) and a command
 /// that moves is refused as busy — also at the ticks where every module has reached one
 /// step's targets and the next step has not yet set its own, when no servo is on its way.
+// req: T1/primitive
 #[test]
 fn a_primitive_is_in_motion_and_refuses_other_moves_at_every_tick_until_it_ends() {
     let mut r = Rig::operational();
@@ -434,6 +439,7 @@ fn a_primitive_is_in_motion_and_refuses_other_moves_at_every_tick_until_it_ends(
 /// the primitive reaches its state the robot stays busy, and command complete (heartbeat byte
 /// 54) stays unset, until it has been still for `idle_settle_ms` (the sensor averages no
 /// longer hold the motion's currents); then the check passes and command complete is set.
+// req: T3/command_complete, D:command-complete, D:idle-check-settling
 #[test]
 fn command_complete_waits_until_the_robot_has_rested_idle_settle_ms_after_the_primitive() {
     let settle = board_a::Config::default().idle_settle_ms;
@@ -519,6 +525,7 @@ fn a_primitive_accepted_right_after_a_motion_starts_once_the_robot_has_rested() 
 /// Entering Operational sends the hip to the configured home angle (`safety.hip_home`: the
 /// contracted-gripped configuration the hip mismatch check reads against), not to a fixed
 /// 180°: a robot whose home is at 90°, reading 90°, is held there.
+// req: P7.6
 #[test]
 fn entering_operational_sends_the_hip_to_its_configured_home() {
     let home = HipAngle::new(9_000).unwrap();
@@ -569,6 +576,7 @@ fn until_idle(r: &mut Rig) {
 /// until its servo is at the target, as the heartbeat reports it: meanwhile the robot is in
 /// motion, another move is refused as busy, and command complete (byte 54) is unset; then
 /// the motion ends with command complete set (spec/decisions.toml, `command-complete`).
+// req: T1/arm, T1/gripper, P5.1
 #[test]
 fn a_single_module_move_is_a_motion_until_its_servo_is_at_its_target() {
     let cfg = board_a::Config::default();
@@ -622,10 +630,27 @@ fn a_single_module_move_is_a_motion_until_its_servo_is_at_its_target() {
     }
 }
 
+/// Section 5: the heartbeat's present arm value is the last interpolated pulse board A sent to
+/// the servo, not a measurement: mid-move it trails the target, pulse by pulse.
+// req: P5.4
+#[test]
+fn the_heartbeats_present_arm_value_is_the_last_pulse_sent() {
+    let mut r = Rig::operational();
+    r.send(arm(Side::A, ServoTarget::Extend));
+    let mut trailing = 0;
+    for _ in 0..300 {
+        let hb = r.tick(Some(Command::Heartbeat)).hb.expect("a heartbeat");
+        assert_eq!(Some(hb.arm_a_now), r.arm_pulse[0]);
+        trailing += u32::from(hb.arm_a_now != hb.arm_a_target);
+    }
+    assert!(trailing > 10, "{trailing} heartbeats mid-move");
+}
+
 /// Table 8's "arm not fully contracted": after a contract arm command, once the arm has
 /// finished its travel, its contraction switch must close within the confirm time
 /// (`motion.confirm_ms`). A switch that stays open raises the fault (and the robot is
 /// safed) — not while the arm is still on its way, and not when the switch closes.
+// req: P5.3, P7.15, T8/arm_not_contracted
 #[test]
 fn an_arm_contraction_is_a_fault_when_the_switch_stays_open_past_the_confirm_time() {
     let cfg = board_a::Config::default();
@@ -747,6 +772,7 @@ fn pairs(events: &[Event]) -> Vec<(BolterPair, u8, bool)> {
 /// should: both sides run Figure 8's steps pair after pair, each pair is fastened at the first
 /// attempt (events name them in order), the job ends done with no fault, the robot is in
 /// motion (and refuses other moves) until then and reports command complete after.
+// req: P4.1, P5.9
 #[test]
 fn bolting_all_four_pairs_runs_both_sides_pair_after_pair_to_done() {
     let mut r = Rig::operational();
@@ -773,6 +799,7 @@ fn bolting_all_four_pairs_runs_both_sides_pair_after_pair_to_done() {
 /// A fastener that side B's head cannot lock at first (it turns on it; Rotate times out):
 /// the attempt is abandoned — both bolters go home — and the pair is tried again, fastened at
 /// the second attempt (Figure 10's "twice"); the other pairs are unaffected.
+// req: T3/bolter_attempt, P5.9
 #[test]
 fn a_pair_that_does_not_lock_at_first_is_fastened_at_its_second_attempt() {
     let mut r = Rig::operational();
@@ -791,6 +818,7 @@ fn a_pair_that_does_not_lock_at_first_is_fastened_at_its_second_attempt() {
 /// A fastener that never locks on side A: after the third failed attempt (Table 8: three) the
 /// pair is given up, the job fails with Table 8's (un)bolting failure, and the robot goes to
 /// Standby (fully gripped: cutting power cannot drop it).
+// req: T8/bolting_failure
 #[test]
 fn a_pair_that_never_locks_fails_the_job_after_three_attempts() {
     let mut r = Rig::operational();
@@ -813,6 +841,7 @@ fn a_pair_that_never_locks_fails_the_job_after_three_attempts() {
 /// and stop there; the job ends reporting contact, with no fault. When one side finds nothing
 /// to touch, its descent times out: the job still ends (nothing was bolted, so no failure),
 /// reporting no contact.
+// req: T1/bolter, D:bolters-down
 #[test]
 fn moving_the_bolters_down_ends_when_both_touch_or_a_descent_times_out() {
     for b_there in [true, false] {
@@ -844,6 +873,7 @@ fn moving_the_bolters_down_ends_when_both_touch_or_a_descent_times_out() {
 /// measures it, side B's as board B judged it — raises that module's idle overcurrent fault
 /// once the robot has rested, the robot is safed, and the motion does not start. The same
 /// current, below the operational limits, faults nothing while no reconfiguration starts.
+// req: P7.16
 #[test]
 fn an_idle_overcurrent_at_the_start_keeps_the_primitive_from_starting() {
     let limits = board_a::Config::default().safety.idle;
@@ -890,6 +920,7 @@ fn matched_other_than_a() -> State {
 /// Table 8's initial state mismatch: a reconfiguration whose initial state is not the state
 /// the robot is in is refused with that reason, latches the fault (Standby: the robot is
 /// gripped), and nothing moves; the same reconfiguration from where the robot is, is accepted.
+// req: P7.10, T8/initial_state_mismatch
 #[test]
 fn a_reconfiguration_from_another_state_is_refused_as_an_initial_state_mismatch() {
     let target = matched_other_than_a();
@@ -979,6 +1010,7 @@ fn events_name_refused_commands_mode_changes_and_new_faults_once() {
 /// Power Control (Table 1): a module switched off in Operational gets no pulse while the
 /// others are driven — on side A by board A, on side B by board B as the A→B command's power
 /// flags tell it; switched on again, it is driven.
+// req: T1/power_control
 #[test]
 fn a_module_switched_off_is_not_driven_and_the_others_are() {
     use mmic::command::PowerTarget;
@@ -1025,6 +1057,7 @@ fn a_module_switched_off_is_not_driven_and_the_others_are() {
 
 /// Power Control of a bolter: with bolter A switched off, a bolting job leaves side A's motor
 /// unpowered (idle) while side B's descends.
+// req: T1/power_control
 #[test]
 fn a_bolter_switched_off_is_not_driven() {
     use mmic::command::PowerTarget;
@@ -1044,6 +1077,7 @@ fn a_bolter_switched_off_is_not_driven() {
 
 /// Table 1's hip commands set the hip's target: a preset to its angle, any other angle to
 /// itself, home to the configured home angle.
+// req: T1/hip
 #[test]
 fn a_hip_command_sets_the_angle_it_names() {
     use mmic::command::HipTarget;
@@ -1065,6 +1099,7 @@ fn a_hip_command_sets_the_angle_it_names() {
 /// A reconfiguration over primitives that turn nothing (the rig's hip reads 180° throughout):
 /// from a to a matched state two or more primitives away, run primitive after primitive, it
 /// reaches its target, which the board then tracks, with no fault and command complete.
+// req: P6.5, T1/reconfiguration
 #[test]
 fn a_reconfiguration_runs_its_primitives_to_its_target() {
     use mmic::motion::route;
@@ -1135,6 +1170,7 @@ fn straight_target() -> State {
 /// command refused with arm_not_contracted — not an initial state mismatch and Standby, which
 /// would tell the operator that their belief of where the robot is was wrong. At rest, before
 /// the reconfiguration, nothing checks the switch.
+// req: T8/arm_not_contracted, D:initial-state-sensors
 #[test]
 fn a_dead_arm_switch_at_rest_is_arm_not_contracted_when_a_reconfiguration_arrives() {
     let target = straight_target();
@@ -1172,6 +1208,7 @@ fn a_dead_arm_switch_at_rest_is_arm_not_contracted_when_a_reconfiguration_arrive
 /// The same dead switch during the reconfiguration (as before issue 39): the motion's last
 /// contraction is not confirmed, Table 8's arm not fully contracted, Safed, the target never
 /// reached; no initial state mismatch.
+// req: T8/arm_not_contracted, P7.15
 #[test]
 fn a_switch_that_dies_during_a_reconfiguration_is_arm_not_contracted() {
     let target = straight_target();
@@ -1206,6 +1243,7 @@ fn a_switch_that_dies_during_a_reconfiguration_is_arm_not_contracted() {
 /// With every switch working, a reconfiguration from any state but the one the robot is in
 /// (a, tracked, arms commanded contracted) is an initial state mismatch: refused by that name,
 /// Standby (the robot is gripped), nothing else latched.
+// req: P7.10, T8/initial_state_mismatch
 #[test]
 fn a_wrong_initial_state_with_working_switches_is_an_initial_state_mismatch_from_every_state() {
     let mut n = 0;
@@ -1232,6 +1270,7 @@ fn a_wrong_initial_state_with_working_switches_is_an_initial_state_mismatch_from
 /// and also with the switch stuck closed, which a check reading the switches took for a
 /// contracted arm (and accepted the command). Not arm not fully contracted: the arm is not
 /// commanded contracted.
+// req: P7.10
 #[test]
 fn an_arm_commanded_extended_is_in_no_matched_state_whatever_its_switch_says() {
     let target = straight_target();
@@ -1730,6 +1769,7 @@ fn a_timed_out_motion_is_not_timed_again_until_the_modules_rest() {
 /// Section 7: "When switching to 'opmode', actuators are set to go to their home position" —
 /// also when Operational is entered again after Safed held them where they were: arm B, held
 /// half-way out, goes back to contracted, within the module budget and with no fault.
+// req: P7.6
 #[test]
 fn re_entering_operational_sends_the_servos_home_again() {
     let cfg = board_a::Config::default();

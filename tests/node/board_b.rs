@@ -37,6 +37,7 @@ fn inputs(command: Option<[u8; 15]>) -> Inputs {
 
 /// Each servo goes to its own target: a command that moves only the gripper moves the
 /// gripper (and not the arm), one that moves only the arm moves the arm.
+// req: P4.2, P4.3
 #[test]
 fn each_servo_follows_its_own_target() {
     let cfg = Config::default();
@@ -75,6 +76,7 @@ fn the_link_is_lost_exactly_past_its_timeout() {
 
 /// B holds its servos where they are when the link falls silent, and when its ADC is lost
 /// (then also saying nothing), each on its own, mid-move; a command afterwards moves it on.
+// req: P4.3
 #[test]
 fn silence_or_a_lost_adc_alone_holds_the_servos_mid_move() {
     let cfg = Config::default();
@@ -119,6 +121,7 @@ fn silence_or_a_lost_adc_alone_holds_the_servos_mid_move() {
 
 /// B's heartbeat goes out every `heartbeat_period_ms`, on the first tick of each period and
 /// on no other.
+// req: P4.5
 #[test]
 fn heartbeats_every_period_and_no_more() {
     let cfg = Config::default();

@@ -85,6 +85,7 @@ fn table7_answer(mode: Mode, c: &Command) -> Option<Refusal> {
 /// the answer is exactly the one [`table7_answer`] gives (a supervisor accepting a primitive
 /// in Standby, or refusing an arm command in Safed, fails here), and the supervisor's mode
 /// after it is the one the command asks for, or unchanged.
+// req: T7/commands, T1/*, P7.4, P7.5
 #[test]
 fn every_command_class_in_every_mode_gets_the_answer_table_7_gives() {
     let mut cases = 0;
@@ -172,6 +173,7 @@ impl Linked {
     }
 }
 
+// req: P3.14
 #[test]
 fn every_command_class_in_every_starting_mode_runs_once_and_is_acknowledged() {
     let mut cases = 0;
@@ -215,6 +217,7 @@ fn every_command_class_in_every_starting_mode_runs_once_and_is_acknowledged() {
 /// judge again (duplicate, stale) the command bytes 57–58 name. So whenever the answered
 /// packet is sequenced, byte 62 is the outcome of the number in bytes 57–58, whatever
 /// unsequenced commands came in between.
+// req: T3/refusal, D:heartbeat-byte-62
 #[test]
 fn byte_62_reports_the_command_the_heartbeat_reports_on() {
     let arm = Command::Arm {
@@ -254,6 +257,7 @@ fn byte_62_reports_the_command_the_heartbeat_reports_on() {
     assert_eq!(answer(&mut a, arm, 10), (11, None));
 }
 
+// req: T2/board, T2/checksum
 #[test]
 fn packets_for_others_or_broken_get_no_answer_and_malformed_ones_a_refusal() {
     let mut a = BoardA::new(board_a::Config::default());
@@ -387,6 +391,7 @@ fn run_linked(
     }
 }
 
+// req: P4.1, P7.19
 #[test]
 fn a_and_b_run_together_without_fault_and_link_loss_is_safed_within_the_timeout() {
     let cut = 5_000;
@@ -443,6 +448,7 @@ fn faulted_after_heartbeat_burst(silence_ms: u32) -> Option<(u32, u32)> {
     fault
 }
 
+// req: P7.19, T8/internal_comm_loss
 #[test]
 fn lost_b_heartbeats_fault_only_past_the_timeout() {
     // Board A keeps refreshing its A->B command every 50 ms meanwhile: refreshes of an

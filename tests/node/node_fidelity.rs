@@ -14,6 +14,7 @@ use mmic::wire::internal_heartbeat::InternalHeartbeatRepr;
 
 /// Defect 10: board B starts with its servos at home, as board A does (it used to start at
 /// 1500 µs, so entering Operational drove B's arm and gripper to mid-travel first).
+// req: D:b-starts-at-home
 #[test]
 fn board_b_starts_at_home_like_board_a() {
     let a_cfg = board_a::Config::default();
@@ -57,6 +58,7 @@ fn hearing(mut hb: InternalHeartbeatRepr, ms: u32) -> BoardA {
 /// Defect 11: board A takes side B's overcurrent verdicts as board B reports them (Table 4
 /// bytes 41–43, B's own limits), instead of recomputing them from B's currents: a flag with
 /// quiet currents is a fault, and high currents B did not flag are not.
+// req: P4.7
 #[test]
 fn board_a_takes_side_b_overcurrent_as_b_judged_it() {
     let a_cfg = board_a::Config::default();

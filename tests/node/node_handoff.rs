@@ -20,6 +20,7 @@ fn packet(i: u64) -> [u8; 14] {
     p
 }
 
+// req: P2.11, P3.17, P3.18
 #[test]
 fn two_threads_exchange_packets_without_loss_duplication_or_tearing() {
     let mut q: PacketQueue<14, 8> = PacketQueue::new();

@@ -214,6 +214,7 @@ impl Rig {
 /// Every ambiguous (state, primitive) pair: the second target, which the old first-match
 /// code could never reach, is commanded and run; a final state the primitive reaches only from
 /// other states is refused first. Each pair starts from a fresh robot in state a.
+// req: T1/primitive, D:primitive-final-state
 #[test]
 fn every_ambiguous_primitive_reaches_the_final_state_it_names() {
     let mut pairs = 0;
@@ -272,6 +273,7 @@ fn the_first_targets_run_too_and_no_move_is_refused() {
 /// it by that name, moves nothing and raises no fault; from another state the same command is
 /// a wrong belief of where the robot is, as before. Fails with the map of before issue 24,
 /// which ran them with the hip held.
+// req: D:turn-to-turn-moves
 #[test]
 fn a_turn_without_the_hip_is_refused_by_name() {
     use mmic::motion::geometry::{model_moves, turns_without_hip};

@@ -89,6 +89,7 @@ fn spec() -> Boards {
     toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
+// req: P8.3, P8.4, P8.5
 #[test]
 fn the_nodes_defaults_equal_spec_boards() {
     let s = spec();
@@ -143,6 +144,7 @@ fn the_nodes_defaults_equal_spec_boards() {
 /// `heartbeat_period_ms` throughout, `link_lost` exactly once board A has been silent longer
 /// than `link_timeout_ms`, from then on arm B held at its last pulse however far from its
 /// target; the next command from A lifts the hold and the arm moves again.
+// req: P4.5
 #[test]
 fn board_b_heartbeats_every_period_and_holds_once_board_a_falls_silent() {
     let s = spec().board_b;

@@ -305,6 +305,7 @@ fn facts(c: &Option<Incoming>) -> &'static [(bool, Result<(), InitialStateError>
     }
 }
 
+// req: T7/*, T8/*, P7.7
 #[test]
 fn supervisor_properties_hold_on_the_whole_domain() {
     let starts = start_states();
@@ -372,6 +373,7 @@ fn fault_classes() -> Vec<Faults> {
 /// what the supervisor branches on (mode, enabled modules, deferred Standby pending, a motion
 /// kept by Stop); the latched fault set rides along as data: no branch reads it (it is only
 /// output, widened by each step's faults and narrowed by ClearFaults).
+// req: T7/*, P7.7
 #[test]
 fn every_reachable_supervisor_state_satisfies_the_properties() {
     use std::collections::{HashSet, VecDeque};
@@ -434,6 +436,7 @@ fn every_reachable_supervisor_state_satisfies_the_properties() {
 /// Deferred faults act exactly at motion end, never before, and are never lost: a deferred
 /// fault raised at any tick of a motion of any length 1..=6 ticks (with the fault still
 /// holding or gone afterwards) takes Operational to Standby at the first tick without motion.
+// req: P7.12, P7.13, T8/assembly_system, T8/low_battery
 #[test]
 fn deferred_faults_act_exactly_at_motion_end() {
     let mut cases = 0;

@@ -236,6 +236,7 @@ const INIT: [Option<&str>; 5] = [
 proptest! {
     #![proptest_config(common::prop::config(2000))]
 
+    // req: T7/*, T8/*
     #[test]
     fn supervisor_agrees_with_the_spec_oracle(
         seq in prop::collection::vec((any::<u16>(), any::<prop::sample::Index>(), any::<bool>(), prop::bool::weighted(0.9), prop::sample::select(INIT.to_vec()), prop::bool::weighted(0.15)), 1..60)
@@ -268,6 +269,7 @@ proptest! {
     }
 }
 
+// req: P7.8
 #[test]
 fn oracle_module_names_match_spec() {
     let names: Vec<String> = Module::ALL.iter().map(|m| module_name(*m)).collect();

@@ -7,6 +7,7 @@ use mmic::mode::Mode;
 use mmic::refusal::Refusal;
 use mmic::safety::detect::Config;
 use mmic::safety::policy::{accepts, fault_action, is_condition, powered, regulator_on};
+use mmic::safety::supervisor::{Input, Supervisor};
 use mmic::safety::ModuleSet;
 use mmic::units::Module;
 use serde::Deserialize;
@@ -81,6 +82,7 @@ fn module_name(m: Module) -> &'static str {
     }
 }
 
+// req: P7.4
 #[test]
 fn the_moving_command_kinds_equal_spec() {
     let got: Vec<&str> = CommandKind::ALL
@@ -91,6 +93,19 @@ fn the_moving_command_kinds_equal_spec() {
     assert_eq!(got, spec().moving, "spec/modes.toml `moving`");
 }
 
+/// Section 7: the robot starts in Standby with nothing powered and the regulator off, and a
+/// first step without any input leaves it there.
+// req: P7.2, P7.3, T7/entry
+#[test]
+fn the_robot_starts_in_standby_with_nothing_powered() {
+    let mut s = Supervisor::new();
+    assert_eq!(s.mode(), Mode::Standby);
+    let out = s.step(&Input::quiet());
+    assert_eq!(out.mode, Mode::Standby);
+    assert!(out.powered.is_empty() && !out.regulator && out.faults.is_empty());
+}
+
+// req: T7/*, P7.1, P7.3, P7.4, P7.5, P7.8
 #[test]
 fn table7_acceptance_and_power_equal_spec() {
     let s = spec();
@@ -123,6 +138,7 @@ fn table7_acceptance_and_power_equal_spec() {
     }
 }
 
+// req: T8/*, P7.7, P7.9, P7.13, P7.14
 #[test]
 fn table8_modes_deferral_and_kinds_equal_spec() {
     let s = spec();
@@ -167,6 +183,7 @@ fn table8_modes_deferral_and_kinds_equal_spec() {
     }
 }
 
+// req: P7.11, P7.17
 #[test]
 fn refusal_codes_and_thresholds_equal_spec() {
     let s = spec();
@@ -237,6 +254,7 @@ fn assert_introduces(decisions: &BTreeMap<String, String>, id: &str, what: &str)
 /// the decision that added it: the code takes every kind Table 7 lets a mode take (Operational:
 /// every Table 1 kind), and each kind taken beyond that has an entry in [accepts_decisions]
 /// whose decision names it. No entry is left over.
+// req: T7/commands, D:commands-in-every-mode
 #[test]
 fn acceptance_beyond_table7_is_a_recorded_decision() {
     let s = spec();
@@ -280,6 +298,7 @@ fn acceptance_beyond_table7_is_a_recorded_decision() {
 }
 
 /// None of the refusal codes is the paper's: each names the decision that introduced it.
+// req: D:heartbeat-byte-62
 #[test]
 fn every_refusal_code_names_the_decision_that_introduced_it() {
     let s = spec();

@@ -101,6 +101,7 @@ fn expected(n: u64) -> [Refusals; 3] {
     })
 }
 
+// req: T2/checksum, D:checksum
 #[test]
 fn every_1_2_3_bit_error_in_a_command_packet_is_refused() {
     let packet = CommandRepr {
@@ -120,6 +121,7 @@ fn every_1_2_3_bit_error_in_a_command_packet_is_refused() {
     }
 }
 
+// req: T4/checksum, D:checksum
 #[test]
 fn every_1_2_3_bit_error_in_an_internal_heartbeat_is_refused() {
     let packet = InternalHeartbeatRepr {

@@ -41,6 +41,7 @@ fn assert_crc(bytes: &[u8]) {
     assert_eq!(crc16_bitwise(&bytes[..n - 2]), carried, "vector checksum");
 }
 
+// req: D:checksum
 #[test]
 fn bitwise_crc_matches_the_catalogue_check_value() {
     // CRC-16/CCITT-FALSE ("CRC-16/IBM-3740" in the CRC catalogue): check = 0x29B1.
@@ -60,6 +61,7 @@ const COMMAND_ARM: [u8; COMMAND_LEN] = [
     0xdf, 0xe6, // 12-13 CRC-16 0xe6df of bytes 0-11, low byte first
 ];
 
+// req: P3.12, T1/arm
 #[test]
 fn golden_command_arm_position() {
     let repr = CommandRepr {
@@ -87,6 +89,7 @@ const COMMAND_RECONFIGURE: [u8; COMMAND_LEN] = [
     0x8a, 0x5e, // 12-13 CRC-16 0x5e8a
 ];
 
+// req: P3.12, T1/reconfiguration
 #[test]
 fn golden_command_reconfigure() {
     let repr = CommandRepr {
@@ -125,6 +128,7 @@ const COMMAND_PRIMITIVE_NO_STATE: [u8; COMMAND_LEN] = [
     0xf9, 0xb9, // 12-13 CRC-16 0xb9f9
 ];
 
+// req: P3.12, T1/primitive
 #[test]
 fn golden_command_primitive() {
     let repr = CommandRepr {
@@ -166,6 +170,7 @@ const COMMAND_RECONFIGURE_SEQUENCED: [u8; COMMAND_LEN] = [
     0xb4, 0x70, // 12-13 CRC-16 0x70b4
 ];
 
+// req: D:command-sequence-number
 #[test]
 fn golden_command_sequenced() {
     let arm = CommandRepr {
@@ -235,6 +240,7 @@ const HEARTBEAT: [u8; HEARTBEAT_LEN] = [
     0x86, 0xb6, // 64-65 CRC-16 0xb686
 ];
 
+// req: P3.16, T3/*
 #[test]
 fn golden_heartbeat() {
     let repr = HeartbeatRepr {
@@ -326,6 +332,7 @@ const INTERNAL_HEARTBEAT: [u8; INTERNAL_HEARTBEAT_LEN] = [
     0xb3, 0xeb, // 45-46 CRC-16 0xebb3
 ];
 
+// req: P4.7, T4/*
 #[test]
 fn golden_internal_heartbeat() {
     let repr = InternalHeartbeatRepr {
@@ -386,6 +393,7 @@ const B_COMMAND: [u8; B_COMMAND_LEN] = [
     0xe4, 0x53, // 13-14 CRC-16 0x53e4
 ];
 
+// req: D:b-command
 #[test]
 fn golden_b_command() {
     let repr = BCommandRepr {

@@ -25,6 +25,7 @@ fn each_command_checked(visit: impl FnMut(Command)) -> usize {
     }
 }
 
+// req: T1/*
 #[test]
 fn every_command_round_trips_through_its_encoding() {
     let mut n = 0;
@@ -37,6 +38,7 @@ fn every_command_round_trips_through_its_encoding() {
     assert_eq!(expected, if cfg!(miri) { 61 } else { 40_595 });
 }
 
+// req: D:command-sequence-number
 #[test]
 fn no_command_uses_its_sequence_slot() {
     // The exactly-once sequence number may take `seq_slot(id)`: exhaustive over all commands.
@@ -50,6 +52,7 @@ fn no_command_uses_its_sequence_slot() {
     assert_eq!(n, expected);
 }
 
+// req: T1/*, D:opcodes
 #[test]
 fn opcodes_are_distinct_per_variant_class() {
     let mut seen = [false; 256];
@@ -69,6 +72,7 @@ fn opcodes_are_distinct_per_variant_class() {
     }
 }
 
+// req: P3.13
 #[test]
 fn unused_parameter_bytes_must_be_zero() {
     for_each_variant_class(PulseWidth::CENTER, HipAngle::ZERO, |c| {
@@ -83,6 +87,7 @@ fn unused_parameter_bytes_must_be_zero() {
     });
 }
 
+// req: P6.4
 #[test]
 fn range_errors_name_the_byte() {
     let bad = 2501u16.to_le_bytes();
@@ -126,6 +131,7 @@ fn range_errors_name_the_byte() {
     );
 }
 
+// req: D:primitive-final-state
 #[test]
 fn a_primitive_names_its_final_state_in_byte_8() {
     // 7 (backTurnCW): e -> a and e -> d; both commandable, each its own bytes.
@@ -167,6 +173,7 @@ fn a_primitive_names_its_final_state_in_byte_8() {
     );
 }
 
+// req: P6.9
 #[test]
 fn every_move_of_the_model_is_one_primitive_command() {
     // 72 moves of the model, 60 commands: a command is (primitive, final state); the

@@ -123,22 +123,26 @@ fn any_bytes(kind: PacketKind) -> impl Strategy<Value = Vec<u8>> {
 proptest! {
     #![proptest_config(common::prop::config(CASES))]
 
+    // req: T1/*
     #[test]
     fn command_encode_decode_round_trips(c in any::<Command>()) {
         let (id, params) = encode(&c);
         prop_assert_eq!(decode(id, params), Ok(c));
     }
 
+    // req: T2/*
     #[test]
     fn command_repr_parse_emit_round_trips(x in any::<CommandRepr>()) {
         prop_assert_eq!(CommandRepr::parse(&x.to_bytes()), Ok(x));
     }
 
+    // req: T3/*
     #[test]
     fn heartbeat_repr_parse_emit_round_trips(x in any::<HeartbeatRepr>()) {
         prop_assert_eq!(HeartbeatRepr::parse(&x.to_bytes()), Ok(x));
     }
 
+    // req: T4/*
     #[test]
     fn internal_heartbeat_repr_parse_emit_round_trips(x in any::<InternalHeartbeatRepr>()) {
         prop_assert_eq!(InternalHeartbeatRepr::parse(&x.to_bytes()), Ok(x));

@@ -70,6 +70,7 @@ struct Addition {
     bytes: Option<Vec<usize>>,
 }
 
+// req: T2/*, T3/*, T4/*, P3.12, P3.16, P4.7
 #[test]
 #[cfg_attr(
     miri,
@@ -184,6 +185,7 @@ struct OpcodeRow {
     additions: Vec<Addition>,
 }
 
+// req: T1/*
 #[test]
 #[cfg_attr(
     miri,
@@ -278,6 +280,7 @@ struct FaultRow {
     additions: Vec<Addition>,
 }
 
+// req: T8/*
 #[test]
 #[cfg_attr(
     miri,

@@ -77,6 +77,7 @@ fn current(cfg: &mmic::bolter::SideConfig, sel: u8, raw: u16) -> u16 {
 /// current selector (one mA below, at, one above the push or the lock threshold, or 0 mA) ×
 /// home switch, after 0, 4000 or 4001 ms (the sensed-step limit and one past); then sampled
 /// inputs.
+// req: P5.11
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(8))]
 fn bolter_side_reports_what_it_runs() {
@@ -209,6 +210,7 @@ fn bolter_side(t0: u32, events: &[(bool, u8, (u8, u8, u8), u8, u16, u16)]) {
 /// both sides report the current order ended, side A reports it timed out, no report from B
 /// after 5001 ms (past the 5000 ms motion limit), reports for no order; long enough for a pair
 /// to succeed, fail an attempt, and for a job to fail or time out; then sampled inputs.
+// req: P5.9
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(8))]
 fn coordinator_bounded_and_orders_change() {

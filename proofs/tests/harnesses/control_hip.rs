@@ -14,6 +14,7 @@ const TICKS: usize = 6;
 /// shifts 0, 8, 31 and u32::MAX, over two tick sequences of extreme errors (a half turn, the
 /// 0/35999 wrap of the angle, none) after 0, 1 and 65,535 ms, from 100 ms before the u32 wrap;
 /// then sampled inputs.
+// req: P5.5
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(8))]
 fn hip_controller_never_overflows_and_saturates() {

@@ -10,6 +10,7 @@ use mmic::units::PulseWidth;
 /// steps 0, 1, 2, 7 and 255 µs, periods 0, 1, 2, 20 and 255 ms, from the clock's 0 and 1000
 /// ms before the u32 wrap, and every sequence of 3 ticks after 0, 1, 2, 19, 20, 21, 255 or
 /// 65,535 ms (one period ±1, partial periods banked across ticks); then sampled inputs.
+// req: P5.1
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn interpolation_is_monotone_and_lands_on_target() {

@@ -89,6 +89,7 @@ fn token_streams(name: &str, property: impl Fn(&[u8], &[u8]) + std::panic::RefUn
 ///
 /// Under `cargo test`: the token streams exhaustively (see [`token_streams`]), then sampled
 /// inputs of every length up to `PLAN + STREAM`.
+// req: D:deframing
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(22))]
 fn deframer_never_panics() {
@@ -140,6 +141,7 @@ fn never_panics(plan: &[u8], stream: &[u8]) {
 ///
 /// Under `cargo test`: the token streams exhaustively (see [`token_streams`]), then sampled
 /// inputs for `build_stream`.
+// req: D:deframing
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(22))]
 fn deframer_conserves_bytes() {
@@ -182,6 +184,7 @@ fn conserves(plan: &[u8], stream: &[u8]) {
 /// Under `cargo test`: exhaustively, every kind, every garbage length 0..=`MAX_GARBAGE` of
 /// zero bytes, every splice (none, or each kind's header at each of the 32 positions), pushed
 /// whole, byte by byte and in 70-byte chunks; then sampled inputs.
+// req: D:deframing
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(22))]
 fn deframer_finds_packet_after_garbage() {

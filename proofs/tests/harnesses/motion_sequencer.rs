@@ -15,6 +15,7 @@ const TICKS: usize = 8;
 /// sequence of 3 ticks over 8 feedback words (none, all, each kind of signal on both sides,
 /// all of side A's, all of side B's) × 4 steps (0 ms, and past the 1000 ms confirmation, the
 /// 3000 ms gripper and the 15,000 ms move limits); then sampled inputs.
+// req: P6.6
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn sequencer_always_holds_with_one_closed_gripper() {

@@ -195,6 +195,7 @@ fn uplink(events: &[(u16, u8, u8, u8)]) {
 /// visit / deliver × robot 1..=3 × number 1 or 2 (the generator's third number behaves as the
 /// second: a different number from the same robot): enough to fill both slots, be refused,
 /// resend, hand a packet back and deliver; then sampled inputs.
+// req: P3.6
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn the_server_never_drops_a_pending_command_silently() {
@@ -275,6 +276,7 @@ fn server(ops: &[(u8, u8, u8)]) {
 /// Under `cargo test`: exhaustively, every sequence of 8 operations (the harness's length)
 /// over pop and push of 3 distinct packets: fills, overflows and drains at every position;
 /// then sampled inputs.
+// req: P3.18
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn the_handoff_queue_is_a_fifo_that_hands_back_when_full() {

@@ -142,6 +142,7 @@ macro_rules! packet_harnesses {
             /// packets, checksum rewritten: every value of every one-byte field (opcode,
             /// parameters, state, mode, faults, refusal, bolter bytes) with the other fields
             /// valid, and every value of each byte of the two-byte fields; then sampled bodies.
+            // req: T2/*, T3/*, T4/*
             #[test]
             #[cfg_attr(kani, kani::proof, kani::unwind($unwind))]
             fn round_trip() {
@@ -183,6 +184,7 @@ macro_rules! packet_harnesses {
             /// opcode class, state, mode, refusal, bolter step, …), and every single edit
             /// (each of the 256 positions, taken modulo the body, and values) of the all-zero
             /// seed's packet; then sampled seeds and edits.
+            // req: T2/*, T3/*, T4/*
             #[test]
             #[cfg_attr(kani, kani::proof, kani::unwind($unwind))]
             fn round_trip_near_valid() {

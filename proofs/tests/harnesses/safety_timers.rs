@@ -21,6 +21,7 @@ const COMM_EVENTS: usize = 12;
 /// the spans those steps add up to include 499, 500 and 501 ms (the threshold ±1) inside one
 /// run, across the wrap, and a run broken at every position; then sampled inputs of the full
 /// type.
+// req: P7.11, T8/low_battery
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn low_battery_fires_exactly_after_half_a_second() {
@@ -91,6 +92,7 @@ fn low_battery(start: u32, samples: &[(u16, bool, bool)]) {
 /// every sequence of 12 events over a send of 0, a send of 1 and a heartbeat echoing 0: ten
 /// sends of an unacknowledged number with every interleaving of refreshes and
 /// acknowledgements (1 is symmetric to 0); then sampled inputs.
+// req: P7.19, T8/internal_comm_loss
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(14))]
 fn comm_loss_fires_exactly_after_timeout_or_ten_unacknowledged_sends() {

@@ -24,6 +24,7 @@ const LEN: usize = 6;
 /// alternating +1/−1: a mean at each extreme and one that floors towards −∞), ADC codes
 /// alternating 0 and 0xffff, and encoder zeros 0 and 0xffff; then sampled inputs over 80
 /// ticks.
+// req: P2.10
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn frontend_stays_in_range_and_averages_signed_accelerations_exactly() {

@@ -20,6 +20,7 @@ const LEN: usize = 8;
 /// sequence of 7 samples from 0, 1, 32767, 32768, 65534 and 65535 (filling, sliding, and the
 /// sums' carries; the code does not depend on N beyond its compile-time overflow check); then
 /// sampled inputs at window 50.
+// req: P2.10
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(10))]
 fn moving_average_equals_naive_mean() {

@@ -32,6 +32,7 @@ const T0: u32 = u32::MAX - 150;
 /// Under `cargo test`: exhaustively, every sequence of 5 events of 16 letters (open, close,
 /// heartbeat, read of 1/5/14/21 bytes of a command stream; each after 0, 1, 99 or 100 ms,
 /// the idle limit being 100 ms), from just before the u32 wrap; then sampled inputs.
+// req: P3.14
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(40))]
 fn the_wifi_session_sends_only_while_open_and_hands_on_whole_commands() {
@@ -134,6 +135,7 @@ fn wifi(ops: &[(u8, u8)]) {
 /// before the u32 wrap) × every sequence of 4 events of 16 letters (read of 1, 9, 30 or 66
 /// bytes of a stream of garbage, a command and two heartbeats; each after 0, 1, 99 or 100 ms);
 /// then sampled inputs.
+// req: P3.7, P3.8
 #[test]
 #[cfg_attr(kani, kani::proof, kani::unwind(40))]
 fn the_visit_ends_at_its_first_heartbeat_or_its_deadline() {

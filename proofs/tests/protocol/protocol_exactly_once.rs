@@ -505,6 +505,7 @@ fn check_link(max_losses: u8, bound_ms: u32) -> (bool, usize) {
     )
 }
 
+// req: P3.11
 #[test]
 fn exactly_once_commanding_and_safed_on_link_loss() {
     let timeout = mmic::safety::detect::Config::default().comm_timeout_ms;

@@ -205,6 +205,7 @@ fn double_execution(patient: bool, max_duplicates: u8) -> (usize, Vec<String>) {
     )
 }
 
+// req: P3.11
 #[test]
 fn the_papers_resend_scheme_executes_a_command_twice() {
     // A link that duplicates: the robot executes both copies (nothing deduplicates).

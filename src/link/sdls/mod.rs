@@ -59,6 +59,7 @@
 //! (12), right after the frame's headers (a TC frame's segment header, a TM frame's primary
 //! header); the trailer is the 16-octet GCM tag, before the OCF and the FECF, which stay
 //! outside the MAC. The choices (SPIs, masks, windows, blocks) are in `spec/ccsds/sdls.toml`.
+// req: D:sdls-suite, D:sdls-auth-mask, D:sdls-counters, D:sdls-keys
 
 pub mod counter;
 pub mod frames;

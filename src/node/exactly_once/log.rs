@@ -25,6 +25,7 @@
 //! wrap-around as long as fewer than 32,768 commands separate a copy from its original.
 //! Board A's log is in RAM: after a reset the first sequenced command is taken whatever its
 //! number (documented in spec/protocol/README.md).
+// req: D:exactly-once-window
 
 use crate::refusal::Refusal;
 
@@ -92,6 +93,7 @@ impl CommandLog {
 mod tests {
     use super::*;
 
+    // req: D:exactly-once-window
     #[test]
     fn serial_arithmetic_at_the_wrap() {
         assert!(newer(0, 0xffff) && newer(1, 0xffff) && !newer(0xffff, 0));
@@ -116,6 +118,7 @@ mod tests {
         }
     }
 
+    // req: D:exactly-once-window
     #[test]
     fn duplicates_report_the_recorded_outcome() {
         let mut log = CommandLog::new();

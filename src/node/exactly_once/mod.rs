@@ -3,6 +3,7 @@
 //! ground sends with it, and so does the server board's gateway. The receive side is board A's
 //! command [`log`]: it runs each number once and answers every copy from its record.
 //! spec/protocol/README.md has the design and what stateright checked.
+// req: D:exactly-once-window, D:command-sequence-number
 
 pub mod log;
 pub mod uplink;

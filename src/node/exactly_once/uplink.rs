@@ -29,6 +29,7 @@
 //! assert_eq!((done.seq, done.outcome, done.attempts), (seq, Outcome::Accepted, 2));
 //! assert_eq!(up.efficiency().percent(), Some(50));
 //! ```
+// req: P3.10, P3.11, P8.4, P8.5, P7.20, D:ground-uplink
 
 use crate::command::Command;
 use crate::refusal::Refusal;
@@ -407,6 +408,7 @@ impl Uplink {
 mod tests {
     use super::*;
 
+    // req: P3.10, P3.11, P7.20
     #[test]
     fn gives_up_after_max_attempts_and_reports_it() {
         let cfg = Config {
@@ -432,6 +434,7 @@ mod tests {
         assert!(up.is_idle());
     }
 
+    // req: P3.11
     #[test]
     fn stale_heartbeats_do_not_acknowledge() {
         let mut up = Uplink::new(Config::default(), BoardNumber::ONE);
@@ -451,6 +454,7 @@ mod tests {
         assert_eq!(up.outstanding(), second);
     }
 
+    // req: P8.5
     #[test]
     fn efficiency_window_forgets_beyond_100() {
         let mut e = Efficiency::default();

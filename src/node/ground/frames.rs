@@ -42,6 +42,7 @@
 //! assert_eq!(frames.len(), 1);
 //! assert_eq!(frames[0][4], 0);
 //! ```
+// req: D:pus-ground-under-cop1
 
 use crate::link::clcw::Clcw;
 use crate::link::extract::{ExtractCounters, Extractor};

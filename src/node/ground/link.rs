@@ -16,6 +16,7 @@
 //! let seq = Link::submit(&mut up, Command::Mode(Mode::Operational)).unwrap();
 //! assert_eq!(Link::tick(&mut up, 0).send.map(|c| c.seq), Some(seq));
 //! ```
+// req: P3.11
 
 use crate::command::Command;
 use crate::faults::Faults;

@@ -39,6 +39,7 @@
 //! assert_eq!(r.done.map(|d| d.outcome), Some(Outcome::Accepted));
 //! assert!(link.is_idle());
 //! ```
+// req: D:pus-ground-resend
 
 use super::link::{Link, LinkTick, MotionEnd};
 

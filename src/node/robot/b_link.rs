@@ -34,6 +34,7 @@
 //! let moved = BCommandRepr { arm_target: PulseWidth::MAX, ..snap };
 //! assert_eq!(link.due(60, 50, moved).map(|c| c.seq), Some(2)); // new content: new number
 //! ```
+// req: P4.5, D:a-to-b-sequence-number
 
 use crate::units::Instant;
 use crate::wire::b_command::{BCommandRepr, BolterOrder};
@@ -144,6 +145,7 @@ mod tests {
         step: BolterStep::Descend,
     };
 
+    // req: P4.5
     #[test]
     fn every_new_content_gets_a_new_number_and_zero_is_skipped() {
         let mut link = BLink::new();

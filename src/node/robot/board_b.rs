@@ -31,6 +31,7 @@
 //! assert!(out.link_lost);
 //! assert_eq!(out.arm.unwrap().micros(), 1100);
 //! ```
+// req: P4.3, P4.5, P4.6, D:board-b-heartbeat-and-hold, D:b-starts-at-home
 
 use crate::bolter::{BolterSide, Drive, MuxLines, Sensed, SideConfig};
 use crate::control::interp::{Interpolator, Rate, Travel};

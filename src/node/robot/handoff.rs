@@ -27,6 +27,7 @@
 //! on the ESP32-C3 (RV32IMC) enable mmic's feature `portable-atomic-critical-section`, or
 //! `portable-atomic` when another crate already selects portable-atomic's backend (esp-hal on
 //! the C3 selects `unsafe-assume-single-core`, which `critical-section` may not join).
+// req: P2.11, P3.17, P3.18
 
 use heapless::spsc;
 
@@ -124,6 +125,7 @@ mod tests {
     /// comes out once, in order, byte for byte; a full queue (N − 1 = 3) hands the packet back
     /// and keeps what it holds; a packet given up is counted. Under Miri (.ci/miri) this walks
     /// heapless's `unsafe` slot accesses at every position of the ring.
+    // req: P3.18
     #[test]
     fn packets_come_out_in_order_over_many_laps_and_a_full_queue_hands_back() {
         let mut q: PacketQueue<14, 4> = PacketQueue::default();

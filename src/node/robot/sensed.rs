@@ -11,6 +11,7 @@
 //! let inputs = board_a::Inputs::sensed(&f, true, true, None, None);
 //! assert_eq!((inputs.hip, inputs.lost), (f.hip, f.lost));
 //! ```
+// req: P2.7
 
 use super::{board_a, board_b};
 use crate::sensors::frontend::Filtered;

@@ -48,6 +48,7 @@
 //! assert!(wifi.close());
 //! assert_eq!(wifi.counts().sent, 1);
 //! ```
+// req: P3.14
 
 use crate::wire::command::COMMAND_LEN;
 use crate::wire::deframer::{Deframed, Deframer};
@@ -241,6 +242,7 @@ mod tests {
         .to_bytes()
     }
 
+    // req: P3.14
     #[test]
     fn a_new_connection_forgets_the_last_ones_cut_packet() {
         let mut w = WifiSession::default();
@@ -258,6 +260,7 @@ mod tests {
         assert_eq!(w.counts().connections, 2);
     }
 
+    // req: P3.14
     #[test]
     fn bytes_without_a_connection_and_other_kinds_are_not_commands() {
         let mut w = WifiSession::default();
@@ -272,6 +275,7 @@ mod tests {
         assert_eq!((got, w.counts().other_kind, w.counts().commands), (1, 1, 1));
     }
 
+    // req: P3.14
     #[test]
     fn stale_heartbeats_are_dropped_and_fresh_ones_sent() {
         let mut w = WifiSession::default();
@@ -292,6 +296,7 @@ mod tests {
         assert_eq!((c.sent, c.unconnected), (1, 3));
     }
 
+    // req: P3.14
     #[test]
     fn idleness_counts_from_the_last_bytes_and_wraps() {
         let mut w = WifiSession::new(WifiConfig { idle_ms: 100 });

@@ -35,6 +35,7 @@
 //! server.delivered(robot, &packet);
 //! assert_eq!(server.next_visit(), None);
 //! ```
+// req: P3.5, P3.6, P3.7, D:server-pending-slot
 
 use crate::units::BoardNumber;
 use crate::wire::command::{CommandRepr, COMMAND_LEN};
@@ -217,6 +218,7 @@ mod tests {
         }
     }
 
+    // req: P3.5, P3.6
     #[test]
     fn full_hands_the_packet_back_and_free_slots_are_reused() {
         let mut s: Server<2> = Server::new();
@@ -235,6 +237,7 @@ mod tests {
         assert_eq!(s.pending_count(), 2);
     }
 
+    // req: P3.7
     #[test]
     fn supersession_is_reported_and_visits_alternate() {
         let mut s: Server<4> = Server::new();

@@ -45,6 +45,7 @@
 //! // Without it, the visit would have ended at its deadline.
 //! assert_eq!(visit.left_ms(300), None);
 //! ```
+// req: P3.7, P3.8, P3.9, D:relay-visit-window
 
 use super::relay::{Packet, Server};
 use crate::units::BoardNumber;
@@ -170,6 +171,7 @@ mod tests {
         .to_bytes()
     }
 
+    // req: D:relay-visit-window
     #[test]
     fn the_deadline_counts_from_the_start_and_wraps() {
         let v = Visit::new(u32::MAX - 50, BoardNumber::ONE, stop(1), 100);
@@ -180,6 +182,7 @@ mod tests {
         assert_eq!(v.left_ms(1_000), None);
     }
 
+    // req: P3.8
     #[test]
     fn the_answer_is_the_first_heartbeat_after_garbage_and_other_kinds() {
         let mut v = Visit::new(0, BoardNumber::ONE, stop(1), 200);
@@ -196,6 +199,7 @@ mod tests {
         assert!(v.discarded() > 0);
     }
 
+    // req: P3.6, P3.9
     #[test]
     fn an_unwritten_visit_leaves_its_command_pending() {
         let mut s: Server<2> = Server::new();

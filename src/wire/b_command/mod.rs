@@ -21,6 +21,7 @@
 //! assert_eq!(&bytes[..6], b"MIbc\x07\x07");
 //! assert_eq!(BCommandRepr::parse(&bytes), Ok(cmd));
 //! ```
+// req: D:b-command
 
 use super::layout::fields;
 use super::pulse;

@@ -10,6 +10,7 @@
 //! assert_eq!(id, opcode::HIP + 1);
 //! assert_eq!(opcode::decode(id, params), Ok(Command::Hip(HipTarget::Straight)));
 //! ```
+// req: T1/*, P3.13, D:opcodes
 
 use crate::command::{
     BolterCommand, BolterPair, Command, CommandKind, Fasteners, HipTarget, PowerTarget,
@@ -471,6 +472,7 @@ mod tests {
         Ok(())
     }
 
+    // req: P3.13
     #[test]
     fn unused_bytes_are_refused_as_byte_by_byte() {
         // Every mask a decoder returns, over every combination of four values per byte

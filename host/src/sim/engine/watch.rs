@@ -727,6 +727,7 @@ mod tests {
         assert!(w.violations.is_empty());
     }
 
+    // req: P7.3
     #[test]
     fn standby_drives_nothing_and_nothing_moves_after_the_grace() {
         let mut w = watch();
@@ -751,6 +752,7 @@ mod tests {
         assert!(w.violations.is_empty());
     }
 
+    // req: T8/*
     #[test]
     fn a_fault_must_reach_its_table8_mode_in_its_tick() {
         // Safed fault in Operational: Safed at once.
@@ -775,6 +777,7 @@ mod tests {
         assert_eq!(kinds(&w), [Invariant::FaultMode]);
     }
 
+    // req: P7.13
     #[test]
     fn a_deferred_fault_waits_for_the_motion_then_gives_standby() {
         let mut moving = tick(Mode::Operational);

@@ -39,6 +39,7 @@
 //! assert_eq!(end, PlanEnd::Completed);
 //! assert!(now >= 2050);
 //! ```
+// req: P3.1, P8.3
 
 mod interject;
 mod over_pus;

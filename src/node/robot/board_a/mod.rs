@@ -33,6 +33,7 @@
 //! assert_eq!(HeartbeatRepr::parse(&out.heartbeat.unwrap()).unwrap().last_seq, 1);
 //! assert!(out.events.iter().any(|e| matches!(e, mmic::node::robot::board_a::Event::Duplicate { seq: 1 })));
 //! ```
+// req: P4.1, P4.4, P3.14, P7.6
 
 //!
 //! The board is split by what each part holds: this file has the board's state and its tick;

@@ -55,6 +55,7 @@
 //! ```
 //!
 //! [`TcFrame::new_checked`]: crate::link::tc_frame::TcFrame::new_checked
+// req: D:link-cop1, D:restart-server
 
 use super::gateway::{Config as GatewayConfig, Gateway, Kept, KEPT_SOURCES};
 use super::store::queue::QUEUE_SLOTS;

@@ -41,6 +41,7 @@
 //! let stages: Vec<_> = out.reports.iter().filter_map(|r| r.stage()).collect();
 //! assert_eq!(stages, [(Stage::Completion, true)]); // start success not asked (ack 0b1001)
 //! ```
+// req: D:pus-gateway
 
 mod robot;
 

@@ -43,6 +43,7 @@
 //! let other = store::boot(End::Server, one, &tc, &key(3), |k| flash.get(&k).copied());
 //! assert_eq!(other.unwrap_err(), Stopped::OtherKey { spi: 513 });
 //! ```
+// req: D:sdls-store, D:restart-server
 
 pub mod keys;
 pub mod log;
