@@ -1774,3 +1774,24 @@ fn a_budget_starts_with_its_motion() {
         r.now - start
     );
 }
+
+/// A report from board B that fails its check is an event, and board A goes on as if it had
+/// heard nothing that tick: the same state as a twin whose report was lost.
+#[test]
+fn a_corrupted_report_from_b_is_rejected_as_if_lost() {
+    let mut r = Rig::operational();
+    r.run(5);
+    let mut bad = r.to_a.expect("B reports every tick");
+    bad[9] ^= 0x04;
+    let err = InternalHeartbeatRepr::parse(&bad).unwrap_err();
+    let mut twin = r.a;
+    let inputs = |from_b| Inputs {
+        from_b,
+        ..Inputs::at_home()
+    };
+    let out = r.a.tick(r.now + 10, &inputs(Some(bad)));
+    assert_eq!(out.events.as_slice(), [Event::Rejected(err)]);
+    let quiet = twin.tick(r.now + 10, &inputs(None));
+    assert!(quiet.events.is_empty());
+    assert_eq!(r.a, twin);
+}
