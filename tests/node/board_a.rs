@@ -1795,3 +1795,53 @@ fn a_corrupted_report_from_b_is_rejected_as_if_lost() {
     assert!(quiet.events.is_empty());
     assert_eq!(r.a, twin);
 }
+
+/// A deferred fault (low battery) latched while an accepted reconfiguration waits for the
+/// robot to rest: the reconfiguration's first primitive never starts, and Standby follows
+/// (Table 8: a deferred fault waits for the motion in progress; none had started).
+#[test]
+fn a_deferred_fault_while_a_reconfiguration_waits_to_start_drops_it() {
+    let mut cfg = board_a::Config::default();
+    // Settling longer than the battery's debounce: the fault comes while the check waits.
+    cfg.idle_settle_ms = 2_000;
+    cfg.safety.low_battery_ms = 100;
+    let mut r = Rig::operational_with(cfg);
+    for target in [ServoTarget::Extend, ServoTarget::Contract] {
+        r.send(arm(Side::A, target));
+        while {
+            r.tick(None);
+            r.a.in_motion()
+        } {}
+    }
+    let hb = r.send(extend_from_a()).hb.unwrap();
+    r.tick(Some(Command::ClearFaults));
+    assert!(
+        r.a.in_motion(),
+        "the reconfiguration waits for the idle check"
+    );
+    let before = (hb.gripper_a_target, r.last_b.unwrap().gripper_target);
+    r.electrical = [Electrical {
+        v_bat: 9_000,
+        ..r.electrical[0]
+    }; 2];
+    let mut events = Vec::new();
+    for _ in 0..300 {
+        let t = r.tick(Some(Command::ClearFaults));
+        events.extend(t.a.events.iter().copied());
+        let hb = t.hb.unwrap();
+        assert_eq!(
+            (hb.gripper_a_target, r.last_b.unwrap().gripper_target),
+            before,
+            "a primitive started at {} ms",
+            r.now
+        );
+    }
+    assert_eq!(r.a.mode(), Mode::Standby);
+    assert!(r.a.faults().contains(Fault::LowBattery));
+    assert!(!r.a.in_motion());
+    assert!(!events.iter().any(|e| matches!(e, Event::Reached(_))));
+    assert!(events.contains(&Event::Mode {
+        from: Mode::Operational,
+        to: Mode::Standby
+    }));
+}
