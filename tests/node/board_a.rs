@@ -1801,10 +1801,16 @@ fn a_corrupted_report_from_b_is_rejected_as_if_lost() {
 /// (Table 8: a deferred fault waits for the motion in progress; none had started).
 #[test]
 fn a_deferred_fault_while_a_reconfiguration_waits_to_start_drops_it() {
-    let mut cfg = board_a::Config::default();
     // Settling longer than the battery's debounce: the fault comes while the check waits.
-    cfg.idle_settle_ms = 2_000;
-    cfg.safety.low_battery_ms = 100;
+    let defaults = board_a::Config::default();
+    let cfg = board_a::Config {
+        idle_settle_ms: 2_000,
+        safety: mmic::safety::detect::Config {
+            low_battery_ms: 100,
+            ..defaults.safety
+        },
+        ..defaults
+    };
     let mut r = Rig::operational_with(cfg);
     for target in [ServoTarget::Extend, ServoTarget::Contract] {
         r.send(arm(Side::A, target));
