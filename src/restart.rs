@@ -162,4 +162,15 @@ mod tests {
         assert_eq!(Boot::after(ResetCause::PowerOn, 1).to_wire(), 0x21);
         assert_eq!(Boot::after(ResetCause::PowerOn, 32).to_wire(), 0x20);
     }
+
+    /// A reset cause displays as its name.
+    #[test]
+    fn a_cause_displays_as_its_name() {
+        extern crate std;
+        use std::string::ToString;
+        for (i, name) in ResetCause::NAMES.iter().enumerate() {
+            let cause = Boot::from_wire((i as u8) << 5).cause;
+            assert_eq!(cause.to_string(), *name);
+        }
+    }
 }

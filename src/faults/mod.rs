@@ -287,4 +287,27 @@ mod tests {
             );
         }
     }
+
+    /// A fault with a Table 8 row goes by the row's name; one without (the project's own)
+    /// by its own.
+    #[test]
+    fn a_fault_without_a_table_8_row_goes_by_its_own_name() {
+        for f in Fault::ALL {
+            match f.table8() {
+                Some(r) => assert_eq!(f.row_name(), r.name()),
+                None => assert_eq!(f.row_name(), f.name()),
+            }
+        }
+        assert_eq!(Fault::MotionTimeout.row_name(), Fault::MotionTimeout.name());
+    }
+
+    /// JSON that is not a list of names is refused, saying what was expected.
+    #[cfg(feature = "serde")]
+    #[test]
+    fn a_faults_set_that_is_not_a_list_is_refused() {
+        extern crate std;
+        use std::string::ToString;
+        let e = serde_json::from_str::<Faults>("3").unwrap_err();
+        assert!(e.to_string().contains("a list of fault names"), "{e}");
+    }
 }

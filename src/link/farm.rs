@@ -351,4 +351,17 @@ mod tests {
         )
         .is_none());
     }
+
+    /// The default window is the mission's; a FARM keeps the window it was made with.
+    #[test]
+    fn the_window_is_the_one_given_and_defaults_to_the_missions() {
+        assert_eq!(FarmWindow::default(), FarmWindow::MISSION);
+        let w = FarmWindow::new(10).unwrap();
+        assert_ne!(w, FarmWindow::MISSION);
+        assert_eq!(Farm::new(w).window(), w);
+        assert_eq!(
+            Farm::new(FarmWindow::default()).window(),
+            FarmWindow::MISSION
+        );
+    }
 }

@@ -674,4 +674,44 @@ mod tests {
         assert_eq!(f.state(), FopState::Active);
         assert_eq!(sent_ns(&outs), [3]);
     }
+
+    /// An Initiate or a Resume directive outside Initial (S6) is rejected and changes
+    /// nothing.
+    #[test]
+    fn initiate_and_resume_outside_initial_are_rejected() {
+        let mut f = active(small());
+        let mut outs = Vec::new();
+        for d in [
+            Directive::InitiateWithSetVr(5),
+            Directive::InitiateWithoutClcw,
+            Directive::Resume,
+        ] {
+            assert_eq!(
+                f.directive(d, 0, &mut |o| outs.push(o)),
+                DirectiveResponse::Rejected,
+                "{d:?}"
+            );
+        }
+        assert!(outs.is_empty());
+        assert_eq!((f.state(), f.vs()), (FopState::Active, 0));
+    }
+
+    /// The alerts go by the standard's names.
+    #[test]
+    fn alerts_go_by_the_standards_names() {
+        let names = [
+            AlertCode::Limit,
+            AlertCode::T1,
+            AlertCode::Lockout,
+            AlertCode::Synch,
+            AlertCode::NnR,
+            AlertCode::Clcw,
+            AlertCode::Term,
+        ]
+        .map(AlertCode::name);
+        assert_eq!(
+            names,
+            ["LIMIT", "T1", "LOCKOUT", "SYNCH", "NN(R)", "CLCW", "TERM"]
+        );
+    }
 }

@@ -301,4 +301,18 @@ mod tests {
             assert_eq!(FirstHeaderPointer::from_field(v).field(), v);
         }
     }
+
+    /// Room for SDLS: a security header and trailer that leave no packet octet are refused;
+    /// otherwise the packet zone shrinks by both and `security` gives them back.
+    #[test]
+    fn security_leaves_a_packet_octet_or_is_refused() {
+        let p = TmFrameParams::new(64, 1, 0, true, true).unwrap();
+        let n = p.data_len();
+        assert_eq!(p.security(), (0, 0));
+        let s = p.with_security(14, 16).unwrap();
+        assert_eq!((s.security(), s.data_len()), ((14, 16), n - 30));
+        let whole = u8::try_from(n).unwrap();
+        assert!(p.with_security(whole - 16, 16).is_none());
+        assert!(p.with_security(whole - 17, 16).is_some());
+    }
 }

@@ -242,4 +242,16 @@ mod tests {
             assert_eq!(all.len(), one[0].len());
         }
     }
+
+    /// Empty until the first sample, whichever filter.
+    #[test]
+    fn empty_until_the_first_sample() {
+        let mut m = MovingAverage::<4>::new();
+        let mut a = Averages::<4, 2>::new();
+        assert!(m.is_empty() && a.is_empty());
+        m.push(7);
+        a.push([7, 8]);
+        assert!(!m.is_empty() && !a.is_empty());
+        assert_eq!((m.len(), a.len()), (1, 1));
+    }
 }

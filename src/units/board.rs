@@ -60,3 +60,18 @@ impl From<BoardNumber> for u8 {
         b.get()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `TryFrom<u8>` is `new`: 1..=255, not 0.
+    #[test]
+    fn try_from_a_byte_is_new() {
+        for n in 0..=u8::MAX {
+            assert_eq!(BoardNumber::try_from(n), BoardNumber::new(n));
+        }
+        assert!(BoardNumber::try_from(0).is_err());
+        assert_eq!(BoardNumber::try_from(7).map(u8::from), Ok(7));
+    }
+}

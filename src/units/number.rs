@@ -129,3 +129,20 @@ pub(crate) mod de {
         milliamps: u16, "current (mA)";
     }
 }
+
+#[cfg(all(test, feature = "serde"))]
+mod tests {
+    use super::*;
+
+    /// A whole float (JSON's form of an integer beyond u64, or written with an exponent) is
+    /// that integer; a fraction is refused.
+    #[test]
+    fn a_whole_float_is_its_integer() {
+        let read = |s: &str| serde_json::from_str::<Number>(s).ok();
+        assert_eq!(read("1e2"), Some(Number(100)));
+        assert_eq!(read("-3.0"), Some(Number(-3)));
+        assert_eq!(read("1e20"), Some(Number(100_000_000_000_000_000_000)));
+        assert_eq!(read("1.5"), None);
+        assert_eq!(read("7"), Some(Number(7)));
+    }
+}

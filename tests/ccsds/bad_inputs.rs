@@ -135,7 +135,16 @@ pub fn verdict(row: &Row, apids: &[u16]) -> Option<&'static str> {
         }
         other => panic!("row {}: no parser named {other:?}", row.name),
     };
-    r.err().map(|e| PusError::from(e).name())
+    r.err().map(|e| {
+        // A check's place in the order names it.
+        assert_eq!(
+            PacketError::NAMES[e.position()],
+            e.name(),
+            "row {}",
+            row.name
+        );
+        PusError::from(e).name()
+    })
 }
 
 /// A `tc-frame` row: the frame through `TcFrame::new_checked` with the mission's configuration

@@ -16,6 +16,7 @@ mod interop_spacepackets;
 mod link_spec;
 mod pics;
 mod sdls;
+mod sdls_edges;
 mod sdls_spec;
 mod shared_link;
 mod store;

@@ -304,3 +304,57 @@ fn every_queued_telecommand_round_trips_through_its_entry() {
         "opcode 0xEE"
     );
 }
+
+/// An entry whose reserved octets are not zero, or an SPI listed twice, is refused when read
+/// even under a CRC that matches (a writer other than `keys::emit`); every refusal's name.
+#[test]
+fn a_sealed_partition_with_a_bad_entry_is_refused_when_read() {
+    let part = partition(2);
+    let signed = HEADER_LEN + 2 * ENTRY_LEN;
+    let reseal = |p: &mut Vec<u8>| {
+        let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(&p[..signed]);
+        p[signed..signed + 4].copy_from_slice(&crc.to_be_bytes());
+    };
+    let mut same = part.clone();
+    reseal(&mut same);
+    assert_eq!(
+        same, part,
+        "the CRC is CRC-32/ISO-HDLC over header and entries"
+    );
+    // Entry 1's reserved octets (after its 2-octet SPI).
+    let mut p = part.clone();
+    p[HEADER_LEN + ENTRY_LEN + 3] = 1;
+    reseal(&mut p);
+    let e = keys::parse(&p).unwrap_err();
+    assert_eq!(
+        e,
+        KeysError::Reserved {
+            at: HEADER_LEN + ENTRY_LEN + 2
+        }
+    );
+    assert_eq!(e.name(), "reserved");
+    // Entry 1 with entry 0's SPI.
+    let mut p = part.clone();
+    p.copy_within(HEADER_LEN..HEADER_LEN + 2, HEADER_LEN + ENTRY_LEN);
+    reseal(&mut p);
+    let e = keys::parse(&p).unwrap_err();
+    assert_eq!(e, KeysError::Duplicate { spi: 0x100 });
+    assert_eq!(e.name(), "duplicate");
+    assert_eq!(KeysError::Blank.name(), "blank");
+    assert_eq!(
+        KeysError::Weak {
+            spi: 1,
+            reason: WeakKey::Repeated { octet: 0 }
+        }
+        .name(),
+        "weak-key"
+    );
+    assert_eq!(
+        KeysError::Room {
+            needed: 2,
+            found: 1
+        }
+        .name(),
+        "room"
+    );
+}

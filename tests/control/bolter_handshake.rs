@@ -332,3 +332,11 @@ fn handshake_single_pair_bolt() {
 fn handshake_single_pair_unbolt() {
     check_direction(BolterDirection::Unbolt);
 }
+
+/// The default coordinator is a new one: no job, idle.
+#[test]
+fn the_default_coordinator_is_idle() {
+    let c = Coordinator::default();
+    assert_eq!(c, Coordinator::new());
+    assert_eq!(c.status(), Status::Idle);
+}

@@ -237,3 +237,28 @@ fn the_defaults_equal_the_table_of_spec_control_hip_md() {
     }
     assert_eq!(table.len(), code.len(), "{table:?}");
 }
+
+/// The controller's law and velocity estimate as the heartbeat and the logs read them: far
+/// from the target it tracks a speed (Velocity) and its estimate follows the hip turning;
+/// at the target it holds the angle (Position); without a reading it starts afresh.
+#[test]
+fn the_law_and_the_velocity_estimate_follow_the_hip() {
+    use mmic::control::hip::Mode;
+    let mut c = HipController::new(Config::default());
+    assert_eq!((c.mode(), c.velocity()), (Mode::Position, 0));
+    let target = HipAngle::STRAIGHT;
+    // Far from the target, turning 1° every 10 ms tick toward it.
+    for t in 0..20u32 {
+        let at = HipAngle::wrapping(9000 + 100 * t as u16);
+        c.step(target, at, t * 10);
+    }
+    assert_eq!(c.mode(), Mode::Velocity);
+    assert!(c.velocity() > 0, "{}", c.velocity());
+    c.blind();
+    assert_eq!((c.mode(), c.velocity()), (Mode::Position, 0));
+    // At the target and still: Position.
+    for t in 0..5u32 {
+        c.step(target, target, 1_000 + t * 10);
+    }
+    assert_eq!(c.mode(), Mode::Position);
+}

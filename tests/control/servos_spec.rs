@@ -114,3 +114,23 @@ fn the_decoder_enforces_the_spec_travel() {
         }
     }
 }
+
+/// A mirrored servo (its contracted pulse above its extended one) has the same travel bounds:
+/// `min` and `max` are the pulses' order, whichever end each is.
+#[test]
+fn a_mirrored_travel_has_the_same_bounds() {
+    use mmic::command::Travel;
+    use mmic::units::PulseWidth;
+    let pw = |us| PulseWidth::new(us).unwrap();
+    let plain = Travel {
+        contracted: pw(900),
+        extended: pw(2100),
+    };
+    let mirrored = Travel {
+        contracted: pw(2100),
+        extended: pw(900),
+    };
+    for t in [plain, mirrored] {
+        assert_eq!((t.min(), t.max()), (pw(900), pw(2100)), "{t:?}");
+    }
+}

@@ -169,3 +169,29 @@ fn matched_plan_table_in_model_md_is_current() {
     }
     assert_eq!(rows, 6, "the table's six rows");
 }
+
+/// A plan hashes by what it visits, as it compares: the 225 plans fall into as many hash-set
+/// entries as there are distinct plans, and a runner started on a plan targets its end.
+#[test]
+fn plans_hash_as_they_compare_and_a_runner_targets_the_plans_end() {
+    use mmic::motion::route::{lookup, Route};
+    use mmic::motion::runner::Runner;
+    use mmic::motion::sequencer::{Config, Targets};
+    use std::collections::HashSet;
+    let plans: Vec<Route> = State::ALL
+        .iter()
+        .flat_map(|&f| State::ALL.iter().map(move |&t| lookup(f, t)))
+        .collect();
+    let mut distinct: Vec<Route> = Vec::new();
+    for p in &plans {
+        if !distinct.contains(p) {
+            distinct.push(*p);
+        }
+    }
+    let hashed: HashSet<Route> = plans.iter().copied().collect();
+    assert_eq!(hashed.len(), distinct.len());
+    for &t in &State::ALL {
+        let r = Runner::start(Config::default(), State::A, t, Targets::home(), 0);
+        assert_eq!(r.target_state(), t);
+    }
+}

@@ -1814,3 +1814,80 @@ fn a_budget_starts_with_its_motion() {
         r.now - start
     );
 }
+
+/// A report from board B that fails its check is an event, and board A goes on as if it had
+/// heard nothing that tick: the same state as a twin whose report was lost.
+#[test]
+fn a_corrupted_report_from_b_is_rejected_as_if_lost() {
+    let mut r = Rig::operational();
+    r.run(5);
+    let mut bad = r.to_a.expect("B reports every tick");
+    bad[9] ^= 0x04;
+    let err = InternalHeartbeatRepr::parse(&bad).unwrap_err();
+    let mut twin = r.a;
+    let inputs = |from_b| Inputs {
+        from_b,
+        ..Inputs::at_home()
+    };
+    let out = r.a.tick(r.now + 10, &inputs(Some(bad)));
+    assert_eq!(out.events.as_slice(), [Event::Rejected(err)]);
+    let quiet = twin.tick(r.now + 10, &inputs(None));
+    assert!(quiet.events.is_empty());
+    assert_eq!(r.a, twin);
+}
+
+/// A deferred fault (low battery) latched while an accepted reconfiguration waits for the
+/// robot to rest: the reconfiguration's first primitive never starts, and Standby follows
+/// (Table 8: a deferred fault waits for the motion in progress; none had started).
+#[test]
+fn a_deferred_fault_while_a_reconfiguration_waits_to_start_drops_it() {
+    // Settling longer than the battery's debounce: the fault comes while the check waits.
+    let defaults = board_a::Config::default();
+    let cfg = board_a::Config {
+        idle_settle_ms: 2_000,
+        safety: mmic::safety::detect::Config {
+            low_battery_ms: 100,
+            ..defaults.safety
+        },
+        ..defaults
+    };
+    let mut r = Rig::operational_with(cfg);
+    for target in [ServoTarget::Extend, ServoTarget::Contract] {
+        r.send(arm(Side::A, target));
+        while {
+            r.tick(None);
+            r.a.in_motion()
+        } {}
+    }
+    let hb = r.send(extend_from_a()).hb.unwrap();
+    r.tick(Some(Command::ClearFaults));
+    assert!(
+        r.a.in_motion(),
+        "the reconfiguration waits for the idle check"
+    );
+    let before = (hb.gripper_a_target, r.last_b.unwrap().gripper_target);
+    r.electrical = [Electrical {
+        v_bat: 9_000,
+        ..r.electrical[0]
+    }; 2];
+    let mut events = Vec::new();
+    for _ in 0..300 {
+        let t = r.tick(Some(Command::ClearFaults));
+        events.extend(t.a.events.iter().copied());
+        let hb = t.hb.unwrap();
+        assert_eq!(
+            (hb.gripper_a_target, r.last_b.unwrap().gripper_target),
+            before,
+            "a primitive started at {} ms",
+            r.now
+        );
+    }
+    assert_eq!(r.a.mode(), Mode::Standby);
+    assert!(r.a.faults().contains(Fault::LowBattery));
+    assert!(!r.a.in_motion());
+    assert!(!events.iter().any(|e| matches!(e, Event::Reached(_))));
+    assert!(events.contains(&Event::Mode {
+        from: Mode::Operational,
+        to: Mode::Standby
+    }));
+}

@@ -84,3 +84,29 @@ fn a_copy_after_a_crash_mid_command_is_never_run_again_nor_acknowledged_falsely(
         }
     }
 }
+
+/// The five-octet record reads back as written, for every outcome; an outcome byte that is
+/// no refusal code reads back as nothing (the shell then boots as from a fresh flash).
+#[test]
+fn the_durable_record_round_trips_and_refuses_an_unknown_outcome() {
+    use mmic::node::robot::board_a::Durable;
+    let outcomes = std::iter::once(None).chain(Refusal::ALL.into_iter().map(Some));
+    for (i, outcome) in outcomes.enumerate() {
+        let d = Durable {
+            last_seq: 0x1234u16.wrapping_add(i as u16),
+            outcome,
+            boots: 0xfe01,
+        };
+        let b = d.to_bytes();
+        assert_eq!(b[2], outcome.map_or(0, Refusal::to_wire));
+        assert_eq!(
+            [b[0], b[1], b[3], b[4]],
+            [0x34u8.wrapping_add(i as u8), 0x12, 0x01, 0xfe]
+        );
+        assert_eq!(Durable::from_bytes(&b), Some(d));
+    }
+    let unknown = (1..=u8::MAX)
+        .find(|x| Refusal::from_wire(*x).is_none())
+        .unwrap();
+    assert_eq!(Durable::from_bytes(&[1, 0, unknown, 2, 0]), None);
+}

@@ -1,7 +1,7 @@
 //! Board B on its own: it follows A's targets for each servo separately, holds on A's stop
 //! flag, and judges the A→B link silent exactly past its timeout.
 
-use mmic::node::robot::board_b::{BoardB, Config, Inputs};
+use mmic::node::robot::board_b::{BoardB, Config, Inputs, Outputs};
 use mmic::units::{Electrical, PulseWidth};
 use mmic::wire::b_command::{BCommandRepr, BPower};
 
@@ -217,5 +217,36 @@ fn each_servo_is_driven_only_with_the_regulator_and_its_power_bit() {
         assert_eq!(out.arm.is_some(), regulator && arm);
         assert_eq!(out.gripper.is_some(), regulator && gripper);
         assert_eq!(out.regulator, regulator);
+    }
+}
+
+/// A command that fails its check is reported rejected and not taken: board B goes on as
+/// if nothing had come (the same outputs, tick after tick, as a twin that heard nothing).
+#[test]
+fn a_corrupted_command_is_rejected_and_not_taken() {
+    let cfg = Config::default();
+    let pw = |us| PulseWidth::new(us).unwrap();
+    let mut b = BoardB::new(cfg);
+    let out = b.tick(0, &inputs(Some(command(1, pw(1400), pw(1600), false))));
+    assert_eq!(out.rejected, None);
+    let mut twin = b;
+    let mut bad = command(2, pw(1700), pw(1300), true);
+    bad[7] ^= 0x10;
+    let err = BCommandRepr::parse(&bad).unwrap_err();
+    let out = b.tick(10, &inputs(Some(bad)));
+    assert_eq!(out.rejected, Some(err));
+    let quiet = twin.tick(10, &inputs(None));
+    assert_eq!(
+        Outputs {
+            rejected: None,
+            ..out
+        },
+        quiet
+    );
+    for t in 2..100u32 {
+        assert_eq!(
+            b.tick(t * 10, &inputs(None)),
+            twin.tick(t * 10, &inputs(None))
+        );
     }
 }

@@ -650,3 +650,15 @@ fn a_flood_of_bad_frames_does_not_delay_good_ones() {
         quiet.done_ms
     );
 }
+
+/// A robot is served once, and no more robots than the gateway has places for.
+#[test]
+fn a_robot_is_served_once_and_the_places_are_counted() {
+    let mut server = Server::new(FrameConfig::default());
+    assert!(server.add(BoardNumber::ONE));
+    assert!(!server.add(BoardNumber::ONE), "served twice");
+    assert!(
+        !server.add(BoardNumber::new(2).unwrap()),
+        "one place (R = 1)"
+    );
+}

@@ -491,3 +491,23 @@ fn kept_key_never_moves_back_on_reordered_telecommands() {
         .iter()
         .all(|(_, c)| c.command != Command::Stop));
 }
+
+/// A robot is served once; one not served is refused everywhere and changes nothing: its
+/// heartbeat is ignored, the store's clearance and a restored queue for it are refused.
+#[test]
+fn a_robot_not_served_is_refused_everywhere() {
+    let mut g: Gateway<2, 4, 8> = Gateway::new(Config::default());
+    assert!(g.add(BoardNumber::ONE));
+    assert!(!g.add(BoardNumber::ONE), "served twice");
+    let two = BoardNumber::new(2).unwrap();
+    let hb = HeartbeatRepr {
+        board: two,
+        ..HeartbeatRepr::default()
+    };
+    let out = g.heartbeat(0, &hb);
+    assert!(out.reports.is_empty() && out.to_robots.is_empty());
+    assert_eq!(out.overflow, 0);
+    assert!(!g.clear_to_send(two, (0, 1)));
+    assert!(!g.restore_queue(two, &[]));
+    assert!(g.queued(two).is_empty());
+}

@@ -308,3 +308,14 @@ fn every_refusal_code_names_the_decision_that_introduced_it() {
         assert_introduces(&d, &s.refusal_decisions[r.name()], r.name());
     }
 }
+
+/// The default supervisor is the one at startup: Standby, every module enabled, no fault.
+#[test]
+fn the_default_supervisor_is_the_startup_one() {
+    use mmic::safety::supervisor::Supervisor;
+    let s = Supervisor::default();
+    assert_eq!(s, Supervisor::new());
+    assert_eq!(s.mode(), Mode::Standby);
+    assert_eq!(s.enabled(), ModuleSet::ALL);
+    assert!(s.faults().is_empty() && !s.stopped() && !s.standby_pending());
+}

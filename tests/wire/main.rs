@@ -11,3 +11,4 @@ mod opcode;
 mod proptest_config;
 mod round_trip;
 mod spec;
+mod trait_emit;

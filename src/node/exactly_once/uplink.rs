@@ -471,4 +471,12 @@ mod tests {
         }
         assert_eq!(e.percent(), Some(100));
     }
+
+    /// Numbers wrap from 65535 to 1: 0 is never a command's number.
+    #[test]
+    fn numbers_wrap_past_65535_to_1() {
+        let mut up = Uplink::starting_at(Config::default(), BoardNumber::ONE, u16::MAX);
+        assert_eq!(up.submit(Command::Reset).ok(), Some(u16::MAX));
+        assert_eq!(up.next_seq(), 1);
+    }
 }

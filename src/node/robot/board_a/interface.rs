@@ -251,3 +251,22 @@ impl Outputs {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Events past [`EVENTS`] in one tick are counted, the first ones kept.
+    #[test]
+    fn events_past_the_capacity_are_counted() {
+        let mut out = Outputs::empty();
+        for _ in 0..EVENTS {
+            out.push(Event::Paused);
+        }
+        assert_eq!((out.events.len(), out.events_lost), (EVENTS, 0));
+        out.push(Event::Resumed);
+        out.push(Event::Resumed);
+        assert_eq!(out.events_lost, 2);
+        assert!(out.events.iter().all(|e| *e == Event::Paused));
+    }
+}
