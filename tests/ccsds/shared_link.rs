@@ -5,7 +5,6 @@
 
 use mmic::ccsds::primary::{Apid, SeqCount};
 use mmic::ccsds::tc::TcRepr;
-use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
 use mmic::link::clcw::Clcw;
 use mmic::link::fop::{
     Directive, DirectiveResponse, Fop, FopConfig, FopOutput, FrameData, TimeoutType,
@@ -22,13 +21,7 @@ fn ping_frame(scid: u16, apid: u16) -> Vec<u8> {
     TcRepr {
         apid: Apid::new(apid).unwrap(),
         seq_count: SeqCount::new(0).unwrap(),
-        header: TcSecondaryHeader {
-            ack: AckFlags::ALL,
-            service: 17,
-            subservice: 1,
-            source_id: 0,
-        },
-        app_data: &[],
+        ..crate::ping()
     }
     .emit(&mut ping)
     .unwrap();

@@ -535,6 +535,8 @@ fn entering_operational_sends_the_hip_to_its_configured_home() {
     let mut reference = Rig::operational();
     let hold = reference.tick(None).a.hip;
     let mut a = BoardA::new(cfg);
+    // The settings a shell restarting the board reads back: the ones it was started with.
+    assert_eq!(a.config(), cfg);
     let inputs = |command| Inputs {
         command,
         hip: Some(home),

@@ -158,38 +158,7 @@ impl BCommandRepr {
                 u32::from(p.flags),
             ));
         }
-        let bolter = match (p.bolter_pair, p.bolter_direction, p.bolter_step) {
-            (0, 0, 0) => None,
-            (pair, dir, step) => Some(BolterOrder {
-                pair: BolterPair::from_number(pair).ok_or_else(|| {
-                    field_err(
-                        KIND,
-                        at!(bolter_pair),
-                        "bolter.pair",
-                        "1..=4 (or bytes 10-12 all 0)",
-                        u32::from(pair),
-                    )
-                })?,
-                direction: BolterDirection::from_wire(dir).ok_or_else(|| {
-                    field_err(
-                        KIND,
-                        at!(bolter_direction),
-                        "bolter.direction",
-                        "1 (bolt) or 2 (unbolt)",
-                        u32::from(dir),
-                    )
-                })?,
-                step: BolterStep::from_wire(step).ok_or_else(|| {
-                    field_err(
-                        KIND,
-                        at!(bolter_step),
-                        "bolter.step",
-                        "1..=8",
-                        u32::from(step),
-                    )
-                })?,
-            }),
-        };
+        let bolter = bolter_order(p)?;
         Ok(BCommandRepr {
             seq: p.seq,
             power: BPower {
@@ -239,4 +208,41 @@ impl BCommandRepr {
         self.emit(&mut out);
         out
     }
+}
+
+/// Bytes 10–12: no order when all three are zero, else a whole, valid one.
+#[inline]
+fn bolter_order(p: &BCommandPacket) -> Result<Option<BolterOrder>, WireError> {
+    Ok(match (p.bolter_pair, p.bolter_direction, p.bolter_step) {
+        (0, 0, 0) => None,
+        (pair, dir, step) => Some(BolterOrder {
+            pair: BolterPair::from_number(pair).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(bolter_pair),
+                    "bolter.pair",
+                    "1..=4 (or bytes 10-12 all 0)",
+                    u32::from(pair),
+                )
+            })?,
+            direction: BolterDirection::from_wire(dir).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(bolter_direction),
+                    "bolter.direction",
+                    "1 (bolt) or 2 (unbolt)",
+                    u32::from(dir),
+                )
+            })?,
+            step: BolterStep::from_wire(step).ok_or_else(|| {
+                field_err(
+                    KIND,
+                    at!(bolter_step),
+                    "bolter.step",
+                    "1..=8",
+                    u32::from(step),
+                )
+            })?,
+        }),
+    })
 }
