@@ -1914,7 +1914,11 @@ fn a_second_stop_keeps_the_motion_the_first_one_kept_for_reset() {
     r.send(arm(Side::A, ServoTarget::Extend));
     r.run(30);
     let first = r.send(Command::Stop);
-    assert!(first.a.events.contains(&Event::Paused), "{:?}", first.a.events);
+    assert!(
+        first.a.events.contains(&Event::Paused),
+        "{:?}",
+        first.a.events
+    );
     let held = r.run(20);
     let second = r.send(Command::Stop);
     assert!(
@@ -1923,7 +1927,11 @@ fn a_second_stop_keeps_the_motion_the_first_one_kept_for_reset() {
         second.a.events
     );
     assert!(r.a.paused(), "the first Stop's motion is still kept");
-    assert_eq!(r.run(20).a.arm, held.a.arm, "the arm holds after the second Stop");
+    assert_eq!(
+        r.run(20).a.arm,
+        held.a.arm,
+        "the arm holds after the second Stop"
+    );
     let reset = r.send(Command::Reset);
     assert!(reset.a.events.contains(&Event::Resumed));
     let after = r.run(300);

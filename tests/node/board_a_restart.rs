@@ -122,7 +122,10 @@ fn nothing_is_written_ahead_for_a_packet_board_a_does_not_run() {
         up.submit(Command::Stop).unwrap();
         up.tick(0).send.unwrap().to_bytes()
     };
-    assert!(a.ahead(Some(&ours(1))).is_some(), "a new command of its own");
+    assert!(
+        a.ahead(Some(&ours(1))).is_some(),
+        "a new command of its own"
+    );
     assert_eq!(a.ahead(Some(&ours(2))), None, "another robot's");
     let mut broken = ours(1);
     broken[3] ^= 0x10;
