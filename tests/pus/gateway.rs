@@ -511,3 +511,76 @@ fn a_robot_not_served_is_refused_everywhere() {
     assert!(!g.restore_queue(two, &[]));
     assert!(g.queued(two).is_empty());
 }
+
+/// More robots than one call's output has places (16): the legacy commands and the reports
+/// that do not fit are counted in `overflow`, never dropped silently; the frame gateway counts
+/// them on its first link.
+#[test]
+fn an_output_too_small_for_every_robot_counts_the_overflow() {
+    let boards: Vec<BoardNumber> = (1..=17).map(|n| BoardNumber::new(n).unwrap()).collect();
+    let mut g: Gateway<17, 4, 8> = Gateway::new(Config::default());
+    // Each board A heard from once: housekeeping reports what it said.
+    let heard = |b: &BoardNumber| HeartbeatRepr {
+        board: *b,
+        ..answer(0)
+    };
+    for b in &boards {
+        assert!(g.add(*b));
+        g.heartbeat(0, &heard(b));
+    }
+    let (mut commands, mut reports) = (false, false);
+    for now in (0..3_000).step_by(10) {
+        let out = g.tick(now);
+        let fit = out.to_robots.len() + out.reports.len();
+        assert!(out.to_robots.len() <= 16 && out.reports.len() <= 16);
+        if out.overflow > 0 {
+            assert!(fit >= 16, "{} lost beside {fit} places used", out.overflow);
+        }
+        commands |= out.to_robots.len() == 16 && out.overflow > 0;
+        reports |= out.reports.len() == 16 && out.overflow > 0;
+    }
+    assert!(commands, "17 robots' commands in one tick");
+    assert!(reports, "17 robots' housekeeping reports in one tick");
+
+    use mmic::node::server::frames::{FrameConfig, FrameGateway};
+    let mut f: FrameGateway<17, 4, 8, 4096> = FrameGateway::new(FrameConfig::default());
+    for b in &boards {
+        assert!(f.add(*b));
+        f.heartbeat(0, &heard(b));
+    }
+    for now in (0..3_000).step_by(10) {
+        f.tick(now);
+    }
+    let first = f.counters(boards[0]).unwrap().tm_overflow;
+    assert!(first > 0, "counted on the first link");
+    assert_eq!(f.counters(boards[1]).unwrap().tm_overflow, 0);
+}
+
+/// A report of another service than ST[1] has no verification stage; a report for an APID no
+/// robot served has no sequence of its own: it goes out numbered 0, counting nothing, and
+/// the served robots' numbering is untouched.
+#[test]
+fn a_report_that_is_no_verification_and_one_for_no_served_robot() {
+    use mmic::ccsds::tm::TmRepr;
+    let mut g: G = Gateway::new(Config::default());
+    assert!(g.add(BoardNumber::ONE));
+    g.heartbeat(0, &answer(0));
+    let hk = g.tick(0).reports[0].clone();
+    assert_eq!((hk.service, hk.stage()), (3, None));
+    let mut buf = [0u8; 256];
+    let stranger = TmOut {
+        apid: 0x1ff,
+        ..hk.clone()
+    };
+    for _ in 0..2 {
+        let n = g.encode(&stranger, 5, &mut buf).unwrap();
+        let tm = TmRepr::parse(&buf[..n], &[0x1ff]).unwrap();
+        assert_eq!((tm.seq_count.get(), tm.header.counter), (0, 0));
+    }
+    // Robot 1's own numbering starts at 0, untouched by the stranger's.
+    for (now, want) in [(6, (0, 0)), (7, (1, 1))] {
+        let n = g.encode(&hk, now, &mut buf).unwrap();
+        let tm = TmRepr::parse(&buf[..n], &[0x101]).unwrap();
+        assert_eq!((tm.seq_count.get(), tm.header.counter), want);
+    }
+}
