@@ -584,3 +584,104 @@ fn a_report_that_is_no_verification_and_one_for_no_served_robot() {
         assert_eq!((tm.seq_count.get(), tm.header.counter), want);
     }
 }
+
+/// More motions started at once than the running queue holds (Q = 4): the one that does not
+/// fit is started, and its completion is reported failed at once (queue full, its capacity),
+/// never lost; the others keep running.
+#[test]
+fn a_motion_past_the_running_queues_capacity_is_reported_queue_full() {
+    use mmic::command::ServoTarget;
+    use mmic::pus::verification::QUEUE_FULL;
+    use mmic::units::Side;
+    let mut g = gateway();
+    let p0 = sent(&mut g, 0);
+    g.heartbeat(5, &answer(p0.seq));
+    let mut last = Vec::new();
+    for k in 1..=5u16 {
+        let arm = Command::Arm {
+            side: Side::A,
+            target: ServoTarget::Position(mmic::units::PulseWidth::saturating(1000 + k)),
+        };
+        g.tc(&tc(k, Request::Function(arm)));
+        let c = sent(&mut g, 300 * u32::from(k));
+        assert_eq!(c.command, arm);
+        last = reports(&g.heartbeat(300 * u32::from(k) + 5, &answer(c.seq)));
+        if k < 5 {
+            assert_eq!(last, [(Stage::Start, None, k)], "motion {k}");
+        }
+    }
+    assert_eq!(
+        last,
+        [
+            (Stage::Start, None, 5),
+            (Stage::Completion, Some(QUEUE_FULL), 5)
+        ]
+    );
+}
+
+/// The key log keeps the last K keys (K = 8): a copy of a telecommand within them is
+/// answered, not queued again; one K + 1 keys back is forgotten and queued as new. The marks
+/// keep the last KEPT_SOURCES sources heard.
+#[test]
+fn the_key_log_and_the_marks_forget_the_oldest() {
+    use mmic::node::server::gateway::KEPT_SOURCES;
+    let mut g: Gateway<2, 16, 8> = Gateway::new(Config {
+        hk_enabled: false,
+        ..Config::default()
+    });
+    assert!(g.add(BoardNumber::ONE));
+    let queued = |g: &Gateway<2, 16, 8>| g.queued(BoardNumber::ONE).len();
+    for seq in 1..=9 {
+        g.tc(&tc(seq, Request::Function(Command::ClearFaults)));
+    }
+    assert_eq!(queued(&g), 9);
+    g.tc(&tc(9, Request::Function(Command::ClearFaults)));
+    assert_eq!(queued(&g), 9, "a copy within the last 8 keys");
+    g.tc(&tc(1, Request::Function(Command::ClearFaults)));
+    assert_eq!(queued(&g), 10, "9 keys back: forgotten, taken as new");
+
+    let mut g = gateway();
+    for source in 1..=KEPT_SOURCES as u16 + 1 {
+        let t = Tc {
+            source_id: source,
+            ..tc(source, Request::Function(Command::ClearFaults))
+        };
+        g.tc(&t);
+    }
+    let kept = g.kept(BoardNumber::ONE).unwrap();
+    let sources: Vec<u16> = kept.iter().map(|k| k.0).collect();
+    assert_eq!(sources, (2..=KEPT_SOURCES as u16 + 1).collect::<Vec<_>>());
+}
+
+/// A queued are-you-alive restored after a restart: a copy of it is not queued twice, and it
+/// is sent to board A as a heartbeat request, answered by TC(17,2)'s report.
+#[test]
+fn a_restored_are_you_alive_runs_once() {
+    use mmic::node::server::gateway::Job;
+    let mut g = gateway();
+    let alive = tc(3, Request::AreYouAlive);
+    let job = Job {
+        request: alive.request,
+        source_id: alive.source_id,
+        ack: alive.ack,
+        command: Command::Heartbeat,
+        alive: true,
+    };
+    assert!(g.restore_queue(BoardNumber::ONE, &[job]));
+    assert_eq!(g.queued(BoardNumber::ONE).len(), 1);
+    g.tc(&alive);
+    assert_eq!(
+        g.queued(BoardNumber::ONE).len(),
+        1,
+        "a copy: not queued again"
+    );
+    let c = sent(&mut g, 0);
+    assert_eq!(c.command, Command::Heartbeat);
+    let out = g.heartbeat(5, &answer(c.seq));
+    assert!(
+        out.reports
+            .iter()
+            .any(|t| (t.service, t.subservice) == (17, 2)),
+        "{out:?}"
+    );
+}
