@@ -51,6 +51,8 @@ struct Rig {
     /// Board B reports arm B at this pulse whatever its servo does (a stalled arm, as a servo
     /// that reports its position would say it).
     b_arm_stuck: Option<PulseWidth>,
+    /// Board A's hip encoder gives no reading (`Inputs::hip` is `None`).
+    no_hip: bool,
 }
 
 /// A bolter over a fastener, as its current sensor and home switch see it: driven down, it
@@ -137,8 +139,13 @@ impl Rig {
 
     /// The same with board A configured by `cfg`.
     fn operational_with(cfg: board_a::Config) -> Rig {
+        Rig::operational_board(BoardA::in_state(cfg, State::A))
+    }
+
+    /// The same with board A as `a` is (for one that tracks no state: `BoardA::new`).
+    fn operational_board(a: BoardA) -> Rig {
         let mut r = Rig {
-            a: BoardA::in_state(cfg, State::A),
+            a,
             b: BoardB::with_pose(
                 board_b::Config::default(),
                 board_a::Config::default().arm.contracted,
@@ -158,6 +165,7 @@ impl Rig {
             heard_b: None,
             b_lost_until: 0,
             b_arm_stuck: None,
+            no_hip: false,
         };
         r.send(Command::Mode(Mode::Operational));
         r.run(150);
@@ -199,6 +207,7 @@ impl Rig {
                 },
                 arm_contracted: self.switch(0),
                 bolter_at_home: self.bolters[0].at_home(),
+                hip: Inputs::at_home().hip.filter(|_| !self.no_hip),
                 ..Inputs::at_home()
             },
         );
@@ -1892,4 +1901,113 @@ fn a_deferred_fault_while_a_reconfiguration_waits_to_start_drops_it() {
         from: Mode::Operational,
         to: Mode::Standby
     }));
+}
+
+/// A second Stop while a first one holds a motion keeps the first one's motion: no second
+/// pause (the motion kept is not replaced by the held one), and Reset resumes the arm towards
+/// the target it had before the first Stop.
+// req: D:stop-and-reset
+#[test]
+fn a_second_stop_keeps_the_motion_the_first_one_kept_for_reset() {
+    let mut r = Rig::operational();
+    let rest = r.tick(None);
+    r.send(arm(Side::A, ServoTarget::Extend));
+    r.run(30);
+    let first = r.send(Command::Stop);
+    assert!(
+        first.a.events.contains(&Event::Paused),
+        "{:?}",
+        first.a.events
+    );
+    let held = r.run(20);
+    let second = r.send(Command::Stop);
+    assert!(
+        !second.a.events.contains(&Event::Paused),
+        "a second pause: {:?}",
+        second.a.events
+    );
+    assert!(r.a.paused(), "the first Stop's motion is still kept");
+    assert_eq!(
+        r.run(20).a.arm,
+        held.a.arm,
+        "the arm holds after the second Stop"
+    );
+    let reset = r.send(Command::Reset);
+    assert!(reset.a.events.contains(&Event::Resumed));
+    let after = r.run(300);
+    assert_ne!(after.a.arm, held.a.arm, "Reset resumed the first motion");
+    assert_ne!(after.a.arm, rest.a.arm);
+    assert!(!r.a.paused());
+}
+
+/// A board that tracks no state (booted without knowing where it is) refuses a primitive as an
+/// initial state mismatch: no move of the map starts from an unknown state.
+// req: T1/primitive
+#[test]
+fn a_board_that_tracks_no_state_refuses_a_primitive_as_an_initial_state_mismatch() {
+    let mut r = Rig::operational_board(BoardA::new(board_a::Config::default()));
+    assert_eq!(r.a.state(), None);
+    let hb = r.tick(Some(extend_from_a())).hb.unwrap();
+    assert_eq!(hb.refusal, Some(Refusal::InitialStateMismatch));
+    assert!(!r.a.in_motion());
+}
+
+/// A reconfiguration arriving in a tick without a hip encoder reading: in Operational the
+/// unread hip counts as not at its target, so the robot is busy and the command refused as
+/// such; in Standby, Table 7 refuses it (not allowed in the mode) before Table 8's
+/// initial-state check, which cannot confirm any state without the hip: no fault is latched.
+// req: T8/initial_state_mismatch
+#[test]
+fn a_reconfiguration_without_a_hip_reading_is_refused_and_latches_no_fault() {
+    let cmd = Command::reconfigure(State::A, straight_target()).unwrap();
+    for (mode, refusal) in [
+        (Mode::Operational, Refusal::Busy),
+        (Mode::Standby, Refusal::NotAllowedInMode),
+    ] {
+        let mut r = Rig::operational();
+        r.send(Command::Mode(mode));
+        r.run(10);
+        r.no_hip = true;
+        let hb = r.tick(Some(cmd)).hb.unwrap();
+        r.no_hip = false;
+        assert_eq!(hb.refusal, Some(refusal), "{mode:?}");
+        assert!(r.a.faults().is_empty(), "{mode:?}: {:?}", r.a.faults());
+        assert_eq!(r.a.mode(), mode);
+    }
+    let mut r = Rig::operational();
+    r.send(cmd);
+    r.run(2);
+    assert!(r.a.in_motion(), "accepted with the hip reading");
+}
+
+/// A bolting job that fails at its first step (the step limit below one tick: a motion
+/// timeout before either side reported) names no pair: none was worked on. The job's end
+/// names the fault.
+// req: D:motion-timeout
+#[test]
+fn a_bolting_job_failing_at_its_first_step_names_no_pair() {
+    let defaults = board_a::Config::default();
+    let cfg = board_a::Config {
+        bolter: mmic::bolter::Config {
+            side: mmic::bolter::SideConfig {
+                sensed_ms: 5,
+                home_ms: 5,
+                ..defaults.bolter.side
+            },
+            link_margin_ms: 0,
+            ..defaults.bolter
+        },
+        ..defaults
+    };
+    let mut r = Rig::operational_with(cfg);
+    r.send(Command::Bolter(BolterCommand::Bolt(Fasteners::Pair(
+        BolterPair::P2,
+    ))));
+    let events = r.tick(None).a.events;
+    assert!(
+        events.contains(&Event::Bolting(Some(Fault::MotionTimeout))),
+        "{events:?}"
+    );
+    assert!(pairs(&events).is_empty(), "{events:?}");
+    assert!(r.a.faults().contains(Fault::MotionTimeout));
 }

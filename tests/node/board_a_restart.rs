@@ -110,3 +110,25 @@ fn the_durable_record_round_trips_and_refuses_an_unknown_outcome() {
         .unwrap();
     assert_eq!(Durable::from_bytes(&[1, 0, unknown, 2, 0]), None);
 }
+
+/// Nothing is written ahead for a packet board A will not run: another robot's command, a
+/// packet failing its check, or no packet at all; a new command of its own is.
+// req: D:restart-board-a
+#[test]
+fn nothing_is_written_ahead_for_a_packet_board_a_does_not_run() {
+    let a = BoardA::new(Config::default());
+    let ours = |board: u8| {
+        let mut up = Uplink::new(uplink::Config::default(), BoardNumber::new(board).unwrap());
+        up.submit(Command::Stop).unwrap();
+        up.tick(0).send.unwrap().to_bytes()
+    };
+    assert!(
+        a.ahead(Some(&ours(1))).is_some(),
+        "a new command of its own"
+    );
+    assert_eq!(a.ahead(Some(&ours(2))), None, "another robot's");
+    let mut broken = ours(1);
+    broken[3] ^= 0x10;
+    assert_eq!(a.ahead(Some(&broken)), None, "a packet failing its check");
+    assert_eq!(a.ahead(None), None, "no packet");
+}

@@ -403,3 +403,62 @@ fn a_restart_at_any_instant_runs_every_queued_telecommand_exactly_once() {
          without the queue kept {lost_without} of them lost"
     );
 }
+
+/// A confirmation counts once: the progress entry confirmed again (the shell retrying a
+/// write) is no longer due, and an entry that is none of the gateway's is refused.
+#[test]
+fn an_entry_confirmed_twice_is_fresh_once_and_a_stranger_is_refused() {
+    let mut l = Link::new();
+    l.send(1, 0);
+    for now in 0..50 {
+        l.step(now);
+        if !l.up.is_empty() {
+            break;
+        }
+    }
+    for f in std::mem::take(&mut l.up) {
+        l.server.tc_frame(100, &f);
+    }
+    let due = l.server.durable_due::<16>();
+    let progress = *due
+        .iter()
+        .find(|e| e.key == store::progress_key(ONE))
+        .expect("the accepted frame's progress is due");
+    assert!(l.server.durable_written(&progress));
+    assert!(!l.server.durable_written(&progress), "confirmed again");
+    assert!(!l
+        .server
+        .durable_due::<16>()
+        .iter()
+        .any(|e| e.key == store::progress_key(ONE)));
+    let stranger = store::Entry {
+        key: 0x7ffe,
+        aux: 3,
+        value: 9,
+    };
+    assert!(!l.server.durable_written(&stranger));
+    // The telecommand's queue slot, as due before it ran: confirmed once it is no longer
+    // what is due, it is refused.
+    let slot = *due
+        .iter()
+        .find(|e| (0x4000..0x5000).contains(&e.key) && e.aux != 0)
+        .expect("the telecommand's queue slot is due");
+    for now in 200..2_000 {
+        l.step(now);
+    }
+    assert_eq!(l.ran.len(), 1);
+    assert!(!l.server.durable_written(&slot), "a slot no longer due");
+    // Everything written (the shell's pass in step): nothing is due again.
+    assert!(l.server.durable_due::<16>().is_empty());
+}
+
+/// A robot the gateway does not serve is neither resumed nor given a queue.
+#[test]
+fn a_robot_not_served_is_neither_resumed_nor_given_a_queue() {
+    let mut s = Server::new(FrameConfig::default());
+    assert!(s.add(ONE));
+    let two = BoardNumber::new(2).unwrap();
+    assert!(!s.resume(two, store::Progress::default()));
+    assert!(!s.restore_queue(two, &[]));
+    assert!(s.resume(ONE, store::Progress::default()));
+}

@@ -511,3 +511,177 @@ fn a_robot_not_served_is_refused_everywhere() {
     assert!(!g.restore_queue(two, &[]));
     assert!(g.queued(two).is_empty());
 }
+
+/// More robots than one call's output has places (16): the legacy commands and the reports
+/// that do not fit are counted in `overflow`, never dropped silently; the frame gateway counts
+/// them on its first link.
+#[test]
+fn an_output_too_small_for_every_robot_counts_the_overflow() {
+    let boards: Vec<BoardNumber> = (1..=17).map(|n| BoardNumber::new(n).unwrap()).collect();
+    let mut g: Gateway<17, 4, 8> = Gateway::new(Config::default());
+    // Each board A heard from once: housekeeping reports what it said.
+    let heard = |b: &BoardNumber| HeartbeatRepr {
+        board: *b,
+        ..answer(0)
+    };
+    for b in &boards {
+        assert!(g.add(*b));
+        g.heartbeat(0, &heard(b));
+    }
+    let (mut commands, mut reports) = (false, false);
+    for now in (0..3_000).step_by(10) {
+        let out = g.tick(now);
+        let fit = out.to_robots.len() + out.reports.len();
+        assert!(out.to_robots.len() <= 16 && out.reports.len() <= 16);
+        if out.overflow > 0 {
+            assert!(fit >= 16, "{} lost beside {fit} places used", out.overflow);
+        }
+        commands |= out.to_robots.len() == 16 && out.overflow > 0;
+        reports |= out.reports.len() == 16 && out.overflow > 0;
+    }
+    assert!(commands, "17 robots' commands in one tick");
+    assert!(reports, "17 robots' housekeeping reports in one tick");
+
+    use mmic::node::server::frames::{FrameConfig, FrameGateway};
+    let mut f: FrameGateway<17, 4, 8, 4096> = FrameGateway::new(FrameConfig::default());
+    for b in &boards {
+        assert!(f.add(*b));
+        f.heartbeat(0, &heard(b));
+    }
+    for now in (0..3_000).step_by(10) {
+        f.tick(now);
+    }
+    let first = f.counters(boards[0]).unwrap().tm_overflow;
+    assert!(first > 0, "counted on the first link");
+    assert_eq!(f.counters(boards[1]).unwrap().tm_overflow, 0);
+}
+
+/// A report of another service than ST[1] has no verification stage; a report for an APID no
+/// robot served has no sequence of its own: it goes out numbered 0, counting nothing, and
+/// the served robots' numbering is untouched.
+#[test]
+fn a_report_that_is_no_verification_and_one_for_no_served_robot() {
+    use mmic::ccsds::tm::TmRepr;
+    let mut g: G = Gateway::new(Config::default());
+    assert!(g.add(BoardNumber::ONE));
+    g.heartbeat(0, &answer(0));
+    let hk = g.tick(0).reports[0].clone();
+    assert_eq!((hk.service, hk.stage()), (3, None));
+    let mut buf = [0u8; 256];
+    let stranger = TmOut {
+        apid: 0x1ff,
+        ..hk.clone()
+    };
+    for _ in 0..2 {
+        let n = g.encode(&stranger, 5, &mut buf).unwrap();
+        let tm = TmRepr::parse(&buf[..n], &[0x1ff]).unwrap();
+        assert_eq!((tm.seq_count.get(), tm.header.counter), (0, 0));
+    }
+    // Robot 1's own numbering starts at 0, untouched by the stranger's.
+    for (now, want) in [(6, (0, 0)), (7, (1, 1))] {
+        let n = g.encode(&hk, now, &mut buf).unwrap();
+        let tm = TmRepr::parse(&buf[..n], &[0x101]).unwrap();
+        assert_eq!((tm.seq_count.get(), tm.header.counter), want);
+    }
+}
+
+/// More motions started at once than the running queue holds (Q = 4): the one that does not
+/// fit is started, and its completion is reported failed at once (queue full, its capacity),
+/// never lost; the others keep running.
+#[test]
+fn a_motion_past_the_running_queues_capacity_is_reported_queue_full() {
+    use mmic::command::ServoTarget;
+    use mmic::pus::verification::QUEUE_FULL;
+    use mmic::units::Side;
+    let mut g = gateway();
+    let p0 = sent(&mut g, 0);
+    g.heartbeat(5, &answer(p0.seq));
+    let mut last = Vec::new();
+    for k in 1..=5u16 {
+        let arm = Command::Arm {
+            side: Side::A,
+            target: ServoTarget::Position(mmic::units::PulseWidth::saturating(1000 + k)),
+        };
+        g.tc(&tc(k, Request::Function(arm)));
+        let c = sent(&mut g, 300 * u32::from(k));
+        assert_eq!(c.command, arm);
+        last = reports(&g.heartbeat(300 * u32::from(k) + 5, &answer(c.seq)));
+        if k < 5 {
+            assert_eq!(last, [(Stage::Start, None, k)], "motion {k}");
+        }
+    }
+    assert_eq!(
+        last,
+        [
+            (Stage::Start, None, 5),
+            (Stage::Completion, Some(QUEUE_FULL), 5)
+        ]
+    );
+}
+
+/// The key log keeps the last K keys (K = 8): a copy of a telecommand within them is
+/// answered, not queued again; one K + 1 keys back is forgotten and queued as new. The marks
+/// keep the last KEPT_SOURCES sources heard.
+#[test]
+fn the_key_log_and_the_marks_forget_the_oldest() {
+    use mmic::node::server::gateway::KEPT_SOURCES;
+    let mut g: Gateway<2, 16, 8> = Gateway::new(Config {
+        hk_enabled: false,
+        ..Config::default()
+    });
+    assert!(g.add(BoardNumber::ONE));
+    let queued = |g: &Gateway<2, 16, 8>| g.queued(BoardNumber::ONE).len();
+    for seq in 1..=9 {
+        g.tc(&tc(seq, Request::Function(Command::ClearFaults)));
+    }
+    assert_eq!(queued(&g), 9);
+    g.tc(&tc(9, Request::Function(Command::ClearFaults)));
+    assert_eq!(queued(&g), 9, "a copy within the last 8 keys");
+    g.tc(&tc(1, Request::Function(Command::ClearFaults)));
+    assert_eq!(queued(&g), 10, "9 keys back: forgotten, taken as new");
+
+    let mut g = gateway();
+    for source in 1..=KEPT_SOURCES as u16 + 1 {
+        let t = Tc {
+            source_id: source,
+            ..tc(source, Request::Function(Command::ClearFaults))
+        };
+        g.tc(&t);
+    }
+    let kept = g.kept(BoardNumber::ONE).unwrap();
+    let sources: Vec<u16> = kept.iter().map(|k| k.0).collect();
+    assert_eq!(sources, (2..=KEPT_SOURCES as u16 + 1).collect::<Vec<_>>());
+}
+
+/// A queued are-you-alive restored after a restart: a copy of it is not queued twice, and it
+/// is sent to board A as a heartbeat request, answered by TC(17,2)'s report.
+#[test]
+fn a_restored_are_you_alive_runs_once() {
+    use mmic::node::server::gateway::Job;
+    let mut g = gateway();
+    let alive = tc(3, Request::AreYouAlive);
+    let job = Job {
+        request: alive.request,
+        source_id: alive.source_id,
+        ack: alive.ack,
+        command: Command::Heartbeat,
+        alive: true,
+    };
+    assert!(g.restore_queue(BoardNumber::ONE, &[job]));
+    assert_eq!(g.queued(BoardNumber::ONE).len(), 1);
+    g.tc(&alive);
+    assert_eq!(
+        g.queued(BoardNumber::ONE).len(),
+        1,
+        "a copy: not queued again"
+    );
+    let c = sent(&mut g, 0);
+    assert_eq!(c.command, Command::Heartbeat);
+    let out = g.heartbeat(5, &answer(c.seq));
+    assert!(
+        out.reports
+            .iter()
+            .any(|t| (t.service, t.subservice) == (17, 2)),
+        "{out:?}"
+    );
+}

@@ -1,5 +1,7 @@
 //! The ground's PUS link across a ground restart (decision `restart-ground`), which robot an
-//! APID names, and an ST[1] report written into too small a buffer.
+//! APID names, an ST[1] report written into too small a buffer, and the link's edges:
+//! telemetry that does not read, rejections, one TC at a time, a motion's end given up, the
+//! heartbeat request's TC(17,1).
 
 use mmic::node::ground::pus::{Config, TcLink};
 use mmic::pus::robot_of_apid;
@@ -56,4 +58,164 @@ fn a_report_into_too_small_a_buffer_writes_nothing() {
         assert_eq!(r.emit(&mut short), 0);
         assert!(short.iter().all(|&b| b == 0xee));
     }
+}
+
+fn arm_extend() -> mmic::command::Command {
+    mmic::command::Command::Arm {
+        side: mmic::units::Side::A,
+        target: mmic::command::ServoTarget::Extend,
+    }
+}
+
+fn report(link: &TcLink, seq_count: u16, stage: Stage, failure: Option<Failure>) -> Report {
+    Report {
+        stage,
+        request: RequestId {
+            apid: link.apid(),
+            seq_count,
+        },
+        failure,
+    }
+}
+
+/// Telemetry that does not read tells the link nothing: a malformed ST[1] report, a malformed
+/// ST[3] housekeeping report (the status stays unknown), a service the link does not follow.
+#[test]
+fn telemetry_that_does_not_read_tells_nothing() {
+    use mmic::node::ground::link::Link;
+    use mmic::node::ground::pus::Heard;
+    let mut link = TcLink::new(Config::default(), BoardNumber::ONE);
+    let seq = link.submit(arm_extend()).unwrap();
+    link.tick(0);
+    let before = link;
+    for (service, subservice, data) in [
+        (1u8, 1u8, &[0xffu8][..]),
+        (3, 25, &[1, 2, 3]),
+        (200, 1, &[]),
+    ] {
+        let heard = link.telemetry(service, subservice, data);
+        assert_eq!(heard, Heard::default(), "TM({service},{subservice})");
+    }
+    assert_eq!(link.status(), None);
+    assert_eq!(link, before);
+    assert_eq!(link.outstanding(), Some(seq));
+}
+
+/// ST[1] reports the link does not take as an outcome: one for another robot's APID is
+/// ignored; a failed acceptance, and a failed start whose code is no refusal (nor one of the
+/// gateway's own), are handed up as rejections with their numbers, the TC no longer pending.
+#[test]
+fn rejections_and_reports_for_others_over_pus() {
+    use mmic::node::ground::link::Link;
+    let mut link = TcLink::new(Config::default(), BoardNumber::ONE);
+    let seq = link.submit(arm_extend()).unwrap();
+    link.tick(0);
+    let other = Report {
+        request: RequestId {
+            apid: link.apid() + 1,
+            seq_count: seq,
+        },
+        ..report(&link, seq, Stage::Acceptance, None)
+    };
+    assert_eq!(link.report(&other), Default::default());
+    assert_eq!(link.outstanding(), Some(seq));
+
+    let bad = Failure {
+        code: 5,
+        data: 0x0102,
+    };
+    let heard = link.report(&report(&link, seq, Stage::Acceptance, Some(bad)));
+    assert_eq!(heard.rejected, Some((seq, bad)));
+    assert_eq!(heard.done, None);
+    assert_eq!(link.outstanding(), None);
+
+    let seq = link.submit(arm_extend()).unwrap();
+    link.tick(10);
+    link.report(&report(&link, seq, Stage::Acceptance, None));
+    let odd = Failure {
+        code: 0x0300,
+        data: 0,
+    };
+    let heard = link.report(&report(&link, seq, Stage::Start, Some(odd)));
+    assert_eq!(heard.rejected, Some((seq, odd)));
+    assert_eq!((heard.done, link.outstanding()), (None, None));
+}
+
+/// One TC at a time: a submit while another awaits its start is refused (no number given).
+#[test]
+fn a_submit_while_a_tc_awaits_its_start_is_refused() {
+    use mmic::node::ground::link::Link;
+    let mut link = TcLink::new(Config::default(), BoardNumber::ONE);
+    let seq = link.submit(arm_extend()).unwrap();
+    assert_eq!(link.submit(mmic::command::Command::Stop), None);
+    assert_eq!(link.outstanding(), Some(seq));
+    assert!(!link.is_idle());
+}
+
+/// A started motion whose completion is never reported: the link asks for it every query
+/// period, `max_attempts` times, then gives it up as an end not heard.
+#[test]
+fn a_motions_unreported_end_is_given_up_after_max_attempts() {
+    use mmic::node::exactly_once::uplink::Outcome;
+    use mmic::node::ground::link::{Link, MotionEnd};
+    let cfg = Config {
+        query_ms: 100,
+        max_attempts: 3,
+        ..Config::default()
+    };
+    let mut link = TcLink::new(cfg, BoardNumber::ONE);
+    let seq = link.submit(arm_extend()).unwrap();
+    link.tick(0);
+    link.report(&report(&link, seq, Stage::Acceptance, None));
+    let started = link.report(&report(&link, seq, Stage::Start, None));
+    assert_eq!(started.done.map(|d| d.outcome), Some(Outcome::Accepted));
+    let (mut queries, mut ended) = (0, None);
+    for now in (10..10_000).step_by(10) {
+        let t = link.tick(now);
+        if let Some(q) = t.send {
+            assert_eq!(q.request.seq_count, seq, "a query for the motion");
+            queries += 1;
+        }
+        if t.ended.is_some() {
+            assert_eq!(t.attempt, Some(false));
+            ended = t.ended;
+            break;
+        }
+    }
+    assert_eq!(ended, Some((seq, MotionEnd::Unacknowledged)));
+    assert_eq!(queries, 3);
+}
+
+/// A heartbeat request goes out as TC(17,1) with no application data; a function as TC(8,1).
+#[test]
+fn a_heartbeat_request_is_tc_17_1_without_data() {
+    use mmic::ccsds::tc::TcRepr;
+    use mmic::node::ground::pus::{TcOut, MAX_TC_LEN};
+    let request = RequestId {
+        apid: ROBOT_APID_BASE + 1,
+        seq_count: 7,
+    };
+    let hb = TcOut {
+        request,
+        source_id: 4,
+        command: mmic::command::Command::Heartbeat,
+    };
+    assert_eq!(hb.service(), (17, 1));
+    let mut buf = [0u8; MAX_TC_LEN];
+    let n = hb.emit(&mut buf).unwrap();
+    let tc = TcRepr::parse(&buf[..n], &[request.apid]).unwrap();
+    assert_eq!((tc.header.service, tc.header.subservice), (17, 1));
+    assert_eq!(tc.header.source_id, 4);
+    assert_eq!(tc.seq_count.get(), 7);
+    assert!(tc.app_data.is_empty());
+    let f = TcOut {
+        command: arm_extend(),
+        ..hb
+    };
+    assert_eq!(f.service(), (8, 1));
+    let n = f.emit(&mut buf).unwrap();
+    assert!(!TcRepr::parse(&buf[..n], &[request.apid])
+        .unwrap()
+        .app_data
+        .is_empty());
 }

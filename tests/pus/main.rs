@@ -12,6 +12,7 @@ mod event;
 mod frames;
 mod function;
 mod gateway;
+mod ground_frames;
 mod ground_link;
 mod housekeeping;
 mod spec;

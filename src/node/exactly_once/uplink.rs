@@ -479,4 +479,29 @@ mod tests {
         assert_eq!(up.submit(Command::Reset).ok(), Some(u16::MAX));
         assert_eq!(up.next_seq(), 1);
     }
+
+    /// A heartbeat reporting 65535, newer than any number given out, moves the numbering past
+    /// it to 1; a probe renumbered to 65535 after a restart is followed by 1 too.
+    #[test]
+    fn numbering_resynced_from_a_heartbeat_wraps_past_65535_to_1() {
+        let hb = |last_seq| HeartbeatRepr {
+            last_seq,
+            ..HeartbeatRepr::default()
+        };
+        let mut up = Uplink::starting_at(Config::default(), BoardNumber::ONE, 40_000);
+        assert!(up.heartbeat(0, &hb(u16::MAX)).done.is_none());
+        assert_eq!(up.submit(Command::Reset), Ok(1));
+
+        let mut up = Uplink::after_restart(Config::default(), BoardNumber::ONE);
+        // Each report newer than the probe renumbers it past the report (steps under 0x8000).
+        for (report, probe) in [(30_000, 30_001), (60_000, 60_001), (65_534, u16::MAX)] {
+            up.heartbeat(0, &hb(report));
+            assert_eq!(up.outstanding(), Some(probe));
+        }
+        assert_eq!(up.next_seq(), 1);
+        assert_eq!(up.tick(0).send.map(|c| c.seq), Some(u16::MAX));
+        up.heartbeat(10, &hb(u16::MAX));
+        assert!(!up.is_syncing());
+        assert_eq!(up.submit(Command::Reset), Ok(1));
+    }
 }

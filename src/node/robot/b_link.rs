@@ -66,11 +66,6 @@ impl BLink {
         }
     }
 
-    /// The number of the last command sent (0 before the first).
-    pub fn seq(&self) -> u8 {
-        self.sent.map_or(0, |(_, c)| c.seq)
-    }
-
     /// The command to send at `now` for `snapshot` (whose own `seq` is ignored), or `None` when
     /// nothing is due: new content is sent at once with the next number, unchanged content
     /// every `period_ms` with the number it already has.

@@ -218,6 +218,16 @@ mod tests {
         }
     }
 
+    /// `Default` (beside the public `new`) is the server that knows no robot: nothing
+    /// pending, nothing to visit.
+    #[test]
+    fn the_default_server_knows_no_robot() {
+        let mut s: Server<2> = Server::default();
+        assert_eq!(s, Server::new());
+        assert_eq!(s.pending_count(), 0);
+        assert_eq!(s.next_visit(), None);
+    }
+
     // req: P3.5, P3.6
     #[test]
     fn full_hands_the_packet_back_and_free_slots_are_reused() {

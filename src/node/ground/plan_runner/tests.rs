@@ -261,3 +261,220 @@ fn a_restarted_ground_goes_on_between_steps_and_ends_an_open_step_as_restarted()
     let end = ended.end();
     assert_eq!(fresh(&ended).end(), end);
 }
+
+/// A link that reports motions' ends (as the PUS and frame links do), scripted by the test:
+/// the outstanding command is answered with `answer` at the next tick, and `end` is reported
+/// at the tick after it is set.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+struct Scripted {
+    out: Option<(u16, Command)>,
+    next: u16,
+    answer: Option<Outcome>,
+    end: Option<(u16, MotionEnd)>,
+}
+
+impl Scripted {
+    const fn new() -> Scripted {
+        Scripted {
+            out: None,
+            next: 1,
+            answer: None,
+            end: None,
+        }
+    }
+}
+
+impl Link for Scripted {
+    type Packet = u16;
+    const POLLS: bool = false;
+
+    fn is_idle(&self) -> bool {
+        self.out.is_none()
+    }
+
+    fn submit(&mut self, command: Command) -> Option<u16> {
+        if self.out.is_some() {
+            return None;
+        }
+        let seq = self.next;
+        self.next += 1;
+        self.out = Some((seq, command));
+        Some(seq)
+    }
+
+    fn tick(&mut self, _now: u32) -> LinkTick<u16> {
+        let mut t = LinkTick {
+            ended: self.end.take(),
+            ..LinkTick::default()
+        };
+        if let (Some((seq, command)), Some(outcome)) = (self.out, self.answer.take()) {
+            self.out = None;
+            t.done = Some(Done {
+                seq,
+                command,
+                outcome,
+                attempts: 1,
+            });
+        } else {
+            t.send = self.out.map(|(seq, _)| seq);
+        }
+        t
+    }
+}
+
+fn arm_extend() -> Command {
+    Command::Arm {
+        side: crate::units::Side::A,
+        target: crate::command::ServoTarget::Extend,
+    }
+}
+
+/// Ticks the runner until its outstanding command is `c`, answers it accepted; its number.
+fn accept(run: &mut PlanRunner<Scripted>, steps: &[PlanStep], c: Command) -> u16 {
+    let t = run.tick(steps, 0);
+    let seq = t.send.unwrap_or(0);
+    assert_eq!(run.uplink().out, Some((seq, c)));
+    run.up.answer = Some(Outcome::Accepted);
+    let t = run.tick(steps, 10);
+    assert_eq!(
+        t.done.map(|d| (d.seq, d.outcome)),
+        Some((seq, Outcome::Accepted))
+    );
+    seq
+}
+
+/// Over a link that reports motions' ends: a motion step is done when the link reports its
+/// end (the next step goes out then), not at an end reported for another number or before
+/// its start was accepted.
+#[test]
+fn a_motion_step_is_done_at_its_own_end_reported_by_the_link() {
+    let steps = [
+        PlanStep::Command(arm_extend()),
+        PlanStep::Command(Command::Mode(Mode::Standby)),
+    ];
+    let mut run = PlanRunner::over(Scripted::new());
+    assert_eq!(run.tick(&steps, 0).send, Some(1));
+    // An end before the start was answered: the step is not settling yet, nothing moves on.
+    run.up.end = Some((1, MotionEnd::Completed));
+    run.tick(&steps, 5);
+    assert_eq!(run.step(), 0);
+    run.up.answer = Some(Outcome::Accepted);
+    run.tick(&steps, 10);
+    // Another number's end.
+    run.up.end = Some((7, MotionEnd::Completed));
+    assert_eq!(run.tick(&steps, 20).send, None);
+    assert_eq!(run.step(), 0);
+    // Its own end: done, and the next step goes out at the next tick.
+    run.up.end = Some((1, MotionEnd::Completed));
+    run.tick(&steps, 30);
+    assert_eq!(run.step(), 1);
+    assert_eq!(run.tick(&steps, 40).send, Some(2));
+    assert_eq!(run.uplink().out, Some((2, Command::Mode(Mode::Standby))));
+}
+
+/// A motion's end that came while a Stop held the plan: the step is done once the Reset is
+/// accepted, not before.
+#[test]
+fn a_motion_that_ended_while_held_is_done_after_the_reset() {
+    let steps = [
+        PlanStep::Command(arm_extend()),
+        PlanStep::Command(Command::Mode(Mode::Standby)),
+    ];
+    let mut run = PlanRunner::over(Scripted::new());
+    let seq = accept(&mut run, &steps, arm_extend());
+    assert_eq!(run.interject(Command::Stop), Ok(()));
+    accept(&mut run, &steps, Command::Stop);
+    assert!(run.held());
+    run.up.end = Some((seq, MotionEnd::Completed));
+    for now in [20, 30, 40] {
+        assert_eq!(run.tick(&steps, now).send, None);
+    }
+    assert_eq!(run.step(), 0, "held: the ended step is not done");
+    assert_eq!(run.interject(Command::Reset), Ok(()));
+    accept(&mut run, &steps, Command::Reset);
+    assert!(!run.held());
+    run.tick(&steps, 50);
+    assert_eq!(run.step(), 1);
+    assert_eq!(
+        run.uplink().out.map(|(_, c)| c),
+        Some(Command::Mode(Mode::Standby))
+    );
+}
+
+/// A mode step's reported end does not finish it (it waits for a settled status), and a
+/// motion whose end the link never heard ends the plan as unacknowledged at that step.
+#[test]
+fn a_mode_step_waits_for_its_status_and_an_unheard_end_ends_the_plan() {
+    let steps = [PlanStep::Command(Command::Mode(Mode::Operational))];
+    let mut run = PlanRunner::over(Scripted::new());
+    let seq = accept(&mut run, &steps, Command::Mode(Mode::Operational));
+    run.up.end = Some((seq, MotionEnd::Completed));
+    run.tick(&steps, 20);
+    assert_eq!((run.step(), run.end()), (0, None));
+
+    let steps = [PlanStep::Command(arm_extend())];
+    let mut run = PlanRunner::over(Scripted::new());
+    let seq = accept(&mut run, &steps, arm_extend());
+    run.up.end = Some((seq, MotionEnd::Unacknowledged));
+    let t = run.tick(&steps, 20);
+    assert_eq!(t.end, Some(PlanEnd::Unacknowledged { step: 0 }));
+}
+
+/// A step that neither moves nor changes the mode is done when accepted: the next step goes
+/// out in the next slot, no poll in between.
+#[test]
+fn a_step_that_does_not_move_is_done_when_accepted() {
+    let steps = [
+        PlanStep::Command(Command::ClearFaults),
+        PlanStep::Command(Command::Mode(Mode::Standby)),
+    ];
+    let mut run = PlanRunner::new(uplink::Config::default(), BoardNumber::ONE);
+    let (now, sent, t) = exchange(&mut run, &steps, 0, Mode::Operational);
+    assert_eq!(sent.map(|p| p.command), Some(Command::ClearFaults));
+    assert_eq!(t.done.map(|d| d.outcome), Some(Outcome::Accepted));
+    assert_eq!(run.step(), 1);
+    let (_, sent, _) = exchange(&mut run, &steps, now + 100, Mode::Operational);
+    assert_eq!(sent.map(|p| p.command), Some(Command::Mode(Mode::Standby)));
+}
+
+/// Over PUS: a step whose telecommand the gateway rejects at acceptance (a failure code that
+/// is no refusal of board A) ends the plan as rejected, with the gateway's code; a rejection
+/// of a telecommand that is not the runner's does not.
+#[test]
+fn a_step_rejected_at_acceptance_over_pus_ends_the_plan_as_rejected() {
+    use crate::node::ground::pus;
+    use crate::pus::request::ST_VERIFICATION;
+    use crate::pus::verification::{Failure, Report, Stage, FAILURE_LEN};
+    let steps = [PlanStep::Command(Command::Mode(Mode::Operational))];
+    let mut run = PlanRunner::pus(pus::Config::default(), BoardNumber::ONE);
+    let tc = run.tick(&steps, 0).send.map(|p| p.request);
+    let Some(request) = tc else {
+        panic!("the step's telecommand goes out");
+    };
+    let rejected = |seq_count| Report {
+        stage: Stage::Acceptance,
+        request: crate::pus::verification::RequestId {
+            seq_count,
+            ..request
+        },
+        failure: Some(Failure {
+            code: 0x0005,
+            data: 0,
+        }),
+    };
+    let mut buf = [0u8; FAILURE_LEN];
+    let other = rejected(request.seq_count + 1);
+    let n = other.emit(&mut buf);
+    let t = run.telemetry(&steps, 10, ST_VERIFICATION, other.subservice(), &buf[..n]);
+    assert_eq!(t.end, None, "not the runner's telecommand");
+    let ours = rejected(request.seq_count);
+    let n = ours.emit(&mut buf);
+    let t = run.telemetry(&steps, 20, ST_VERIFICATION, ours.subservice(), &buf[..n]);
+    assert_eq!(
+        t.end,
+        Some(PlanEnd::Rejected {
+            step: 0,
+            code: 0x0005
+        })
+    );
+}

@@ -334,14 +334,6 @@ impl<const R: usize, const Q: usize, const K: usize> Gateway<R, Q, K> {
             .map(|r| Q.saturating_sub(r.queue.len()))
     }
 
-    /// The latest heartbeat of robot `board`.
-    pub fn latest(&self, board: BoardNumber) -> Option<&HeartbeatRepr> {
-        self.robots
-            .iter()
-            .find(|r| r.board == board)
-            .and_then(|r| r.last.as_ref())
-    }
-
     /// A telecommand packet from the ground: checked (CCSDS and PUS headers, CRC, one of the
     /// served robots' APIDs; a packet that fails is refused whole, as its request ID cannot be
     /// trusted, and the caller counts it), then its request read and served as [`Gateway::tc`].

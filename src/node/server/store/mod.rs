@@ -242,16 +242,6 @@ impl Stopped {
             Stopped::Weak { .. } => 3,
         }
     }
-
-    /// The SPI it is about.
-    pub const fn spi(&self) -> u16 {
-        match self {
-            Stopped::Unprovisioned { spi }
-            | Stopped::OtherKey { spi }
-            | Stopped::NoCounter { spi }
-            | Stopped::Weak { spi, .. } => *spi,
-        }
-    }
 }
 
 // The boot check's reasons are the first of ST[5]'s link_stopped reasons, in order.
