@@ -352,7 +352,8 @@ mod tests {
         assert!(!c.lost(&cfg));
         c.heartbeat(650, 6); // acknowledges an older command: not this one
         c.sent(7);
-        assert!(!c.lost(&cfg), "{} sends", n - 1);
+        let below = n - 1;
+        assert!(!c.lost(&cfg), "{below} sends");
         c.sent(7);
         assert!(c.lost(&cfg), "{n} sends");
         c.heartbeat(700, 7);
