@@ -8,12 +8,12 @@ use mmic::link::sdls::frames::{
 use mmic::link::sdls::key::Fingerprint;
 use mmic::link::sdls::sa::MAX_MASK_LEN;
 use mmic::link::sdls::{
-    mask, AuthMask, Channel, Iv, Key256, ReplayWindow, Role, SaTable, SdlsError,
-    SdlsRefusal, SecurityAssociation, TxCounter, HEADER_LEN, MAC_LEN,
+    mask, AuthMask, Channel, Iv, Key256, ReplayWindow, Role, SaTable, SdlsError, SdlsRefusal,
+    SecurityAssociation, TxCounter, HEADER_LEN, MAC_LEN,
 };
 use mmic::link::tc_frame::{
-    MapId, SpacecraftId, TcContent, TcFrame, TcFrameConfig, TcFrameRepr, VcConfig, Vcid, MAX_FRAME_LEN,
-    TC_PRIMARY_HEADER_LEN,
+    MapId, SpacecraftId, TcContent, TcFrame, TcFrameConfig, TcFrameRepr, VcConfig, Vcid,
+    MAX_FRAME_LEN, TC_PRIMARY_HEADER_LEN,
 };
 use mmic::link::tm_frame::{FirstHeaderPointer, TmFrameParams, TmFrameRepr, PRIMARY_HEADER_LEN};
 use mmic::link::ControlCommand;
@@ -327,7 +327,10 @@ fn tc_frame_without_fecf() {
     let n = repr.emit_with(false, &mut out).unwrap();
     assert_eq!(n, TC_PRIMARY_HEADER_LEN + 1 + field.len());
     let sec_start = TC_PRIMARY_HEADER_LEN + 1;
-    assert_eq!(tx.protect(257, &mut out[..n], sec_start, n).unwrap().get(), 0);
+    assert_eq!(
+        tx.protect(257, &mut out[..n], sec_start, n).unwrap().get(),
+        0
+    );
     let mut rx: SaTable<1> = SaTable::new();
     rx.add(fresh_receiver(257, mask::TC)).unwrap();
     let vcs = [VcConfig {
