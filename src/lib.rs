@@ -38,7 +38,7 @@
 //! | node | `node` | the boards, the gateway and the ground station: everything wired together |
 //! | pus | `pus` | the PUS-C services: what each telecommand means and what each report carries |
 //! | link | `link` | the space data link: TC transfer frames with COP-1 (FARM-1, FOP-1, the CLCW) and fixed-length TM transfer frames |
-//! | ccsds | `ccsds` | the CCSDS space packets and PUS headers the services travel in |
+//! | ccsds | `ccsds`, `cfdp` | the CCSDS space packets and PUS headers the services travel in; the file delivery protocol's PDUs (727.0-B-5) |
 //! | wire | `wire` | the paper's packets (Tables 2–4, the A→B command), byte by byte |
 //! | behaviour | `sensors`, `control`, `motion`, `safety` | the robot's logic: filters, servo and hip control, the motion sequencer, the safety supervisor; it speaks only the vocabulary, never a packet |
 //! | vocabulary | `mode`, `faults`, `refusal`, `restart`, `pose`, `bolter`, `command` | what the robot and its operator talk about: modes, faults, refusal codes, reset causes and boot counts, states and primitives, the bolter's steps, the command set |
@@ -80,6 +80,7 @@ mod wire_enum;
 pub mod arbitrary;
 pub mod bolter;
 pub mod ccsds;
+pub mod cfdp;
 pub mod command;
 pub mod control;
 pub mod faults;

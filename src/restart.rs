@@ -150,6 +150,20 @@ impl Boot {
 mod tests {
     use super::*;
 
+    /// Decision `restart-board-a`: a power cycle or a brown-out (or a cause not reported, read
+    /// as the worst) loses the RTC memory; a software, panic, watchdog, external or other reset
+    /// keeps it.
+    #[test]
+    fn only_power_loss_loses_rtc_memory() {
+        for cause in ResetCause::ALL {
+            let lost = matches!(
+                cause,
+                ResetCause::PowerOn | ResetCause::BrownOut | ResetCause::Unreported
+            );
+            assert_eq!(cause.loses_rtc_memory(), lost, "{cause:?}");
+        }
+    }
+
     #[test]
     fn every_byte_is_one_boot_and_back() {
         for b in 0..=u8::MAX {

@@ -22,7 +22,7 @@ const ORDER: &[(&str, &[&str])] = &[
     ),
     ("behaviour", &["sensors", "control", "motion", "safety"]),
     ("wire", &["wire"]),
-    ("ccsds", &["ccsds"]),
+    ("ccsds", &["ccsds", "cfdp"]),
     ("link", &["link"]),
     ("pus", &["pus"]),
     ("node", &["node"]),

@@ -377,10 +377,12 @@ pub enum AnyKind {
     TmFrame,
     /// A Communications Link Control Word (CCSDS 232.0-B §4.2).
     Clcw,
+    /// A CFDP PDU (CCSDS 727.0-B-5), decode only.
+    Cfdp,
 }
 
 /// A packet kind from its name: the legacy names, `pus-tc`, `pus-tm`, `tc-frame`, `tm-frame`,
-/// `clcw`.
+/// `clcw`, `cfdp` (decode only).
 pub fn parse_any_kind(name: &str) -> Result<AnyKind, CliError> {
     match name {
         "pus-tc" => Ok(AnyKind::PusTc),
@@ -388,6 +390,7 @@ pub fn parse_any_kind(name: &str) -> Result<AnyKind, CliError> {
         "tc-frame" => Ok(AnyKind::TcFrame),
         "tm-frame" => Ok(AnyKind::TmFrame),
         "clcw" => Ok(AnyKind::Clcw),
+        "cfdp" => Ok(AnyKind::Cfdp),
         _ => parse_kind(name).map(AnyKind::Legacy),
     }
 }
@@ -427,6 +430,11 @@ fn encode(kind: AnyKind, json: &str, out: &mut dyn Write) -> Result<(), CliError
         AnyKind::TcFrame => link::encode_tc_frame(json, &[])?,
         AnyKind::TmFrame => link::encode_tm_frame(json)?,
         AnyKind::Clcw => link::encode_clcw(json)?,
+        AnyKind::Cfdp => {
+            return Err(CliError::Usage(
+                "mmic encode cfdp: CFDP PDUs are decoded only (mmic decode cfdp HEX)".into(),
+            ))
+        }
     };
     writeln!(out, "{}", codec::to_hex(&bytes)).map_err(CliError::Output)
 }
@@ -461,6 +469,7 @@ fn decode(
         AnyKind::TcFrame => link::decode_tc_frame(&bytes, &options)?.to_string(),
         AnyKind::TmFrame => link::decode_tm_frame(&bytes, &options)?.to_string(),
         AnyKind::Clcw => link::decode_clcw(&bytes)?.to_string(),
+        AnyKind::Cfdp => crate::cfdp::decode(&bytes)?.to_string(),
     };
     writeln!(out, "{json}").map_err(CliError::Output)
 }

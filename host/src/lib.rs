@@ -2,6 +2,7 @@
 //! packets as JSON and hex in [`codec`], motion plans in [`motion`], and the generated review
 //! pages of spec/ in [`pages`]), kept out of `main.rs` so tests can call it.
 
+pub mod cfdp;
 pub mod cli;
 pub mod codec;
 pub mod error;

@@ -266,6 +266,22 @@ impl FromIterator<Fault> for Faults {
 mod tests {
     use super::*;
 
+    /// `without` takes exactly its fault out and leaves the others (and an absent one) alone.
+    #[test]
+    fn without_removes_one_fault_only() {
+        let all = Fault::ALL.into_iter().fold(Faults::EMPTY, Faults::with);
+        for f in Fault::ALL {
+            let rest = all.without(f);
+            assert!(!rest.contains(f));
+            assert!(Fault::ALL
+                .into_iter()
+                .filter(|&g| g != f)
+                .all(|g| rest.contains(g)));
+            assert_eq!(rest.without(f), rest);
+            assert_eq!(rest.with(f), all);
+        }
+    }
+
     // req: T8/*
     #[test]
     fn every_subset_round_trips_and_reserved_bits_are_refused() {

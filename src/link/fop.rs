@@ -494,6 +494,46 @@ mod tests {
         assert_eq!(f.sent_len(), 0);
     }
 
+    /// Suspended while retransmitting with wait (S3, suspend state 3), resume takes S3 up
+    /// again (E29's row for that state).
+    // req: 232.1-B-2/FOP-6, 232.1-B-2/FOP-9
+    #[test]
+    fn resume_takes_up_retransmit_with_wait() {
+        let mut f = active(FopConfig {
+            timeout_type: TimeoutType::Suspend,
+            tx_limit: 2,
+            ..small()
+        });
+        let mut outs = Vec::new();
+        f.transfer_ad(7, 0, &mut |o| outs.push(o)).unwrap();
+        // Retransmit (E10: the second and last transmission, T1 from 10), then wait with the
+        // limit reached (E103): S3, where T1's expiry suspends.
+        let retransmit = Clcw {
+            retransmit: true,
+            ..clcw(0)
+        };
+        f.clcw(&retransmit, 10, &mut |o| outs.push(o));
+        assert_eq!(f.state(), FopState::RetransmitWithoutWait);
+        let waiting = Clcw {
+            wait: true,
+            ..retransmit
+        };
+        f.clcw(&waiting, 20, &mut |o| outs.push(o));
+        assert_eq!(f.state(), FopState::RetransmitWithWait);
+        outs.clear();
+        f.tick(110, &mut |o| outs.push(o));
+        assert_eq!(outs, [FopOutput::Suspended]);
+        assert_eq!((f.state(), f.suspend_state()), (FopState::Initial, 3));
+        assert_eq!(
+            f.directive(Directive::Resume, 150, &mut |o| outs.push(o)),
+            DirectiveResponse::Confirmed
+        );
+        assert_eq!(
+            (f.state(), f.suspend_state(), f.timer_deadline()),
+            (FopState::RetransmitWithWait, 0, Some(250))
+        );
+    }
+
     // req: 232.1-B-2/FOP-8, 232.1-B-2/FOP-11
     #[test]
     fn lockout_alerts_and_unlock_recovers() {

@@ -72,11 +72,6 @@ impl StateSet {
         self.0 == 0
     }
 
-    /// Raw bits.
-    pub const fn bits(self) -> u16 {
-        self.0
-    }
-
     /// The states in Table 5 order.
     pub fn iter(self) -> impl Iterator<Item = State> {
         State::ALL.into_iter().filter(move |s| self.contains(*s))

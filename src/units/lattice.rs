@@ -156,6 +156,21 @@ pub struct Gravity {
 mod tests {
     use super::*;
 
+    /// The hip and side A's arm, gripper and bolter sit on side A (board A drives them); side
+    /// B's three on side B.
+    #[test]
+    fn each_module_sits_on_its_side() {
+        let a = [Module::Hip, Module::ArmA, Module::GripperA, Module::BolterA];
+        for m in Module::ALL {
+            let want = if a.contains(&m) { Side::A } else { Side::B };
+            assert_eq!(m.side(), want, "{m:?}");
+        }
+        assert_eq!(
+            Module::ALL.iter().filter(|m| m.side() == Side::B).count(),
+            3
+        );
+    }
+
     #[test]
     fn module_index_is_the_position_in_all() {
         for (i, m) in Module::ALL.iter().enumerate() {

@@ -60,14 +60,6 @@ impl<T: Copy> PerSide<T> {
     pub const fn both(v: T) -> Self {
         PerSide { a: v, b: v }
     }
-
-    /// The value of side `s`.
-    pub const fn get(&self, s: Side) -> T {
-        match s {
-            Side::A => self.a,
-            Side::B => self.b,
-        }
-    }
 }
 
 impl PerSide<bool> {
@@ -97,6 +89,21 @@ impl<T> core::ops::IndexMut<Side> for PerSide<T> {
         match s {
             Side::A => &mut self.a,
             Side::B => &mut self.b,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `all` and `any` over the four pairs of flags; indexing by side reads each.
+    #[test]
+    fn all_and_any_over_both_sides() {
+        for (a, b) in [(false, false), (false, true), (true, false), (true, true)] {
+            let p = PerSide { a, b };
+            assert_eq!((p.all(), p.any()), (a && b, a || b), "{a} {b}");
+            assert_eq!((p[Side::A], p[Side::B]), (a, b));
         }
     }
 }

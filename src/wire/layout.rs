@@ -177,8 +177,6 @@ pub enum Unit {
     Sequence,
     /// 16-bit sequence number, little-endian (exactly-once commanding).
     Sequence16,
-    /// Zero on emit; refused unless zero on parse.
-    Reserved,
     /// Parameter bytes whose meaning depends on the opcode.
     Parameter,
     /// CRC-16/CCITT-FALSE, little-endian.
@@ -202,7 +200,6 @@ impl Unit {
             Unit::Bits => "bits",
             Unit::Sequence => "seq",
             Unit::Sequence16 => "seq16",
-            Unit::Reserved => "reserved",
             Unit::Parameter => "param",
             Unit::Crc16 => "crc16",
         }

@@ -127,6 +127,7 @@ pub fn verdict(row: &Row, apids: &[u16]) -> Option<&'static str> {
         "tm" => TmRepr::parse(&bytes, apids).map(|_| ()),
         "tc-service" => return mmic::pus::read_tc(&bytes, apids).err().map(|e| e.name()),
         "tc-frame" => return tc_frame_verdict(&bytes).err().map(|e| e.name()),
+        "cfdp" => return mmic::cfdp::Pdu::parse(&bytes).err().map(|e| e.name()),
         // Under `TmFrameParams::mission(0x142)` (robot 0x42's spacecraft ID).
         "tm-frame" => {
             return TmFrameRepr::parse(&bytes, &super::tm_frame::params())
@@ -188,6 +189,10 @@ fn every_bad_input_is_refused_by_name() {
     for (parser, names) in [
         ("tc-frame", &TcFrameError::NAMES[..]),
         ("tm-frame", &TmFrameError::NAMES[..]),
+        (
+            "cfdp",
+            &mmic::cfdp::PduError::NAMES[..mmic::cfdp::PduError::PARSE],
+        ),
     ] {
         for name in names {
             assert!(

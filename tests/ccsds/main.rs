@@ -9,6 +9,7 @@
 mod common;
 
 mod bad_inputs;
+mod cfdp;
 mod corruption;
 mod farm_table;
 mod golden;

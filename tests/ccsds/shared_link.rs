@@ -148,3 +148,26 @@ fn bd_frames_go_at_once_beside_the_ad_service() {
         "BD frames take no N(S) and wait for nothing"
     );
 }
+
+/// A packet inside robot 1's TC frame that carries robot 2's APID is refused (counted in the
+/// frame's result), never handed to either robot's queue: a frame's spacecraft ID and its
+/// packets' APIDs must agree. The frame itself is FARM-1's to accept.
+// req: 232.0-B-4/TC-34, 232.0-B-4/TC-35
+#[test]
+fn a_packet_for_another_robot_inside_a_frame_is_refused() {
+    let two = BoardNumber::new(2).unwrap();
+    let mut g: FrameGateway<2, 4, 8, 1024> = FrameGateway::new(FrameConfig::default());
+    assert!(g.add(BoardNumber::ONE) && g.add(two));
+    let v = g.tc_frame(0, &ping_frame(0x101, 0x102));
+    assert_eq!(
+        (v.robot, v.accepted, v.refused),
+        (Some(BoardNumber::ONE), 0, 1)
+    );
+    assert!(v.verdict.is_ok(), "{:?}", v.verdict);
+    assert_eq!(g.farm(BoardNumber::ONE).unwrap().vr(), 1);
+    assert_eq!(
+        g.farm(two).unwrap().vr(),
+        0,
+        "robot 2's channel saw nothing"
+    );
+}

@@ -141,6 +141,11 @@ fn golden_frames_are_the_standards_bits() {
     assert_eq!(view.data(), &p[..]);
     assert_eq!(view.data_field().len(), SEGMENT_HEADER_LEN + p.len());
     assert_eq!(view.control_command(), None);
+    assert_eq!(
+        view.into_inner(),
+        unhex(AD_PING),
+        "the buffer back, unchanged"
+    );
     let unlock = TcFrame::new_checked(unhex(BC_UNLOCK), &config()).unwrap();
     assert_eq!(unlock.segment(), None);
     assert_eq!(unlock.control_command(), Some(ControlCommand::Unlock));

@@ -404,9 +404,11 @@ fn repr(count: u8, fhp: FirstHeaderPointer, data: &[u8]) -> TmFrameRepr<'_> {
     }
 }
 
-/// Feeds `frames` to a fresh extractor: the packets out and the counters.
+/// Feeds `frames` to a fresh extractor (`Default`, the empty extractor `new` gives: the
+/// tests above start from `new`): the packets out and the counters.
 fn feed(frames: &[TmFrameRepr]) -> (Vec<Vec<u8>>, ExtractCounters) {
-    let mut x = Extractor::<64>::new();
+    let mut x = Extractor::<64>::default();
+    assert!(!x.in_packet());
     let mut got = Vec::new();
     for f in frames {
         x.frame(f, |p| got.push(p.to_vec()));

@@ -257,6 +257,83 @@ fn rendered_grid_is_current_in_spec() {
     assert_eq!(grid.matches('*').count(), 60 - used);
 }
 
+/// The geometric model's single moves computed at run time over all 225 ordered pairs (the
+/// map itself is built at compile time, which coverage does not see): 72 moves, the map's 60
+/// where the map has them and 12 turns without a hip rotation, each reaching its target.
+// req: P6.9
+#[test]
+fn single_moves_at_run_time_are_the_models_72() {
+    let mut model = 0;
+    for f in State::ALL {
+        for t in State::ALL {
+            let m = single_move(f, t);
+            if let Some((_, p)) = m {
+                model += 1;
+                assert!(map::reaches(p, t), "{f} -> {t} by {p}");
+            }
+            if let Some(p) = map::primitive(f, t) {
+                assert_eq!(m.map(|(_, q)| q), Some(p), "{f} -> {t}");
+            }
+        }
+    }
+    assert_eq!(model, 72);
+}
+
+/// A writer that takes `room` octets, then fails (a full buffer, a closed console).
+struct Fails {
+    room: usize,
+    got: String,
+}
+
+impl std::fmt::Write for Fails {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        if s.len() > self.room {
+            return Err(std::fmt::Error);
+        }
+        self.room -= s.len();
+        self.got.push_str(s);
+        Ok(())
+    }
+}
+
+/// The legend names every primitive by its Table 6 name, and a writer's failure at any octet
+/// of the grid or the legend is the caller's error, never a shorter text reported as whole.
+// req: P6.9
+#[test]
+fn legend_names_the_primitives_and_a_failing_writer_is_an_error() {
+    use mmic::motion::figure9::{render, write_legend};
+    let mut legend = String::new();
+    write_legend(&mut legend).unwrap();
+    for p in Primitive::ALL {
+        assert!(
+            legend.contains(&format!(" {} {}", p.number(), p.name())),
+            "{legend}"
+        );
+    }
+    assert!(legend.ends_with('\n'));
+    let mut grid = String::new();
+    render(&mut grid).unwrap();
+    type Write = fn(&mut Fails) -> std::fmt::Result;
+    for (name, whole, write) in [
+        ("legend", legend.len(), (|w| write_legend(w)) as Write),
+        ("grid", grid.len(), (|w| render(w)) as Write),
+    ] {
+        for room in 0..whole {
+            let mut w = Fails {
+                room,
+                got: String::new(),
+            };
+            assert_eq!(write(&mut w), Err(std::fmt::Error), "{name}, room {room}");
+        }
+        let mut w = Fails {
+            room: whole,
+            got: String::new(),
+        };
+        assert_eq!(write(&mut w), Ok(()), "{name}");
+        assert_eq!(w.got.len(), whole);
+    }
+}
+
 /// spec/motion/ambiguous-primitives.txt: the (state, primitive) pairs with two targets.
 fn render_ambiguous() -> String {
     use std::fmt::Write as _;

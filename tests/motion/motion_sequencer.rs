@@ -157,6 +157,10 @@ fn every_reconfiguration_reaches_its_target() {
     for from in State::ALL {
         for to in State::ALL {
             let mut r = Runner::start(Config::default(), from, to, Targets::home(), 0);
+            // The plan the runner runs is the route table's, empty exactly from a state to itself.
+            assert_eq!(*r.plan(), route::lookup(from, to), "{from}->{to}");
+            assert_eq!(r.plan().is_empty(), from == to, "{from}->{to}");
+            assert_eq!(r.plan().is_empty(), r.plan().primitives().is_empty());
             let mut visited = vec![];
             let mut t = 0u32;
             let mut last = from;

@@ -170,3 +170,27 @@ fn refusals_name_the_check() {
         })
     );
 }
+
+/// A security event (ID 0x02xx) reads back with its count and SPI, and one whose count of
+/// refused frames is 0 is refused by that field's name: the link reports only what it refused.
+// req: PUS/ST[5].4
+#[test]
+fn a_security_event_with_no_refused_frame_is_refused() {
+    let e = Event::Security {
+        reason: 1,
+        refused: 3,
+        spi: 0x0101,
+    };
+    let b = e.to_bytes();
+    assert_eq!(Event::parse(e.severity(), &b), Ok(e));
+    let mut none = b;
+    (none[2], none[3]) = (0, 0);
+    assert_eq!(
+        Event::parse(e.severity(), &none),
+        Err(EventError::Field {
+            id: 0x0201,
+            field: "refused",
+            found: 0
+        })
+    );
+}

@@ -685,3 +685,102 @@ fn a_restored_are_you_alive_runs_once() {
         "{out:?}"
     );
 }
+
+/// The frame gateway's next deadline: `now` while a frame is due (none sent yet), else the
+/// earliest of the idle frame, a gathered report's frame and the gateway's own deadlines; a
+/// time already past reads as `now`.
+#[test]
+fn the_frame_gateways_next_deadline_is_the_earliest_thing_due() {
+    use mmic::link::tm_frame::TM_FRAME_LEN;
+    use mmic::node::server::frames::{FrameConfig, FrameGateway, GATHER_MS};
+    let cfg = FrameConfig {
+        gateway: Config {
+            poll_ms: 0,
+            ..Config::default()
+        },
+        ..FrameConfig::default()
+    };
+    let idle = cfg.idle_period_ms;
+    let mut f: FrameGateway<1, 4, 8, 1024> = FrameGateway::new(cfg);
+    assert!(f.add(BoardNumber::ONE));
+    assert_eq!(
+        f.next_deadline(5),
+        Some(5),
+        "the first frame is due at once"
+    );
+    let mut tm = [0u8; TM_FRAME_LEN];
+    while f.frame(5, &mut tm).is_some() {}
+    assert_eq!(f.next_deadline(5), Some(5 + idle), "the idle frame");
+    assert_eq!(
+        f.next_deadline(5 + 3 * idle),
+        Some(5 + 3 * idle),
+        "past: now"
+    );
+    // Board A heard: housekeeping is due at once; its report then waits up to GATHER_MS for
+    // others to share its frame.
+    f.heartbeat(10, &answer(0));
+    assert_eq!(f.next_deadline(10), Some(10));
+    f.tick(10);
+    assert_eq!(f.next_deadline(10), Some(10 + GATHER_MS));
+    assert!(f.frame(10 + GATHER_MS - 1, &mut tm).is_none());
+    assert!(f.frame(10 + GATHER_MS, &mut tm).is_some());
+}
+
+/// A report the robot's framer has no room for is counted (`tm_overflow`), never written in
+/// part: a 64-octet framer takes two acceptance reports of three pings in one frame.
+#[test]
+fn a_report_the_framer_cannot_hold_is_counted() {
+    use mmic::node::server::frames::{FrameConfig, FrameGateway};
+    let cfg = FrameConfig {
+        gateway: Config {
+            hk_enabled: false,
+            ..Config::default()
+        },
+        ..FrameConfig::default()
+    };
+    let mut f: FrameGateway<1, 4, 8, 64> = FrameGateway::new(cfg);
+    assert!(f.add(BoardNumber::ONE));
+    f.heartbeat(0, &answer(0));
+    let frame = ping_frame(3);
+    let got = f.tc_frame(1, &frame);
+    assert_eq!((got.accepted, got.refused), (3, 0), "{got:?}");
+    assert!(f.counters(BoardNumber::ONE).unwrap().tm_overflow > 0);
+}
+
+/// An AD frame N(S) = 0 to robot 1 carrying `n` TC(17,1) of counts 0, 1, ….
+fn ping_frame(n: u16) -> Vec<u8> {
+    use mmic::ccsds::primary::{Apid, SeqCount};
+    use mmic::ccsds::tc::TcRepr;
+    use mmic::ccsds::tc_header::{AckFlags, TcSecondaryHeader};
+    use mmic::link::tc_frame::{MapId, SpacecraftId, TcContent, TcFrameRepr, Vcid};
+    let mut data = Vec::new();
+    for seq in 0..n {
+        let mut ping = [0u8; 13];
+        TcRepr {
+            apid: Apid::new(0x101).unwrap(),
+            seq_count: SeqCount::new(seq).unwrap(),
+            header: TcSecondaryHeader {
+                ack: AckFlags::ALL,
+                service: 17,
+                subservice: 1,
+                source_id: 0,
+            },
+            app_data: &[],
+        }
+        .emit(&mut ping)
+        .unwrap();
+        data.extend_from_slice(&ping);
+    }
+    let frame = TcFrameRepr {
+        spacecraft_id: SpacecraftId::new(0x101).unwrap(),
+        vcid: Vcid::new(0).unwrap(),
+        seq: 0,
+        content: TcContent::Ad {
+            map_id: Some(MapId::new(0).unwrap()),
+            data: &data,
+        },
+    };
+    let mut buf = [0u8; 128];
+    let len = frame.emit(&mut buf).unwrap();
+    buf[..len].to_vec()
+}

@@ -219,3 +219,31 @@ fn a_heartbeat_request_is_tc_17_1_without_data() {
         .app_data
         .is_empty());
 }
+
+/// A start failure with UNACKNOWLEDGED (board A never answered the gateway) or RESTARTED (the
+/// gateway restarted after taking the TC) ends the TC as unacknowledged: run at most once,
+/// its outcome not known; neither is read as a refusal.
+#[test]
+fn a_start_failure_unacknowledged_or_restarted_ends_the_tc_unacknowledged() {
+    use mmic::node::exactly_once::uplink::Outcome;
+    use mmic::node::ground::link::Link;
+    use mmic::pus::verification::{RESTARTED, UNACKNOWLEDGED};
+    for code in [UNACKNOWLEDGED, RESTARTED] {
+        let mut link = TcLink::new(Config::default(), BoardNumber::ONE);
+        let seq = link.submit(arm_extend()).unwrap();
+        link.tick(0);
+        link.report(&report(&link, seq, Stage::Acceptance, None));
+        let failure = Failure { code, data: 0 };
+        let heard = link.report(&report(&link, seq, Stage::Start, Some(failure)));
+        assert_eq!(
+            heard.done.map(|d| d.outcome),
+            Some(Outcome::Unacknowledged),
+            "{code:#06x}"
+        );
+        assert_eq!(
+            (heard.rejected, link.outstanding()),
+            (None, None),
+            "{code:#06x}"
+        );
+    }
+}

@@ -305,14 +305,16 @@ fn facts(c: &Option<Incoming>) -> &'static [(bool, Result<(), InitialStateError>
     }
 }
 
-// req: T7/*, T8/*, P7.7
-#[test]
-fn supervisor_properties_hold_on_the_whole_domain() {
+/// One part of the whole domain: the start states whose index is `part` modulo `PARTS`, each
+/// with every command, fault subset, motion flag and hip/initial-state fact. The domain is cut
+/// into parts so that the test runner spreads it over the cores (one test is one thread).
+fn supervisor_properties_hold_on_part(part: usize) {
     let starts = start_states();
     let cmds = incoming();
     let n_faults = 1u32 << Fault::ALL.len();
     let mut steps: u64 = 0;
-    for (name, s0) in &starts {
+    let mine: Vec<_> = starts.iter().skip(part).step_by(PARTS).collect();
+    for (name, s0) in &mine {
         for c in &cmds {
             // hip/initial-state facts only matter to two commands: enumerate them there.
             let facts = facts(c);
@@ -334,11 +336,46 @@ fn supervisor_properties_hold_on_the_whole_domain() {
             }
         }
     }
-    println!("supervisor: {steps} steps checked ({} start states x {} inputs x {n_faults} fault subsets x 2 motion flags, + hip/initial-state facts)", starts.len(), cmds.len());
+    println!("supervisor, part {part} of {PARTS}: {steps} steps checked ({} of {} start states x {} inputs x {n_faults} fault subsets x 2 motion flags, + hip/initial-state facts)", mine.len(), starts.len(), cmds.len());
     assert_eq!(
         steps,
-        starts.len() as u64 * (cmds.len() as u64 + 2 * 5) * n_faults as u64 * 2
+        mine.len() as u64 * (cmds.len() as u64 + 2 * 5) * n_faults as u64 * 2
     );
+}
+
+/// The parts the whole domain is walked in.
+const PARTS: usize = 4;
+
+/// The parts together are every start state once.
+#[test]
+fn the_parts_cover_every_start_state_once() {
+    let n = start_states().len();
+    let covered: usize = (0..PARTS).map(|p| (p..n).step_by(PARTS).count()).sum();
+    assert_eq!(covered, n);
+}
+
+// req: T7/*, T8/*, P7.7
+#[test]
+fn supervisor_properties_hold_on_the_whole_domain_part_0() {
+    supervisor_properties_hold_on_part(0);
+}
+
+// req: T7/*, T8/*, P7.7
+#[test]
+fn supervisor_properties_hold_on_the_whole_domain_part_1() {
+    supervisor_properties_hold_on_part(1);
+}
+
+// req: T7/*, T8/*, P7.7
+#[test]
+fn supervisor_properties_hold_on_the_whole_domain_part_2() {
+    supervisor_properties_hold_on_part(2);
+}
+
+// req: T7/*, T8/*, P7.7
+#[test]
+fn supervisor_properties_hold_on_the_whole_domain_part_3() {
+    supervisor_properties_hold_on_part(3);
 }
 
 /// The fault sets the breadth-first search feeds: every subset of one representative per

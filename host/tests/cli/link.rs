@@ -574,3 +574,31 @@ fn tm_frame_and_clcw_json_round_trip_over_every_field_value() {
         assert_eq!(lib.emit().to_vec(), bytes);
     }
 }
+
+/// `mmic decode cfdp`: YAMCS's EOF PDU (its PacketParseTest) as its header's fields and its data
+/// field; `mmic encode cfdp` is refused as a usage error (decode only).
+#[test]
+fn decode_cfdp_reads_yamcs_eof() {
+    let d = decode(&[
+        "decode",
+        "cfdp",
+        "00000a130018000000010015048000000000000065fc",
+    ]);
+    assert_eq!(d["header"]["pdu_type"], "Directive");
+    assert_eq!(d["header"]["mode"], "Acknowledged");
+    assert_eq!(
+        (
+            &d["header"]["source"],
+            &d["header"]["seq"],
+            &d["header"]["dest"]
+        ),
+        (&json!(0x18), &json!(1), &json!(0x15))
+    );
+    assert_eq!(d["header"]["data_len"], 10);
+    assert_eq!(d["data"], "048000000000000065fc");
+    refused(
+        &["encode", "cfdp", "{}"],
+        mmic_host::exit::EXIT_INPUT.into(),
+        "decoded only",
+    );
+}

@@ -259,4 +259,50 @@ mod tests {
             Err(ImageError::Size { .. })
         ));
     }
+
+    /// A sealed record (its CRC right) of an unknown tag, or a header with a key or an aux,
+    /// is read as invalid: only the two known forms are records.
+    #[test]
+    fn a_sealed_record_of_an_unknown_form_is_invalid() {
+        let mut r = [0u8; RECORD_LEN];
+        r[15] = 1;
+        for (tag, aux, key) in [
+            (0x00, 0, 0),
+            (0xC6, 0, 0),
+            (TAG_SECTOR, 1, 0),
+            (TAG_SECTOR, 0, 1),
+        ] {
+            r[0] = tag;
+            r[1] = aux;
+            r[3] = key;
+            assert_eq!(
+                decode(&seal(r)),
+                Record::Invalid,
+                "tag {tag:#04x} aux {aux} key {key}"
+            );
+        }
+        r[0] = TAG_SECTOR;
+        (r[1], r[3]) = (0, 0);
+        assert_eq!(decode(&seal(r)), Record::Header(1));
+    }
+
+    /// An image refuses more entries than a sector holds after its header, with the numbers.
+    #[test]
+    fn an_image_refuses_more_entries_than_a_sector_holds() {
+        let entries = [Entry {
+            key: 0x1101,
+            aux: 0,
+            value: 5,
+        }; 3];
+        let mut out = [0u8; 2 * 3 * RECORD_LEN];
+        assert_eq!(
+            image(&entries, 3 * RECORD_LEN, &mut out),
+            Err(ImageError::TooMany {
+                entries: 3,
+                sector: 60,
+                fit: 2
+            })
+        );
+        assert_eq!(image(&entries[..2], 3 * RECORD_LEN, &mut out), Ok(()));
+    }
 }
