@@ -37,7 +37,7 @@ use mmic_proofs::seal;
 
 /// The fuzz targets, one per parser and one for the deframer (test names in
 /// `tests/targets.rs`, and the names `cargo bolero test` takes).
-pub const TARGETS: [&str; 19] = [
+pub const TARGETS: [&str; 20] = [
     "command_parser",
     "heartbeat_parser",
     "internal_heartbeat_parser",
@@ -57,6 +57,7 @@ pub const TARGETS: [&str; 19] = [
     "sdls_tm_verify",
     "pus_event",
     "server_store",
+    "cfdp_pdu",
 ];
 
 /// Target name of the CCSDS/PUS parser for `kind`.
@@ -566,6 +567,7 @@ pub fn seeds() -> Vec<SeedFile> {
     out.extend(tm_seeds());
     out.extend(sdls_seeds());
     out.extend(store_seeds());
+    out.extend(cfdp_seeds());
     // Deframer: 4 bytes of chunk plan (chunk sizes 1 + b % 70), then the stream.
     let packet = |k: PacketKind| {
         valid
@@ -954,4 +956,63 @@ pub fn store_seeds() -> Vec<SeedFile> {
     body.extend_from_slice(&v.to_be_bytes()[4..]);
     push("queue-slot", 2, &body);
     out
+}
+
+/// Seeds of `cfdp_pdu`: YAMCS's EOF PDU (its PacketParseTest), the same with the CRC flag and
+/// its CRC, a file data PDU, and a near miss of each check of `PduError` the reader runs.
+pub fn cfdp_seeds() -> Vec<SeedFile> {
+    use mmic::cfdp::header::{Direction, Lengths, Mode, PduHeader, PduType};
+    let target = TARGETS[19];
+    let header = |pdu_type, crc| PduHeader {
+        pdu_type,
+        direction: Direction::TowardReceiver,
+        mode: Mode::Acknowledged,
+        crc,
+        segmentation: false,
+        lengths: Lengths::MISSION,
+        data_len: 0,
+        source: 0x18,
+        seq: 1,
+        dest: 0x15,
+    };
+    let eof_data = [0x04, 0x80, 0, 0, 0, 0, 0, 0, 0x65, 0xfc];
+    let pdu = |h: PduHeader, data: &[u8]| {
+        let mut out = [0u8; 64];
+        let n = mmic::cfdp::emit(&h, data, &mut out).expect("fits");
+        out[..n].to_vec()
+    };
+    let mut yamcs = pdu(header(PduType::Directive, false), &eof_data);
+    yamcs[0] = 0x00; // YAMCS writes version 000
+    let crc = pdu(header(PduType::Directive, true), &eof_data);
+    let data = pdu(
+        header(PduType::FileData, false),
+        &[0, 0, 0, 0, b'p', b'l', b'a', b'n'],
+    );
+    let with = |b: &[u8], at: usize, v: u8| {
+        let mut b = b.to_vec();
+        b[at] = v;
+        b
+    };
+    let named = [
+        ("eof-yamcs", yamcs.clone()),
+        ("eof-crc", crc.clone()),
+        ("file-data", data),
+        ("truncated", yamcs[..3].to_vec()),
+        ("version-2", with(&yamcs, 0, 0x40)),
+        ("large-file", with(&yamcs, 0, 0x01)),
+        ("segment-metadata", with(&yamcs, 3, 0x1b)),
+        ("length-short", yamcs[..yamcs.len() - 1].to_vec()),
+        (
+            "crc-miss",
+            with(&crc, crc.len() - 1, crc[crc.len() - 1] ^ 1),
+        ),
+    ];
+    named
+        .into_iter()
+        .map(|(name, bytes)| SeedFile {
+            target,
+            name: name.to_string(),
+            bytes,
+        })
+        .collect()
 }

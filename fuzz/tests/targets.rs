@@ -306,3 +306,14 @@ fn server_store() {
         _ => {}
     });
 }
+
+/// A CFDP PDU (cut to `MAX_PDU` octets) through `cfdp::Pdu::parse`: exactly the oracle's verdict
+/// (`mmic_proofs::cfdp::check_cfdp_parse`), and an accepted PDU re-emits to the same octets
+/// but for the version.
+#[test]
+fn cfdp_pdu() {
+    bolero::check!().for_each(|input: &[u8]| {
+        let input = &input[..input.len().min(mmic_proofs::cfdp::MAX_PDU)];
+        mmic_proofs::cfdp::check_cfdp_parse(input);
+    });
+}

@@ -31,6 +31,7 @@
 #![deny(missing_docs)]
 
 pub mod ccsds;
+pub mod cfdp;
 pub mod link;
 pub mod link_cop;
 pub mod link_tm;

@@ -55,20 +55,20 @@ pub struct Pdu<'a> {
 
 impl<'a> Pdu<'a> {
     /// Checks `bytes` as exactly one PDU: the header ([`PduHeader::parse`]), then the data
-    /// field length against the octets that follow (`length`), then the CRC (`crc`).
+    /// field length against the octets that follow (`length`), then, with the CRC flag, a data
+    /// field long enough for the CRC (`truncated`) and the CRC itself (`crc`).
     pub fn parse(bytes: &'a [u8]) -> Result<Pdu<'a>, PduError> {
-        let (pdu, rest) = Self::parse_prefix(bytes)?;
-        if !rest.is_empty() {
-            let (h, _) = PduHeader::parse(bytes)?;
-            return Err(PduError::Length {
-                declared: usize::from(h.data_len),
-                found: bytes.len().saturating_sub(h.len()),
-            });
+        let (header, len) = PduHeader::parse(bytes)?;
+        let declared = usize::from(header.data_len);
+        let found = bytes.len().saturating_sub(len);
+        if found != declared {
+            return Err(PduError::Length { declared, found });
         }
-        Ok(pdu)
+        Self::parse_prefix(bytes).map(|(pdu, _)| pdu)
     }
 
-    /// The PDU at the start of `bytes` and the octets after it (a stream of PDUs).
+    /// The PDU at the start of `bytes` and the octets after it (a stream of PDUs): as
+    /// [`Pdu::parse`], but octets after the data field are the next PDU's.
     pub fn parse_prefix(bytes: &'a [u8]) -> Result<(Pdu<'a>, &'a [u8]), PduError> {
         let (header, len) = PduHeader::parse(bytes)?;
         let declared = usize::from(header.data_len);
@@ -77,17 +77,16 @@ impl<'a> Pdu<'a> {
             declared,
             found: after.len(),
         })?;
-        let whole = bytes.get(..len.saturating_add(declared)).unwrap_or(&[]);
+        let end = len.saturating_add(declared);
+        let whole = bytes.get(..end).unwrap_or(&[]);
         let data = if header.crc {
             let (data, crc) = field
                 .split_last_chunk::<CRC_LEN>()
-                .ok_or(PduError::Length {
-                    declared,
-                    found: after.len(),
+                .ok_or(PduError::Truncated {
+                    expected: len.saturating_add(CRC_LEN),
+                    found: end,
                 })?;
-            let before = whole
-                .get(..whole.len().saturating_sub(CRC_LEN))
-                .unwrap_or(&[]);
+            let before = whole.get(..end.saturating_sub(CRC_LEN)).unwrap_or(&[]);
             let (expected, found) = (pdu_crc(before), u16::from_be_bytes(*crc));
             if expected != found {
                 return Err(PduError::Crc { expected, found });

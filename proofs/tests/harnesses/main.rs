@@ -4,6 +4,7 @@
 
 mod bolter_executor;
 mod ccsds;
+mod cfdp;
 mod control_hip;
 mod control_interp;
 mod deframer;
