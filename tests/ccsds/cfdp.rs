@@ -207,13 +207,19 @@ fn emit_refuses_what_the_header_cannot_carry() {
 }
 
 /// Every combination of the header's flags, with every pair of lengths 1..=8 and the largest
-/// values they hold: emitted, read back the same.
+/// values they hold: emitted, read back the same. Under Miri (63 s for the whole walk, CI
+/// 2026-11-28) the lengths 1, 2, 4 and 8 only: every flag still, and the copies of 1 to 8 octets.
 #[test]
 fn every_header_round_trips() {
+    let lengths: &[u8] = if cfg!(miri) {
+        &[1, 2, 4, 8]
+    } else {
+        &[1, 2, 3, 4, 5, 6, 7, 8]
+    };
     let mut n = 0u32;
     for bits in 0u8..32 {
-        for entity in 1..=8u8 {
-            for seq in 1..=8u8 {
+        for &entity in lengths {
+            for &seq in lengths {
                 let max = |octets: u8| u64::MAX >> (64 - 8 * u32::from(octets));
                 let h = PduHeader {
                     pdu_type: if bits & 1 == 0 {
@@ -249,7 +255,7 @@ fn every_header_round_trips() {
             }
         }
     }
-    assert_eq!(n, 32 * 64);
+    assert_eq!(n as usize, 32 * lengths.len() * lengths.len());
 }
 
 /// The modular checksum: the sum of the file's big-endian words, the last padded with zeros.

@@ -516,6 +516,10 @@ fn a_robot_not_served_is_refused_everywhere() {
 /// that do not fit are counted in `overflow`, never dropped silently; the frame gateway counts
 /// them on its first link.
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "17 robots over 300 ticks twice: 143 s under Miri (CI, 2026-11-28), and no dependency's unsafe code the other gateway tests do not reach"
+)]
 fn an_output_too_small_for_every_robot_counts_the_overflow() {
     let boards: Vec<BoardNumber> = (1..=17).map(|n| BoardNumber::new(n).unwrap()).collect();
     let mut g: Gateway<17, 4, 8> = Gateway::new(Config::default());
