@@ -38,7 +38,10 @@ pub fn for_each_variant_class(pw: PulseWidth, angle: HipAngle, mut visit: impl F
     bolter_classes(&mut visit);
     // Each primitive with its first final state in Table 5 order.
     for p in Primitive::ALL {
-        if let Some(m) = PrimitiveMove::all().find(|m| m.primitive() == p) {
+        let first = State::ALL
+            .into_iter()
+            .find_map(|to| PrimitiveMove::new(p, to).ok());
+        if let Some(m) = first {
             visit(Command::Primitive(m));
         }
     }

@@ -35,6 +35,8 @@ wire_enum! {
     const ALL;
     /// Table 6 number, 1..=8.
     pub const fn number(self) -> u8;
+    /// Position in Table 6 order, 0..=7 (the number less one).
+    pub const fn index(self) -> usize;
     /// Primitive with Table 6 number `n`.
     pub const fn from_number(n: u8) -> Option<Self>;
     /// Table 6 name.

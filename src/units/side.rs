@@ -106,4 +106,13 @@ mod tests {
             assert_eq!((p[Side::A], p[Side::B]), (a, b));
         }
     }
+
+    /// A side prints as its letter (the messages that name a side: refusals, faults, logs).
+    #[test]
+    fn a_side_prints_as_its_letter() {
+        extern crate std;
+        use std::string::ToString;
+        assert_eq!(Side::A.to_string(), "A");
+        assert_eq!(Side::B.to_string(), "B");
+    }
 }

@@ -416,15 +416,21 @@ mod tests {
                 ..HeartbeatRepr::default()
             },
         ];
-        // Under Miri (about 100x slower) each octet's two edges, 0 and 255: the view's code
-        // (zerocopy's cast, what Miri checks) does not depend on the values; natively all 256.
-        let step = if cfg!(miri) { 255 } else { 1 };
+        // Under Miri (about 100x slower, .ci/miri) the first sample with every sixth octet at
+        // 255 (10 packets; 60 took 18 s there): the view's code (zerocopy's cast, what Miri
+        // checks) does not depend on the values, and the walk runs natively, all 256 values of
+        // every octet of both samples.
+        let (samples, values, every) = if cfg!(miri) {
+            (&samples[..1], 255..=255u8, 6)
+        } else {
+            (&samples[..], 0..=255u8, 1)
+        };
         let mut checked = 0u32;
         for repr in samples {
             let good = repr.to_bytes();
-            assert_eq!(HeartbeatRepr::parse(&good), Ok(repr));
-            for at in field::BOARD.start..field::CHECKSUM.start {
-                for v in (0..=255u8).step_by(step) {
+            assert_eq!(HeartbeatRepr::parse(&good), Ok(*repr));
+            for at in (field::BOARD.start..field::CHECKSUM.start).step_by(every) {
+                for v in values.clone() {
                     let mut b = good;
                     b[at] = v;
                     let crc = crc16(&b[..field::CHECKSUM.start]).to_le_bytes();
@@ -439,6 +445,7 @@ mod tests {
                 }
             }
         }
-        assert_eq!(checked, 2 * 60 * 256_u32.div_ceil(step as u32));
+        let expected = if cfg!(miri) { 10 } else { 2 * 60 * 256 };
+        assert_eq!(checked, expected);
     }
 }

@@ -165,14 +165,18 @@ fn emit_refuses_a_short_buffer_and_oversized_data() {
             found: 65_530
         })
     );
-    // The largest telecommand: data length field 0xffff, 65,542 octets.
+    // The largest telecommand: data length field 0xffff, 65,542 octets. Not under Miri
+    // (.ci/miri): its CRC over 64 KiB took 82 s of the i686 lane there, and it takes the same
+    // slices and casts as any shorter packet, which Miri checks in the golden packets above.
     let largest = TcRepr {
         app_data: &data[..TC_MAX_APP_DATA],
         ..ping()
     };
-    assert_eq!(largest.emit(&mut out), Ok(65_542));
-    assert_eq!(out[4..6], [0xff, 0xff]);
-    assert_eq!(TcRepr::parse(&out[..65_542], &[APID]), Ok(largest));
+    if !cfg!(miri) {
+        assert_eq!(largest.emit(&mut out), Ok(65_542));
+        assert_eq!(out[4..6], [0xff, 0xff]);
+        assert_eq!(TcRepr::parse(&out[..65_542], &[APID]), Ok(largest));
+    }
     let tm_data = vec![0u8; TM_MAX_SOURCE_DATA + 1];
     let too_long = TmRepr {
         source_data: &tm_data,
