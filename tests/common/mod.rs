@@ -8,17 +8,26 @@ pub mod prop;
 use mmic::wire::{PacketKind, WireError, CHECKSUM_LEN, HEADER_LEN};
 
 /// CRC-16/CCITT-FALSE: poly 0x1021, init 0xFFFF, MSB first, no final xor; one bit at a time.
+/// Each bit: shift left, and xor the polynomial in when the bit shifted out was set (the mask
+/// `0u16.wrapping_sub(crc >> 15)`). No branch and no inner loop, so that CI's instrumented run
+/// counts each octet once, not each bit's branch (issue 40); the proofs crate's oracle is the same.
 pub fn crc16_bitwise(bytes: &[u8]) -> u16 {
+    macro_rules! bit {
+        ($crc:ident) => {
+            $crc = ($crc << 1) ^ (0x1021 & 0u16.wrapping_sub($crc >> 15))
+        };
+    }
     let mut crc: u16 = 0xffff;
     for &b in bytes {
         crc ^= (b as u16) << 8;
-        for _ in 0..8 {
-            crc = if crc & 0x8000 != 0 {
-                (crc << 1) ^ 0x1021
-            } else {
-                crc << 1
-            };
-        }
+        bit!(crc);
+        bit!(crc);
+        bit!(crc);
+        bit!(crc);
+        bit!(crc);
+        bit!(crc);
+        bit!(crc);
+        bit!(crc);
     }
     crc
 }
