@@ -11,6 +11,17 @@ mod restarts;
 mod sdls;
 
 use mmic::node::robot::board_a::{self, BoardA, Event};
+
+/// Threads for a model check that may run on several: libtest's own budget when it is given as
+/// `RUST_TEST_THREADS` (CI's instrumented run sets 1: its one-thread processes already run side
+/// by side on every core, and two threads of one instrumented process contend for its counters,
+/// see .ci/cov-runner), else two. The unique state counts are the same on any number.
+fn model_threads() -> usize {
+    std::env::var("RUST_TEST_THREADS")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .map_or(2, |n: usize| n.clamp(1, 2))
+}
 use mmic::wire::command::COMMAND_LEN;
 use mmic::wire::heartbeat::HEARTBEAT_LEN;
 

@@ -283,7 +283,7 @@ fn check_ground(max_duplicates: u8, max_attempts: u8) -> (usize, usize) {
         max_attempts,
     }
     .checker()
-    .threads(2)
+    .threads(crate::model_threads())
     .spawn_bfs()
     .join();
     for p in [
@@ -469,7 +469,7 @@ fn check_link(max_losses: u8, bound_ms: u32) -> (bool, usize) {
         bound_ms,
     }
     .checker()
-    .threads(2)
+    .threads(crate::model_threads())
     .spawn_bfs()
     .join();
     assert!(checker.discovery("Operational at the cut").is_some());

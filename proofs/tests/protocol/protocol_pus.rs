@@ -337,7 +337,7 @@ fn pus_exactly_once() {
     // A violation ends the search at once (and fails below, with its path).
     let checker = PusModel
         .checker()
-        .threads(2)
+        .threads(crate::model_threads())
         .finish_when(stateright::HasDiscoveries::AnyFailures)
         .spawn_bfs()
         .join();

@@ -604,7 +604,7 @@ where
     let t0 = std::time::Instant::now();
     let checker = model
         .checker()
-        .threads(2)
+        .threads(crate::model_threads())
         .finish_when(HasDiscoveries::AnyFailures)
         .spawn_bfs()
         .join();
