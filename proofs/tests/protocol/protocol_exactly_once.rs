@@ -68,9 +68,9 @@ struct Ground {
     submitted: usize,
     outcomes: [Option<Outcome>; COMMANDS.len()],
     server: Server<1>,
-    wifi: Vec<Packet>,
+    wifi: super::InFlight<Packet>,
     duplicates: u8,
-    a: BoardA,
+    a: super::Shared<BoardA>,
     a_now: u32,
     executed: [u8; COMMANDS.len()],
     silent_drop: bool,
@@ -92,11 +92,6 @@ enum GroundAction {
 struct GroundModel {
     max_duplicates: u8,
     max_attempts: u8,
-}
-
-fn put(v: &mut Vec<Packet>, p: Packet) {
-    v.push(p);
-    v.sort();
 }
 
 fn index_of(seq: u16) -> Option<usize> {
@@ -144,9 +139,9 @@ impl Model for GroundModel {
             submitted: 0,
             outcomes: [None; COMMANDS.len()],
             server: Server::new(),
-            wifi: vec![],
+            wifi: super::InFlight::new(),
             duplicates: 0,
-            a: BoardA::new(board_a::Config::default()),
+            a: super::Shared::new(BoardA::new(board_a::Config::default())),
             a_now: 0,
             executed: [0; COMMANDS.len()],
             silent_drop: false,
@@ -163,9 +158,7 @@ impl Model for GroundModel {
         if s.server.pending_count() > 0 && s.wifi.len() < MAX_IN_FLIGHT {
             actions.push(GroundAction::ServerTransmit);
         }
-        let mut seen = s.wifi.clone();
-        seen.dedup();
-        for p in seen {
+        for p in super::distinct(&s.wifi) {
             actions.push(GroundAction::Deliver(p));
             actions.push(GroundAction::Drop(p));
             if s.duplicates < self.max_duplicates && s.wifi.len() < MAX_IN_FLIGHT {
@@ -191,7 +184,7 @@ impl Model for GroundModel {
             GroundAction::ServerTransmit => {
                 let (robot, packet) = n.server.next_visit()?;
                 n.server.delivered(robot, &packet);
-                put(&mut n.wifi, Packet::Command(packet));
+                super::put(&mut n.wifi, Packet::Command(packet));
             }
             GroundAction::Deliver(p) => {
                 let i = n.wifi.iter().position(|x| *x == p)?;
@@ -199,14 +192,17 @@ impl Model for GroundModel {
                 match p {
                     Packet::Command(bytes) => {
                         let executed = &mut n.executed;
-                        let hb = super::board_a_takes(&mut n.a, &mut n.a_now, bytes, |seq| {
-                            if let Some(i) = index_of(seq) {
-                                executed[i] = executed[i].saturating_add(1);
-                            }
+                        let a_now = &mut n.a_now;
+                        let hb = n.a.update(|a| {
+                            super::board_a_takes(a, a_now, bytes, |seq| {
+                                if let Some(i) = index_of(seq) {
+                                    executed[i] = executed[i].saturating_add(1);
+                                }
+                            })
                         });
                         if let Some(hb) = hb {
                             if n.wifi.len() < MAX_IN_FLIGHT {
-                                put(&mut n.wifi, Packet::Heartbeat(hb));
+                                super::put(&mut n.wifi, Packet::Heartbeat(hb));
                             }
                         }
                     }
@@ -222,7 +218,7 @@ impl Model for GroundModel {
                 n.wifi.remove(i);
             }
             GroundAction::Duplicate(p) => {
-                put(&mut n.wifi, p);
+                super::put(&mut n.wifi, p);
                 n.duplicates += 1;
             }
         }

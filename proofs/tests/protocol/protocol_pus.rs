@@ -51,15 +51,15 @@ enum Final {
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct State {
-    g: Gateway<1, 4, 8>,
+    g: super::Shared<Gateway<1, 4, 8>>,
     now: u32,
     sent: usize,
     resent: u8,
-    up: Vec<Packet>,
-    down: Vec<Packet>,
-    wifi: Vec<Packet>,
+    up: super::InFlight<Packet>,
+    down: super::InFlight<Packet>,
+    wifi: super::InFlight<Packet>,
     duplicates: u8,
-    a: BoardA,
+    a: super::Shared<BoardA>,
     a_now: u32,
     /// Executions per telecommand (board A's `Executed` for its legacy number).
     executed: [u8; TCS.len()],
@@ -89,11 +89,6 @@ enum Action {
 
 struct PusModel;
 
-fn put(v: &mut Vec<Packet>, p: Packet) {
-    v.push(p);
-    v.sort();
-}
-
 fn tc(i: u8) -> Tc {
     Tc {
         request: RequestId {
@@ -114,7 +109,7 @@ impl PusModel {
                 n.seq_of[i] = Some(c.seq);
             }
             if n.wifi.len() < MAX_IN_FLIGHT {
-                put(&mut n.wifi, Packet::Command(c.to_bytes()));
+                super::put(&mut n.wifi, Packet::Command(c.to_bytes()));
             }
         }
         for tm in out.reports {
@@ -141,7 +136,7 @@ impl PusModel {
                 n.conflict |= n.made[i].is_some_and(|m| m != f);
                 n.made[i] = Some(f);
                 if n.down.len() < MAX_IN_FLIGHT {
-                    put(&mut n.down, Packet::Report(i as u8, f));
+                    super::put(&mut n.down, Packet::Report(i as u8, f));
                 }
             }
         }
@@ -176,15 +171,15 @@ impl Model for PusModel {
             },
         );
         vec![State {
-            g,
+            g: super::Shared::new(g),
             now: 0,
             sent: 0,
             resent: 0,
-            up: vec![],
-            down: vec![],
-            wifi: vec![],
+            up: super::InFlight::new(),
+            down: super::InFlight::new(),
+            wifi: super::InFlight::new(),
             duplicates: 0,
-            a: BoardA::new(board_a::Config::default()),
+            a: super::Shared::new(BoardA::new(board_a::Config::default())),
             a_now: 0,
             executed: [0; TCS.len()],
             seq_of: [None; TCS.len()],
@@ -208,9 +203,7 @@ impl Model for PusModel {
             actions.push(Action::Advance);
         }
         for link in [&s.up, &s.down, &s.wifi] {
-            let mut seen = link.clone();
-            seen.dedup();
-            for p in seen {
+            for p in super::distinct(link) {
                 actions.push(Action::Deliver(p));
                 actions.push(Action::Drop(p));
                 if s.duplicates < MAX_DUPLICATES && link.len() < MAX_IN_FLIGHT {
@@ -224,17 +217,18 @@ impl Model for PusModel {
         let mut n = s.clone();
         match a {
             Action::Send => {
-                put(&mut n.up, Packet::Tc(n.sent as u8));
+                super::put(&mut n.up, Packet::Tc(n.sent as u8));
                 n.sent += 1;
             }
             Action::Resend(i) => {
-                put(&mut n.up, Packet::Tc(i));
+                super::put(&mut n.up, Packet::Tc(i));
                 n.resent += 1;
             }
             Action::Advance => {
                 let t = n.g.next_deadline(n.now)?;
                 n.now = t.max(n.now);
-                let out = n.g.tick(n.now);
+                let now = n.now;
+                let out = n.g.update(|g| g.tick(now));
                 self.out(&mut n, out);
             }
             Action::Deliver(p) | Action::Drop(p) => {
@@ -248,7 +242,7 @@ impl Model for PusModel {
                 if matches!(a, Action::Deliver(_)) {
                     match p {
                         Packet::Tc(i) => {
-                            let out = n.g.tc(&tc(i));
+                            let out = n.g.update(|g| g.tc(&tc(i)));
                             self.out(&mut n, out);
                         }
                         Packet::Report(i, f) => {
@@ -258,20 +252,24 @@ impl Model for PusModel {
                         }
                         Packet::Command(bytes) => {
                             let (executed, seq_of) = (&mut n.executed, &n.seq_of);
-                            let hb = super::board_a_takes(&mut n.a, &mut n.a_now, bytes, |seq| {
-                                if let Some(i) = seq_of.iter().position(|s| *s == Some(seq)) {
-                                    executed[i] = executed[i].saturating_add(1);
-                                }
+                            let a_now = &mut n.a_now;
+                            let hb = n.a.update(|a| {
+                                super::board_a_takes(a, a_now, bytes, |seq| {
+                                    if let Some(i) = seq_of.iter().position(|s| *s == Some(seq)) {
+                                        executed[i] = executed[i].saturating_add(1);
+                                    }
+                                })
                             });
                             if let Some(hb) = hb {
                                 if n.wifi.len() < MAX_IN_FLIGHT {
-                                    put(&mut n.wifi, Packet::Heartbeat(hb));
+                                    super::put(&mut n.wifi, Packet::Heartbeat(hb));
                                 }
                             }
                         }
                         Packet::Heartbeat(bytes) => {
                             let hb = HeartbeatRepr::parse(&bytes).ok()?;
-                            let out = n.g.heartbeat(n.now, &hb);
+                            let now = n.now;
+                            let out = n.g.update(|g| g.heartbeat(now, &hb));
                             self.out(&mut n, out);
                         }
                     }
@@ -283,7 +281,7 @@ impl Model for PusModel {
                     Packet::Report(..) => &mut n.down,
                     _ => &mut n.wifi,
                 };
-                put(v, p);
+                super::put(v, p);
                 n.duplicates += 1;
             }
         }

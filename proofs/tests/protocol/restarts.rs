@@ -88,11 +88,6 @@ impl Packet {
     }
 }
 
-fn put(v: &mut Vec<Packet>, p: Packet) {
-    v.push(p);
-    v.sort();
-}
-
 /// Board A's part, shared by both models: the board, its clock and its store.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct RobotA {
@@ -244,10 +239,10 @@ struct Legacy {
     probes: u8,
     ends: [Option<End>; COMMANDS.len()],
     server: Server<1>,
-    wifi: Vec<Packet>,
+    wifi: super::InFlight<Packet>,
     drops: u8,
     duplicates: u8,
-    robot: RobotA,
+    robot: super::Shared<RobotA>,
     judged: [u8; COMMANDS.len()],
     ran: [u8; COMMANDS.len()],
     restarts: [u8; NODES.len()],
@@ -355,10 +350,10 @@ impl Model for LegacyModel {
             probes: 0,
             ends: [None; COMMANDS.len()],
             server: Server::new(),
-            wifi: vec![],
+            wifi: super::InFlight::new(),
             drops: 0,
             duplicates: 0,
-            robot: RobotA::new(),
+            robot: super::Shared::new(RobotA::new()),
             judged: [0; COMMANDS.len()],
             ran: [0; COMMANDS.len()],
             restarts: [0; NODES.len()],
@@ -380,9 +375,7 @@ impl Model for LegacyModel {
             actions.push(LegacyAction::ServerTransmit);
         }
         let total: u8 = s.restarts.iter().sum();
-        let mut seen = s.wifi.clone();
-        seen.dedup();
-        for p in seen {
+        for p in super::distinct(&s.wifi) {
             actions.push(LegacyAction::Deliver(p));
             if matches!(p, Packet::Command(_))
                 && s.restarts[0] < self.max_restarts
@@ -422,7 +415,7 @@ impl Model for LegacyModel {
             LegacyAction::ServerTransmit => {
                 let (robot, packet) = n.server.next_visit()?;
                 n.server.delivered(robot, &packet);
-                put(&mut n.wifi, Packet::Command(packet));
+                super::put(&mut n.wifi, Packet::Command(packet));
             }
             LegacyAction::Deliver(p) | LegacyAction::Crash(p, _) => {
                 let i = n.wifi.iter().position(|x| *x == p)?;
@@ -443,9 +436,8 @@ impl Model for LegacyModel {
                             judged: &mut n.judged,
                             ran: &mut n.ran,
                         };
-                        let (hb, _) =
-                            n.robot
-                                .take(bytes, how, (self.restore_a, self.ahead_accepted), counts);
+                        let keeps = (self.restore_a, self.ahead_accepted);
+                        let (hb, _) = n.robot.update(|r| r.take(bytes, how, keeps, counts));
                         if how != Take::Whole {
                             for (k, r) in ran_before.iter().enumerate() {
                                 n.ran_before_a_restart[k] |= *r > 0 || n.ran[k] > 0;
@@ -453,7 +445,7 @@ impl Model for LegacyModel {
                         }
                         if let Some(hb) = hb {
                             if n.wifi.len() < self.max_in_flight {
-                                put(&mut n.wifi, Packet::Heartbeat(hb));
+                                super::put(&mut n.wifi, Packet::Heartbeat(hb));
                             }
                         }
                     }
@@ -471,7 +463,7 @@ impl Model for LegacyModel {
                 n.drops += 1;
             }
             LegacyAction::Duplicate(p) => {
-                put(&mut n.wifi, p);
+                super::put(&mut n.wifi, p);
                 n.duplicates += 1;
             }
             LegacyAction::Restart(node) => {
@@ -483,7 +475,7 @@ impl Model for LegacyModel {
                         for (k, r) in n.ran.iter().enumerate() {
                             n.ran_before_a_restart[k] |= *r > 0;
                         }
-                        n.robot.restart(self.restore_a);
+                        n.robot.update(|r| r.restart(self.restore_a));
                     }
                     Node::Server => n.server = Server::new(),
                     Node::Ground => {
@@ -697,7 +689,7 @@ enum Final {
 
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 struct Pus {
-    g: Gateway<1, 4, 8>,
+    g: super::Shared<Gateway<1, 4, 8>>,
     /// What the gateway wrote to flash (the last `kept`).
     g_store: Kept,
     g_life: u8,
@@ -710,11 +702,11 @@ struct Pus {
     /// The key (sequence count) each telecommand went out under.
     key_of: [Option<u16>; TCS.len()],
     resent: u8,
-    up: Vec<Packet>,
-    down: Vec<Packet>,
-    wifi: Vec<Packet>,
+    up: super::InFlight<Packet>,
+    down: super::InFlight<Packet>,
+    wifi: super::InFlight<Packet>,
     drops: u8,
-    robot: RobotA,
+    robot: super::Shared<RobotA>,
     judged: [u8; TCS.len()],
     ran: [u8; TCS.len()],
     /// The gateway life that took (accepted) each telecommand, and the life that made its
@@ -796,7 +788,7 @@ impl PusModel {
                 }
             }
             if n.wifi.len() < self.max_in_flight {
-                put(&mut n.wifi, Packet::Command(c.to_bytes()));
+                super::put(&mut n.wifi, Packet::Command(c.to_bytes()));
             }
         }
         for tm in out.reports {
@@ -836,7 +828,7 @@ impl PusModel {
                 }
                 n.made_in[i] = Some(n.g_life);
                 if n.down.len() < self.max_in_flight {
-                    put(&mut n.down, Packet::Report(i as u8, f));
+                    super::put(&mut n.down, Packet::Report(i as u8, f));
                 }
             }
         }
@@ -867,7 +859,7 @@ impl Model for PusModel {
         );
         vec![Pus {
             g_store: g.kept(BoardNumber::ONE).unwrap_or_default(),
-            g,
+            g: super::Shared::new(g),
             g_life: 0,
             g_probes: 0,
             now: 0,
@@ -875,11 +867,11 @@ impl Model for PusModel {
             next_count: 1,
             key_of: [None; TCS.len()],
             resent: 0,
-            up: vec![],
-            down: vec![],
-            wifi: vec![],
+            up: super::InFlight::new(),
+            down: super::InFlight::new(),
+            wifi: super::InFlight::new(),
             drops: 0,
-            robot: RobotA::new(),
+            robot: super::Shared::new(RobotA::new()),
             judged: [0; TCS.len()],
             ran: [0; TCS.len()],
             taken_in: [None; TCS.len()],
@@ -914,9 +906,7 @@ impl Model for PusModel {
         let total: u8 = s.restarts.iter().sum();
         let restart_a = s.restarts[0] < self.max_restarts && total < self.max_restarts_total;
         for link in [&s.up, &s.down, &s.wifi] {
-            let mut seen = link.clone();
-            seen.dedup();
-            for p in seen {
+            for p in super::distinct(link) {
                 actions.push(PusAction::Deliver(p));
                 if matches!(p, Packet::Command(_)) && restart_a {
                     actions.push(PusAction::Crash(p, Take::CrashBeforeTick));
@@ -940,11 +930,11 @@ impl Model for PusModel {
             PusAction::Send => {
                 n.key_of[n.sent] = Some(n.next_count);
                 n.next_count += 1;
-                put(&mut n.up, Packet::Tc(n.sent as u8));
+                super::put(&mut n.up, Packet::Tc(n.sent as u8));
                 n.sent += 1;
             }
             PusAction::Resend(i) => {
-                put(&mut n.up, Packet::Tc(i));
+                super::put(&mut n.up, Packet::Tc(i));
                 n.resent += 1;
             }
             PusAction::Advance => {
@@ -952,7 +942,8 @@ impl Model for PusModel {
                 n.now = t.max(n.now);
                 // The kept keys are written before the tick.
                 n.g_store = n.g.kept(BoardNumber::ONE)?;
-                let out = n.g.tick(n.now);
+                let now = n.now;
+                let out = n.g.update(|g| g.tick(now));
                 self.out(&mut n, out)?;
             }
             PusAction::Drop(p) => {
@@ -984,7 +975,7 @@ impl Model for PusModel {
                 match p {
                     Packet::Tc(i) => {
                         let tc = PusModel::tc(&n, i)?;
-                        let out = n.g.tc(&tc);
+                        let out = n.g.update(|g| g.tc(&tc));
                         self.out(&mut n, out)?;
                     }
                     Packet::Report(i, f) => {
@@ -1002,18 +993,18 @@ impl Model for PusModel {
                             judged: &mut n.judged,
                             ran: &mut n.ran,
                         };
-                        let (hb, _) =
-                            n.robot
-                                .take(bytes, how, (self.restore_a, self.ahead_accepted), counts);
+                        let keeps = (self.restore_a, self.ahead_accepted);
+                        let (hb, _) = n.robot.update(|r| r.take(bytes, how, keeps, counts));
                         if let Some(hb) = hb {
                             if n.wifi.len() < self.max_in_flight {
-                                put(&mut n.wifi, Packet::Heartbeat(hb));
+                                super::put(&mut n.wifi, Packet::Heartbeat(hb));
                             }
                         }
                     }
                     Packet::Heartbeat(bytes) => {
                         let hb = HeartbeatRepr::parse(&bytes).ok()?;
-                        let out = n.g.heartbeat(n.now, &hb);
+                        let now = n.now;
+                        let out = n.g.update(|g| g.heartbeat(now, &hb));
                         self.out(&mut n, out)?;
                     }
                 }
@@ -1023,7 +1014,7 @@ impl Model for PusModel {
                 n.mid_command[k] |= PusModel::open(&n);
                 n.restarts[k] += 1;
                 match node {
-                    Node::BoardA => n.robot.restart(self.restore_a),
+                    Node::BoardA => n.robot.update(|r| r.restart(self.restore_a)),
                     Node::Server => {
                         let mut g = Gateway::new(PusModel::cfg());
                         if self.restore_gateway {
@@ -1031,7 +1022,7 @@ impl Model for PusModel {
                         } else {
                             g.add(BoardNumber::ONE);
                         }
-                        n.g = g;
+                        n.g = super::Shared::new(g);
                         n.g_life += 1;
                         n.g_probes = 0;
                     }
