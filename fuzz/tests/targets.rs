@@ -52,6 +52,14 @@ use mmic::wire::MAX_PACKET_LEN;
 use mmic_proofs::ccsds::{check_pus_parse, check_pus_parse_with, min_len, reseal, MAX_PACKET};
 use mmic_proofs::{build_stream, check_parse, check_round_trip, run_deframer, Repr};
 
+/// Random inputs each target runs under plain `cargo test`, after its committed corpus and
+/// crashes: a fixed count (bolero's default is as many as fit in one second, a count that
+/// changes with the machine's load), so that the README's command does the same work on every
+/// run. The fuzzing itself is `cargo bolero test` (CI's fuzz step and the campaigns, README),
+/// where this count does not apply; `BOLERO_RANDOM_ITERATIONS=N cargo test -p mmic-fuzz` runs
+/// N instead.
+const RANDOM_INPUTS: usize = 10_000;
+
 fn parser<R: Repr>(input: &[u8]) {
     check_parse::<R>(input);
     check_round_trip::<R>(input);
@@ -96,55 +104,69 @@ fn tc_frame_parser_property(input: &[u8]) {
 
 #[test]
 fn tc_frame_parser() {
-    bolero::check!().for_each(tc_frame_parser_property);
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(tc_frame_parser_property);
 }
 
 #[test]
 fn pus_tc_parser() {
-    bolero::check!().for_each(|input: &[u8]| pus_parser(PacketType::Tc, input));
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| pus_parser(PacketType::Tc, input));
 }
 
 #[test]
 fn pus_tm_parser() {
-    bolero::check!().for_each(|input: &[u8]| pus_parser(PacketType::Tm, input));
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| pus_parser(PacketType::Tm, input));
 }
 
 /// The services layer: two octets of service and subservice, then the application data.
 #[test]
 fn pus_request() {
-    bolero::check!().for_each(|input: &[u8]| {
-        if let [service, subservice, data @ ..] = input {
-            mmic_proofs::pus::check_request(*service, *subservice, data);
-        }
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            if let [service, subservice, data @ ..] = input {
+                mmic_proofs::pus::check_request(*service, *subservice, data);
+            }
+        });
 }
 
 /// TM(3,25) source data through `housekeeping::parse`.
 #[test]
 fn pus_housekeeping() {
-    bolero::check!().for_each(|input: &[u8]| {
-        mmic_proofs::pus::check_housekeeping(input);
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            mmic_proofs::pus::check_housekeeping(input);
+        });
 }
 
 /// A subservice octet, then TM(1,x) source data through `verification::Report::parse`.
 #[test]
 fn pus_verification() {
-    bolero::check!().for_each(|input: &[u8]| {
-        if let [subservice, data @ ..] = input {
-            mmic_proofs::pus::check_verification(*subservice, data);
-        }
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            if let [subservice, data @ ..] = input {
+                mmic_proofs::pus::check_verification(*subservice, data);
+            }
+        });
 }
 
 /// A subservice octet, then TM(5,x) source data through `event::Event::parse`.
 #[test]
 fn pus_event() {
-    bolero::check!().for_each(|input: &[u8]| {
-        if let [subservice, data @ ..] = input {
-            mmic_proofs::pus::check_event(*subservice, data);
-        }
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            if let [subservice, data @ ..] = input {
+                mmic_proofs::pus::check_event(*subservice, data);
+            }
+        });
 }
 
 /// The TM frame parser: the input (cut to 300 octets) under the mission's parameters must get
@@ -154,20 +176,22 @@ fn pus_event() {
 #[test]
 fn tm_frame_parser() {
     use mmic_proofs::link_tm::{check_tm_frame_parse, reseal, PARAMS};
-    bolero::check!().for_each(|input: &[u8]| {
-        let input = &input[..input.len().min(300)];
-        check_tm_frame_parse(input, &PARAMS);
-        if input.len() >= 256 {
-            let mut f = input[..256].to_vec();
-            // Spacecraft 0x142 and segment length ID 11 set; version, VCID, OCF flag, the
-            // other flags and the pointer left as the input has them (each check reachable).
-            f[0] = (f[0] & 0xc0) | 0x14;
-            f[1] = (f[1] & 0x0f) | 0x20;
-            f[4] |= 0x18;
-            reseal(&mut f);
-            check_tm_frame_parse(&f, &PARAMS);
-        }
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            let input = &input[..input.len().min(300)];
+            check_tm_frame_parse(input, &PARAMS);
+            if input.len() >= 256 {
+                let mut f = input[..256].to_vec();
+                // Spacecraft 0x142 and segment length ID 11 set; version, VCID, OCF flag, the
+                // other flags and the pointer left as the input has them (each check reachable).
+                f[0] = (f[0] & 0xc0) | 0x14;
+                f[1] = (f[1] & 0x0f) | 0x20;
+                f[4] |= 0x18;
+                reseal(&mut f);
+                check_tm_frame_parse(&f, &PARAMS);
+            }
+        });
 }
 
 /// The TM link: the input as a run of the framer and the extractor with frame loss
@@ -176,42 +200,54 @@ fn tm_frame_parser() {
 #[test]
 fn tm_extractor() {
     use mmic_proofs::link_tm::{check_extractor_stream, check_link};
-    bolero::check!().for_each(|input: &[u8]| {
-        check_link(&input[..input.len().min(80)], true);
-        check_extractor_stream(input);
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            check_link(&input[..input.len().min(80)], true);
+            check_extractor_stream(input);
+        });
 }
 
 #[test]
 fn command_parser() {
-    bolero::check!().for_each(parser::<CommandRepr>);
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(parser::<CommandRepr>);
 }
 
 #[test]
 fn heartbeat_parser() {
-    bolero::check!().for_each(parser::<HeartbeatRepr>);
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(parser::<HeartbeatRepr>);
 }
 
 #[test]
 fn internal_heartbeat_parser() {
-    bolero::check!().for_each(parser::<InternalHeartbeatRepr>);
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(parser::<InternalHeartbeatRepr>);
 }
 
 #[test]
 fn b_command_parser() {
-    bolero::check!().for_each(parser::<BCommandRepr>);
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(parser::<BCommandRepr>);
 }
 
 #[test]
 fn deframer_stream() {
-    bolero::check!().for_each(|input: &[u8]| {
-        let (plan, stream) = input.split_at(input.len().min(4));
-        run_deframer::<MAX_PACKET_LEN>(stream, plan, |_, _| {});
-        run_deframer::<256>(stream, plan, |_, _| {});
-        let mut built = [0u8; 4096];
-        let n = build_stream(stream, &mut built);
-        run_deframer::<MAX_PACKET_LEN>(&built[..n], plan, |_, _| {});
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            let (plan, stream) = input.split_at(input.len().min(4));
+            run_deframer::<MAX_PACKET_LEN>(stream, plan, |_, _| {});
+            run_deframer::<256>(stream, plan, |_, _| {});
+            let mut built = [0u8; 4096];
+            let n = build_stream(stream, &mut built);
+            run_deframer::<MAX_PACKET_LEN>(&built[..n], plan, |_, _| {});
+        });
 }
 
 /// Four octets (zero-padded) through `Clcw::parse`: the verdict of the CLCW's bit table, the
@@ -219,16 +255,18 @@ fn deframer_stream() {
 /// (`mmic_proofs::link_cop::check_clcw_word`); any other length refused by the length check.
 #[test]
 fn link_clcw() {
-    bolero::check!().for_each(|input: &[u8]| {
-        let mut w = [0u8; 4];
-        let n = input.len().min(4);
-        w[..n].copy_from_slice(&input[..n]);
-        mmic_proofs::link_cop::check_clcw_word(u32::from_be_bytes(w));
-        if input.len() != 4 {
-            let e = mmic::link::clcw::Clcw::parse(input).err().map(|e| e.name());
-            assert_eq!(e, Some("length"));
-        }
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            let mut w = [0u8; 4];
+            let n = input.len().min(4);
+            w[..n].copy_from_slice(&input[..n]);
+            mmic_proofs::link_cop::check_clcw_word(u32::from_be_bytes(w));
+            if input.len() != 4 {
+                let e = mmic::link::clcw::Clcw::parse(input).err().map(|e| e.name());
+                assert_eq!(e, Some("length"));
+            }
+        });
 }
 
 /// Octet 0 even: FARM-1 (octet 1 the window, then events of three octets) through
@@ -236,26 +274,28 @@ fn link_clcw() {
 /// `check_fop_inputs`. At most 64 events.
 #[test]
 fn link_cop() {
-    bolero::check!().for_each(|input: &[u8]| {
-        let [which, param, rest @ ..] = input else {
-            return;
-        };
-        if which % 2 == 0 {
-            let evs: Vec<(u8, u8, bool)> = rest
-                .chunks_exact(3)
-                .take(64)
-                .map(|c| (c[0], c[1], c[2] & 1 == 1))
-                .collect();
-            mmic_proofs::link_cop::check_farm_events(*param, &evs);
-        } else {
-            let inputs: Vec<(u8, u8)> = rest
-                .chunks_exact(2)
-                .take(64)
-                .map(|c| (c[0], c[1]))
-                .collect();
-            mmic_proofs::link_cop::check_fop_inputs(*param, &inputs);
-        }
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            let [which, param, rest @ ..] = input else {
+                return;
+            };
+            if which % 2 == 0 {
+                let evs: Vec<(u8, u8, bool)> = rest
+                    .chunks_exact(3)
+                    .take(64)
+                    .map(|c| (c[0], c[1], c[2] & 1 == 1))
+                    .collect();
+                mmic_proofs::link_cop::check_farm_events(*param, &evs);
+            } else {
+                let inputs: Vec<(u8, u8)> = rest
+                    .chunks_exact(2)
+                    .take(64)
+                    .map(|c| (c[0], c[1]))
+                    .collect();
+                mmic_proofs::link_cop::check_fop_inputs(*param, &inputs);
+            }
+        });
 }
 
 /// SDLS on the uplink: the octets (cut to 264) through a fresh secured `FrameGateway`'s
@@ -265,10 +305,12 @@ fn link_cop() {
 /// (`mmic_proofs::sdls::test_key`), not secrets.
 #[test]
 fn sdls_tc_verify() {
-    bolero::check!().for_each(|input: &[u8]| {
-        mmic_proofs::sdls::check_secured_tc_frame(input);
-        mmic_proofs::sdls::check_secured_tc_frame_resealed(input);
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            mmic_proofs::sdls::check_secured_tc_frame(input);
+            mmic_proofs::sdls::check_secured_tc_frame_resealed(input);
+        });
 }
 
 /// SDLS on the downlink: the octets (cut to 300) through a fresh secured `GroundLink`'s
@@ -276,35 +318,39 @@ fn sdls_tc_verify() {
 /// FECF written over them.
 #[test]
 fn sdls_tm_verify() {
-    bolero::check!().for_each(|input: &[u8]| {
-        let input = &input[..input.len().min(300)];
-        mmic_proofs::sdls::check_secured_tm_frame(input);
-        mmic_proofs::sdls::check_secured_tm_frame_resealed(input);
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            let input = &input[..input.len().min(300)];
+            mmic_proofs::sdls::check_secured_tm_frame(input);
+            mmic_proofs::sdls::check_secured_tm_frame_resealed(input);
+        });
 }
 
 /// The server board's durable store (issue 38): a selector octet, then the input of one of its
 /// readers (`mmic_proofs::store`): a flash log record, the keys partition, a queue slot.
 #[test]
 fn server_store() {
-    bolero::check!().for_each(|input: &[u8]| match input {
-        [0, rest @ ..] if rest.len() >= 20 => {
-            let mut r = [0u8; 20];
-            r.copy_from_slice(&rest[..20]);
-            mmic_proofs::store::check_log_record(&r);
-        }
-        [1, rest @ ..] => {
-            mmic_proofs::store::check_keys_partition(&rest[..rest.len().min(600)]);
-        }
-        [2, board, slot, rest @ ..] if rest.len() >= 12 => {
-            if let Ok(b) = mmic::units::BoardNumber::new(*board) {
-                let mut v = [0u8; 16];
-                v[4..].copy_from_slice(&rest[..12]);
-                mmic_proofs::store::check_queue_value(b, *slot % 16, u128::from_be_bytes(v));
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| match input {
+            [0, rest @ ..] if rest.len() >= 20 => {
+                let mut r = [0u8; 20];
+                r.copy_from_slice(&rest[..20]);
+                mmic_proofs::store::check_log_record(&r);
             }
-        }
-        _ => {}
-    });
+            [1, rest @ ..] => {
+                mmic_proofs::store::check_keys_partition(&rest[..rest.len().min(600)]);
+            }
+            [2, board, slot, rest @ ..] if rest.len() >= 12 => {
+                if let Ok(b) = mmic::units::BoardNumber::new(*board) {
+                    let mut v = [0u8; 16];
+                    v[4..].copy_from_slice(&rest[..12]);
+                    mmic_proofs::store::check_queue_value(b, *slot % 16, u128::from_be_bytes(v));
+                }
+            }
+            _ => {}
+        });
 }
 
 /// A CFDP PDU (cut to `MAX_PDU` octets) through `cfdp::Pdu::parse`: exactly the oracle's verdict
@@ -312,8 +358,10 @@ fn server_store() {
 /// but for the version.
 #[test]
 fn cfdp_pdu() {
-    bolero::check!().for_each(|input: &[u8]| {
-        let input = &input[..input.len().min(mmic_proofs::cfdp::MAX_PDU)];
-        mmic_proofs::cfdp::check_cfdp_parse(input);
-    });
+    bolero::check!()
+        .with_iterations(RANDOM_INPUTS)
+        .for_each(|input: &[u8]| {
+            let input = &input[..input.len().min(mmic_proofs::cfdp::MAX_PDU)];
+            mmic_proofs::cfdp::check_cfdp_parse(input);
+        });
 }
