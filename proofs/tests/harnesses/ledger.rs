@@ -81,8 +81,8 @@ pub fn exhaustive<G>(
         n.fetch_add(1, Ordering::Relaxed);
         property(v)
     };
-    // Behind `dyn`: bolero's engine (its runner, panic catcher and shrinker, some 8,000 lines of
-    // LLVM IR a copy) is then built once per generator type, not once per harness's closure.
+    // Behind `dyn`: bolero's engine (its runner, panic catcher and shrinker, some 6,400 lines of
+    // LLVM IR a copy: cargo-llvm-lines, 1.19 M lines for 140 copies, 0.56 M for 42) is then built once per generator type, not once per harness's closure.
     let body: &(dyn Fn(&G::Output) + RefUnwindSafe) = &body;
     bolero::check!()
         .with_generator(generator)
