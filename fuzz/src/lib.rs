@@ -959,7 +959,8 @@ pub fn store_seeds() -> Vec<SeedFile> {
 }
 
 /// Seeds of `cfdp_pdu`: YAMCS's EOF PDU (its PacketParseTest), the same with the CRC flag and
-/// its CRC, a file data PDU, and a near miss of each check of `PduError` the reader runs.
+/// its CRC, a file data PDU, a near miss of each check of `PduError` the PDU reader runs, one
+/// PDU of each directive as LibreCube writes it, and near misses of the directive checks.
 pub fn cfdp_seeds() -> Vec<SeedFile> {
     use mmic::cfdp::header::{Direction, Lengths, Mode, PduHeader, PduType};
     let target = TARGETS[19];
@@ -1007,6 +1008,30 @@ pub fn cfdp_seeds() -> Vec<SeedFile> {
             with(&crc, crc.len() - 1, crc[crc.len() - 1] ^ 1),
         ),
     ];
+    // One PDU of each directive and file data, as LibreCube's cfdp 0.2.0 writes them
+    // (tests/ccsds/cfdp_directive.rs), and a near miss of each directive check.
+    let librecube = [
+        ("librecube-metadata", "20001f1301020a0b0c0d03040740000004d208706c616e2e7478740f2f726f626f742f706c616e2e747874"),
+        ("librecube-file-data", "3000091301020a0b0c0d03040000001068656c6c6f"),
+        ("librecube-eof", "20000a1301020a0b0c0d03040400181c2015000004d2"),
+        ("librecube-finished", "2800021301020a0b0c0d0304050a"),
+        ("librecube-ack-eof", "2800031301020a0b0c0d0304064001"),
+        ("librecube-ack-finished", "2000031301020a0b0c0d0304065102"),
+        ("librecube-nak", "2800191301020a0b0c0d030408000000000000040000000000000000000000020000000300"),
+        ("librecube-prompt", "2000021301020a0b0c0d03040980"),
+        ("librecube-keep-alive", "2800051301020a0b0c0d03040c00000200"),
+        ("directive-unknown", "2000011301020a0b0c0d030403"),
+        ("ack-of-metadata", "2800031301020a0b0c0d0304067001"),
+        ("nak-backwards", "2800111301020a0b0c0d03040800000000000004000000020000000100"),
+        ("eof-fault-location", "20000e1301020a0b0c0d03040450000000000000000006020304"),
+    ];
+    let named = named.into_iter().chain(librecube.map(|(name, hex)| {
+        let bytes = (0..hex.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&hex[i..i + 2], 16).expect("hex"))
+            .collect();
+        (name, bytes)
+    }));
     named
         .into_iter()
         .map(|(name, bytes)| SeedFile {

@@ -355,7 +355,9 @@ fn server_store() {
 
 /// A CFDP PDU (cut to `MAX_PDU` octets) through `cfdp::Pdu::parse`: exactly the oracle's verdict
 /// (`mmic_proofs::cfdp::check_cfdp_parse`), and an accepted PDU re-emits to the same octets
-/// but for the version.
+/// but for the version; then its data field through `cfdp::directive::PduRepr::parse`: refused
+/// by a directive check, or fields that re-emit to the same octets but for the spare bits
+/// (`mmic_proofs::cfdp::check_cfdp_directive`).
 #[test]
 fn cfdp_pdu() {
     bolero::check!()
@@ -363,5 +365,6 @@ fn cfdp_pdu() {
         .for_each(|input: &[u8]| {
             let input = &input[..input.len().min(mmic_proofs::cfdp::MAX_PDU)];
             mmic_proofs::cfdp::check_cfdp_parse(input);
+            mmic_proofs::cfdp::check_cfdp_directive(input);
         });
 }

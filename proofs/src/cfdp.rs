@@ -18,6 +18,8 @@
 //! ```
 
 use crate::crc16_bitwise;
+use mmic::cfdp::directive::PduRepr;
+use mmic::cfdp::header::PduType;
 use mmic::cfdp::{emit, Pdu, PduError};
 
 /// Longest input the property takes; the fuzz target cuts its input to it.
@@ -92,5 +94,65 @@ pub fn check_cfdp_parse(b: &[u8]) -> bool {
     } else {
         assert_eq!(&out[1..n], &b[1..]);
     }
+    true
+}
+
+/// The bits of a directive's data field that carry nothing [`PduRepr`] keeps, by the octet's
+/// place: spare and reserved bits (727.0-B-5 §5.2), the ACK's subtype (written from the
+/// acknowledged code), the Prompt's seven spare bits. Written from the standard's tables.
+fn kept_bits(code: Option<u8>, at: usize) -> u8 {
+    match (code, at) {
+        (Some(0x04), 1) => 0xf0, // EOF: condition, spare
+        (Some(0x05), 1) => 0xf7, // Finished: condition, spare, delivery, status
+        (Some(0x06), 1) => 0xf0, // ACK: acknowledged code, subtype
+        (Some(0x06), 2) => 0xf3, // ACK: condition, spare, status
+        (Some(0x07), 1) => 0x4f, // Metadata: reserved, closure, reserved, checksum type
+        (Some(0x09), 1) => 0x80, // Prompt: response required, spare
+        _ => 0xff,
+    }
+}
+
+/// `PduRepr::parse` of a PDU `Pdu::parse` accepts either refuses it by one of the directive
+/// checks (or `truncated`), or gives fields that emit, from the PDU's own header, to the same
+/// octets but for the version and the bits of [`kept_bits`] (which emit writes as 727.0-B-5
+/// says: zero, the ACK's subtype from its code); and those octets read as the same fields.
+/// Returns whether the fields were read.
+pub fn check_cfdp_directive(b: &[u8]) -> bool {
+    let Ok(pdu) = Pdu::parse(b) else { return false };
+    let repr = match PduRepr::parse(&pdu) {
+        Ok(r) => r,
+        Err(e) => {
+            let at = e.position();
+            assert!(at == 0 || (6..PduError::PARSE).contains(&at), "{e:?}");
+            return false;
+        }
+    };
+    let mut out = [0u8; MAX_PDU + 8];
+    let n = repr
+        .emit(pdu.header(), &mut out)
+        .expect("fields read re-emit");
+    assert_eq!(n, b.len(), "{b:02x?}");
+    let start = pdu.header().len();
+    let end = if pdu.header().crc { n - 2 } else { n };
+    let code = (pdu.header().pdu_type == PduType::Directive).then(|| b[start]);
+    assert_eq!(out[0] & 0x1f, b[0] & 0x1f);
+    assert_eq!(&out[1..start], &b[1..start]);
+    for at in 0..end - start {
+        let keep = kept_bits(code, at);
+        assert_eq!(
+            out[start + at] & keep,
+            b[start + at] & keep,
+            "octet {at}: {b:02x?}"
+        );
+        // What emit writes there: zero, but for the subtype of an ACK of Finished (0001).
+        let ack_of_finished = code == Some(0x06) && at == 1 && out[start + 1] >> 4 == 0x05;
+        assert_eq!(
+            out[start + at] & !keep,
+            u8::from(ack_of_finished),
+            "octet {at}"
+        );
+    }
+    let again = Pdu::parse(&out[..n]).expect("the emitted PDU is whole");
+    assert_eq!(PduRepr::parse(&again), Ok(repr));
     true
 }

@@ -1,6 +1,8 @@
 //! Why bytes are not a CFDP PDU this library takes, and why a PDU does not fit a buffer: one
 //! variant per check, named ([`PduError::name`]) as `spec/ccsds/bad-inputs.toml` names them.
 
+use super::header::Direction;
+
 /// Why bytes are not a PDU this library takes, or why one cannot be written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -42,6 +44,82 @@ pub enum PduError {
         /// The CRC carried.
         found: u16,
     },
+    /// A directive code 727.0-B-5 does not define.
+    #[error("PDU: directive code {found:#04x} is none of 727.0-B-5's")]
+    Directive {
+        /// The code.
+        found: u8,
+    },
+    /// Octets after a directive's last field.
+    #[error("PDU: the directive ends after {expected} octets of its data field, {found} given")]
+    Trailing {
+        /// Octets the directive's fields take.
+        expected: usize,
+        /// Octets of the data field.
+        found: usize,
+    },
+    /// The direction bit is not the directive's way.
+    #[error("PDU: this directive travels {expected:?}, the direction bit says {found:?}")]
+    Direction {
+        /// The directive's way.
+        expected: Direction,
+        /// The header's.
+        found: Direction,
+    },
+    /// A reserved condition code (12, 13).
+    #[error("PDU: condition code {found} is reserved")]
+    Condition {
+        /// The code.
+        found: u8,
+    },
+    /// An ACK of a directive other than EOF and Finished.
+    #[error("PDU: an ACK acknowledges EOF (4) or Finished (5), not directive {found}")]
+    AckOf {
+        /// The acknowledged directive's code.
+        found: u8,
+    },
+    /// An LV (a file name) longer than the octets left.
+    #[error("PDU: a name of {declared} octets, {found} left in the data field")]
+    Lv {
+        /// The length octet.
+        declared: usize,
+        /// Octets after it.
+        found: usize,
+    },
+    /// A TLV longer than the octets left.
+    #[error("PDU: a TLV of {declared} octets, {found} left in the data field")]
+    Tlv {
+        /// Octets the TLV takes, its type and length octets included.
+        declared: usize,
+        /// Octets left.
+        found: usize,
+    },
+    /// A TLV of a type this directive does not carry there.
+    #[error("PDU: a TLV of type {found:#04x} where this directive carries none")]
+    TlvType {
+        /// The type.
+        found: u8,
+    },
+    /// An entity ID TLV (the fault location) whose value is not 1 to 8 octets.
+    #[error("PDU: an entity ID of {found} octets; 1 to 8")]
+    EntityId {
+        /// Octets of the value.
+        found: usize,
+    },
+    /// A NAK's segment requests that are not a whole number of 8-octet pairs.
+    #[error("PDU: {found} octets of NAK segment requests, not a multiple of 8")]
+    NakSegments {
+        /// Octets after the scope.
+        found: usize,
+    },
+    /// A NAK's scope or segment request whose end is before its start.
+    #[error("PDU: a NAK range from {start} to {end}, which ends before it starts")]
+    NakRange {
+        /// Its start offset.
+        start: u32,
+        /// Its end offset.
+        end: u32,
+    },
     /// Lengths outside 1..=8 octets, on emit.
     #[error(
         "PDU: entity IDs of {entity} and sequence numbers of {seq} octets; each must be 1 to 8"
@@ -73,20 +151,31 @@ pub enum PduError {
 impl PduError {
     /// Every check's name, in the order the parsers run them (the first [`PduError::PARSE`]),
     /// then emit's.
-    pub const NAMES: [&'static str; 9] = [
+    pub const NAMES: [&'static str; 20] = [
         "truncated",
         "version",
         "large-file",
         "segment-metadata",
         "length",
         "crc",
+        "directive",
+        "trailing",
+        "direction",
+        "condition",
+        "ack-of",
+        "lv",
+        "tlv",
+        "tlv-type",
+        "entity-id",
+        "nak-segments",
+        "nak-range",
         "lengths",
         "too-large",
         "buffer",
     ];
 
     /// How many of [`PduError::NAMES`] are the parser's checks.
-    pub const PARSE: usize = 6;
+    pub const PARSE: usize = 17;
 
     /// The check's place in [`PduError::NAMES`].
     pub const fn position(&self) -> usize {
@@ -97,9 +186,20 @@ impl PduError {
             PduError::SegmentMetadata => 3,
             PduError::Length { .. } => 4,
             PduError::Crc { .. } => 5,
-            PduError::Lengths { .. } => 6,
-            PduError::TooLarge { .. } => 7,
-            PduError::Buffer { .. } => 8,
+            PduError::Directive { .. } => 6,
+            PduError::Trailing { .. } => 7,
+            PduError::Direction { .. } => 8,
+            PduError::Condition { .. } => 9,
+            PduError::AckOf { .. } => 10,
+            PduError::Lv { .. } => 11,
+            PduError::Tlv { .. } => 12,
+            PduError::TlvType { .. } => 13,
+            PduError::EntityId { .. } => 14,
+            PduError::NakSegments { .. } => 15,
+            PduError::NakRange { .. } => 16,
+            PduError::Lengths { .. } => 17,
+            PduError::TooLarge { .. } => 18,
+            PduError::Buffer { .. } => 19,
         }
     }
 

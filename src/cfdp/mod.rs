@@ -26,8 +26,13 @@
 // req: D:cfdp-version, D:cfdp-profile
 
 pub mod checksum;
+pub mod codes;
+pub mod directive;
 mod error;
+mod field;
 pub mod header;
+pub mod received;
+pub mod tlv;
 
 pub use error::PduError;
 use header::PduHeader;

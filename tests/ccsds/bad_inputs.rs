@@ -151,7 +151,13 @@ pub fn verdict(row: &Row, apids: &[u16]) -> Option<&'static str> {
         "tm" => TmRepr::parse(&bytes, apids).map(|_| ()),
         "tc-service" => return mmic::pus::read_tc(&bytes, apids).err().map(|e| e.name()),
         "tc-frame" => return tc_frame_verdict(&bytes).err().map(|e| e.name()),
-        "cfdp" => return mmic::cfdp::Pdu::parse(&bytes).err().map(|e| e.name()),
+        // The PDU's checks, then its directive's (mmic::cfdp::directive::PduRepr::parse).
+        "cfdp" => {
+            return mmic::cfdp::Pdu::parse(&bytes)
+                .and_then(|p| mmic::cfdp::directive::PduRepr::parse(&p))
+                .err()
+                .map(|e| e.name())
+        }
         // Under `TmFrameParams::mission(0x142)` (robot 0x42's spacecraft ID).
         "tm-frame" => {
             return TmFrameRepr::parse(&bytes, &super::tm_frame::params())

@@ -10,6 +10,7 @@ mod common;
 
 mod bad_inputs;
 mod cfdp;
+mod cfdp_directive;
 mod corruption;
 mod farm_table;
 mod golden;
