@@ -1,7 +1,7 @@
 //! Why bytes are not a CFDP PDU this library takes, and why a PDU does not fit a buffer: one
 //! variant per check, named ([`PduError::name`]) as `spec/ccsds/bad-inputs.toml` names them.
 
-use super::header::Direction;
+use super::flags::Direction;
 
 /// Why bytes are not a PDU this library takes, or why one cannot be written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]

@@ -32,6 +32,7 @@
 //! ```
 
 use super::error::PduError;
+pub use super::flags::{Direction, Mode, PduType};
 
 /// The version this library emits (`001`, 727.0-B-5 §5.1.1).
 pub const VERSION: u8 = 1;
@@ -39,39 +40,6 @@ pub const VERSION: u8 = 1;
 pub const VERSIONS_READ: [u8; 2] = [0, 1];
 /// Octets before the variable fields.
 pub const FIXED_LEN: usize = 4;
-
-/// File directive (0) or file data (1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub enum PduType {
-    /// A file directive PDU (Metadata, EOF, Finished, ACK, NAK, Prompt, Keep Alive).
-    Directive,
-    /// A file data PDU.
-    FileData,
-}
-
-/// Which way the PDU travels.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub enum Direction {
-    /// From the sending entity to the receiving one.
-    TowardReceiver,
-    /// From the receiving entity back to the sending one.
-    TowardSender,
-}
-
-/// Acknowledged (class 2, reliable) or unacknowledged (class 1) transmission.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub enum Mode {
-    /// Class 2: NAKs, EOF and Finished acknowledged.
-    Acknowledged,
-    /// Class 1: sent once, nothing acknowledged.
-    Unacknowledged,
-}
 
 /// The octets of the entity IDs and of the transaction sequence number, 1 to 8 each.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

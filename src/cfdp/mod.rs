@@ -28,8 +28,10 @@
 pub mod checksum;
 pub mod codes;
 pub mod directive;
+pub mod entity;
 mod error;
 mod field;
+mod flags;
 pub mod header;
 pub mod received;
 pub mod tlv;

@@ -3,6 +3,7 @@
 //!
 //! One test binary per area, each file a module: fewer binaries to link than one per file.
 
+mod cfdp;
 mod cop1;
 mod protocol_exactly_once;
 mod protocol_paper;
