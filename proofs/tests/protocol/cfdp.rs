@@ -316,7 +316,7 @@ fn cfdp_class2_over_a_lossy_link() {
          and all sent is lost) and time runs to {CAP} ms. Each end sends all it has after every step (a PDU for a\n\
          full link is lost). ACK and NAK timers 10 ms, limits 2, inactivity 30 ms.\n\
          \n\
-         {unique} unique states, depth {depth}, breadth-first, exhaustive:\n\
+         {unique} unique states, breadth-first, exhaustive:\n\
          \x20 always: a file at the robot is the ground's                     holds\n\
          \x20 always: the sender's success means the file is there            holds\n\
          \x20 always: the receiver's report says what it holds                holds\n\
