@@ -11,6 +11,7 @@ mod common;
 mod bad_inputs;
 mod cfdp;
 mod cfdp_directive;
+mod cfdp_edges;
 mod cfdp_entity;
 mod corruption;
 mod farm_table;

@@ -232,7 +232,8 @@ fn hex(s: &str) -> Vec<u8> {
 
 /// The receiver's gap list (`mmic::cfdp::received::Received`, two ranges kept) after any
 /// sequence of adds is exactly a bit-per-octet model's: its ranges the model's runs, each
-/// add's count of new octets, the progress, the gaps, completeness; an add that would need a
+/// add's count of new octets, the progress, the gaps, completeness at its edges (no size, one
+/// octet, the progress, one past it, 24); an add that would need a
 /// third range is refused and changes nothing.
 ///
 /// Under `cargo test`, exhaustive: every sequence of three adds in a 22-octet file, each add
@@ -301,7 +302,9 @@ fn check_received(adds: &[(u32, u32)]) {
         assert_eq!(r.ranges(), &runs(model)[..]);
         assert_eq!(r.progress(), model.trailing_ones());
         assert_eq!(r.total(), model.count_ones());
-        for size in 0..=24u32 {
+        // Completeness at its edges: none, the progress and one past it, the largest.
+        let p = model.trailing_ones();
+        for size in [0, 1, p, p + 1, 24] {
             let all = if size == 0 {
                 0
             } else {

@@ -231,15 +231,14 @@ impl<'a> PduRepr<'a> {
 
     /// Writes the data field (the CRC aside).
     fn write(&self, w: &mut Writer<'_>, entity: u8) -> Result<(), PduError> {
-        if let PduRepr::FileData(f) = self {
-            w.u32(f.offset)?;
-            return w.put(f.data);
-        }
         if let Some(d) = self.directive() {
             w.u8(d.code())?;
         }
         match self {
-            PduRepr::FileData(_) => Ok(()),
+            PduRepr::FileData(f) => {
+                w.u32(f.offset)?;
+                w.put(f.data)
+            }
             PduRepr::Metadata(m) => m.write(w),
             PduRepr::Eof(e) => e.write(w, entity),
             PduRepr::Finished(f) => f.write(w, entity),

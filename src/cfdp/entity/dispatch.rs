@@ -86,10 +86,11 @@ impl<const T: usize, const G: usize, const R: usize> Entity<T, G, R> {
             Some(at) => at,
             None => self.open(now, &h, &repr, id)?,
         };
-        match self.tx.get_mut(at) {
-            Some(Transaction::Send(s)) => s.handle(now, &repr),
-            Some(Transaction::Receive(r)) => r.handle(now, &cfg, &repr, store),
-            None => {}
+        if let Some(t) = self.tx.get_mut(at) {
+            match t {
+                Transaction::Send(s) => s.handle(now, &repr),
+                Transaction::Receive(r) => r.handle(now, &cfg, &repr, store),
+            }
         }
         self.collect();
         Ok(())

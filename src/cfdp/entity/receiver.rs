@@ -178,7 +178,9 @@ impl<const G: usize> Receiver<G> {
                 return self.finish(ConditionCode::FileSizeError, store);
             }
         }
-        if offset > self.highest && self.class2() && cfg.immediate_nak {
+        // A gap opened, or the first file data came without the Metadata: ask at once.
+        let first_without_metadata = self.meta.is_none() && self.highest == 0;
+        if (offset > self.highest || first_without_metadata) && self.class2() && cfg.immediate_nak {
             self.owed.nak = true;
         }
         self.highest = self.highest.max(end);
