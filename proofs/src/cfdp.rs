@@ -114,7 +114,7 @@ fn kept_bits(code: Option<u8>, at: usize) -> u8 {
 
 /// `PduRepr::parse` of a PDU `Pdu::parse` accepts either refuses it by one of the directive
 /// checks (or `truncated`), or gives fields that emit, from the PDU's own header, to the same
-/// octets but for the version and the bits of [`kept_bits`] (which emit writes as 727.0-B-5
+/// octets but for the version and the bits of `kept_bits` (which emit writes as 727.0-B-5
 /// says: zero, the ACK's subtype from its code); and those octets read as the same fields.
 /// Returns whether the fields were read.
 pub fn check_cfdp_directive(b: &[u8]) -> bool {
