@@ -177,6 +177,10 @@ fn check(seed: u64, o: &Outcome, data: &[u8], mode: Mode) {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "nine transfers of up to 8,000 octets: natively; under Miri the entities run in tests/ccsds/cfdp_edges.rs"
+)]
 fn class2_without_loss_delivers_every_file_size() {
     for len in [0usize, 1, 3, 4, 479, 480, 481, 1500, 8000] {
         let data = file(len as u64, len);
@@ -204,6 +208,10 @@ fn class2_without_loss_delivers_every_file_size() {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "300 simulated transfers: natively; under Miri the entities run in tests/ccsds/cfdp_edges.rs"
+)]
 fn class2_through_loss_duplication_and_reordering() {
     let (mut delivered, mut runs) = (0, 0);
     for seed in 1..=300u64 {
@@ -252,6 +260,10 @@ fn class2_through_loss_duplication_and_reordering() {
 }
 
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "202 simulated transfers: natively; under Miri the entities run in tests/ccsds/cfdp_edges.rs"
+)]
 fn class1_delivers_without_loss_and_never_a_wrong_file() {
     let data = file(9, 3000);
     let clean = Link {
@@ -280,6 +292,10 @@ fn class1_delivers_without_loss_and_never_a_wrong_file() {
 
 // req: D:cfdp-timers
 #[test]
+#[cfg_attr(
+    miri,
+    ignore = "parses spec/ TOML: 7 s under Miri, and no dependency's unsafe code the other spec tests do not reach"
+)]
 fn the_entity_profile_in_spec_is_the_librarys() {
     let t: toml::Table = toml::from_str(&crate::repo("spec/ccsds/cfdp.toml")).unwrap();
     let e = &t["entity"];
