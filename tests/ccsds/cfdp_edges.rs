@@ -212,6 +212,9 @@ impl Filestore for Failing {
     fn discard(&mut self, id: TransactionId) {
         self.inner.discard(id);
     }
+    fn discard_all_incoming(&mut self) {
+        self.inner.discard_all_incoming();
+    }
 }
 
 #[test]
@@ -525,4 +528,54 @@ fn the_memory_store_refuses_by_reason() {
         s.commit(ID, &[b'n'; 65]),
         Err(StoreError::Name { len: 65, max: 64 })
     );
+}
+
+/// A transaction of the same source that started earlier but ends later (its EOF delayed past a
+/// restart of the sender, which then sent a corrected file under the same name) never replaces
+/// the later one's file: the store refuses it as stale, the receiver ends it with filestore
+/// rejection. Another source's transaction, or an operator's put, still replaces it.
+#[test]
+fn a_late_older_transaction_never_replaces_a_newer_file() {
+    let newer = TransactionId {
+        seq: ID.seq + 1,
+        ..ID
+    };
+    let mut s = MemoryStore::<4, 64>::new();
+    s.write_incoming(newer, 0, b"new").unwrap();
+    s.commit(newer, b"f").unwrap();
+    s.write_incoming(ID, 0, b"old").unwrap();
+    assert_eq!(s.commit(ID, b"f"), Err(StoreError::Stale { id: ID, newer }));
+    assert_eq!(s.get(b"f"), Some(&b"new"[..]));
+    // The same through a receiver: the older transaction's whole file, checked, refused.
+    let pdus = [
+        metadata(4, ChecksumType::MODULAR, b"f"),
+        data(0, b"abcd"),
+        eof(ConditionCode::NoError, ABCD, 4),
+    ];
+    let e = receive(Mode::Acknowledged, &pdus, &mut s);
+    assert_eq!(condition(e), (ConditionCode::FilestoreRejection, false));
+    assert_eq!(s.get(b"f"), Some(&b"new"[..]));
+    assert_eq!(s.incoming(), 0, "the refused file is discarded");
+    // Another source's transaction replaces it; so does an operator.
+    let other = TransactionId { source: 9, seq: 0 };
+    s.write_incoming(other, 0, b"other").unwrap();
+    s.commit(other, b"f").unwrap();
+    assert_eq!(s.get(b"f"), Some(&b"other"[..]));
+    s.put(b"f", b"op").unwrap();
+    s.write_incoming(ID, 0, b"again").unwrap();
+    s.commit(ID, b"f").unwrap();
+    assert_eq!(s.get(b"f"), Some(&b"again"[..]));
+}
+
+/// At boot the shell discards every incoming file: no receiver is left to finish them.
+#[test]
+fn incoming_files_are_discarded_at_boot_and_named_ones_kept() {
+    let mut s = MemoryStore::<4, 64>::new();
+    s.put(b"kept", b"k").unwrap();
+    s.write_incoming(ID, 0, b"half").unwrap();
+    s.write_incoming(TransactionId { seq: 9, ..ID }, 0, b"h")
+        .unwrap();
+    s.discard_all_incoming();
+    assert_eq!(s.incoming(), 0);
+    assert_eq!(s.get(b"kept"), Some(&b"k"[..]));
 }

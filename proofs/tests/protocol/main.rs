@@ -13,15 +13,14 @@ mod sdls;
 
 use mmic::node::robot::board_a::{self, BoardA, Event};
 
-/// Threads for a model check that may run on several: libtest's own budget when it is given as
-/// `RUST_TEST_THREADS` (CI's instrumented run sets 1: its one-thread processes already run side
-/// by side on every core, and two threads of one instrumented process contend for its counters,
-/// see .ci/cov-runner), else two. The unique state counts are the same on any number.
+/// Threads for one model check: one. libtest already runs two checks at once (one a core on
+/// this 2-core machine), and two threads inside one checker fought over the allocator's locks
+/// (perf, `exactly_once_commanding_and_safed_on_link_loss`: a quarter of its samples in the
+/// kernel's futex wake and wait under glibc's malloc): with one thread each the binary took
+/// 24.8 s instead of 27.8 (2026-11-29, issue 40). The unique state counts are the same on any
+/// number of threads.
 fn model_threads() -> usize {
-    std::env::var("RUST_TEST_THREADS")
-        .ok()
-        .and_then(|n| n.parse().ok())
-        .map_or(2, |n: usize| n.clamp(1, 2))
+    1
 }
 
 /// A node's state inside a model's state, shared until it changes and hashed once when it

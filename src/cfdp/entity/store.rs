@@ -33,6 +33,15 @@ pub enum StoreError {
         /// Octets the store can give it.
         capacity: u32,
     },
+    /// A file of that name was committed by transaction `newer`, later than `id` of the same
+    /// source: an older transaction, late, never replaces it (decision `cfdp-restarts`).
+    #[error("{id:?} is older than {newer:?}, which wrote that file")]
+    Stale {
+        /// The transaction that would commit.
+        id: TransactionId,
+        /// The one that did, later.
+        newer: TransactionId,
+    },
     /// A name the store cannot hold (too long).
     #[error("a name of {len} octets, more than the {max} the store holds")]
     Name {
@@ -63,10 +72,16 @@ pub trait Filestore {
         offset: u32,
         buf: &mut [u8],
     ) -> Result<usize, StoreError>;
-    /// Gives `id`'s incoming file the name `name`, in place of any file of that name.
+    /// Gives `id`'s incoming file the name `name`, in place of any file of that name, unless
+    /// that file was committed by a later transaction of the same source
+    /// ([`StoreError::Stale`]): the store remembers which transaction wrote each file.
     fn commit(&mut self, id: TransactionId, name: &[u8]) -> Result<(), StoreError>;
     /// Forgets `id`'s incoming file, if any.
     fn discard(&mut self, id: TransactionId);
+    /// Forgets every incoming file: the shell calls it at boot, before the entity's first
+    /// step, since a restarted entity has no receiver left to finish them (727.0 keeps no
+    /// transaction across a restart: decision `cfdp-restarts`).
+    fn discard_all_incoming(&mut self);
 }
 
 /// Longest name a [`MemoryStore`] keeps, octets.
@@ -82,7 +97,16 @@ enum Owner {
 /// A filestore in memory: up to `F` files (named or incoming) of up to `C` octets each.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
 pub struct MemoryStore<const F: usize, const C: usize> {
-    files: Vec<(Owner, Vec<u8, C>), F>,
+    files: Vec<Slot<C>, F>,
+}
+
+/// A file: whose it is, the transaction that wrote it (none when an operator put it), its
+/// octets.
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+struct Slot<const C: usize> {
+    owner: Owner,
+    by: Option<TransactionId>,
+    data: Vec<u8, C>,
 }
 
 impl<const F: usize, const C: usize> MemoryStore<F, C> {
@@ -98,31 +122,39 @@ impl<const F: usize, const C: usize> MemoryStore<F, C> {
             needed: len_u32(data.len()),
             capacity: len_u32(C),
         };
-        let content = Vec::from_slice(data).map_err(|_| full)?;
-        self.files.retain(|(o, _)| *o != owner);
-        self.files.push((owner, content)).map_err(|_| full)
+        let data = Vec::from_slice(data).map_err(|_| full)?;
+        self.files.retain(|f| f.owner != owner);
+        let slot = Slot {
+            owner,
+            by: None,
+            data,
+        };
+        self.files.push(slot).map_err(|_| full)
     }
 
     /// The named file's octets.
     pub fn get(&self, name: &[u8]) -> Option<&[u8]> {
-        self.files.iter().find_map(|(o, d)| match o {
-            Owner::Named(n) if n.as_slice() == name => Some(d.as_slice()),
-            _ => None,
-        })
+        self.named(name).map(|f| f.data.as_slice())
+    }
+
+    fn named(&self, name: &[u8]) -> Option<&Slot<C>> {
+        self.files
+            .iter()
+            .find(|f| matches!(&f.owner, Owner::Named(n) if n.as_slice() == name))
     }
 
     /// How many incoming files are held (of transactions not yet ended).
     pub fn incoming(&self) -> usize {
         self.files
             .iter()
-            .filter(|(o, _)| matches!(o, Owner::Incoming(_)))
+            .filter(|f| matches!(f.owner, Owner::Incoming(_)))
             .count()
     }
 
     fn file(&mut self, owner: &Owner) -> Option<&mut Vec<u8, C>> {
         self.files
             .iter_mut()
-            .find_map(|(o, d)| (o == owner).then_some(d))
+            .find_map(|f| (f.owner == *owner).then_some(&mut f.data))
     }
 }
 
@@ -146,12 +178,15 @@ impl<const F: usize, const C: usize> Filestore for MemoryStore<F, C> {
     ) -> Result<(), StoreError> {
         let owner = Owner::Incoming(id);
         if self.file(&owner).is_none() {
-            self.files
-                .push((owner.clone(), Vec::new()))
-                .map_err(|_| StoreError::Full {
-                    needed: len_u32(data.len()),
-                    capacity: 0,
-                })?;
+            let slot = Slot {
+                owner: owner.clone(),
+                by: Some(id),
+                data: Vec::new(),
+            };
+            self.files.push(slot).map_err(|_| StoreError::Full {
+                needed: len_u32(data.len()),
+                capacity: 0,
+            })?;
         }
         let file = self.file(&owner).ok_or(StoreError::NotFound)?;
         let start = usize::try_from(offset).unwrap_or(usize::MAX);
@@ -182,21 +217,30 @@ impl<const F: usize, const C: usize> Filestore for MemoryStore<F, C> {
     fn commit(&mut self, id: TransactionId, name: &[u8]) -> Result<(), StoreError> {
         let named = Owner::Named(name_of(name)?);
         let incoming = Owner::Incoming(id);
+        let by = self.named(name).and_then(|f| f.by);
+        if let Some(newer) = by.filter(|b| b.source == id.source && b.seq > id.seq) {
+            return Err(StoreError::Stale { id, newer });
+        }
         if self.file(&incoming).is_none() {
             // An empty file: nothing was ever written.
             self.write_incoming(id, 0, &[])?;
         }
-        self.files.retain(|(o, _)| *o != named);
-        for (o, _) in self.files.iter_mut() {
-            if *o == incoming {
-                *o = named.clone();
+        self.files.retain(|f| f.owner != named);
+        for f in self.files.iter_mut() {
+            if f.owner == incoming {
+                f.owner = named.clone();
             }
         }
         Ok(())
     }
 
     fn discard(&mut self, id: TransactionId) {
-        self.files.retain(|(o, _)| *o != Owner::Incoming(id));
+        self.files.retain(|f| f.owner != Owner::Incoming(id));
+    }
+
+    fn discard_all_incoming(&mut self) {
+        self.files
+            .retain(|f| !matches!(f.owner, Owner::Incoming(_)));
     }
 }
 
