@@ -1024,6 +1024,8 @@ pub fn cfdp_seeds() -> Vec<SeedFile> {
         ("ack-of-metadata", "2800031301020a0b0c0d0304067001"),
         ("nak-backwards", "2800111301020a0b0c0d03040800000000000004000000020000000100"),
         ("eof-fault-location", "20000e1301020a0b0c0d03040450000000000000000006020304"),
+        // Found by the campaign: a 2-octet fault location in a PDU of 3-octet IDs.
+        ("eof-fault-location-length", "20000e2101020a0b0c0d03040450000000000000000006020304"),
     ];
     let named = named.into_iter().chain(librecube.map(|(name, hex)| {
         let bytes = (0..hex.len())

@@ -100,9 +100,12 @@ pub enum PduError {
         /// The type.
         found: u8,
     },
-    /// An entity ID TLV (the fault location) whose value is not 1 to 8 octets.
-    #[error("PDU: an entity ID of {found} octets; 1 to 8")]
+    /// An entity ID TLV (the fault location) whose value is not as long as the header's
+    /// entity IDs.
+    #[error("PDU: an entity ID of {found} octets in a PDU of {expected}-octet entity IDs")]
     EntityId {
+        /// Octets of the header's entity IDs.
+        expected: u8,
         /// Octets of the value.
         found: usize,
     },

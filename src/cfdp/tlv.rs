@@ -108,13 +108,15 @@ pub(super) fn write_lv(w: &mut Writer<'_>, value: &[u8]) -> Result<(), PduError>
     w.put(value)
 }
 
-/// The entity ID an entity ID TLV carries: 1 to 8 octets, big-endian (`entity-id` otherwise).
-pub(super) fn entity_id(tlv: Tlv<'_>) -> Result<u64, PduError> {
+/// The entity ID an entity ID TLV carries, big-endian, of the `octets` the PDU's header gives
+/// its entity IDs (`entity-id` otherwise: an ID of another length would write back otherwise).
+pub(super) fn entity_id(tlv: Tlv<'_>, octets: u8) -> Result<u64, PduError> {
     if tlv.kind != ENTITY_ID {
         return Err(PduError::TlvType { found: tlv.kind });
     }
-    if !(1..=8).contains(&tlv.value.len()) {
+    if tlv.value.len() != usize::from(octets) {
         return Err(PduError::EntityId {
+            expected: octets,
             found: tlv.value.len(),
         });
     }

@@ -30,6 +30,7 @@ fn header(pdu_type: PduType, crc: bool) -> PduHeader {
 }
 
 // req: D:cfdp-version, D:cfdp-profile
+// req: 727.0-B-5/CFDP-1, 727.0-B-5/CFDP-2, 727.0-B-5/CFDP-11
 #[test]
 fn yamcs_eof_reads_and_writes_back_but_for_the_version() {
     let bytes = unhex(YAMCS_EOF);
@@ -54,6 +55,7 @@ fn yamcs_eof_reads_and_writes_back_but_for_the_version() {
 }
 
 // req: D:cfdp-profile
+// req: 727.0-B-5/CFDP-20, 727.0-B-5/CFDP-21
 #[test]
 fn the_crc_ends_the_data_field_and_is_checked() {
     let h = header(PduType::FileData, true);
@@ -209,6 +211,7 @@ fn emit_refuses_what_the_header_cannot_carry() {
 /// Every combination of the header's flags, with every pair of lengths 1..=8 and the largest
 /// values they hold: emitted, read back the same. Under Miri (63 s for the whole walk, CI
 /// 2026-11-28) the lengths 1, 2, 4 and 8 only: every flag still, and the copies of 1 to 8 octets.
+// req: 727.0-B-5/CFDP-3, 727.0-B-5/CFDP-5, 727.0-B-5/CFDP-6
 #[test]
 fn every_header_round_trips() {
     let lengths: &[u8] = if cfg!(miri) {
@@ -267,6 +270,7 @@ fn words(file: &[u8]) -> u32 {
     })
 }
 
+// req: 727.0-B-5/CFDP-22
 #[test]
 fn the_modular_checksum_of_every_length_up_to_64() {
     let file: Vec<u8> = (0..64u32).map(|i| (i * 37 + 11) as u8).collect();

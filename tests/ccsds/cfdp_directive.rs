@@ -137,6 +137,7 @@ fn librecube() -> Vec<(&'static str, &'static str, PduRepr<'static>)> {
 }
 
 // req: D:cfdp-ack-subtype, D:cfdp-direction
+// req: 727.0-B-5/CFDP-8, 727.0-B-5/CFDP-11, 727.0-B-5/CFDP-12, 727.0-B-5/CFDP-13, 727.0-B-5/CFDP-14, 727.0-B-5/CFDP-15, 727.0-B-5/CFDP-16, 727.0-B-5/CFDP-17, 727.0-B-5/CFDP-18
 #[test]
 fn librecube_pdus_read_as_their_fields_and_write_back() {
     for (name, hex, want) in librecube() {
@@ -206,6 +207,7 @@ fn directive(dir: u8, data: &[u8]) -> Vec<u8> {
     v
 }
 
+// req: 727.0-B-5/CFDP-38
 #[test]
 fn refusals_name_the_check_with_their_numbers() {
     let cases: Vec<(Vec<u8>, PduError)> = vec![
@@ -259,7 +261,18 @@ fn refusals_name_the_check_with_their_numbers() {
         ),
         (
             directive(0, &[0x04, 0x50, 0, 0, 0, 0, 0, 0, 0, 0, 0x06, 0]),
-            PduError::EntityId { found: 0 },
+            PduError::EntityId {
+                expected: 2,
+                found: 0,
+            },
+        ),
+        // A fault location shorter than the header's entity IDs (found by the fuzz campaign).
+        (
+            directive(0, &[0x04, 0x50, 0, 0, 0, 0, 0, 0, 0, 0, 0x06, 1, 4]),
+            PduError::EntityId {
+                expected: 2,
+                found: 1,
+            },
         ),
         (
             directive(1, &[0x08, 0, 0, 0, 0, 0, 0, 0, 9, 0, 0, 0, 1]),
@@ -283,10 +296,10 @@ fn refusals_name_the_check_with_their_numbers() {
         ),
         // A filestore response after the fault location.
         (
-            directive(1, &[0x05, 0x52, 6, 1, 7, 1, 0]),
+            directive(1, &[0x05, 0x52, 6, 2, 0, 7, 1, 0]),
             PduError::Trailing {
-                expected: 3,
-                found: 5,
+                expected: 4,
+                found: 6,
             },
         ),
         // An ACK of Finished travels toward the receiver.
@@ -304,6 +317,7 @@ fn refusals_name_the_check_with_their_numbers() {
     }
 }
 
+// req: 727.0-B-5/CFDP-9, 727.0-B-5/CFDP-10
 #[test]
 #[cfg_attr(
     miri,

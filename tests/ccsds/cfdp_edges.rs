@@ -93,6 +93,7 @@ fn condition(e: Option<Event>) -> (ConditionCode, bool) {
 /// The modular checksum of "abcd".
 const ABCD: u32 = u32::from_be_bytes(*b"abcd");
 
+// req: 727.0-B-5/CFDP-23, 727.0-B-5/CFDP-40
 #[test]
 fn a_receiver_ends_each_bad_transfer_with_its_condition() {
     let m = Mode::Acknowledged;
@@ -241,6 +242,7 @@ fn a_store_that_fails_ends_the_transfer_never_with_a_wrong_file() {
     assert_eq!(loses.inner.get(b"f"), None);
 }
 
+// req: 727.0-B-5/CFDP-16, 727.0-B-5/CFDP-17
 #[test]
 fn a_receiver_answers_prompts_and_ends_once() {
     let cfg = Config::mission(0x42);
@@ -274,6 +276,7 @@ fn a_receiver_answers_prompts_and_ends_once() {
     assert_eq!(one.take_event(), None);
 }
 
+// req: 727.0-B-5/CFDP-23
 #[test]
 fn a_sender_reads_its_file_as_it_goes_and_says_when_it_cannot() {
     let cfg = Config {
@@ -388,6 +391,7 @@ fn an_entity_refuses_by_reason_and_counts() {
     assert_eq!(robot.config().local, 0x42);
 }
 
+// req: 727.0-B-5/CFDP-32
 #[test]
 fn late_pdus_of_ended_transactions_start_nothing_and_the_ids_are_kept_in_a_ring() {
     let cfg = Config::mission(0x42);
@@ -413,6 +417,7 @@ fn late_pdus_of_ended_transactions_start_nothing_and_the_ids_are_kept_in_a_ring(
     assert_eq!(robot.counters().ended, 20);
 }
 
+// req: 727.0-B-5/CFDP-32
 #[test]
 fn puts_are_refused_without_room_file_or_sequence_numbers() {
     let mut s = MemoryStore::<4, 64>::new();
@@ -534,6 +539,7 @@ fn the_memory_store_refuses_by_reason() {
 /// restart of the sender, which then sent a corrected file under the same name) never replaces
 /// the later one's file: the store refuses it as stale, the receiver ends it with filestore
 /// rejection. Another source's transaction, or an operator's put, still replaces it.
+// req: 727.0-B-5/CFDP-40
 #[test]
 fn a_late_older_transaction_never_replaces_a_newer_file() {
     let newer = TransactionId {

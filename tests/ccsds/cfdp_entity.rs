@@ -176,6 +176,7 @@ fn check(seed: u64, o: &Outcome, data: &[u8], mode: Mode) {
     }
 }
 
+// req: 727.0-B-5/CFDP-18, 727.0-B-5/CFDP-27
 #[test]
 #[cfg_attr(
     miri,
@@ -207,6 +208,7 @@ fn class2_without_loss_delivers_every_file_size() {
     }
 }
 
+// req: 727.0-B-5/CFDP-27, 727.0-B-5/CFDP-28, 727.0-B-5/CFDP-29, 727.0-B-5/CFDP-30
 #[test]
 #[cfg_attr(
     miri,
@@ -259,6 +261,7 @@ fn class2_through_loss_duplication_and_reordering() {
     println!("class 2: {delivered} of {runs} delivered");
 }
 
+// req: 727.0-B-5/CFDP-25, 727.0-B-5/CFDP-26
 #[test]
 #[cfg_attr(
     miri,

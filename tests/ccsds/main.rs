@@ -10,6 +10,7 @@ mod common;
 
 mod bad_inputs;
 mod cfdp;
+mod cfdp_concurrent;
 mod cfdp_directive;
 mod cfdp_edges;
 mod cfdp_entity;

@@ -29,12 +29,12 @@ pub struct EofRepr {
 }
 
 impl EofRepr {
-    /// Reads the fields after the directive code.
-    pub(super) fn read(r: &mut Reader<'_>) -> Result<EofRepr, PduError> {
+    /// Reads the fields after the directive code, in a PDU of `entity`-octet IDs.
+    pub(super) fn read(r: &mut Reader<'_>, entity: u8) -> Result<EofRepr, PduError> {
         let condition = condition(r.u8()? >> 4)?;
         let checksum = r.u32()?;
         let file_size = r.u32()?;
-        let fault_location = fault_location(r)?;
+        let fault_location = fault_location(r, entity)?;
         Ok(EofRepr {
             condition,
             checksum,
@@ -66,7 +66,7 @@ pub(super) fn tlv_len(at: Option<u64>, entity: u8) -> usize {
 }
 
 /// The optional fault location that ends the field: nothing, or exactly one entity ID TLV.
-fn fault_location(r: &mut Reader<'_>) -> Result<Option<u64>, PduError> {
+fn fault_location(r: &mut Reader<'_>, entity: u8) -> Result<Option<u64>, PduError> {
     let rest = r.rest();
     let Some(first) = Tlvs::parse(rest)?.iter().next() else {
         return Ok(None);
@@ -78,5 +78,5 @@ fn fault_location(r: &mut Reader<'_>) -> Result<Option<u64>, PduError> {
             found: rest.len(),
         });
     }
-    tlv::entity_id(first).map(Some)
+    tlv::entity_id(first, entity).map(Some)
 }

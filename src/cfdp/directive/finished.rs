@@ -29,8 +29,8 @@ pub struct FinishedRepr<'a> {
 }
 
 impl<'a> FinishedRepr<'a> {
-    /// Reads the fields after the directive code.
-    pub(super) fn read(r: &mut Reader<'a>) -> Result<FinishedRepr<'a>, PduError> {
+    /// Reads the fields after the directive code, in a PDU of `entity`-octet IDs.
+    pub(super) fn read(r: &mut Reader<'a>, entity: u8) -> Result<FinishedRepr<'a>, PduError> {
         let b = r.u8()?;
         let condition = condition(b >> 4)?;
         let status = FileStatus::from_code(b & 0x03).unwrap_or(FileStatus::Unreported);
@@ -48,7 +48,7 @@ impl<'a> FinishedRepr<'a> {
             let n = t.value.len().saturating_add(2);
             match t.kind {
                 FILESTORE_RESPONSE => responses_len = responses_len.saturating_add(n),
-                ENTITY_ID => fault_location = Some(tlv::entity_id(t)?),
+                ENTITY_ID => fault_location = Some(tlv::entity_id(t, entity)?),
                 found => return Err(PduError::TlvType { found }),
             }
             used = used.saturating_add(n);

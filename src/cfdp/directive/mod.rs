@@ -135,8 +135,10 @@ impl<'a> PduRepr<'a> {
             check_direction(expected, header.direction)?;
         }
         let repr = match directive {
-            DirectiveCode::Eof => PduRepr::Eof(EofRepr::read(r)?),
-            DirectiveCode::Finished => PduRepr::Finished(FinishedRepr::read(r)?),
+            DirectiveCode::Eof => PduRepr::Eof(EofRepr::read(r, header.lengths.entity)?),
+            DirectiveCode::Finished => {
+                PduRepr::Finished(FinishedRepr::read(r, header.lengths.entity)?)
+            }
             DirectiveCode::Ack => PduRepr::Ack(AckRepr::read(r)?),
             DirectiveCode::Metadata => PduRepr::Metadata(MetadataRepr::read(r)?),
             DirectiveCode::Nak => PduRepr::Nak(NakRepr::read(r)?),
