@@ -10,8 +10,8 @@ use mmic::cfdp::directive::{
     Segments,
 };
 use mmic::cfdp::entity::{
-    Config, Entity, Event, Filestore, HandleError, MemoryStore, Put, PutError, Receiver, Sender,
-    StoreError, TransactionId,
+    Config, Entity, Event, FaultHandler, FaultHandlers, Filestore, HandleError, MemoryStore, Put,
+    PutError, Receiver, Sender, StoreError, TransactionId,
 };
 use mmic::cfdp::header::{Direction, Lengths, Mode, PduHeader, PduType};
 use mmic::cfdp::received::Received;
@@ -329,7 +329,110 @@ fn a_sender_reads_its_file_as_it_goes_and_says_when_it_cannot() {
             condition: ConditionCode::FilestoreRejection
         })
     );
+    // Its handler cancels: the receiver is told by an EOF with the condition.
+    assert_eq!(
+        gone.poll(0, &cfg, &mut empty, &mut buf),
+        Some(PduRepr::Eof(EofRepr {
+            condition: ConditionCode::FilestoreRejection,
+            checksum: 0,
+            file_size: 0,
+            fault_location: Some(0x15),
+        }))
+    );
     assert_eq!(gone.poll(0, &cfg, &mut empty, &mut buf), None);
+}
+
+/// A fault's handler (727.0-B-5 §4.8): cancel tells the peer under the positive ACK
+/// procedure, then ends (acknowledged, or abandoned at the limit); abandon sends nothing. The
+/// fault is reported once, at once, either way.
+// req: 727.0-B-5/CFDP-35
+#[test]
+fn fault_handlers_cancel_with_a_notice_or_abandon_in_silence() {
+    let cancel = Config {
+        ack_timeout_ms: 10,
+        ack_limit: 2,
+        ..Config::mission(0x15)
+    };
+    let abandon = Config {
+        handlers: FaultHandlers::CANCEL
+            .with(ConditionCode::FilestoreRejection, FaultHandler::Abandon),
+        ..cancel
+    };
+    let put = Put::new(b"s", b"d", Mode::Acknowledged).unwrap();
+    let mut buf = [0u8; 64];
+    let mut empty = MemoryStore::<4, 64>::new();
+    let notice = |at| {
+        Some(PduRepr::Eof(EofRepr {
+            condition: ConditionCode::FilestoreRejection,
+            checksum: 0,
+            file_size: 0,
+            fault_location: Some(at),
+        }))
+    };
+    let fault = Some(Event::Sent {
+        id: ID,
+        condition: ConditionCode::FilestoreRejection,
+    });
+    // Cancel, never acknowledged: the notice at 0, again at 10, abandoned at 20.
+    let mut tx = Sender::<4>::new(ID, 0x42, put.clone(), 8, 0);
+    tx.poll(0, &cancel, &mut empty, &mut buf); // the Metadata
+    assert_eq!(tx.poll(0, &cancel, &mut empty, &mut buf), None);
+    assert_eq!(tx.take_event(), fault);
+    assert_eq!(tx.poll(0, &cancel, &mut empty, &mut buf), notice(0x15));
+    assert_eq!(tx.poll(5, &cancel, &mut empty, &mut buf), None);
+    tx.tick(10, &cancel);
+    assert_eq!(tx.poll(10, &cancel, &mut empty, &mut buf), notice(0x15));
+    assert!(!tx.is_ended());
+    tx.tick(20, &cancel);
+    assert!(tx.is_ended(), "the positive ACK limit: abandoned");
+    assert_eq!(tx.take_event(), None, "reported once");
+    // Cancel, acknowledged: ended at the ACK; a Finished from the receiver is acknowledged.
+    let mut tx = Sender::<4>::new(ID, 0x42, put.clone(), 8, 0);
+    tx.poll(0, &cancel, &mut empty, &mut buf);
+    tx.poll(0, &cancel, &mut empty, &mut buf);
+    assert_eq!(tx.poll(0, &cancel, &mut empty, &mut buf), notice(0x15));
+    let ack = AckRepr {
+        of: DirectiveCode::Eof,
+        condition: ConditionCode::FilestoreRejection,
+        status: TransactionStatus::Terminated,
+    };
+    tx.handle(3, &PduRepr::Ack(ack));
+    assert_eq!(tx.take_event(), fault);
+    assert!(tx.is_ended());
+    // Abandon: nothing after the Metadata; ended at once.
+    let mut tx = Sender::<4>::new(ID, 0x42, put, 8, 0);
+    tx.poll(0, &abandon, &mut empty, &mut buf);
+    assert_eq!(tx.poll(0, &abandon, &mut empty, &mut buf), None);
+    assert_eq!(tx.take_event(), fault);
+    assert_eq!(tx.poll(0, &abandon, &mut empty, &mut buf), None);
+    assert!(tx.is_ended());
+    // A receiver: cancel owes the Finished PDU (class 2), abandon does not.
+    for (cfg, finished) in [(cancel, true), (abandon, false)] {
+        let mut r = Receiver::<4>::new(ID, Mode::Acknowledged, 0);
+        let mut s = Failing {
+            inner: MemoryStore::new(),
+            commit: false,
+            keep: true,
+        };
+        for p in [
+            metadata(4, ChecksumType::MODULAR, b"f"),
+            data(0, b"abcd"),
+            eof(ConditionCode::NoError, ABCD, 4),
+        ] {
+            r.handle(0, &cfg, &p, &mut s);
+        }
+        assert_eq!(
+            condition(r.take_event()),
+            (ConditionCode::FilestoreRejection, false)
+        );
+        let mut sent = Vec::new();
+        let mut segments = [(0, 0); 4];
+        while let Some(p) = r.poll(0, &cfg, &mut segments) {
+            sent.push(format!("{p:?}"));
+        }
+        let has_finished = sent.iter().any(|p| p.starts_with("Finished"));
+        assert_eq!(has_finished, finished, "{sent:?}");
+    }
 }
 
 #[test]

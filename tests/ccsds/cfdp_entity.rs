@@ -312,6 +312,16 @@ fn the_entity_profile_in_spec_is_the_librarys() {
     assert_eq!(int("file_data"), i64::from(c.file_data));
     assert_eq!(e["immediate_nak"].as_bool(), Some(c.immediate_nak));
     assert_eq!(e["crc"].as_bool(), Some(c.crc));
+    assert_eq!(e["fault_handler"].as_str(), Some("cancel"));
+    for code in 1..16u8 {
+        let condition = mmic::cfdp::codes::ConditionCode::from_code(code);
+        if let Some(condition) = condition {
+            assert_eq!(
+                c.handlers.handler(condition),
+                mmic::cfdp::entity::FaultHandler::Cancel
+            );
+        }
+    }
     // A full file data PDU fits YAMCS's 512 octets, a CRC included.
     let h = c.lengths.header_len();
     assert!(h + 4 + usize::from(c.file_data) + 2 <= mmic::cfdp::MAX_PDU_LEN);

@@ -79,6 +79,8 @@ pub struct Config {
     pub inactivity_ms: u32,
     /// NAK a gap as soon as it appears, not only at EOF.
     pub immediate_nak: bool,
+    /// What a fault found here does, per condition (727.0-B-5 §4.8).
+    pub handlers: FaultHandlers,
 }
 
 impl Config {
@@ -101,6 +103,63 @@ impl Config {
             nak_limit: 5,
             inactivity_ms: 30_000,
             immediate_nak: true,
+            handlers: FaultHandlers::CANCEL,
+        }
+    }
+}
+
+/// What an entity does when it finds a fault (727.0-B-5 §4.8). Either way the fault is
+/// reported once at this end ([`Event`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FaultHandler {
+    /// Notice of cancellation: the peer is told, by the sender's EOF or the receiver's
+    /// Finished PDU carrying the condition (in class 2 until acknowledged or the positive ACK
+    /// limit is reached), so that it ends at once rather than by its timers.
+    Cancel,
+    /// The transaction ends here with nothing more sent; the peer ends by its own timers.
+    Abandon,
+}
+
+/// A [`FaultHandler`] per condition code: cancel, unless set to abandon. Suspend and ignore
+/// are not offered (decision `cfdp-fault-handlers`).
+///
+/// ```
+/// use mmic::cfdp::codes::ConditionCode;
+/// use mmic::cfdp::entity::{FaultHandler, FaultHandlers};
+///
+/// let h = FaultHandlers::CANCEL.with(ConditionCode::InactivityDetected, FaultHandler::Abandon);
+/// assert_eq!(h.handler(ConditionCode::InactivityDetected), FaultHandler::Abandon);
+/// assert_eq!(h.handler(ConditionCode::NakLimitReached), FaultHandler::Cancel);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub struct FaultHandlers {
+    /// Bit `c` set: condition code `c` abandons.
+    abandon: u16,
+}
+
+impl FaultHandlers {
+    /// Cancel on every fault (the mission's: decision `cfdp-fault-handlers`).
+    pub const CANCEL: FaultHandlers = FaultHandlers { abandon: 0 };
+
+    /// These handlers with `condition` handled by `handler`.
+    #[must_use]
+    pub const fn with(self, condition: ConditionCode, handler: FaultHandler) -> FaultHandlers {
+        let bit = 1u16 << (condition.code() & 0x0f);
+        FaultHandlers {
+            abandon: match handler {
+                FaultHandler::Cancel => self.abandon & !bit,
+                FaultHandler::Abandon => self.abandon | bit,
+            },
+        }
+    }
+
+    /// The handler of `condition`.
+    pub const fn handler(&self, condition: ConditionCode) -> FaultHandler {
+        if self.abandon & (1u16 << (condition.code() & 0x0f)) != 0 {
+            FaultHandler::Abandon
+        } else {
+            FaultHandler::Cancel
         }
     }
 }

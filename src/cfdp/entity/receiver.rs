@@ -7,7 +7,7 @@
 //! inactivity timeout before the EOF ends the transaction with that fault; after the EOF the
 //! NAK limit bounds the wait.
 
-use super::{Config, Event, Filestore, Timer, TransactionId, NAME_MAX};
+use super::{Config, Event, FaultHandler, Filestore, Timer, TransactionId, NAME_MAX};
 use crate::cfdp::checksum::Modular;
 use crate::cfdp::codes::{ChecksumType, ConditionCode, DirectiveCode, FileStatus};
 use crate::cfdp::directive::{
@@ -142,13 +142,13 @@ impl<const G: usize> Receiver<G> {
             return;
         }
         if !(m.checksum == ChecksumType::MODULAR || m.checksum == ChecksumType::NULL) {
-            return self.finish(ConditionCode::UnsupportedChecksumType, store);
+            return self.fault(ConditionCode::UnsupportedChecksumType, cfg, store);
         }
         let Ok(name) = Vec::from_slice(m.dest) else {
-            return self.finish(ConditionCode::FilestoreRejection, store);
+            return self.fault(ConditionCode::FilestoreRejection, cfg, store);
         };
         if self.highest > m.file_size {
-            return self.finish(ConditionCode::FileSizeError, store);
+            return self.fault(ConditionCode::FileSizeError, cfg, store);
         }
         self.meta = Some(Meta {
             size: m.file_size,
@@ -162,20 +162,20 @@ impl<const G: usize> Receiver<G> {
     fn file_data<S: Filestore>(&mut self, offset: u32, data: &[u8], cfg: &Config, store: &mut S) {
         let len = u32::try_from(data.len()).unwrap_or(u32::MAX);
         let Some(end) = offset.checked_add(len) else {
-            return self.finish(ConditionCode::FileSizeError, store);
+            return self.fault(ConditionCode::FileSizeError, cfg, store);
         };
         if self.size().is_some_and(|size| end > size) {
-            return self.finish(ConditionCode::FileSizeError, store);
+            return self.fault(ConditionCode::FileSizeError, cfg, store);
         }
         if store.write_incoming(self.id, offset, data).is_err() {
-            return self.finish(ConditionCode::FilestoreRejection, store);
+            return self.fault(ConditionCode::FilestoreRejection, cfg, store);
         }
         match self.got.add(offset, len) {
             // New octets: the NAK limit counts NAKs without progress.
             Ok(new) if new > 0 => self.nak.count = 0,
             Ok(_) | Err(ReceivedError::Full { .. }) => {}
             Err(ReceivedError::Overflow { .. }) => {
-                return self.finish(ConditionCode::FileSizeError, store);
+                return self.fault(ConditionCode::FileSizeError, cfg, store);
             }
         }
         // A gap opened, or the first file data came without the Metadata: ask at once.
@@ -198,7 +198,7 @@ impl<const G: usize> Receiver<G> {
             return self.finish(e.condition, store);
         }
         if self.highest > e.file_size || self.meta.as_ref().is_some_and(|m| m.size != e.file_size) {
-            return self.finish(ConditionCode::FileSizeError, store);
+            return self.fault(ConditionCode::FileSizeError, cfg, store);
         }
         self.eof = Some((e.checksum, e.file_size));
         self.nak = Timer::start(now, cfg.nak_timeout_ms);
@@ -218,7 +218,7 @@ impl<const G: usize> Receiver<G> {
 
     /// Once the EOF and the Metadata are in and every octet is here: the file checked and
     /// named, or refused.
-    fn evaluate<S: Filestore>(&mut self, _cfg: &Config, store: &mut S) {
+    fn evaluate<S: Filestore>(&mut self, cfg: &Config, store: &mut S) {
         let (Some((checksum, size)), Some(meta)) = (self.eof, self.meta.as_ref()) else {
             return;
         };
@@ -228,14 +228,25 @@ impl<const G: usize> Receiver<G> {
         let ok = meta.checksum == ChecksumType::NULL
             || matches!(stored_checksum(store, self.id, size), Some(c) if c == checksum);
         if !ok {
-            return self.finish(ConditionCode::FileChecksumFailure, store);
+            return self.fault(ConditionCode::FileChecksumFailure, cfg, store);
         }
         let name = meta.name.clone();
         if store.commit(self.id, &name).is_err() {
-            return self.finish(ConditionCode::FilestoreRejection, store);
+            return self.fault(ConditionCode::FilestoreRejection, cfg, store);
         }
         self.delivered = true;
         self.finish(ConditionCode::NoError, store);
+    }
+
+    /// A fault found here ends the transaction as its handler says (`Config::handlers`):
+    /// cancel, the sender told by the Finished PDU (in class 2, or with closure); abandon,
+    /// nothing more sent.
+    fn fault<S: Filestore>(&mut self, condition: ConditionCode, cfg: &Config, store: &mut S) {
+        self.finish(condition, store);
+        if cfg.handlers.handler(condition) == FaultHandler::Abandon {
+            self.owed.finished = false;
+            self.phase = Phase::Ended;
+        }
     }
 
     /// Ends the transaction with `condition`: the incoming file discarded unless delivered,
@@ -275,14 +286,14 @@ impl<const G: usize> Receiver<G> {
                 // the NAK limit bounds how long.
                 let silent = now >= self.heard.saturating_add(u64::from(cfg.inactivity_ms));
                 if silent && self.eof.is_none() {
-                    return self.finish(ConditionCode::InactivityDetected, store);
+                    return self.fault(ConditionCode::InactivityDetected, cfg, store);
                 }
                 if self.nak.expired(now) {
                     if !self.class2() {
-                        return self.finish(ConditionCode::CheckLimitReached, store);
+                        return self.fault(ConditionCode::CheckLimitReached, cfg, store);
                     }
                     if self.nak.count >= cfg.nak_limit {
-                        return self.finish(ConditionCode::NakLimitReached, store);
+                        return self.fault(ConditionCode::NakLimitReached, cfg, store);
                     }
                     self.owed.nak = true;
                     self.nak.deadline = None;

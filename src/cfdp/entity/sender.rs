@@ -5,7 +5,7 @@
 //! again, and the Finished PDU acknowledged. Silence for the inactivity timeout while waiting
 //! for the Finished PDU ends the transaction with that fault.
 
-use super::{Config, Event, Filestore, Timer, TransactionId, NAME_MAX};
+use super::{Config, Event, FaultHandler, Filestore, Timer, TransactionId, NAME_MAX};
 use crate::cfdp::checksum::Modular;
 use crate::cfdp::codes::{ConditionCode, DirectiveCode};
 use crate::cfdp::directive::{AckRepr, EofRepr, FileDataRepr, MetadataRepr, PduRepr};
@@ -21,6 +21,9 @@ enum Phase {
     /// EOF sent (class 2: waiting for its ACK, then for the Finished PDU; class 1 with closure:
     /// for the Finished PDU).
     Waiting,
+    /// A fault found here, its handler cancel: the EOF with the fault's condition sent (in
+    /// class 2 until acknowledged or the positive ACK limit is reached).
+    Cancelling,
     /// Done: nothing more to send.
     Ended,
 }
@@ -122,13 +125,22 @@ impl<const R: usize> Sender<R> {
             PduRepr::Ack(a) if a.of == DirectiveCode::Eof && self.eof && !self.eof_acked => {
                 self.eof_acked = true;
                 self.timer = Timer::IDLE;
+                if self.phase == Phase::Cancelling {
+                    self.phase = Phase::Ended;
+                }
             }
             PduRepr::Nak(n)
-                if self.phase != Phase::Ended && self.put.mode == Mode::Acknowledged =>
+                if matches!(self.phase, Phase::Sending | Phase::Waiting)
+                    && self.put.mode == Mode::Acknowledged =>
             {
                 for (start, end) in n.segments.iter() {
                     self.ask(start, end);
                 }
+            }
+            PduRepr::Finished(_) if self.phase == Phase::Cancelling => {
+                // The receiver ended too: acknowledged, the fault already reported.
+                self.ack_finished = self.put.mode == Mode::Acknowledged;
+                self.phase = Phase::Ended;
             }
             PduRepr::Finished(f) if self.phase != Phase::Ended => {
                 self.ack_finished = self.put.mode == Mode::Acknowledged;
@@ -166,20 +178,38 @@ impl<const R: usize> Sender<R> {
         });
     }
 
+    /// A fault found here: reported at once, then the transaction ends as its handler says
+    /// (`Config::handlers`): cancel, the receiver told by an EOF with the condition; abandon,
+    /// nothing more sent.
+    fn fault(&mut self, condition: ConditionCode, cfg: &Config) {
+        self.end(condition);
+        if cfg.handlers.handler(condition) == FaultHandler::Cancel {
+            self.phase = Phase::Cancelling;
+            self.eof = false;
+            self.eof_acked = false;
+            self.metadata = false;
+        }
+    }
+
     /// The timers at `now`: the EOF's ACK timer, and inactivity while waiting.
     pub fn tick(&mut self, now: u64, cfg: &Config) {
-        if self.phase != Phase::Waiting {
+        let waiting = self.phase == Phase::Waiting;
+        if !waiting && self.phase != Phase::Cancelling {
             return;
         }
         if self.timer.expired(now) && !self.eof_acked {
-            if self.timer.count >= cfg.ack_limit {
-                return self.end(ConditionCode::PositiveAckLimitReached);
+            if self.timer.count < cfg.ack_limit {
+                self.eof = false;
+                self.timer.deadline = None;
+            } else if waiting {
+                return self.fault(ConditionCode::PositiveAckLimitReached, cfg);
+            } else {
+                // A notice of cancellation unacknowledged: abandoned.
+                self.phase = Phase::Ended;
             }
-            self.eof = false;
-            self.timer.deadline = None;
         }
-        if now >= self.heard.saturating_add(u64::from(cfg.inactivity_ms)) {
-            self.end(ConditionCode::InactivityDetected);
+        if waiting && now >= self.heard.saturating_add(u64::from(cfg.inactivity_ms)) {
+            self.fault(ConditionCode::InactivityDetected, cfg);
         }
     }
 
@@ -204,8 +234,10 @@ impl<const R: usize> Sender<R> {
                 status: super::status(false),
             }));
         }
-        if self.phase == Phase::Ended {
-            return None;
+        match self.phase {
+            Phase::Ended => return None,
+            Phase::Cancelling => return self.cancel_eof(now, cfg),
+            Phase::Sending | Phase::Waiting => {}
         }
         if core::mem::take(&mut self.metadata) {
             // The names copied into `buf`, which the PDU borrows.
@@ -224,10 +256,10 @@ impl<const R: usize> Sender<R> {
         }
         let chunk = buf.len().min(usize::from(cfg.file_data));
         if let Some(&(start, end)) = self.resend.first() {
-            return self.data(start, end, chunk, store, buf, false);
+            return self.data(start, end, chunk, (cfg, store), buf, false);
         }
         if self.sent < self.size {
-            return self.data(self.sent, self.size, chunk, store, buf, true);
+            return self.data(self.sent, self.size, chunk, (cfg, store), buf, true);
         }
         if !self.eof && self.phase != Phase::Ended {
             self.eof = true;
@@ -235,11 +267,7 @@ impl<const R: usize> Sender<R> {
             self.phase = Phase::Waiting;
             let eof = PduRepr::Eof(EofRepr {
                 condition: ConditionCode::NoError,
-                checksum: if cfg.checksum == crate::cfdp::codes::ChecksumType::NULL {
-                    0
-                } else {
-                    self.sum.value()
-                },
+                checksum: self.checksum(cfg),
                 file_size: self.size,
                 fault_location: None,
             });
@@ -251,6 +279,35 @@ impl<const R: usize> Sender<R> {
         None
     }
 
+    /// The notice of cancellation: an EOF with the fault's condition, the checksum and size
+    /// of what was sent, and this entity as the fault location; once, and in class 2 again
+    /// each ACK timeout up to the positive ACK limit ([`Sender::tick`]).
+    fn cancel_eof<'b>(&mut self, now: u64, cfg: &Config) -> Option<PduRepr<'b>> {
+        if self.eof {
+            return None;
+        }
+        self.eof = true;
+        self.timer = self.timer.restart(now, cfg.ack_timeout_ms);
+        if self.put.mode == Mode::Unacknowledged {
+            self.phase = Phase::Ended;
+        }
+        Some(PduRepr::Eof(EofRepr {
+            condition: self.condition,
+            checksum: self.checksum(cfg),
+            file_size: self.sent,
+            fault_location: Some(cfg.local),
+        }))
+    }
+
+    /// The checksum an EOF carries: of the octets sent so far (0 with the null checksum).
+    fn checksum(&self, cfg: &Config) -> u32 {
+        if cfg.checksum == crate::cfdp::codes::ChecksumType::NULL {
+            0
+        } else {
+            self.sum.value()
+        }
+    }
+
     /// File data from `start` (before `end`), at most `chunk` octets read into `buf`; on the
     /// first pass the checksum takes them.
     fn data<'b, S: Filestore>(
@@ -258,7 +315,7 @@ impl<const R: usize> Sender<R> {
         start: u32,
         end: u32,
         chunk: usize,
-        store: &mut S,
+        (cfg, store): (&Config, &mut S),
         buf: &'b mut [u8],
         first: bool,
     ) -> Option<PduRepr<'b>> {
@@ -267,7 +324,7 @@ impl<const R: usize> Sender<R> {
         let n = match store.read(&self.put.source, start, dst) {
             Ok(n) if n > 0 => n,
             _ => {
-                self.end(ConditionCode::FilestoreRejection);
+                self.fault(ConditionCode::FilestoreRejection, cfg);
                 return None;
             }
         };
