@@ -358,6 +358,10 @@ fn fault_handlers_cancel_with_a_notice_or_abandon_in_silence() {
             .with(ConditionCode::FilestoreRejection, FaultHandler::Abandon),
         ..cancel
     };
+    let c = ConditionCode::FilestoreRejection;
+    assert_eq!(abandon.handlers.handler(c), FaultHandler::Abandon);
+    let undone = abandon.handlers.with(c, FaultHandler::Cancel);
+    assert_eq!(undone, FaultHandlers::CANCEL, "set back to cancel");
     let put = Put::new(b"s", b"d", Mode::Acknowledged).unwrap();
     let mut buf = [0u8; 64];
     let mut empty = MemoryStore::<4, 64>::new();
