@@ -68,9 +68,13 @@ pub(crate) fn a_realtime_fleet_polls_every_robot_over_real_sockets() {
         Some(realtime::WORKERS + 1),
         "no thread per robot"
     );
-    // A poll every 1.2 s per robot: at 0, 1.2, 2.4, 3.6, 4.8 s, and the one at 6.0 s that
-    // ends the 5 s wait.
-    assert_eq!(r.attempts, (40 * 6, 40 * 6), "{}", r.line());
+    // A poll every 1.2 s per robot: at 0, 1.2, 2.4, 3.6, 4.8 s, and the one due at 6.0 s,
+    // which races the end of the run: under load (CI's instrumented step, 2026-11-29) 9 of the
+    // 40 robots' sixth polls were not made before the fleet stopped (231 polls, all answered).
+    // Every poll made is answered, and at least the 200 due within the run are made.
+    let (answered, polled) = r.attempts;
+    assert_eq!(answered, polled, "{}", r.line());
+    assert!((40 * 5..=40 * 6).contains(&polled), "{}", r.line());
     assert_eq!(r.ends, (40, 0), "{}", r.line());
     assert!((5.9..7.5).contains(&r.wall.as_secs_f64()), "{:?}", r.wall);
     let pus = realtime::run(&FleetConfig {
