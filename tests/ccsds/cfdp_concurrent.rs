@@ -5,6 +5,7 @@
 //! another's octets. A put beyond the entity's capacity, and a new transaction arriving at a
 //! full entity, are refused by name.
 
+use crate::common::Rng;
 use mmic::cfdp::codes::ConditionCode;
 use mmic::cfdp::entity::{
     Config, Entity, Event, HandleError, MemoryStore, Put, PutError, TransactionId,
@@ -17,21 +18,6 @@ type Store = MemoryStore<12, 4096>;
 
 const GROUND: u64 = 0x15;
 const ROBOT: u64 = 0x42;
-
-/// xorshift64*, seeded.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn below(&mut self, percent: u64) -> bool {
-        self.next() % 100 < percent
-    }
-}
 
 /// A file to send: its names, its class, its octets.
 struct Transfer {

@@ -3,6 +3,7 @@
 //! class 2, for many seeds. Each run ends with both sides' events; the file arrives exact, or
 //! it is not under its name and the sender reports a fault; no incoming file is left behind.
 
+use crate::common::Rng;
 use mmic::cfdp::codes::ConditionCode;
 use mmic::cfdp::entity::{Config, Entity, Event, MemoryStore, Put};
 use mmic::cfdp::header::Mode;
@@ -10,21 +11,6 @@ use std::collections::BinaryHeap;
 
 type Node = Entity<4, 16, 16>;
 type Store = MemoryStore<6, 8192>;
-
-/// A seeded generator (xorshift64*).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-    fn chance(&mut self, p: f64) -> bool {
-        ((self.next() >> 11) as f64 / (1u64 << 53) as f64) < p
-    }
-}
 
 /// The link's behaviour, each direction alike.
 #[derive(Debug, Clone, Copy)]

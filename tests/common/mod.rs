@@ -68,3 +68,26 @@ pub fn framing_error(kind: PacketKind, bytes: &[u8]) -> Option<WireError> {
         computed,
     })
 }
+
+/// A seeded generator for the simulated links of the tests (xorshift64*): the same seed, the
+/// same run.
+pub struct Rng(pub u64);
+
+impl Rng {
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// True with probability `p`.
+    pub fn chance(&mut self, p: f64) -> bool {
+        ((self.next() >> 11) as f64 / (1u64 << 53) as f64) < p
+    }
+
+    /// True for `percent` of the draws.
+    pub fn below(&mut self, percent: u64) -> bool {
+        self.next() % 100 < percent
+    }
+}
