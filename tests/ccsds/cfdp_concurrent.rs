@@ -50,7 +50,7 @@ fn transfers(seed: u64) -> Vec<Transfer> {
 /// Runs every transfer at once over a link losing and copying `loss` and `dup` percent of
 /// the PDUs, with up to 40 ms of jitter: each end's events by transaction, and both stores.
 fn run(seed: u64, loss: u64, dup: u64) -> (BTreeMap<TransactionId, Vec<Event>>, Store, Store) {
-    let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
+    let mut rng = Rng::seeded(seed);
     let mut ends = [
         (Node::new(Config::mission(GROUND), 1), Store::new()),
         (Node::new(Config::mission(ROBOT), 1), Store::new()),

@@ -35,7 +35,7 @@ struct Outcome {
 }
 
 fn run(seed: u64, file: &[u8], mode: Mode, closure: bool, link: Link) -> Outcome {
-    let mut rng = Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
+    let mut rng = Rng::seeded(seed);
     let mut ground = Node::new(Config::mission(0x15), 1);
     let mut robot = Node::new(Config::mission(0x42), 1);
     let (mut gs, mut rs) = (Store::new(), Store::new());

@@ -70,10 +70,15 @@ pub fn framing_error(kind: PacketKind, bytes: &[u8]) -> Option<WireError> {
 }
 
 /// A seeded generator for the simulated links of the tests (xorshift64*): the same seed, the
-/// same run.
+/// same run. The one copy of it: the CFDP, COP-1 and frame link simulations all draw from it.
 pub struct Rng(pub u64);
 
 impl Rng {
+    /// The generator for `seed`, scrambled (nearby seeds start far apart) and never zero.
+    pub fn seeded(seed: u64) -> Rng {
+        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
+    }
+
     pub fn next(&mut self) -> u64 {
         self.0 ^= self.0 >> 12;
         self.0 ^= self.0 << 25;
@@ -81,13 +86,29 @@ impl Rng {
         self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
     }
 
+    /// Uniform in [0, 1), from the 53 high bits of a draw.
+    pub fn uniform(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
     /// True with probability `p`.
     pub fn chance(&mut self, p: f64) -> bool {
-        ((self.next() >> 11) as f64 / (1u64 << 53) as f64) < p
+        self.uniform() < p
+    }
+
+    /// As [`Rng::chance`], but a `p` of 0 draws nothing: a fault switched off leaves the
+    /// stream, and so every other draw of the run, as it was.
+    pub fn maybe(&mut self, p: f64) -> bool {
+        p > 0.0 && self.chance(p)
     }
 
     /// True for `percent` of the draws.
     pub fn below(&mut self, percent: u64) -> bool {
         self.next() % 100 < percent
+    }
+
+    /// One of `0..n` (0 when `n` is 0), from the high half of a draw.
+    pub fn pick(&mut self, n: u32) -> u32 {
+        (self.next() >> 33) as u32 % n.max(1)
     }
 }

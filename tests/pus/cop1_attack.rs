@@ -29,6 +29,7 @@
 //! frames only from the source of the last authenticated frame (decision `sdls-bc-source`);
 //! it has no key, so it makes nothing run and forges no report.
 
+use crate::common::Rng;
 use mmic::ccsds::tm::TmRepr;
 use mmic::command::{Command, ServoTarget};
 use mmic::link::clcw::Clcw;
@@ -87,31 +88,8 @@ fn recovered_ms(tactics: &Tactics) -> Option<u32> {
         .then(|| tactics.until + u32::from(fop.tx_limit) * fop.t1_ms)
 }
 
-/// xorshift64*, seeded.
-struct Rng(u64);
-
-impl Rng {
-    fn new(seed: u64) -> Rng {
-        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
-    }
-
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
-    }
-
-    fn chance(&mut self, p: f64) -> bool {
-        p > 0.0 && ((self.next() >> 11) as f64 / (1u64 << 53) as f64) < p
-    }
-
-    fn below(&mut self, n: u32) -> u32 {
-        (self.next() >> 33) as u32 % n.max(1)
-    }
-}
-
-/// A wire: frames delivered in order 2..=6 ms after they were sent.
+/// A wire: frames delivered in order 2..=6 ms after they were sent (tests/common's seeded
+/// generator).
 struct Wire {
     rng: Rng,
     queue: Vec<(u32, Vec<u8>)>,
@@ -121,14 +99,14 @@ struct Wire {
 impl Wire {
     fn new(seed: u64) -> Wire {
         Wire {
-            rng: Rng::new(seed),
+            rng: Rng::seeded(seed),
             queue: Vec::new(),
             last: 0,
         }
     }
 
     fn send(&mut self, now: u32, frame: &[u8]) {
-        let at = (now + 2 + self.rng.below(5)).max(self.last);
+        let at = (now + 2 + self.rng.pick(5)).max(self.last);
         self.last = at;
         self.queue.push((at, frame.to_vec()));
     }
@@ -267,7 +245,7 @@ fn tc_kind(f: &[u8]) -> (bool, bool, u8) {
 impl Attacker {
     fn new(seed: u64, tactics: Tactics, script: Option<Scripted>) -> Attacker {
         Attacker {
-            rng: Rng::new(seed ^ 0xa77a_c4e7),
+            rng: Rng::seeded(seed ^ 0xa77a_c4e7),
             tactics,
             script,
             vs: None,
@@ -318,26 +296,26 @@ impl Attacker {
         }
         let t = self.tactics;
         if now < t.until {
-            if ad && self.rng.chance(t.skip) {
+            if ad && self.rng.maybe(t.skip) {
                 self.forge(&mut out, ControlCommand::SetVr(ns.wrapping_add(1)));
             }
-            if self.rng.chance(t.set_vr) {
-                let v = self.rng.below(256) as u8;
+            if self.rng.maybe(t.set_vr) {
+                let v = self.rng.pick(256) as u8;
                 self.forge(&mut out, ControlCommand::SetVr(v));
             }
-            if self.rng.chance(t.unlock) {
+            if self.rng.maybe(t.unlock) {
                 self.forge(&mut out, ControlCommand::Unlock);
             }
-            if ad && self.rng.chance(t.drop_and_ack) {
+            if ad && self.rng.maybe(t.drop_and_ack) {
                 self.dropped += 1;
                 self.ack_next = true;
                 return out;
             }
-            if self.rng.chance(t.drop) {
+            if self.rng.maybe(t.drop) {
                 self.dropped += 1;
                 return out;
             }
-            if self.rng.chance(t.dup) {
+            if self.rng.maybe(t.dup) {
                 out.push(frame.clone());
             }
         }
@@ -361,7 +339,7 @@ impl Attacker {
             self.ack_next = false;
             rewrite = Some(Rewrite::AckAll);
         }
-        let random = active && rewrite.is_none() && self.rng.chance(t.rewrite);
+        let random = active && rewrite.is_none() && self.rng.maybe(t.rewrite);
         let ocf = frame.len() - FECF_LEN - OCF_LEN;
         if rewrite.is_some() || random {
             let mut c = Clcw::parse(&frame[ocf..ocf + OCF_LEN]).unwrap();
@@ -369,14 +347,14 @@ impl Attacker {
             if let Some(r) = rewrite {
                 r.apply(&mut c, vs);
             } else {
-                c.report_value = match self.rng.below(4) {
+                c.report_value = match self.rng.pick(4) {
                     0 => vs,
                     1 => c.report_value.wrapping_add(1),
                     2 => c.report_value.wrapping_sub(1),
-                    _ => self.rng.below(256) as u8,
+                    _ => self.rng.pick(256) as u8,
                 };
                 for flag in [&mut c.lockout, &mut c.wait, &mut c.retransmit] {
-                    if self.rng.chance(0.25) {
+                    if self.rng.maybe(0.25) {
                         *flag = !*flag;
                     }
                 }
@@ -389,11 +367,11 @@ impl Attacker {
             frame[n - FECF_LEN..].copy_from_slice(&crc.to_be_bytes());
             self.rewritten += 1;
         }
-        if active && self.rng.chance(t.drop) {
+        if active && self.rng.maybe(t.drop) {
             self.dropped += 1;
             return Vec::new();
         }
-        if active && self.rng.chance(t.dup) {
+        if active && self.rng.maybe(t.dup) {
             return vec![frame.clone(), frame];
         }
         vec![frame]
@@ -555,7 +533,7 @@ fn run(n: u16, seed: u64, tactics: Tactics, script: Option<Scripted>, limit_ms: 
     let mut ground = Ground::new(board);
     // Throwaway keys made from the seed at run time (no key is in the tree).
     let key = |k: u64| {
-        let mut r = Rng::new(seed.wrapping_mul(31).wrapping_add(k));
+        let mut r = Rng::seeded(seed.wrapping_mul(31).wrapping_add(k));
         let bytes: Vec<u8> = (0..32).map(|_| r.next() as u8).collect();
         Key256::from_slice(&bytes).unwrap()
     };
@@ -907,13 +885,13 @@ fn random_attacks(part: u64) {
         .and_then(|s| s.parse().ok())
         .unwrap_or(90);
     for seed in part * seeds / 3 + 1..=(part + 1) * seeds / 3 {
-        let mut rng = Rng::new(seed);
+        let mut rng = Rng::seeded(seed);
         // Every third run an aggressive attacker (up to a forged frame before every AD frame,
         // every CLCW rewritten, half the frames dropped); the others a moderate one.
         let scale = if seed % 3 == 0 { 1.0 } else { 0.0 };
         let mut p = |moderate: f64, aggressive: f64| {
             let max = moderate + scale * (aggressive - moderate);
-            (rng.below(1001) as f64 / 1000.0) * max
+            (rng.pick(1001) as f64 / 1000.0) * max
         };
         let tactics = Tactics {
             skip: p(0.5, 1.0),

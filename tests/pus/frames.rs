@@ -5,6 +5,7 @@
 //! order (its ST[1] acceptance reports, read back through the TM frames, say so), whatever the
 //! channels do; COP-1 retransmits what they lose.
 
+use crate::common::Rng;
 use mmic::ccsds::tm::TmRepr;
 use mmic::link::farm::{DiscardReason, FarmState};
 use mmic::link::fop::FopState;
@@ -21,9 +22,9 @@ type Server = FrameGateway<1, 4, 64, 4096>;
 type Ground = GroundLink<10, 64, 1024>;
 
 /// A frame channel: each frame lost, duplicated or held back with the given probabilities,
-/// otherwise delivered after 2..=6 ms; seeded (xorshift64*).
+/// otherwise delivered after 2..=6 ms; seeded (tests/common's generator, xorshift64*).
 struct Channel {
-    state: u64,
+    rng: Rng,
     loss: f64,
     dup: f64,
     reorder: f64,
@@ -36,7 +37,7 @@ struct Channel {
 impl Channel {
     fn new(seed: u64, loss: f64, dup: f64, reorder: f64) -> Channel {
         Channel {
-            state: seed | 1,
+            rng: Rng(seed | 1),
             loss,
             dup,
             reorder,
@@ -48,10 +49,7 @@ impl Channel {
     }
 
     fn uniform(&mut self) -> f64 {
-        self.state ^= self.state >> 12;
-        self.state ^= self.state << 25;
-        self.state ^= self.state >> 27;
-        (self.state.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64
+        self.rng.uniform()
     }
 
     fn send(&mut self, now: u32, frame: &[u8]) {
