@@ -48,6 +48,12 @@ def first_ad_dropper():
     return drop
 
 
+def settled(status) -> bool:
+    """COP-1 has sent something and FARM-1 acknowledged all of it: nothing waiting, nothing unacknowledged."""
+    p = status._proto          # yamcs-client 2.1.0 does not expose the queue sizes as properties
+    return bool(status.v_s) and status.nn_r == status.v_s and not p.waitQueueNumTC and not p.sentQueueNumFrames
+
+
 def binary_of(cmd, seconds: float = 5.0) -> bytes | None:
     """The packet YAMCS sent: `binary` once the postprocessor filled the sequence count (see README)."""
     def get():
@@ -60,9 +66,9 @@ def binary_of(cmd, seconds: float = 5.0) -> bytes | None:
 
 
 def run(reprotect: bool, mdb=DEFAULT_MDB, t1: float = 1.0, extra_seconds: float = 1.5, commands: int = 1) -> dict:
-    """`commands` are issued back to back (AD frames N(S) 0 .. commands-1): the first transmission of N(S) 0 is
-    dropped, the others arrive ahead of V(R) and FARM-1 discards them, so T1 makes YAMCS send them all again
-    (go-back-N)."""
+    """`commands` are issued back to back, in AD frames N(S) 0 .. k-1 (1 <= k <= commands: YAMCS may put several
+    queued commands into one frame): the first transmission of N(S) 0 is dropped, the others arrive ahead of
+    V(R) and FARM-1 discards them, so T1 makes YAMCS send them all again (go-back-N)."""
     y = Yamcs(mdb, link="frames-sdls", cop1_t1=t1, sdls_plugin=reprotect, max_lifetime=120)
     y.start()
     try:
@@ -76,7 +82,7 @@ def run(reprotect: bool, mdb=DEFAULT_MDB, t1: float = 1.0, extra_seconds: float 
             cmds = [conn.issue("/MMIC/are_you_alive") for _ in range(commands)]
             packets = [binary_of(c) for c in cmds]
             # the dropped first transmission, then T1 (t1 s), then the retransmissions, then FARM-1's CLCW
-            wait(lambda: link.get_cop1_status().nn_r == commands, 6 * t1 + 5)
+            wait(lambda: settled(link.get_cop1_status()), 6 * t1 + 5)
             time.sleep(extra_seconds)   # further retransmissions, if any
             cop1 = link.get_cop1_status()
             records = list(robot.tc)
@@ -86,9 +92,32 @@ def run(reprotect: bool, mdb=DEFAULT_MDB, t1: float = 1.0, extra_seconds: float 
         y.stop()
 
 
+def split_packets(data: bytes) -> list[bytes] | None:
+    """`data` cut into CCSDS space packets by their length fields, or None when it is not a whole number of
+    packets. YAMCS puts commands queued at the same time into one TC frame, so a frame may carry several."""
+    out = []
+    while data:
+        if len(data) < 6 or len(data) < 7 + int.from_bytes(data[4:6], "big"):
+            return None
+        n = 7 + int.from_bytes(data[4:6], "big")
+        out.append(data[:n])
+        data = data[n:]
+    return out or None
+
+
+def carried(plain: bytes, packets: list) -> list[int] | None:
+    """Indices of the packets YAMCS sent that `plain` is, in order, or None when it is anything else."""
+    parts = split_packets(plain)
+    if parts is None:
+        return None
+    idx = [next((i for i, p in enumerate(packets) if p == part), None) for part in parts]
+    return None if None in idx or idx != list(range(idx[0], idx[0] + len(idx))) else idx
+
+
 def analyse(records, packets: list, sa: sdls.SecurityAssociation, cop1, reprotect: bool, t1: float) -> dict:
-    """Per TC datagram: kind, N(S), IV, MAC, plaintext; for AD frame N(S) k, whether the plaintext is the k-th
-    packet YAMCS sent and whether it is the ciphertext of the previous transmission of the same N(S)."""
+    """Per TC datagram: kind, N(S), IV, MAC, plaintext; for an AD frame, which of the packets YAMCS sent it
+    carries (`carries`; `plaintext_is_packet` when it carries at least one and nothing else) and whether its
+    plaintext is the ciphertext of the previous transmission of the same N(S)."""
     out = {"reprotect": reprotect, "cop1T1_s": t1, "packets_sent_by_yamcs": [p.hex() if p else None for p in packets],
            "transmissions": [], "cop1_end": {"state": cop1.state, "v_s": cop1.v_s, "nn_r": cop1.nn_r}}
     prev_cipher = {}
@@ -106,15 +135,25 @@ def analyse(records, packets: list, sa: sdls.SecurityAssociation, cop1, reprotec
                 _, plain = sdls.process_security(raw, sdls.TC_SEC_START, len(raw) - 2, sa)
                 entry["mac"] = "ok"
                 entry["plaintext"] = plain.hex()
-                entry["plaintext_is_packet"] = raw[4] < len(packets) and plain == packets[raw[4]]
+                entry["carries"] = carried(plain, packets)
+                entry["plaintext_is_packet"] = entry["carries"] is not None
                 entry["plaintext_is_previous_ciphertext"] = plain == prev_cipher.get((kind, raw[4]))
             except sdls.SdlsError as e:
                 entry["mac"] = e.check
             prev_cipher[(kind, raw[4])] = cipher
         out["transmissions"].append(entry)
     ads = [e for e in out["transmissions"] if e["kind"] == "AD"]
+    seen = set()
+    first = []
+    for e in ads:                           # the first transmissions: up to the first N(S) sent again
+        if e["ns"] in seen:
+            break
+        seen.add(e["ns"])
+        first.append(e)
     out["ad_transmissions"] = len(ads)
-    out["retransmitted"] = len(ads) > len(packets)
+    out["ad_frames"] = len(first)
+    out["retransmitted"] = len(ads) > len(first)
+    out["first_transmissions_carry"] = [i for e in first for i in (e.get("carries") or [None])]
     out["farm_accepted"] = [e["ns"] for e in out["transmissions"] if e["verdict"] == "accept"]
     out["all_carry_the_packet"] = bool(ads) and all(e.get("plaintext_is_packet") for e in ads)
     return out

@@ -8,8 +8,8 @@ minimal FARM-1, protected TM frames with the CLCW). No Rust: these are the facts
 (b) YAMCS takes our protected TM frames (packets archived, link counters), with verifySeqNum on; a
     replayed frame and a forged one are refused (`Invalid frames`, the link's warning event naming
     AntiReplaySequenceNumberFailure / MacVerificationFailure), their packets not archived.
-(c) COP-1 retransmissions (T1 = 1 s, three commands, the first transmission of N(S) 0 dropped, so all three
-    go again): with YAMCS's own SA the MACs of the retransmissions verify but their plaintexts are the
+(c) COP-1 retransmissions (T1 = 1 s, three commands in one to three AD frames: YAMCS may put queued
+    commands into one frame; the first transmission of N(S) 0 dropped, so every frame goes again): with YAMCS's own SA the MACs of the retransmissions verify but their plaintexts are the
     first transmissions' ciphertexts; with the plug-in's SA (ground/yamcs-plugin/) they are the packets
     again, under fresh IVs (repro_cop1_sdls.py).
 (d) with YAMCS's own SA (`sdls_plugin=False`), the first TM frame after YAMCS starts is not window-checked (the
@@ -152,23 +152,44 @@ def test_tm_frames_accepted_replay_and_forgery_refused(loop):
     print("\nYAMCS's events: " + " | ".join(m for m in messages()))
 
 
+def test_a_frame_may_carry_several_of_the_packets_yamcs_sent():
+    """YAMCS puts commands queued at once into one TC frame (CI, 2026-11-29: N(S) 1 carried the second and
+    the third command): `carried` names them in order, and anything else (a part, a stranger, the order
+    changed, garbage) is None. No YAMCS: the packets of that run."""
+    p = [bytes.fromhex(h) for h in ("1901c00100062f110100008987", "1901c00200062f1101000041f2",
+                                    "1901c00300062f110100000621")]
+    assert repro_cop1_sdls.carried(p[0], p) == [0]
+    assert repro_cop1_sdls.carried(p[1] + p[2], p) == [1, 2]
+    assert repro_cop1_sdls.carried(p[0] + p[1] + p[2], p) == [0, 1, 2]
+    assert repro_cop1_sdls.carried(p[2] + p[1], p) is None                 # out of order
+    assert repro_cop1_sdls.carried(p[0] + p[2], p) is None                 # one left out
+    assert repro_cop1_sdls.carried(p[1] + p[2][:-1], p) is None            # cut short
+    assert repro_cop1_sdls.carried(p[1] + b"\x00", p) is None              # a stray octet
+    assert repro_cop1_sdls.carried(bytes.fromhex("8f90e847a35733a0b138b0e7fd"), p) is None   # ciphertext
+    assert repro_cop1_sdls.carried(b"", p) is None
+
+
 def test_cop1_retransmission_with_yamcs_sa_is_encrypted_twice():
-    """Three commands back to back; the first transmission of N(S) 0 dropped, N(S) 1 and 2 discarded as ahead
-    by FARM-1; T1 expires and YAMCS sends all three again (go-back-N)."""
+    """Three commands back to back, in k AD frames (YAMCS may put queued commands into one frame); the first
+    transmission of N(S) 0 dropped, the others discarded as ahead by FARM-1; T1 expires and YAMCS sends all k
+    again (go-back-N)."""
     res = repro_cop1_sdls.run(False, commands=3)
     ads = [t for t in res["transmissions"] if t["kind"] == "AD"]
     print(f"\n{[{k: v for k, v in t.items() if k != 'hex'} for t in ads]}")
     assert res["retransmitted"], res
-    first, again = ads[:3], ads[3:]
-    assert [t["ns"] for t in first] == [0, 1, 2] and first[0]["dropped"]
+    k = res["ad_frames"]
+    assert 1 <= k <= 3, res
+    first, again = ads[:k], ads[k:]
+    assert [t["ns"] for t in first] == list(range(k)) and first[0]["dropped"]
     assert all(t["plaintext_is_packet"] for t in first)
-    assert [t["ns"] for t in again[:3]] == [0, 1, 2]
+    assert res["first_transmissions_carry"] == [0, 1, 2]                   # each command once, in order
+    assert [t["ns"] for t in again[:k]] == list(range(k))
     assert [t["iv"] for t in ads] == list(range(len(ads)))                # a fresh IV each time ...
     for t in again:
         assert t["mac"] == "ok"                                            # ... the MAC verifies ...
         assert not t["plaintext_is_packet"] and t["plaintext_is_previous_ciphertext"], t  # ... garbage
-    assert res["farm_accepted"] == [0, 1, 2]          # FARM-1 takes them: COP-1 thinks the TCs delivered
-    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == 3
+    assert res["farm_accepted"] == list(range(k))     # FARM-1 takes them: COP-1 thinks the TCs delivered
+    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == k
 
 
 @pytest.mark.skipif(not PLUGIN_JAR.is_file(), reason="run ground/setup: it builds ground/yamcs-plugin/")
@@ -177,11 +198,15 @@ def test_cop1_retransmission_with_the_plugin_carries_the_packet():
     ads = [t for t in res["transmissions"] if t["kind"] == "AD"]
     print(f"\n{[{k: v for k, v in t.items() if k != 'hex'} for t in ads]}")
     assert res["retransmitted"], res
+    k = res["ad_frames"]
+    assert 1 <= k <= 3, res
     assert [t["iv"] for t in ads] == list(range(len(ads)))                 # a fresh IV each time
     assert all(t["mac"] == "ok" and t["plaintext_is_packet"] for t in ads), ads
-    assert ads[0]["dropped"] and [t["ns"] for t in ads[3:6]] == [0, 1, 2]
-    assert res["farm_accepted"] == [0, 1, 2]
-    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == 3
+    assert res["first_transmissions_carry"] == [0, 1, 2]
+    assert ads[0]["dropped"] and [t["ns"] for t in ads[k:2 * k]] == list(range(k))
+    assert [t["carries"] for t in ads[k:2 * k]] == [t["carries"] for t in ads[:k]]   # the same packets again
+    assert res["farm_accepted"] == list(range(k))
+    assert res["cop1_end"]["nn_r"] == res["cop1_end"]["v_s"] == k
 
 
 def test_tm_first_frame_after_start_is_not_window_checked():
