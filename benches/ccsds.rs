@@ -1,6 +1,6 @@
 //! The CCSDS/PUS wire layer against the `spacepackets` crate (0.19), in one run, on identical
 //! octets: telecommand parse+validate and telemetry build (issue 15). Run:
-//! `cargo bench --bench ccsds` (about 30 s). Results: benches/README.md.
+//! `cargo bench -p mmic-benches --bench ccsds` (about 30 s). Results: benches/README.md.
 
 use arbitrary_int::{u11, u14};
 use criterion::{criterion_group, criterion_main, Criterion};

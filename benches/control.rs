@@ -1,4 +1,4 @@
-//! One step of each Section 5 piece. Run: `cargo bench --bench control`.
+//! One step of each Section 5 piece. Run: `cargo bench -p mmic-benches --bench control`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Sensed};

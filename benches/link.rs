@@ -3,7 +3,7 @@
 //! (`TcFrameRepr::emit`) against the bare packet's `TcRepr::parse` / `TcRepr::emit`; the
 //! mission's 256-octet TM frame parsed and built; the on-board framer (`TmFramer::push` of one
 //! TM(3,25) + `next_frame`) and the ground's extractor (`Extractor::frame`) per frame. Run:
-//! `cargo bench --bench link` (about 30 s). Results: benches/README.md.
+//! `cargo bench -p mmic-benches --bench link` (about 30 s). Results: benches/README.md.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use mmic::ccsds::cuc::Cuc;

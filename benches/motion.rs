@@ -1,5 +1,5 @@
 //! Plan lookup (precomputed table) vs the iterative search, per query over all 225 pairs.
-//! Run: `cargo bench --bench motion`.
+//! Run: `cargo bench -p mmic-benches --bench motion`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mmic::motion::{route, State};

@@ -1,6 +1,6 @@
 //! Packet parse+validate and emit, the deframer, and the CRC table choice, with spacepackets'
 //! 13-byte PUS-C telecommand parse measured in the same run as the reference.
-//! Run: `cargo bench --bench wire` (about a minute). Results: benches/README.md.
+//! Run: `cargo bench -p mmic-benches --bench wire` (about a minute). Results: benches/README.md.
 
 use arbitrary_int::{u11, u14};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};

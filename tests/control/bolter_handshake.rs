@@ -25,12 +25,14 @@
 //! The state and transition counts are asserted: a change to the coordinator or executor that
 //! changes the reachable space shows here and in the README's row.
 
+use hashbrown::HashTable;
 use mmic::bolter::{BolterDirection, BolterSide, Config, Coordinator, Job, Sensed, Status};
 use mmic::command::{BolterPair, Fasteners};
 use mmic::faults::Fault;
 use mmic::wire::b_command::BolterOrder;
 use mmic::wire::internal_heartbeat::BolterAux;
-use std::collections::{HashMap, VecDeque};
+use std::collections::VecDeque;
+use std::hash::BuildHasher;
 // The 2.8 M states' index hashes with rustc's FxHash (rustc-hash): std's SipHash, made to resist
 // flooding by chosen keys, was most of the walk's time, and the keys are the model's own states (a
 // weak hash only makes the map slower, never wrong). From a crate rather than written here: its
@@ -53,7 +55,16 @@ const JUMP: u32 = 1 << 30; // past every timeout, and the clock cycles through 4
 
 /// `lossy`: links may lose messages and time may jump past every timeout (the full model);
 /// otherwise neither happens (the fairness model).
-fn successors(cfg: &Config, w: &World, lossy: bool) -> Vec<World> {
+/// At most nine successors: A's tick, two end signals, delivered and lost on each link, B's
+/// heartbeat and the time jump.
+type Successors = heapless::Vec<World, 9>;
+
+/// Pushes `x` into `out`: nine places suffice (see [`Successors`]).
+fn put(out: &mut Successors, x: World) {
+    assert!(out.push(x).is_ok(), "more than nine successors");
+}
+
+fn successors(cfg: &Config, w: &World, lossy: bool) -> Successors {
     let (push, lock) = (cfg.side.push_threshold_ma, cfg.side.lock_threshold_ma);
     // The end event: I_bo just reaches the higher threshold (so every sensed step's), home.
     let all = Sensed {
@@ -65,7 +76,7 @@ fn successors(cfg: &Config, w: &World, lossy: bool) -> Vec<World> {
         i_bo: push.min(lock) - 1,
         at_home: false,
     };
-    let mut out = Vec::new();
+    let mut out = Successors::new();
     // A's control loop: coordinator tick, side A follows, a fresh snapshot goes on the link.
     let mut x = *w;
     let o = x.coord.step(cfg, x.now, &x.a.aux(), x.b_seen.as_ref());
@@ -76,46 +87,46 @@ fn successors(cfg: &Config, w: &World, lossy: bool) -> Vec<World> {
     x.a.order(seq, order, x.now);
     x.a.tick(&cfg.side, x.now, none);
     x.ab = Some((seq, order));
-    out.push(x);
+    put(&mut out, x);
     // Side A's end signal for its step.
     let mut x = *w;
     x.a.tick(&cfg.side, x.now, all);
-    out.push(x);
+    put(&mut out, x);
     // Side B's end signal.
     let mut x = *w;
     x.b.tick(&cfg.side, x.now, all);
-    out.push(x);
+    put(&mut out, x);
     // A→B delivered (kept on the link: it may be delivered again), or lost.
     if let Some((seq, order)) = w.ab {
         let mut x = *w;
         x.b.order(seq, order, x.now);
-        out.push(x);
+        put(&mut out, x);
         if lossy {
             let mut x = *w;
             x.ab = None;
-            out.push(x);
+            put(&mut out, x);
         }
     }
     // B sends its heartbeat; B→A delivered (duplicable) or lost.
     let mut x = *w;
     x.b.tick(&cfg.side, x.now, none);
     x.ba = Some(x.b.aux());
-    out.push(x);
+    put(&mut out, x);
     if let Some(aux) = w.ba {
         let mut x = *w;
         x.b_seen = Some(aux);
-        out.push(x);
+        put(&mut out, x);
         if lossy {
             let mut x = *w;
             x.ba = None;
-            out.push(x);
+            put(&mut out, x);
         }
     }
     // Time jumps past every timeout.
     if lossy {
         let mut x = *w;
         x.now = x.now.wrapping_add(JUMP);
-        out.push(x);
+        put(&mut out, x);
     }
     out
 }
@@ -157,11 +168,23 @@ fn explore(job: Job, lossy: bool) -> Counts {
         now: 0,
     };
     start.coord.start(job, 0);
-    let mut index: HashMap<World, usize, FxBuildHasher> = HashMap::default();
-    let mut states = vec![start];
+    // The index holds each state's number, the state itself only in `states`: 4 octets a slot
+    // instead of a `World` and a `usize` (a `HashMap<World, usize>` spent 40 % of the walk
+    // missing the cache in its 2.8 M slots of 80-odd octets; issue 40).
+    // Room for the full model's counts (`COUNTS`) from the start: growing the index rehashed
+    // every state again and again (8 % of the walk).
+    let (room, edge_room) = if lossy {
+        (2_900_000, 20_000_000)
+    } else {
+        (128, 1024)
+    };
+    let fx = FxBuildHasher;
+    let mut index: HashTable<u32> = HashTable::with_capacity(room);
+    let mut states = Vec::with_capacity(room);
+    states.push(start);
     // Every transition (from, to), in one array: millions of small lists cost more than the walk.
-    let mut edges: Vec<(u32, u32)> = Vec::new();
-    index.insert(start, 0);
+    let mut edges: Vec<(u32, u32)> = Vec::with_capacity(edge_room);
+    index.insert_unique(fx.hash_one(start), 0, |&m| fx.hash_one(states[m as usize]));
     let mut queue = VecDeque::from([0usize]);
     let mut terminal = [0usize; 3]; // done, bolting failure, side B never reported (motion timeout)
     while let Some(i) = queue.pop_front() {
@@ -177,11 +200,18 @@ fn explore(job: Job, lossy: bool) -> Counts {
             continue;
         }
         for n in successors(&cfg, &w, lossy) {
-            let j = *index.entry(n).or_insert_with(|| {
-                states.push(n);
-                queue.push_back(states.len() - 1);
-                states.len() - 1
-            });
+            let hash = fx.hash_one(n);
+            let j = match index.find(hash, |&k| states[k as usize] == n) {
+                Some(&k) => k as usize,
+                None => {
+                    let k = states.len();
+                    states.push(n);
+                    queue.push_back(k);
+                    let id = u32::try_from(k).expect("under 5 M states");
+                    index.insert_unique(hash, id, |&m| fx.hash_one(states[m as usize]));
+                    k
+                }
+            };
             edges.push((i as u32, j as u32));
             if states[j].coord.status() == Status::Failed(Fault::BoltingFailure) {
                 use mmic::bolter::BolterStep::*;
