@@ -47,6 +47,7 @@ pub mod plant;
 pub mod progress;
 pub mod realtime;
 pub mod report;
+pub mod serial_line;
 pub mod shell;
 pub mod steps;
 

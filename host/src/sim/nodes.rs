@@ -11,6 +11,7 @@ use super::downtime::{Downtime, Phase};
 use super::inject::BOOT_MS;
 use super::log::Log;
 use super::plant::{Drives, Plant};
+use super::serial_line::SerialRx;
 use super::shell::{SideA, SideB};
 use super::FrameStats;
 use mmic::link::farm::Verdict;
@@ -34,6 +35,7 @@ use mmic::wire::heartbeat::HEARTBEAT_LEN;
 use serde_json::{json, Value};
 use std::io::{ErrorKind, Read, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, UdpSocket};
+use std::os::unix::net::UnixStream;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, Sender};
 use std::sync::{Arc, Mutex};
@@ -356,9 +358,9 @@ pub struct ControlTask<'q> {
     /// Heartbeats to the WiFi task (the tx queue).
     pub heartbeats: Producer<'q, HEARTBEAT_LEN, 8>,
     /// Packets from board B's serial line.
-    pub from_b: Receiver<Vec<u8>>,
+    pub from_b: SerialRx,
     /// Board B's serial line.
-    pub to_b: Lossy<std::io::PipeWriter>,
+    pub to_b: Lossy<UnixStream>,
     /// The robot's body.
     pub plant: Arc<Mutex<Plant>>,
     /// Board A's mode, faults and state for the run's summary.
@@ -403,7 +405,7 @@ impl ControlTask<'_> {
         }
         // Down: what reaches it is lost.
         while self.commands.pop().is_some() {}
-        while self.from_b.try_recv().is_ok() {}
+        while self.from_b.try_recv().is_some() {}
         true
     }
 
@@ -412,7 +414,7 @@ impl ControlTask<'_> {
             return;
         }
         let command = self.commands.pop();
-        let from_b = self.from_b.try_recv().ok().and_then(|v| v.try_into().ok());
+        let from_b = self.from_b.try_recv().and_then(|v| v.try_into().ok());
         // Board A's flash: the record written ahead of a tick that may run a new command,
         // then after it.
         if let Some(d) = self.a.board.ahead(command.as_ref()) {
@@ -449,9 +451,9 @@ pub struct BoardBTask {
     /// The library's board B and side B's sensor front end.
     pub b: SideB,
     /// Packets from board A's serial line.
-    pub from_a: Receiver<Vec<u8>>,
+    pub from_a: SerialRx,
     /// Board A's serial line.
-    pub to_a: Lossy<std::io::PipeWriter>,
+    pub to_a: Lossy<UnixStream>,
     /// The robot's body.
     pub plant: Arc<Mutex<Plant>>,
     /// Board B's restarts (`--inject reboot-b@S`): it keeps nothing (decision
@@ -477,10 +479,10 @@ impl BoardBTask {
                 }
             }
             if matches!(phase, Phase::WentDown | Phase::Down) {
-                while self.from_a.try_recv().is_ok() {}
+                while self.from_a.try_recv().is_some() {}
                 return;
             }
-            let command = self.from_a.try_recv().ok().and_then(|v| v.try_into().ok());
+            let command = self.from_a.try_recv().and_then(|v| v.try_into().ok());
             let out = {
                 let mut p = self.plant.lock().unwrap_or_else(|e| e.into_inner());
                 self.b.tick(&mut p, now, command)

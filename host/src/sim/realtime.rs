@@ -3,8 +3,9 @@
 //! RS232-over-USB line; UDP on loopback with `--protocol pus`), the server and board A over TCP
 //! on loopback (the WiFi link, connected and disconnected each server loop), board A's WiFi task
 //! and control loop on two threads joined by the library's hand-off queues, board A and board B
-//! over OS pipes (the wired serial line) — around the plant, on the wall clock multiplied by a
-//! scale ([`super::clock`], paced). Eight OS threads per robot: it proves the transports, but its
+//! over a Unix stream socket pair (the wired serial line, read by each board at its tick:
+//! [`super::serial_line`]) — around the plant, on the wall clock multiplied by a scale
+//! ([`super::clock`], paced). Six OS threads per robot: it proves the transports, but its
 //! outcome can depend on how busy the host is, which the virtual-time engine
 //! ([`super::engine`], the default) cannot.
 
@@ -36,11 +37,11 @@ struct Robot {
     listener: TcpListener,
 }
 
-/// A serial line: its two ends as OS pipes, with a reader thread deframing packets into a
-/// channel at the receiving end.
+/// A serial line: its writing end, and its receiving end read by the receiving node at its
+/// tick ([`super::serial_line`]).
 struct Serial {
-    write: std::io::PipeWriter,
-    read: std::sync::mpsc::Receiver<Vec<u8>>,
+    write: std::os::unix::net::UnixStream,
+    read: super::serial_line::SerialRx,
 }
 
 /// A robot's SDLS keys, TC and TM, and the durable store of both ends of its link.
@@ -110,11 +111,25 @@ impl<'a> RunEnv<'a> {
 }
 
 /// Opens a serial line and starts its reader.
-fn serial<'scope>(scope: &'scope std::thread::Scope<'scope, '_>) -> std::io::Result<Serial> {
+fn serial() -> std::io::Result<Serial> {
+    let (write, read) = super::serial_line::pair()?;
+    Ok(Serial { write, read })
+}
+
+/// The ground's line to a server board: an OS pipe each way, with a reader thread deframing
+/// packets into a channel at the receiving end (the ground and the server wait on it).
+struct GroundSerial {
+    write: std::io::PipeWriter,
+    read: std::sync::mpsc::Receiver<Vec<u8>>,
+}
+
+fn ground_serial<'scope>(
+    scope: &'scope std::thread::Scope<'scope, '_>,
+) -> std::io::Result<GroundSerial> {
     let (r, write) = std::io::pipe()?;
     let (tx, read) = std::sync::mpsc::channel();
     scope.spawn(move || nodes::reader(r, tx));
-    Ok(Serial { write, read })
+    Ok(GroundSerial { write, read })
 }
 
 /// Starts robot `i`'s four nodes (board A's WiFi and control tasks joined by `queues`, board
@@ -142,7 +157,7 @@ fn spawn_robot<'scope, 'env>(
         },
         cfg.start_state,
     )));
-    let (a_to_b, b_to_a) = (serial(scope)?, serial(scope)?);
+    let (a_to_b, b_to_a) = (serial()?, serial()?);
     let (cmd_queue, hb_queue) = (&mut queues.0, &mut queues.1);
     let (cmd_p, cmd_c) = cmd_queue.split();
     let (hb_p, hb_c) = hb_queue.split();
@@ -347,7 +362,8 @@ fn spawn_server<'scope, 'env>(
                     (rx, write, (sink.boxed(), none, s.board))
                 }
                 None => {
-                    let (ground_to_server, server_to_ground) = (serial(scope)?, serial(scope)?);
+                    let (ground_to_server, server_to_ground) =
+                        (ground_serial(scope)?, ground_serial(scope)?);
                     let to_server = s.lossy(env, ground_to_server.write, "serial_ground", 4);
                     let write: Box<dyn Write + Send> = Box::new(server_to_ground.write);
                     let end = (to_server.boxed(), server_to_ground.read, s.board);
