@@ -11,7 +11,7 @@ use proptest::prelude::*;
 const YAMCS_EOF: &str = "00000A130018000000010015048000000000000065fc";
 
 fn unhex(s: &str) -> Vec<u8> {
-    crate::unhex(&s.to_ascii_lowercase())
+    crate::ccsds::unhex(&s.to_ascii_lowercase())
 }
 
 fn header(pdu_type: PduType, crc: bool) -> PduHeader {
@@ -320,8 +320,8 @@ proptest! {
     ignore = "parses spec/ TOML (decisions.toml among it): slow under Miri, and no dependency's unsafe code the other spec tests do not reach"
 )]
 fn the_profile_in_spec_is_the_librarys() {
-    let t: toml::Table = toml::from_str(&crate::repo("spec/ccsds/cfdp.toml")).unwrap();
-    crate::assert_sections_name_decisions("spec/ccsds/cfdp.toml", &t);
+    let t: toml::Table = toml::from_str(&crate::ccsds::repo("spec/ccsds/cfdp.toml")).unwrap();
+    crate::ccsds::assert_sections_name_decisions("spec/ccsds/cfdp.toml", &t);
     let int = |s: &str, k: &str| t[s][k].as_integer().unwrap();
     assert_eq!(
         int("version", "emitted"),

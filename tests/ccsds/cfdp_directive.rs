@@ -20,7 +20,7 @@ use mmic::cfdp::{Pdu, PduError};
 use proptest::prelude::*;
 
 fn unhex(s: &str) -> Vec<u8> {
-    crate::unhex(s)
+    crate::ccsds::unhex(s)
 }
 
 /// The LibreCube vectors' header: 0x0102 to 0x0304, transaction 0x0A0B0C0D.
@@ -556,7 +556,7 @@ proptest! {
     ignore = "parses spec/ TOML: 7 s under Miri, and no dependency's unsafe code the other spec tests do not reach"
 )]
 fn the_codes_in_spec_are_the_librarys() {
-    let t: toml::Table = toml::from_str(&crate::repo("spec/ccsds/cfdp.toml")).unwrap();
+    let t: toml::Table = toml::from_str(&crate::ccsds::repo("spec/ccsds/cfdp.toml")).unwrap();
     let directives = t["directives"].as_table().unwrap();
     let mut named = 0;
     for d in DirectiveCode::ALL {

@@ -286,7 +286,7 @@ fn class1_delivers_without_loss_and_never_a_wrong_file() {
     ignore = "parses spec/ TOML: 7 s under Miri, and no dependency's unsafe code the other spec tests do not reach"
 )]
 fn the_entity_profile_in_spec_is_the_librarys() {
-    let t: toml::Table = toml::from_str(&crate::repo("spec/ccsds/cfdp.toml")).unwrap();
+    let t: toml::Table = toml::from_str(&crate::ccsds::repo("spec/ccsds/cfdp.toml")).unwrap();
     let e = &t["entity"];
     let c = Config::mission(0x42);
     let int = |k: &str| e[k].as_integer().unwrap();

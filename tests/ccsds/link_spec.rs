@@ -7,7 +7,7 @@ use mmic::link::{fop, tc_frame, tm_frame, tm_framer};
 use mmic::node::server::frames::{FrameConfig, GATHER_MS};
 use mmic::units::BoardNumber;
 
-use crate::repo;
+use crate::ccsds::repo;
 
 fn link() -> toml::Table {
     toml::from_str(&repo("spec/ccsds/link.toml")).unwrap()
@@ -119,7 +119,7 @@ fn the_managed_parameters_are_the_codes() {
 #[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
 fn every_section_names_a_decision() {
     let t = link();
-    crate::assert_sections_name_decisions("spec/ccsds/link.toml", &t);
+    crate::ccsds::assert_sections_name_decisions("spec/ccsds/link.toml", &t);
     assert_eq!(t.len(), 4);
 }
 

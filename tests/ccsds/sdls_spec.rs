@@ -7,7 +7,7 @@ use mmic::node::server::frames::SECURITY_EVENT_PERIOD_MS;
 use mmic::pus::event::Event;
 use mmic::units::BoardNumber;
 
-use crate::repo;
+use crate::ccsds::repo;
 
 fn spec() -> toml::Table {
     toml::from_str(&repo("spec/ccsds/sdls.toml")).unwrap()
@@ -134,8 +134,8 @@ fn the_choices_are_the_codes() {
 #[cfg_attr(miri, ignore = "the toml parser: minutes under Miri")]
 fn every_section_names_a_decision() {
     let t = spec();
-    crate::assert_sections_name_decisions("spec/ccsds/sdls.toml", &t);
-    assert!(crate::repo("spec/decisions.toml").contains("id = \"sdls-scope\""));
+    crate::ccsds::assert_sections_name_decisions("spec/ccsds/sdls.toml", &t);
+    assert!(crate::ccsds::repo("spec/decisions.toml").contains("id = \"sdls-scope\""));
     assert_eq!(t.len(), 8);
 }
 

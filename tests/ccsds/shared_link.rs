@@ -21,7 +21,7 @@ fn ping_frame(scid: u16, apid: u16) -> Vec<u8> {
     TcRepr {
         apid: Apid::new(apid).unwrap(),
         seq_count: SeqCount::new(0).unwrap(),
-        ..crate::ping()
+        ..crate::ccsds::ping()
     }
     .emit(&mut ping)
     .unwrap();

@@ -106,7 +106,7 @@ fn run_pair(cfg: &Config, succeeds: [bool; 3]) -> (u8, Status) {
 #[test]
 fn attempt_histogram_matches_figure_10() {
     // Figure 10's counts, from spec/hardware.toml (in fastener pairs: decision figure-10-pairs).
-    let figure = crate::hardware::figure10();
+    let figure = crate::control::hardware::figure10();
     let demo = figure.histogram();
     let total: u32 = demo.iter().sum();
     assert_eq!(total, figure.engaged);

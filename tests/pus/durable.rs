@@ -27,7 +27,7 @@ fn key(s: u8) -> Key256 {
 }
 
 fn stop(seq: u16) -> Vec<u8> {
-    crate::function_tc(seq, &[6])
+    crate::pus::function_tc(seq, &[6])
 }
 
 /// The server board as it boots from its flash (both ends provisioned for keys 1 and 2).
@@ -56,7 +56,7 @@ fn arm(seq: u16, k: u16) -> Vec<u8> {
     };
     let mut data = [0u8; 16];
     let n = mmic::pus::function::encode(&c, &mut data).unwrap();
-    crate::function_tc(seq, &data[..n])
+    crate::pus::function_tc(seq, &data[..n])
 }
 
 /// Both ends over a clean link, 1 ms steps; board A answers every command at once.

@@ -81,7 +81,7 @@ impl Channel {
 
 /// TC(8,1) perform function 6, Stop (spec/ccsds/functions.toml), numbered `seq`.
 fn stop(seq: u16) -> Vec<u8> {
-    crate::function_tc(seq, &[6])
+    crate::pus::function_tc(seq, &[6])
 }
 
 /// SDLS on both ends, and an attacker on the uplink.

@@ -96,7 +96,7 @@ fn t1_expiring_at_the_limit_alerts_and_the_link_initiates_again() {
     );
     let mut sent = 0;
     ground
-        .send(&crate::function_tc(1, &[6]), 1000, &mut |_| sent += 1)
+        .send(&crate::pus::function_tc(1, &[6]), 1000, &mut |_| sent += 1)
         .unwrap();
     assert_eq!((sent, ground.waiting()), (1, 0));
     let mut expiries = 0;
@@ -133,9 +133,11 @@ fn retransmissions_asked_for_past_the_limit_alert_limit() {
     let mut frames = Vec::new();
     for seq in [1, 2] {
         ground
-            .send(&crate::function_tc(seq, &[6]), 10, &mut |f: &[u8]| {
-                frames.push(f.to_vec())
-            })
+            .send(
+                &crate::pus::function_tc(seq, &[6]),
+                10,
+                &mut |f: &[u8]| frames.push(f.to_vec()),
+            )
             .unwrap();
     }
     assert_eq!(frames.len(), 2);
@@ -184,7 +186,7 @@ fn a_frame_sdls_cannot_protect_yet_waits_for_the_reservation() {
     assert_eq!(r, Ok(()));
     assert_eq!(ground.state(), FopState::Active);
     ground
-        .send(&crate::function_tc(1, &[6]), 10, &mut |f: &[u8]| {
+        .send(&crate::pus::function_tc(1, &[6]), 10, &mut |f: &[u8]| {
             sent.push(f.to_vec())
         })
         .unwrap();

@@ -281,7 +281,7 @@ fn housekeeping_toml_is_the_report_layout() {
         "# ST[3] housekeeping report structure 1, TM(3,25): the heartbeat's content (Table 3).\n\
          # Source data: structure_id (u8) then each parameter, unsigned big-endian, at `offset`\n\
          # (from the start of the source data). Written from src/pus/housekeeping.rs FIELDS by\n\
-         # `MMIC_REGENERATE=1 cargo test --test pus housekeeping_toml`; checked fresh by that test.\n\n",
+         # `MMIC_REGENERATE=1 cargo test -p mmic --test library housekeeping_toml`; checked fresh by that test.\n\n",
     );
     text.push_str(&format!("structure_id = 1\nreport_len = {REPORT_LEN}\n"));
     let mut at = 1;

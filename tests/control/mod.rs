@@ -1,11 +1,6 @@
 //! Sections 2 and 5, Figures 8 and 10: the hip controller, the sensor front end and the bolter
 //! (its current sensing, A/B handshake and statistics), and the paper's hardware facts
 //! (spec/hardware.toml).
-//!
-//! One test binary per area, each file a module: fewer binaries to link than one per file.
-
-#[path = "../common/mod.rs"]
-mod common;
 
 mod bolter_current;
 mod bolter_handshake;

@@ -1,6 +1,4 @@
 //! Sections 3 and 4: boards A and B as nodes, and the two-core hand-off.
-//!
-//! One test binary per area, each file a module: fewer binaries to link than one per file.
 
 mod board_a;
 mod board_a_restart;

@@ -2,11 +2,6 @@
 //! against the standards, the bad-input table of spec/ccsds/, every 1–3-bit corruption, and
 //! interoperation with the `spacepackets` crate; the conformance statements (PICS) of the CCSDS
 //! books and the PUS-C tailoring held to the code and its tests (`pics`).
-//!
-//! One test binary per area, each file a module: fewer binaries to link than one per file.
-
-#[path = "../common/mod.rs"]
-mod common;
 
 mod bad_inputs;
 mod cfdp;

@@ -1,6 +1,4 @@
 //! Section 6, Tables 5 and 6, Figure 9: the map, plans, estimation and the sequencer.
-//!
-//! One test binary per area, each file a module: fewer binaries to link than one per file.
 
 mod motion_estimate;
 mod motion_estimate_oracle;
