@@ -44,9 +44,8 @@ pub(crate) fn swarm_on_test_jobs(
     opts: &Options,
     progress: &mut dyn FnMut(String),
 ) -> Report {
-    let runs = max_runs.map_or(usize::MAX, |m| usize::try_from(m).unwrap_or(usize::MAX));
     mmic_host::swarm::swarm_over(
-        &mut (seed_start..=u64::MAX).take(runs),
+        &mut mmic_host::swarm::seeds_from(seed_start, max_runs),
         budget,
         stop_at_failures,
         JOBS,

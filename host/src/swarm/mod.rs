@@ -479,15 +479,20 @@ pub fn swarm(
     opts: &Options,
     progress: &mut dyn FnMut(String),
 ) -> Report {
-    let runs = max_runs.map_or(usize::MAX, |m| usize::try_from(m).unwrap_or(usize::MAX));
     swarm_over(
-        &mut (seed_start..=u64::MAX).take(runs),
+        &mut seeds_from(seed_start, max_runs),
         budget,
         stop_at_failures,
         pool::default_jobs(),
         opts,
         progress,
     )
+}
+
+/// The seeds of [`swarm`]: from `seed_start` on, at most `max_runs` of them (unbounded: none).
+pub fn seeds_from(seed_start: u64, max_runs: Option<u64>) -> impl Iterator<Item = u64> {
+    let runs = max_runs.map_or(usize::MAX, |m| usize::try_from(m).unwrap_or(usize::MAX));
+    (seed_start..=u64::MAX).take(runs)
 }
 
 /// Runs the seeds `seeds` gives, on `jobs` threads, until it ends or `budget` of wall time is
