@@ -54,7 +54,7 @@ fn a_virtual_fleet_is_deterministic() {
     assert!(a.attempts.0 < a.attempts.1, "the loss did lose polls");
 }
 
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn a_realtime_fleet_polls_every_robot_over_real_sockets() {
     let cfg = FleetConfig {
         robots: 40,
@@ -88,7 +88,7 @@ pub(crate) fn a_realtime_fleet_polls_every_robot_over_real_sockets() {
     assert_eq!(pus.ends, (40, 0), "{}", pus.line());
 }
 
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn mmic_fleet_sweeps_and_plots() {
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("fleet");
     std::fs::create_dir_all(&dir).unwrap();

@@ -222,7 +222,7 @@ fn accepted_and_executed(dir: &std::path::Path) -> (Vec<u64>, BTreeMap<u64, u32>
     (accepted, executed)
 }
 
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn the_demo_runs_over_a_serial_line_every_command_once() {
     let dir = std::env::temp_dir().join(format!("mmic-opsui-serial-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

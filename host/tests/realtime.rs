@@ -39,7 +39,7 @@ fn events<'a>(s: &'a Summary, ty: &'a str) -> Vec<&'a Value> {
         .collect()
 }
 
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn the_demo_completes_over_real_transports_as_in_virtual_time() {
     // Both protocols' realtime runs side by side (they wait on the wall clock, each on its own
     // sockets and pipes), then each checked against its virtual-time run.
@@ -89,7 +89,7 @@ pub(crate) fn the_demo_completes_over_real_transports_as_in_virtual_time() {
     }
 }
 
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn thirty_percent_wifi_loss_over_tcp_runs_nothing_twice() {
     let mut cfg = realtime_demo(Protocol::Legacy);
     cfg.wifi_loss = 0.3;
@@ -105,7 +105,7 @@ pub(crate) fn thirty_percent_wifi_loss_over_tcp_runs_nothing_twice() {
     }
 }
 
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn the_space_data_link_over_lossy_udp_completes_the_demo_and_counts_its_frames() {
     // TC and TM transfer frames, one per datagram, 20 % of them lost each way: FOP-1's
     // retransmissions and the TM frames' CLCWs carry the demo through, and nothing runs twice.
@@ -161,7 +161,7 @@ pub(crate) fn the_space_data_link_over_lossy_udp_completes_the_demo_and_counts_i
 /// Restarts on the wall clock (`--inject reboot-a/-b/-server/-ground@S` with `--realtime`):
 /// the threads of board A (both tasks), board B, the server board and the ground go down for
 /// 300 ms and boot from what they kept, as in virtual time; nothing runs twice.
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn board_a_board_b_and_the_ground_restart_on_the_wall_clock() {
     for (protocol, inject, node) in [
         (Protocol::Legacy, "reboot-a@8", 0),

@@ -2,13 +2,12 @@
 //! what each keeps (spec/decisions.toml `restart-*`) holds exactly-once and the SDLS counters
 //! across them, and the swarm finds a planted restart defect and replays it.
 
-use crate::swarm_on_test_jobs as swarm;
 use mmic_host::sim::engine::watch::Invariant;
 use mmic_host::sim::engine::{self, PlantedBug};
 use mmic_host::sim::inject::Scheduled;
 use mmic_host::sim::{LinkLayer, Protocol, SdlsConfig, SdlsKeys, SimConfig};
 use mmic_host::swarm::scenario::{Options, RestartDraw};
-use mmic_host::swarm::{replay_command, run_one};
+use mmic_host::swarm::{replay_command, run_one, swarm};
 use serde_json::Value;
 use std::time::Duration;
 

@@ -3,12 +3,11 @@
 //! summary's SDLS figures, the log's protected frames by their headers only, and the attacker on
 //! the uplink whose replays and bit flips are all refused before FARM-1.
 
-use crate::swarm_on_test_jobs as swarm;
 use mmic_host::sim::engine::watch::Invariant;
 use mmic_host::sim::engine::{self, watch::Watch};
 use mmic_host::sim::{LinkLayer, Protocol, SdlsConfig, SdlsKeys, SdlsStats, SimConfig, Summary};
-use mmic_host::swarm::run_one;
 use mmic_host::swarm::scenario::{LinkDraw, Options, Scenario, SdlsDraw};
+use mmic_host::swarm::{run_one, swarm};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::time::Duration;
@@ -354,7 +353,7 @@ fn the_watch_flags_more_frames_verified_than_protected() {
     assert_eq!(Invariant::ForgedFrame.name(), "forged-frame");
 }
 
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn the_realtime_engine_secures_its_own_ground_with_keys_made_at_run_time() {
     let mut cfg = secured(1, 0.0, 0.0);
     cfg.realtime = true;

@@ -334,7 +334,7 @@ fn external_life(
 /// first's (on main at ca6056d both started at 0), a TC frame the first run accepted is refused
 /// as a replay in the second (board A ran it again there), and the ground's next frame (the
 /// next IV, the next N(S)) is taken at once: FARM-1 and the TC window resumed exactly.
-/// Wall clock: run by `clock::the_wall_clock_tests_side_by_side`.
+/// Wall clock: run by `wall_clock::the_wall_clock_tests_side_by_side`.
 pub(crate) fn the_external_ground_simulator_keeps_its_counters_across_processes() {
     let d = scratch("restart");
     let kd = d.join("keys");

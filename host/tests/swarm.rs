@@ -1,12 +1,11 @@
 //! The fault swarm (issue 16): scenarios drawn from their seed alone, invariants that hold on
 //! the real firmware, a planted double execution found and replayed from its seed.
 
-use crate::swarm_on_test_jobs as swarm;
 use mmic_host::sim::engine::watch::Invariant;
 use mmic_host::sim::engine::PlantedBug;
 use mmic_host::sim::{LinkLayer, Protocol};
 use mmic_host::swarm::scenario::{LinkDraw, Options, Scenario};
-use mmic_host::swarm::{replay_command, run_one};
+use mmic_host::swarm::{replay_command, run_one, swarm};
 use std::process::Command;
 use std::time::Duration;
 

@@ -7,7 +7,7 @@
 //! tests run nine engines side by side) that thread could be kept off the cores for longer than
 //! board B's 500 ms of silence at 10× (50 ms of wall time), and board A declared
 //! `internal_comm_loss` with B's heartbeats waiting in the pipe (measured: 1 run in 3 of the
-//! wall-clock checks, `host/tests/clock.rs`, 2026-11-29). The paced clock (`super::clock`)
+//! wall-clock checks, `host/tests/wall_clock.rs`, 2026-11-29). The paced clock (`super::clock`)
 //! holds simulated time for a slow node, not for a slow thread between two nodes; with no such
 //! thread there is nothing to hold.
 //!

@@ -3,16 +3,12 @@
 //!
 //! They mostly sleep: one after the other on libtest's threads (two on a 2-core machine) they
 //! held the binary for over a minute; side by side they take as long as the longest (the serial
-//! opsUI demo, about 27 s) and less than one core between them (18 CPU-s in 27 s, 2026-11-29).
-//! They need that core when their time comes (the opsUI demo's simulator, another process, must
-//! answer within 140 ms: the paper's 700 ms at `--scale 5`): beside computing tests that took
-//! both cores (the swarm's, on a thread per core) they missed their windows on a loaded machine
-//! (measured: 4 runs in 5 failed). So the computing tests here run on one thread each
-//! ([`crate::JOBS`]), and this test starts first: libtest runs tests in the order of their names,
-//! and `clock::` comes before every other module here. One libtest thread holds this test, the
-//! other runs the computing tests one after the other beside it, on the second core. Until
-//! issue 40 it ran last, after the computing tests: the binary took their 17 s and then its
-//! 27 s.
+//! opsUI demo, about 27 s) and less than one core between them. They need that core when their
+//! time comes (the opsUI demo's simulator, another process, must answer within 140 ms: the
+//! paper's 700 ms at `--scale 5`): started first, beside the computing tests (the swarm's take
+//! both cores), they missed their windows on a loaded machine (measured: 4 runs in 5 failed).
+//! libtest runs tests in the order of their names, and `wall_clock::` comes after every other
+//! module here: this test starts last, when at most one computing test is left to run beside it.
 
 //! `MMIC_WALL_CLOCK=<part of a name>` runs only the matching ones (libtest's filter cannot
 //! reach inside this test).
