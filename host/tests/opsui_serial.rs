@@ -1,8 +1,8 @@
 //! The opsUI on a serial device, end to end: `mmic opsui --serial` and `mmic sim --realtime
 //! --opsui-serial` as two processes, each on a pseudo-terminal of its own, the two
 //! pseudo-terminals' master ends joined by a bridge in this test (no external program), at
-//! --scale 5 on both sides. The README's command runs [`SHORT_PLAN`] this way (its 57 s in
-//! about 12 s, beside the other wall-clock checks); CI runs the whole demo plan after it (its
+//! --scale 5 on both sides. The README's command runs [`SHORT_PLAN`] this way (its 64 s in
+//! about 13 s, beside the other wall-clock checks); CI runs the whole demo plan after it (its
 //! 134 s in under 30 s, `the_demo_runs_over_a_serial_line_every_command_once`, ignored here):
 //! the same checks on both. And the typed errors: a device that cannot be opened (exit 5), a
 //! line lost mid-run (exit 6), options the simulator's side refuses (exit 2).
@@ -23,7 +23,7 @@ const SCALE: &str = "5";
 
 /// The demo plan (`host/plans/demo.plan`) without its turn towards Y and the voxel after it:
 /// every kind of step the demo has (both modes, bolting a face and a fastener, releasing one,
-/// a reconfiguration, a wait), 57 s of the paper's timing instead of 134. On the wall clock
+/// a reconfiguration, a wait), 64 simulated seconds instead of 134. On the wall clock
 /// the whole demo takes 27 s at --scale 5, which held the README's test command for twice as
 /// long as its next-longest wall-clock check (issue 40).
 const SHORT_PLAN: &str = "robot 1\n\
