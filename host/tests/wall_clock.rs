@@ -17,7 +17,8 @@
 
 use crate::{fleet, opsui_serial, realtime, sdls, security};
 
-/// A check's name as libtest named it before, and the check.
+/// A check's name (its module and function, as libtest named the checks before they ran side
+/// by side), and the check.
 type Check = (&'static str, fn());
 
 /// Run side by side, the longest first.
