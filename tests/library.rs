@@ -1,7 +1,7 @@
 //! The library's integration tests, one binary: a module per area, each a directory of files.
 //!
-//! - `wire`: Tables 2–4, the packets: golden bytes, corruption, round trips, spec/ tables, and
-//!   the property-test configuration;
+//! - `wire`: Tables 2–4, the packets: golden bytes, corruption, round trips, and the
+//!   property-test configuration;
 //! - `ccsds`: CCSDS space packets, PUS-C headers, transfer frames, SDLS and CFDP, against the
 //!   standards, spec/ccsds/ and the `spacepackets` crate, and the conformance statements (PICS);
 //! - `pus`: the PUS-C services and the PUS gateway, the ground's data link and COP-1;
@@ -15,6 +15,10 @@
 //! the exhaustive walks need. One build took 84.6 CPU-s against 97.9 for the seven, and the run,
 //! its long checks spread over libtest's two threads, 27.6 s against 30.4 s. Run one area with
 //! its module's name: `cargo test -p mmic --test library wire::`.
+//!
+//! The checks of the code against spec/'s tables (Tables 1–8, the hardware, the boards, the
+//! servos, the PUS services) are the package `mmic-spec-check` (spec/check/): built at opt-level
+//! 0 beside this binary rather than inside it (issue 40).
 
 mod common;
 

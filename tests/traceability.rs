@@ -44,7 +44,7 @@ fn world() -> World {
     let reqs = sources::requirements(&root);
     let mut known: BTreeSet<String> = reqs.iter().map(|r| r.id.clone()).collect();
     known.extend(sources::other_known_ids(&root));
-    let scan = scan::scan_tree(&root, &["src", "tests", "proofs", "host"]);
+    let scan = scan::scan_tree(&root, &["src", "tests", "spec/check", "proofs", "host"]);
     World { reqs, known, scan }
 }
 

@@ -4,8 +4,8 @@
 //! tables is the project's, with the decision that introduced it ([`origins`]: spec/faults.toml,
 //! spec/commands.toml, spec/modes.toml, spec/packets/), which the review pages mark. They are
 //! compiled in (`include_str!`) and parsed once, so the XTCE generator, the PUS codec and the
-//! pages have no second copy of any of them; tests/pus/spec.rs, tests/wire/spec.rs and
-//! tests/safety/safety_spec.rs hold the library to the same files.
+//! pages have no second copy of any of them; spec/check/tests/pus/spec.rs, spec/check/tests/wire/spec.rs and
+//! spec/check/tests/safety/safety_spec.rs hold the library to the same files.
 
 use mmic::faults::Fault;
 use mmic::pus::function::FunctionId;

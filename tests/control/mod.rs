@@ -6,6 +6,4 @@ mod bolter_current;
 mod bolter_handshake;
 mod bolter_statistics;
 mod control_hip;
-mod hardware;
 mod sensors;
-mod servos_spec;

@@ -5,4 +5,3 @@ mod motion_estimate_oracle;
 mod motion_map;
 mod motion_plan_lengths;
 mod motion_sequencer;
-mod motion_tables;

@@ -7,4 +7,3 @@ mod node_boards;
 mod node_fidelity;
 mod node_handoff;
 mod node_primitives;
-mod node_spec;

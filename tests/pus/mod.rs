@@ -10,7 +10,6 @@ mod gateway;
 mod ground_frames;
 mod ground_link;
 mod housekeeping;
-mod spec;
 
 /// TC(8,1) perform function to robot 1 (APID 0x101), numbered `seq`, from source 9 with every
 /// report asked for: `app_data` is the function (spec/ccsds/functions.toml), e.g. `[6]`, Stop.

@@ -2,4 +2,3 @@
 
 mod safety_exhaustive;
 mod safety_oracle;
-mod safety_spec;

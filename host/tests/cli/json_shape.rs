@@ -1,5 +1,5 @@
 //! The JSON of every packet kind follows spec/: its key paths are the `name`s of the packet's
-//! field table (`PacketKind::fields()`, checked against spec/packets/*.toml by tests/wire/spec.rs),
+//! field table (`PacketKind::fields()`, checked against spec/packets/*.toml by spec/check/tests/wire/spec.rs),
 //! a dotted name being a nested object.
 
 use mmic::wire::PacketKind;

@@ -85,7 +85,7 @@ struct Estimate {
 }
 
 fn spec() -> Boards {
-    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/boards.toml");
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec/boards.toml");
     toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 

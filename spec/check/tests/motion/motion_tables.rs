@@ -8,7 +8,7 @@ use mmic::motion::{route, Primitive, State, StateKind};
 use serde::Deserialize;
 
 fn root() -> std::path::PathBuf {
-    std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    std::path::PathBuf::from(crate::ROOT)
 }
 
 fn text(rel: &str) -> String {

@@ -15,9 +15,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 fn spec_path(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("spec")
-        .join(rel)
+    PathBuf::from(crate::ROOT).join("spec").join(rel)
 }
 
 fn load<T: for<'de> Deserialize<'de>>(rel: &str) -> T {
@@ -652,7 +650,7 @@ fn prose_about_bytes() -> Vec<(String, String, Option<&'static str>, bool)> {
     }
     // The library's doc comments, one block of consecutive lines at a time; a packet module's
     // blocks mean its own packet unless they name another.
-    let mut files = vec![PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src")];
+    let mut files = vec![PathBuf::from(crate::ROOT).join("src")];
     while let Some(p) = files.pop() {
         if p.is_dir() {
             files.extend(std::fs::read_dir(&p).unwrap().map(|e| e.unwrap().path()));
@@ -681,7 +679,7 @@ fn prose_about_bytes() -> Vec<(String, String, Option<&'static str>, bool)> {
                 block.push((n + 1, doc.trim()));
             } else if let Some(&(first, _)) = block.first() {
                 let text: Vec<&str> = block.iter().map(|b| b.1).collect();
-                let name = p.strip_prefix(env!("CARGO_MANIFEST_DIR")).unwrap_or(&p);
+                let name = p.strip_prefix(crate::ROOT).unwrap_or(&p);
                 texts.push((
                     format!("{}:{first}", name.display()),
                     text.join(" "),
@@ -693,7 +691,7 @@ fn prose_about_bytes() -> Vec<(String, String, Option<&'static str>, bool)> {
         }
     }
     // The Markdown of spec/, docs/ and the README, a paragraph at a time.
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let root = PathBuf::from(crate::ROOT);
     let mut md = vec![root.join("README.md")];
     let mut dirs = vec![root.join("spec"), root.join("docs")];
     while let Some(d) = dirs.pop() {

@@ -12,9 +12,7 @@ use serde::Deserialize;
 use std::path::PathBuf;
 
 fn load<T: for<'de> Deserialize<'de>>(rel: &str) -> T {
-    let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("spec")
-        .join(rel);
+    let p = PathBuf::from(crate::ROOT).join("spec").join(rel);
     let text = std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
@@ -292,7 +290,7 @@ fn housekeeping_toml_is_the_report_layout() {
         ));
         at += f.len;
     }
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("spec/ccsds/housekeeping.toml");
+    let path = PathBuf::from(crate::ROOT).join("spec/ccsds/housekeeping.toml");
     if std::env::var_os("MMIC_REGENERATE").is_some() {
         std::fs::write(&path, &text).unwrap();
     }

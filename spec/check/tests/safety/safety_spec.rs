@@ -66,7 +66,7 @@ struct Thresholds {
 }
 
 fn spec() -> Spec {
-    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/modes.toml");
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec/modes.toml");
     toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
@@ -233,7 +233,7 @@ fn decisions() -> BTreeMap<String, String> {
         id: String,
         decision: String,
     }
-    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/decisions.toml");
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec/decisions.toml");
     let f: File = toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
     f.decision.into_iter().map(|e| (e.id, e.decision)).collect()
 }
@@ -267,7 +267,7 @@ fn acceptance_beyond_table7_is_a_recorded_decision() {
     struct Row {
         kind: String,
     }
-    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/commands.toml");
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/../../spec/commands.toml");
     let c: Commands = toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
     let table1: Vec<String> = c.table1.into_iter().map(|r| r.kind).collect();
     assert_eq!(

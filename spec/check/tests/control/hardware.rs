@@ -10,7 +10,7 @@ use serde::Deserialize;
 use std::path::PathBuf;
 
 fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    PathBuf::from(crate::ROOT)
 }
 
 fn text(rel: &str) -> String {

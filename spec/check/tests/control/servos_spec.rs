@@ -51,7 +51,10 @@ struct Deadline {
 }
 
 fn spec() -> Spec {
-    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/spec/control/servos.toml");
+    let p = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../spec/control/servos.toml"
+    );
     toml::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
