@@ -134,7 +134,8 @@ class Console:
         self.out = Path(out) if out else REPO / "target" / "console"
         self.start_timeout = start_timeout
         self.yamcs = Yamcs(mdb, http_port=http_port, tm_port=tm_port, tc_port=tc_port, link=link,
-                           max_lifetime=seconds + 60, start_timeout=start_timeout)
+                           max_lifetime=seconds + 60, start_timeout=start_timeout,
+                           jvm_options=())  # the JVM's defaults: an operator's run lasts hours
         self.robot: Robot | None = None
 
     @property
