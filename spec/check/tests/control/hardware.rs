@@ -1,6 +1,7 @@
 //! spec/hardware.toml, the paper's hardware facts: it parses, every entry quotes the paper, every
 //! departure names a recorded decision, and each number the code has a counterpart for equals
-//! it. Figure 10's counts are read from here by the bolter statistics test.
+//! it. The bolter statistics test (tests/control/bolter_statistics.rs) reads Figure 10's counts
+//! from the same file, with the toml crate's table rather than these types.
 
 use mmic::bolter::{BolterPair, Config as BolterConfig};
 use mmic::safety::detect::Config as SafetyConfig;
@@ -97,11 +98,11 @@ struct Filter {
 /// Figure 10, in fastener pairs (spec/decisions.toml, `figure-10-pairs`).
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(crate) struct Figure10 {
+struct Figure10 {
     paper: String,
-    pub engaged: u32,
-    pub bolted_after_attempt: Vec<u32>,
-    pub failed: u32,
+    engaged: u32,
+    bolted_after_attempt: Vec<u32>,
+    failed: u32,
     #[allow(dead_code)]
     counts: String,
     #[allow(dead_code)]
@@ -110,7 +111,7 @@ pub(crate) struct Figure10 {
 
 impl Figure10 {
     /// The histogram of Figure 10: bolted after attempt 1, 2, 3, then failed.
-    pub fn histogram(&self) -> Vec<u32> {
+    fn histogram(&self) -> Vec<u32> {
         let mut h = self.bolted_after_attempt.clone();
         h.push(self.failed);
         h
@@ -122,7 +123,7 @@ fn hardware() -> Hardware {
 }
 
 /// Figure 10's counts as spec/hardware.toml gives them.
-pub(crate) fn figure10() -> Figure10 {
+fn figure10() -> Figure10 {
     hardware().figure10
 }
 
@@ -230,7 +231,8 @@ fn the_codes_numbers_equal_the_papers_hardware() {
 }
 
 /// Figure 10's counts add up, one per attempt Table 8 allows; the statistics test draws its
-/// rates from them (`bolter_statistics::attempt_histogram_matches_figure_10`).
+/// rates from them (`control::bolter_statistics::attempt_histogram_matches_figure_10`, in the
+/// library's test binary).
 // req: P8.1
 #[test]
 fn figure_10_counts_add_up_to_the_pairs_engaged_one_count_per_attempt() {
